@@ -1,0 +1,234 @@
+//! Homogeneous-mixture cavitation equation of state (MODEL.md §3).
+//!
+//! ```text
+//! α(p) = ½ [1 − tanh(β (p − p0))]
+//! ρ = ρl (1−α) + ρg α ,   μ = μl (1−α) + μg α
+//! β  = ln[ α_v (1−α_s) / (α_s (1−α_v)) ] / (2 (p_s − p_v))
+//! p0 = p_s + ln[ α_s / (1−α_s) ] / (2 β)
+//! ```
+//!
+//! | symbol | meaning | unit |
+//! |---|---|---|
+//! | p | absolute pressure | Pa |
+//! | α | vapour volume fraction | – |
+//! | β | steepness of the liquid–vapour transition | 1/Pa |
+//! | p0 | pressure at α = ½ | Pa |
+//! | ρ, ρl, ρg | mixture, liquid, gas density | kg/m³ |
+//! | μ, μl, μg | mixture, liquid, gas viscosity | Pa·s |
+//!
+//! The formulas for β and p0 are the corrected eqs. 12–13 of the paper
+//! (as printed they give β < 0).
+
+use super::params::Lubricant;
+
+/// Beyond |β (p − p0)| > this, tanh is ±1 to double precision.
+const SATURATED: f64 = 19.5;
+
+/// Mixture properties at one pressure, with pressure derivatives.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MixtureState {
+    pub alpha: f64,
+    pub rho: f64,
+    /// dρ/dp, kg/(m³·Pa)
+    pub drho: f64,
+    pub mu: f64,
+    /// dμ/dp, Pa·s/Pa
+    pub dmu: f64,
+}
+
+/// The mixture EOS with its derived constants.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MixtureEos {
+    pub rho_l: f64,
+    pub rho_g: f64,
+    pub mu_l: f64,
+    pub mu_g: f64,
+    pub beta: f64,
+    pub p0: f64,
+}
+
+impl MixtureEos {
+    pub fn new(l: &Lubricant) -> Self {
+        let (a_s, a_v) = (l.vapour_fraction_saturation, l.vapour_fraction_vapour);
+        let beta = ((a_v * (1.0 - a_s)) / (a_s * (1.0 - a_v))).ln()
+            / (2.0 * (l.saturation_pressure - l.vapour_pressure));
+        let p0 = l.saturation_pressure + (a_s / (1.0 - a_s)).ln() / (2.0 * beta);
+        Self {
+            rho_l: l.density,
+            rho_g: l.gas_density,
+            mu_l: l.viscosity,
+            mu_g: l.gas_viscosity,
+            beta,
+            p0,
+        }
+    }
+
+    /// Vapour fraction α(p).
+    #[inline]
+    pub fn alpha(&self, p: f64) -> f64 {
+        let z = self.beta * (p - self.p0);
+        if z > SATURATED {
+            0.0
+        } else if z < -SATURATED {
+            1.0
+        } else {
+            // ½ (1 − tanh z) = 1 / (1 + e^(2z)): one exp, no cancellation.
+            1.0 / (1.0 + (2.0 * z).exp())
+        }
+    }
+
+    /// Full state with derivatives.
+    #[inline]
+    pub fn eval(&self, p: f64) -> MixtureState {
+        let z = self.beta * (p - self.p0);
+        if z > SATURATED {
+            return MixtureState {
+                alpha: 0.0,
+                rho: self.rho_l,
+                drho: 0.0,
+                mu: self.mu_l,
+                dmu: 0.0,
+            };
+        }
+        if z < -SATURATED {
+            return MixtureState {
+                alpha: 1.0,
+                rho: self.rho_g,
+                drho: 0.0,
+                mu: self.mu_g,
+                dmu: 0.0,
+            };
+        }
+        let e = (2.0 * z).exp();
+        let inv = 1.0 / (1.0 + e);
+        let alpha = inv;
+        // 1 − α without cancellation.
+        let liquid = e * inv;
+        // dα/dp = −½ β sech²z = −2 β α (1 − α)
+        let dalpha = -2.0 * self.beta * alpha * liquid;
+        MixtureState {
+            alpha,
+            rho: self.rho_l * liquid + self.rho_g * alpha,
+            drho: (self.rho_g - self.rho_l) * dalpha,
+            mu: self.mu_l * liquid + self.mu_g * alpha,
+            dmu: (self.mu_g - self.mu_l) * dalpha,
+        }
+    }
+}
+
+/// Cell properties needed by the discretisation: ρ, dρ/dp, ρ/μ, d(ρ/μ)/dp,
+/// μ, dμ/dp. Same function as [`MixtureEos::eval`], arranged around
+/// e = exp(2z) so that one division serves α and 1/μ:
+///
+/// ```text
+/// α = 1/(1+e),  ρ = (ρl e + ρg)/(1+e),  μ = (μl e + μg)/(1+e),
+/// ρ/μ = (ρl e + ρg)/(μl e + μg),  d(ρ/μ)/dp = 2β e (ρl μg − μl ρg)/(μl e + μg)²
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CellState {
+    pub rho: f64,
+    pub drho: f64,
+    pub gr: f64,
+    pub dgr: f64,
+    pub mu: f64,
+    pub dmu: f64,
+}
+
+impl MixtureEos {
+    #[inline(always)]
+    pub fn cell(&self, p: f64) -> CellState {
+        let z = self.beta * (p - self.p0);
+        if z > SATURATED {
+            return CellState {
+                rho: self.rho_l,
+                drho: 0.0,
+                gr: self.rho_l / self.mu_l,
+                dgr: 0.0,
+                mu: self.mu_l,
+                dmu: 0.0,
+            };
+        }
+        if z < -SATURATED {
+            return CellState {
+                rho: self.rho_g,
+                drho: 0.0,
+                gr: self.rho_g / self.mu_g,
+                dgr: 0.0,
+                mu: self.mu_g,
+                dmu: 0.0,
+            };
+        }
+        let e = (2.0 * z).exp();
+        let one_e = 1.0 + e;
+        let num = self.rho_l * e + self.rho_g;
+        let den = self.mu_l * e + self.mu_g;
+        let inv = 1.0 / (one_e * den);
+        let alpha = den * inv;
+        let inv_den = one_e * inv;
+        // dα/dp = −2β α (1−α), with 1 − α = e α
+        let dalpha = -2.0 * self.beta * alpha * (e * alpha);
+        let gr = num * inv_den;
+        CellState {
+            rho: self.rho_l * (e * alpha) + self.rho_g * alpha,
+            drho: (self.rho_g - self.rho_l) * dalpha,
+            gr,
+            dgr: 2.0
+                * self.beta
+                * e
+                * (self.rho_l * self.mu_g - self.mu_l * self.rho_g)
+                * inv_den
+                * inv_den,
+            mu: self.mu_l * (e * alpha) + self.mu_g * alpha,
+            dmu: (self.mu_g - self.mu_l) * dalpha,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    #[test]
+    fn default_constants_match_model_md() {
+        let eos = MixtureEos::new(&Lubricant::default());
+        assert_relative_eq!(eos.beta, 4.641535e-5, max_relative = 1e-6);
+        assert_relative_eq!(eos.p0, 50_500.0, max_relative = 1e-9);
+    }
+
+    #[test]
+    fn vapour_fractions_are_reproduced_at_anchor_pressures() {
+        let l = Lubricant::default();
+        let eos = MixtureEos::new(&l);
+        assert_relative_eq!(eos.alpha(l.saturation_pressure), 0.01, max_relative = 1e-9);
+        assert_relative_eq!(eos.alpha(l.vapour_pressure), 0.99, max_relative = 1e-9);
+    }
+
+    #[test]
+    fn cell_state_agrees_with_the_plain_evaluation() {
+        let eos = MixtureEos::new(&Lubricant::default());
+        for &p in &[-5e5, -2e4, 1e3, 3e4, 5.05e4, 8e4, 1e5, 3e5, 1e6] {
+            let s = eos.eval(p);
+            let c = eos.cell(p);
+            assert_relative_eq!(c.rho, s.rho, max_relative = 1e-14);
+            assert_relative_eq!(c.mu, s.mu, max_relative = 1e-14);
+            assert_relative_eq!(c.gr, s.rho / s.mu, max_relative = 1e-14);
+            let dgr = (s.drho - s.rho * s.dmu / s.mu) / s.mu;
+            assert_relative_eq!(c.dgr, dgr, max_relative = 1e-10, epsilon = 1e-30);
+        }
+    }
+
+    #[test]
+    fn derivatives_match_finite_differences() {
+        let eos = MixtureEos::new(&Lubricant::default());
+        for &p in &[-2e4, 1e3, 3e4, 5.05e4, 8e4, 1e5, 3e5] {
+            // Step small against the transition width 1/β ≈ 21 kPa, large
+            // against rounding of ρ ≈ 850.
+            let h = 50.0;
+            let (a, b) = (eos.eval(p + h), eos.eval(p - h));
+            let s = eos.eval(p);
+            assert_relative_eq!(s.drho, (a.rho - b.rho) / (2.0 * h), max_relative = 1e-5, epsilon = 1e-15);
+            assert_relative_eq!(s.dmu, (a.mu - b.mu) / (2.0 * h), max_relative = 1e-5, epsilon = 1e-18);
+        }
+    }
+}

@@ -1,0 +1,126 @@
+//! What one step returns: the estimate, its numerical status and diagnostics.
+//!
+//! | field | meaning | unit |
+//! |---|---|---|
+//! | `time` | solver time at the end of the step | s |
+//! | `velocity` | sliding velocity v | m/s |
+//! | `load` | external normal load F_ext | N |
+//! | `h0`, `h_min` | minimum nominal separation, minimum film thickness | m |
+//! | `hydrodynamic_force` | F_hyd = B ∫ (p − p_amb) dx | N |
+//! | `asperity_force` | F_asp = B ∫ p_asp dx | N |
+//! | `viscous_force` | F_visc = B ∫ (−(h/2) ∂x p + μ v / h) dx | N |
+//! | `friction_force` | F_f = F_visc + μ_bl F_asp tanh(v/v_reg) | N |
+//! | `cof` | (|F_visc| + μ_bl F_asp) / F_ext | – |
+//! | `asperity_load_share` | F_asp / F_ext | – |
+//! | `inertia_force` | m h0'' | N |
+//! | `contact_area_ratio` | mean A_r/A_0 over the slider | – |
+//! | `max_pressure` | max absolute fluid pressure | Pa |
+//! | `cavitated_fraction` | share of the length with vapour fraction > ½ | – |
+//!
+//! `friction_force` carries the sign of the velocity: it is the force the
+//! contact exerts *against* the motion, i.e. what a feed-forward controller
+//! adds to its command.
+
+/// Numerical outcome of a step. Not an error: the estimate is always returned.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Status {
+    /// The update fell below the tolerance.
+    Converged,
+    /// The iteration bound was hit; the last finite iterate was kept.
+    MaxIterations,
+    /// The iteration produced a non-finite value or a singular system; the
+    /// previous state was kept.
+    NonFinite,
+    /// The velocity or load handed to the step was not finite; nothing was
+    /// computed and the previous state was kept.
+    NonFiniteInput,
+}
+
+impl Status {
+    /// Stable lower-case name (CSV, logs).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Status::Converged => "converged",
+            Status::MaxIterations => "max_iterations",
+            Status::NonFinite => "non_finite",
+            Status::NonFiniteInput => "non_finite_input",
+        }
+    }
+
+    pub fn is_converged(self) -> bool {
+        self == Status::Converged
+    }
+}
+
+/// Lubrication regime from the asperity load share.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Regime {
+    /// Asperities carry at least 95 % of the load.
+    Boundary,
+    Mixed,
+    /// Asperities carry at most 5 % of the load.
+    Hydrodynamic,
+}
+
+impl Regime {
+    pub const BOUNDARY_SHARE: f64 = 0.95;
+    pub const HYDRODYNAMIC_SHARE: f64 = 0.05;
+
+    pub fn from_asperity_share(share: f64) -> Self {
+        if share >= Self::BOUNDARY_SHARE {
+            Regime::Boundary
+        } else if share <= Self::HYDRODYNAMIC_SHARE {
+            Regime::Hydrodynamic
+        } else {
+            Regime::Mixed
+        }
+    }
+
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Regime::Boundary => "boundary",
+            Regime::Mixed => "mixed",
+            Regime::Hydrodynamic => "hydrodynamic",
+        }
+    }
+}
+
+/// How the step went numerically.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Diagnostics {
+    /// Newton iterations (reference solver: secant iterations on h0).
+    pub iterations: u32,
+    /// Reference solver only: total Picard iterations in the step.
+    pub inner_iterations: u32,
+    /// Scaled max-norm of the last update (relative to max|p| and h0).
+    pub residual: f64,
+    /// |load-balance residual| / F_ext at the returned state.
+    pub load_residual: f64,
+    /// Line-search step halvings in the step.
+    pub backtracks: u32,
+    /// The h0 floor (`contact.min_film`) was active.
+    pub film_floor_active: bool,
+}
+
+/// The model's output for one step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Estimate {
+    pub time: f64,
+    pub velocity: f64,
+    pub load: f64,
+    pub h0: f64,
+    pub h_min: f64,
+    pub hydrodynamic_force: f64,
+    pub asperity_force: f64,
+    pub viscous_force: f64,
+    pub friction_force: f64,
+    pub cof: f64,
+    pub asperity_load_share: f64,
+    pub inertia_force: f64,
+    pub contact_area_ratio: f64,
+    pub max_pressure: f64,
+    pub cavitated_fraction: f64,
+    pub regime: Regime,
+    pub status: Status,
+    pub diagnostics: Diagnostics,
+}

@@ -1,0 +1,206 @@
+//! The paper's reference algorithm (Algorithm 1, MODEL.md §7).
+//!
+//! For each step, an under-relaxed secant iteration on h0 drives the load
+//! residual `ΔF = Σ w_k (F_hyd + F_asp − F_ext)^(n−k) − m h0''` to zero. For
+//! every trial h0 the Reynolds equation is solved by under-relaxed Picard
+//! iterations on its linearised form: ρ and μ are frozen at the current
+//! iterate Pᵏ, the linear tridiagonal system is solved for P̂, and
+//!
+//! ```text
+//! δp = max(P̂, 0) − Pᵏ ,   Pᵏ⁺¹ = Pᵏ + ω_fluid δp
+//! ```
+//!
+//! The Couette term is central-differenced (face density = mean of the two
+//! cells), as in the paper; the storage term uses the same θ/BDF2
+//! coefficients as the Newton solver. It is kept as a cross-check and as the
+//! benchmark baseline; it is slow by construction.
+
+use super::estimate::Status;
+use super::solver::{Ctx, Gap, Outcome, Solver};
+
+impl Solver {
+    pub(crate) fn reference_solve(&mut self, ctx: &Ctx) -> Outcome {
+        let rs = self.settings.reference;
+        let mut out = Outcome {
+            status: Status::MaxIterations,
+            iterations: 0,
+            inner_iterations: 0,
+            residual: f64::NAN,
+            backtracks: 0,
+        };
+        if let Gap::Prescribed(h) = ctx.gap {
+            let (_, it, conv) = self.picard(h, ctx);
+            self.h0 = h;
+            out.inner_iterations = it;
+            out.iterations = 1;
+            out.status = if !self.p.iter().all(|x| x.is_finite()) {
+                Status::NonFinite
+            } else if conv {
+                Status::Converged
+            } else {
+                Status::MaxIterations
+            };
+            return out;
+        }
+        let mut h_a = self.h0;
+        let (mut r_a, it, _) = self.picard(h_a, ctx);
+        out.inner_iterations += it;
+        let mut h_b = h_a * (1.0 + 1e-3);
+        let (mut r_b, it, mut fluid_ok) = self.picard(h_b, ctx);
+        out.inner_iterations += it;
+        for k in 1..=rs.max_motion_iterations {
+            out.iterations = k;
+            if !(r_a.is_finite() && r_b.is_finite()) {
+                out.status = Status::NonFinite;
+                return out;
+            }
+            let denom = r_b - r_a;
+            let h_new = if denom != 0.0 {
+                h_b - r_b * (h_b - h_a) / denom
+            } else {
+                h_b
+            };
+            let mut h_next = h_b + rs.motion_relaxation * (h_new - h_b);
+            h_next = h_next.clamp(0.5 * h_b, 2.0 * h_b);
+            let eps = (h_next - h_b).abs() / h_b;
+            out.residual = eps;
+            h_a = h_b;
+            r_a = r_b;
+            h_b = h_next;
+            let (r, it, ok) = self.picard(h_b, ctx);
+            out.inner_iterations += it;
+            r_b = r;
+            fluid_ok = ok;
+            if eps < rs.motion_tolerance {
+                break;
+            }
+        }
+        self.h0 = h_b;
+        out.status = if !(r_b.is_finite() && self.p.iter().all(|x| x.is_finite())) {
+            Status::NonFinite
+        } else if out.residual < rs.motion_tolerance && fluid_ok {
+            Status::Converged
+        } else {
+            Status::MaxIterations
+        };
+        out
+    }
+
+    /// Picard solve of the Reynolds equation at fixed h0. Returns the load
+    /// residual ΔF (N), the iterations used and whether it converged.
+    fn picard(&mut self, h0: f64, ctx: &Ctx) -> (f64, u32, bool) {
+        let rs = self.settings.reference;
+        let d = &self.d;
+        let w = &mut self.w;
+        let n = d.grid.n;
+        let dx = d.grid.dx;
+        let (coef, inv_dt) = match ctx.time {
+            Some((c, dt)) => (Some(c), 1.0 / dt),
+            None => (None, 0.0),
+        };
+        let w0 = ctx.w0();
+        let half_v = 0.5 * ctx.v;
+        let mut converged = false;
+        let mut iters = 0;
+        for it in 1..=rs.max_fluid_iterations {
+            iters = it;
+            for i in 0..n {
+                let s = d.eos.eval(self.p[i]);
+                w.cells[i].rho = s.rho;
+                w.cells[i].gr = s.rho / s.mu;
+            }
+            // Face conductances K_f (stored in dql) and Couette fluxes (q).
+            for f in 0..=n {
+                let hf = h0 + d.grid.g_face[f];
+                let inv_df = if f == 0 || f == n { 2.0 / dx } else { 1.0 / dx };
+                let (phi, phis) = match &d.ff {
+                    Some(ff) => (ff.pressure(hf).0, ff.shear(hf).0),
+                    None => (1.0, 0.0),
+                };
+                let (rl, gl) = if f == 0 {
+                    (d.rho_b, d.gr_b)
+                } else {
+                    (w.cells[f - 1].rho, w.cells[f - 1].gr)
+                };
+                let (rr, gr) = if f == n {
+                    (d.rho_b, d.gr_b)
+                } else {
+                    (w.cells[f].rho, w.cells[f].gr)
+                };
+                w.faces[f].dql = phi * hf * hf * hf * inv_df / 12.0 * 0.5 * (gl + gr);
+                w.faces[f].q = half_v * (hf + d.sigma * phis) * 0.5 * (rl + rr);
+            }
+            for i in 0..n {
+                let (kl, kr) = (w.faces[i].dql, w.faces[i + 1].dql);
+                let mut rhs = -w0 * (w.faces[i + 1].q - w.faces[i].q);
+                if let Some(c) = coef {
+                    let hc = h0 + d.grid.g_cell[i];
+                    rhs -= dx
+                        * inv_dt
+                        * (c.a[0] * w.cells[i].rho * hc
+                            + c.a[1] * self.hist[0].rho_h[i]
+                            + c.a[2] * self.hist[1].rho_h[i]);
+                    rhs -= c.w[1] * self.hist[0].div[i] + c.w[2] * self.hist[1].div[i];
+                }
+                if w.has_source {
+                    rhs += w.source[i];
+                }
+                if i == 0 {
+                    rhs += w0 * kl * d.p_amb;
+                }
+                if i + 1 == n {
+                    rhs += w0 * kr * d.p_amb;
+                }
+                w.rows[i].a = if i == 0 { 0.0 } else { -w0 * kl };
+                w.rows[i].b = w0 * (kl + kr);
+                w.rows[i].c = if i + 1 == n { 0.0 } else { -w0 * kr };
+                w.rows[i].r = rhs;
+            }
+            // Thomas: P̂ into w.tmp.
+            let mut prev_cp = 0.0;
+            let mut prev = 0.0;
+            for i in 0..n {
+                let row = w.rows[i];
+                let m = row.b - row.a * prev_cp;
+                prev_cp = row.c / m;
+                prev = (row.r - row.a * prev) / m;
+                w.factors[i].cp = prev_cp;
+                w.tmp[i] = prev;
+            }
+            for i in (0..n - 1).rev() {
+                w.tmp[i] -= w.factors[i].cp * w.tmp[i + 1];
+            }
+            let mut pmax = d.p_amb;
+            let mut change: f64 = 0.0;
+            for i in 0..n {
+                let dp = w.tmp[i].max(0.0) - self.p[i];
+                change = change.max(dp.abs());
+                pmax = pmax.max(self.p[i].abs());
+                self.p[i] += rs.fluid_relaxation * dp;
+            }
+            if !change.is_finite() {
+                return (f64::NAN, iters, false);
+            }
+            if change / pmax < rs.fluid_tolerance {
+                converged = true;
+                break;
+            }
+        }
+        // Load residual ΔF = weighted net force − inertia.
+        let bdx = d.grid.width * dx;
+        let mut sum = 0.0;
+        for i in 0..n {
+            sum += self.p[i] - d.p_amb + d.gw.pressure(h0 + d.grid.g_cell[i]).0;
+        }
+        let f_net = bdx * sum - ctx.load;
+        let df = match ctx.time {
+            Some((c, dt)) => {
+                let acc = (h0 - 2.0 * self.hist[0].h0 + self.hist[1].h0) / (dt * dt);
+                c.w[0] * f_net + c.w[1] * self.hist[0].f_net + c.w[2] * self.hist[1].f_net
+                    - d.mass * acc
+            }
+            None => f_net,
+        };
+        (df, iters, converged)
+    }
+}
