@@ -227,8 +227,18 @@ mod tests {
             let h = 50.0;
             let (a, b) = (eos.eval(p + h), eos.eval(p - h));
             let s = eos.eval(p);
-            assert_relative_eq!(s.drho, (a.rho - b.rho) / (2.0 * h), max_relative = 1e-5, epsilon = 1e-15);
-            assert_relative_eq!(s.dmu, (a.mu - b.mu) / (2.0 * h), max_relative = 1e-5, epsilon = 1e-18);
+            assert_relative_eq!(
+                s.drho,
+                (a.rho - b.rho) / (2.0 * h),
+                max_relative = 1e-5,
+                epsilon = 1e-15
+            );
+            assert_relative_eq!(
+                s.dmu,
+                (a.mu - b.mu) / (2.0 * h),
+                max_relative = 1e-5,
+                epsilon = 1e-18
+            );
         }
     }
 }

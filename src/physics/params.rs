@@ -182,7 +182,11 @@ impl TimeScheme {
 /// Settings of the paper's reference algorithm (Table A2).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ReferenceSettings {
+    /// Largest (initial) Picard under-relaxation ω_fluid.
     pub fluid_relaxation: f64,
+    /// Smallest ω_fluid: ω is halved whenever the Picard update grows, and
+    /// never below this (the paper's range is 5e-4 … 5e-2).
+    pub fluid_relaxation_min: f64,
     pub max_fluid_iterations: u32,
     pub fluid_tolerance: f64,
     pub motion_relaxation: f64,
@@ -194,6 +198,7 @@ impl Default for ReferenceSettings {
     fn default() -> Self {
         Self {
             fluid_relaxation: 0.05,
+            fluid_relaxation_min: 5e-4,
             max_fluid_iterations: 10_000,
             fluid_tolerance: 1e-4,
             motion_relaxation: 0.5,
@@ -358,6 +363,13 @@ impl SolverSettings {
                 "solver.reference.fluid_relaxation",
                 r.fluid_relaxation,
                 "must lie in (0, 1]",
+            ));
+        }
+        if !(r.fluid_relaxation_min > 0.0 && r.fluid_relaxation_min <= r.fluid_relaxation) {
+            return Err(SetupError::invalid(
+                "solver.reference.fluid_relaxation_min",
+                r.fluid_relaxation_min,
+                "must lie in (0, fluid_relaxation]",
             ));
         }
         if !(r.motion_relaxation > 0.0 && r.motion_relaxation <= 1.0) {

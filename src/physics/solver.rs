@@ -484,6 +484,40 @@ impl Solver {
         self.last = None;
     }
 
+    /// Start from a given pressure field (Pa, one value per cell) and gap
+    /// (m), time 0. The first step is backward Euler. Non-finite or
+    /// wrongly-sized input is rejected.
+    pub fn initialize_state(&mut self, p: &[f64], h0: f64) -> Result<(), SetupError> {
+        if p.len() != self.d.grid.n {
+            return Err(SetupError::invalid(
+                "initial_state.pressure.len",
+                p.len() as f64,
+                "must equal the number of cells",
+            ));
+        }
+        if let Some(bad) = p.iter().find(|x| !x.is_finite()) {
+            return Err(SetupError::invalid(
+                "initial_state.pressure",
+                *bad,
+                "must be finite",
+            ));
+        }
+        if !(h0.is_finite() && h0 > 0.0) {
+            return Err(SetupError::invalid(
+                "initial_state.h0",
+                h0,
+                "must be finite and > 0",
+            ));
+        }
+        self.initialize_gap(h0);
+        self.p.copy_from_slice(p);
+        self.hist_len = 0;
+        self.push_history_current(0.0);
+        self.push_history_current(0.0);
+        self.hist_len = 1;
+        Ok(())
+    }
+
     fn fill_history_with_current(&mut self) {
         self.hist_len = 0;
         self.p_old_valid = false;
@@ -1358,5 +1392,170 @@ pub(crate) fn direction_with_old_factors(w: &mut Work) -> f64 {
             *v = -*v;
         }
         0.0
+    }
+}
+
+#[cfg(test)]
+mod jacobian_tests {
+    //! The analytic Jacobian equals central finite differences of the
+    //! residual, for random states (property test).
+    use super::*;
+    use crate::physics::params::{Pocket, Profile, TimeScheme};
+    use proptest::prelude::*;
+
+    fn residual(s: &mut Solver, p: &[f64], h0: f64, ctx: &Ctx) -> (Vec<f64>, f64) {
+        assemble(&s.d, &s.hist, p, h0, ctx, &mut s.w);
+        (s.w.rows.iter().map(|r| r.r).collect(), s.w.g)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn check(
+        profile: Profile,
+        pocket: bool,
+        flow_factors: bool,
+        sigma: f64,
+        p: Vec<f64>,
+        h0: f64,
+        v: f64,
+        theta: bool,
+    ) {
+        let mut m = ModelParams::default();
+        m.geometry.profile = profile;
+        if pocket {
+            m.geometry.pockets.push(Pocket {
+                start: 0.02,
+                width: 0.011,
+                depth: 4e-6,
+            });
+        }
+        m.roughness.flow_factors = flow_factors;
+        m.roughness.sigma = sigma;
+        let st = SolverSettings {
+            cells: p.len(),
+            scheme: if theta {
+                TimeScheme::PAPER
+            } else {
+                TimeScheme::Bdf2
+            },
+            ..Default::default()
+        };
+        let mut s = Solver::new(&m, &st).unwrap();
+        s.initialize_steady(0.1, 20_000.0);
+        let coef = StepCoefficients::for_scheme(st.scheme);
+        let ctx = Ctx {
+            v,
+            load: 20_000.0,
+            time: Some((coef, st.dt)),
+            gap: Gap::Balance,
+        };
+        assemble(&s.d, &s.hist, &p, h0, &ctx, &mut s.w);
+        let rows = s.w.rows.clone();
+        let (c_row, dgdh) = (s.w.c_row, s.w.dgdh);
+        // Magnitude of the terms of G, for its rounding error.
+        let bdx = s.d.grid.width * s.d.grid.dx;
+        let g_mag = bdx * p.iter().map(|x| x.abs()).sum::<f64>()
+            + bdx * s.d.contact.pressure_sum(h0).0
+            + ctx.load
+            + s.d.mass * h0 / (st.dt * st.dt);
+        let n = p.len();
+        let scale: Vec<f64> = rows
+            .iter()
+            .map(|r| r.a.abs().max(r.b.abs()).max(r.c.abs()) + 1e-300)
+            .collect();
+        // Magnitude of the terms of each mass residual (storage levels and
+        // face fluxes), for the rounding error of a difference quotient.
+        let g_max = s.d.grid.g_cell.iter().cloned().fold(0.0, f64::max);
+        let storage = s.d.grid.dx / st.dt * 4.0 * s.d.eos.rho_l * (h0 + g_max);
+        let r_mag: Vec<f64> = (0..n)
+            .map(|i| storage + s.w.faces[i].q.abs() + s.w.faces[i + 1].q.abs())
+            .collect();
+        let close = |fd: f64, an: f64, sc: f64, round: f64, what: &str| {
+            assert!(
+                (fd - an).abs() <= 1e-5 * (an.abs() + sc) + round,
+                "{what}: finite difference {fd:e} vs analytic {an:e}"
+            );
+        };
+        for j in 0..n {
+            let h = 1e-6 * p[j].abs().max(1e5);
+            let (mut pp, mut pm) = (p.clone(), p.clone());
+            pp[j] += h;
+            pm[j] -= h;
+            let (rp, gp) = residual(&mut s, &pp, h0, &ctx);
+            let (rm, gm) = residual(&mut s, &pm, h0, &ctx);
+            for i in 0..n {
+                let fd = (rp[i] - rm[i]) / (2.0 * h);
+                let an = if i == j {
+                    rows[i].b
+                } else if i + 1 == j {
+                    rows[i].c
+                } else if j + 1 == i {
+                    rows[i].a
+                } else {
+                    0.0
+                };
+                let round = 8.0 * f64::EPSILON * r_mag[i] / h;
+                close(fd, an, scale[i], round, &format!("dR{i}/dp{j}"));
+            }
+            let fd = (gp - gm) / (2.0 * h);
+            assert!(
+                (fd - c_row).abs() <= 1e-5 * c_row.abs() + 8.0 * f64::EPSILON * g_mag / h,
+                "dG/dp{j}: finite difference {fd:e} vs analytic {c_row:e}"
+            );
+        }
+        let hh = 1e-7 * h0;
+        let (rp, gp) = residual(&mut s, &p, h0 + hh, &ctx);
+        let (rm, gm) = residual(&mut s, &p, h0 - hh, &ctx);
+        for i in 0..n {
+            let col_scale = rows.iter().map(|r| r.col.abs()).fold(0.0, f64::max);
+            let round = 8.0 * f64::EPSILON * r_mag[i] / hh;
+            close(
+                (rp[i] - rm[i]) / (2.0 * hh),
+                rows[i].col,
+                col_scale,
+                round,
+                &format!("dR{i}/dh0"),
+            );
+        }
+        let fd = (gp - gm) / (2.0 * hh);
+        assert!(
+            (fd - dgdh).abs() <= 1e-5 * dgdh.abs() + 8.0 * f64::EPSILON * g_mag / hh,
+            "dG/dh0: finite difference {fd:e} vs analytic {dgdh:e}"
+        );
+    }
+
+    fn profile() -> impl Strategy<Value = Profile> {
+        prop_oneof![
+            (5e-6..40e-6f64).prop_map(|depth| Profile::Parabolic { depth }),
+            (1e-6..20e-6f64).prop_map(|depth| Profile::Linear { depth }),
+            Just(Profile::Flat),
+        ]
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+
+        #[test]
+        fn jacobian_matches_finite_differences(
+            profile in profile(),
+            pocket in any::<bool>(),
+            p in prop::collection::vec(prop_oneof![2e3..1.2e5f64, 1e5..4e6f64], 6..20),
+            h0 in 8e-6..30e-6f64,
+            v in -3.0..3.0f64,
+            theta in any::<bool>(),
+        ) {
+            check(profile, pocket, false, 5e-6, p, h0, v, theta);
+        }
+
+        #[test]
+        fn jacobian_with_flow_factors_matches_finite_differences(
+            thick in any::<bool>(),
+            p in prop::collection::vec(prop_oneof![2e3..1.2e5f64, 1e5..4e6f64], 6..20),
+            h0f in 0.0..1.0f64,
+            v in -3.0..3.0f64,
+        ) {
+            // Stay inside one branch of Table A1's φs (it jumps at H = 5).
+            let (sigma, h0) = if thick { (1e-6, 6e-6 + 20e-6 * h0f) } else { (5e-6, 3e-6 + 20e-6 * h0f * 0.05) };
+            check(Profile::Flat, false, true, sigma, p, h0, v, false);
+        }
     }
 }

@@ -1,0 +1,381 @@
+//! Hysteresis-loop metrics per motion cycle (MODEL.md §8).
+//!
+//! | metric | definition | unit |
+//! |---|---|---|
+//! | `friction_loop_area` | Σ over half-cycles (between velocity zero crossings) of the absolute enclosed area of the F_f–v loop | N·m/s |
+//! | `cof_loop_area` | the same for the COF–v loop | m/s |
+//! | `cof_v0_accelerating`, `cof_v0_decelerating` | one-sided limits of the COF at v = 0: linear extrapolation from the two samples after (accelerating) or before (decelerating) each zero crossing, averaged over the crossings of the cycle | – |
+//! | `peak_cof`, `peak_cof_velocity` | maximum COF in the cycle and the velocity where it occurs | –, m/s |
+//! | `h0_min`, `h0_max` | range of the minimum separation | m |
+//! | `mean_asperity_share` | mean F_asp/F_ext | – |
+//! | `branch_cof_gap` | mean COF while |v| increases minus mean COF while |v| decreases | – |
+//! | `branch_h0_gap` | the same for h0 | m |
+//! | `inertia_share` | max |m h0''| / F_ext over the cycle (raw, includes spikes) | – |
+//! | `inertia_share_smooth` | the same for the first `harmonics` Fourier harmonics of h0(t) over the cycle | – |
+//!
+//! Cycles are `(t0 + kT, t0 + (k+1)T]`; a cycle is reported only when it is
+//! complete. Periodic runs should report the last of at least three.
+
+use crate::physics::Estimate;
+
+/// What the metrics need of one step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LoopSample {
+    pub t: f64,
+    pub velocity: f64,
+    pub friction: f64,
+    pub cof: f64,
+    pub h0: f64,
+    pub asperity_share: f64,
+    pub inertia_force: f64,
+    pub load: f64,
+    pub hydrodynamic_force: f64,
+    pub asperity_force: f64,
+}
+
+impl From<&Estimate> for LoopSample {
+    fn from(e: &Estimate) -> Self {
+        Self {
+            t: e.time,
+            velocity: e.velocity,
+            friction: e.friction_force,
+            cof: e.cof,
+            h0: e.h0,
+            asperity_share: e.asperity_load_share,
+            inertia_force: e.inertia_force,
+            load: e.load,
+            hydrodynamic_force: e.hydrodynamic_force,
+            asperity_force: e.asperity_force,
+        }
+    }
+}
+
+/// Metrics of one cycle (see the module table).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LoopMetrics {
+    pub cycle: usize,
+    pub t_start: f64,
+    pub t_end: f64,
+    pub friction_loop_area: f64,
+    pub cof_loop_area: f64,
+    pub cof_v0_accelerating: Option<f64>,
+    pub cof_v0_decelerating: Option<f64>,
+    pub peak_cof: f64,
+    pub peak_cof_velocity: f64,
+    pub mean_cof: f64,
+    pub h0_min: f64,
+    pub h0_max: f64,
+    pub mean_asperity_share: f64,
+    pub mean_fluid_share: f64,
+    pub branch_cof_gap: Option<f64>,
+    pub branch_h0_gap: Option<f64>,
+    pub inertia_share: f64,
+    pub inertia_share_smooth: f64,
+}
+
+/// Split `samples` into cycles of `period` starting at `t0` and compute the
+/// metrics of every complete cycle. `mass` (kg) is used for the smooth
+/// inertia share; `harmonics` is the number of Fourier harmonics kept.
+pub fn cycle_metrics(
+    samples: &[LoopSample],
+    t0: f64,
+    period: f64,
+    mass: f64,
+    harmonics: usize,
+) -> Vec<LoopMetrics> {
+    if !(period > 0.0) || samples.len() < 4 {
+        return Vec::new();
+    }
+    let dt = if samples.len() > 1 {
+        samples[1].t - samples[0].t
+    } else {
+        0.0
+    };
+    let last_t = samples[samples.len() - 1].t;
+    let count = ((last_t - t0) / period + 1e-9).floor().max(0.0) as usize;
+    let mut out = Vec::new();
+    for k in 0..count {
+        let (a, b) = (t0 + k as f64 * period, t0 + (k + 1) as f64 * period);
+        let tol = 1e-6 * dt.abs();
+        let cyc: Vec<LoopSample> = samples
+            .iter()
+            .copied()
+            .filter(|s| s.t > a + tol && s.t <= b + tol)
+            .collect();
+        if cyc.len() < 4 {
+            continue;
+        }
+        out.push(one_cycle(k, a, b, &cyc, mass, harmonics));
+    }
+    out
+}
+
+/// Metrics of samples forming one cycle.
+pub fn one_cycle(
+    index: usize,
+    t_start: f64,
+    t_end: f64,
+    cyc: &[LoopSample],
+    mass: f64,
+    harmonics: usize,
+) -> LoopMetrics {
+    let n = cyc.len();
+    let mean = |f: &dyn Fn(&LoopSample) -> f64| cyc.iter().map(f).sum::<f64>() / n as f64;
+    let (peak_cof, peak_cof_velocity) = cyc.iter().fold((f64::NEG_INFINITY, 0.0), |(m, v), s| {
+        if s.cof > m {
+            (s.cof, s.velocity)
+        } else {
+            (m, v)
+        }
+    });
+    let h0_min = cyc.iter().map(|s| s.h0).fold(f64::INFINITY, f64::min);
+    let h0_max = cyc.iter().map(|s| s.h0).fold(f64::NEG_INFINITY, f64::max);
+    let inertia_share = cyc
+        .iter()
+        .map(|s| (s.inertia_force / s.load).abs())
+        .fold(0.0, f64::max);
+    // Zero crossings: index j with v_j, v_{j+1} of opposite sign (or v_j = 0).
+    let crossings: Vec<usize> = (0..n - 1)
+        .filter(|&j| {
+            let (a, b) = (cyc[j].velocity, cyc[j + 1].velocity);
+            (a > 0.0 && b <= 0.0) || (a < 0.0 && b >= 0.0)
+        })
+        .collect();
+    let extrapolate = |s1: &LoopSample, s2: &LoopSample| -> Option<f64> {
+        let dv = s2.velocity - s1.velocity;
+        if dv == 0.0 {
+            return None;
+        }
+        Some(s2.cof + (s2.cof - s1.cof) * (0.0 - s2.velocity) / dv)
+    };
+    let mut acc = Vec::new();
+    let mut dec = Vec::new();
+    for &j in &crossings {
+        if j >= 1 {
+            if let Some(c) = extrapolate(&cyc[j - 1], &cyc[j]) {
+                dec.push(c);
+            }
+        }
+        if j + 2 < n {
+            if let Some(c) = extrapolate(&cyc[j + 2], &cyc[j + 1]) {
+                acc.push(c);
+            }
+        }
+    }
+    let avg = |v: &[f64]| (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64);
+    // Loop areas per half-cycle lobe.
+    let friction_loop_area = lobe_areas(cyc, &crossings, |s| s.friction);
+    let cof_loop_area = lobe_areas(cyc, &crossings, |s| s.cof);
+    // Accelerating (|v| rising) versus decelerating branch.
+    let (mut ca, mut cd, mut ha, mut hd) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for j in 1..n - 1 {
+        let rising = cyc[j + 1].velocity.abs() > cyc[j - 1].velocity.abs();
+        let falling = cyc[j + 1].velocity.abs() < cyc[j - 1].velocity.abs();
+        if rising {
+            ca.push(cyc[j].cof);
+            ha.push(cyc[j].h0);
+        } else if falling {
+            cd.push(cyc[j].cof);
+            hd.push(cyc[j].h0);
+        }
+    }
+    let gap = |a: &[f64], b: &[f64]| match (avg(a), avg(b)) {
+        (Some(x), Some(y)) => Some(x - y),
+        _ => None,
+    };
+    let inertia_share_smooth =
+        smooth_inertia_share(cyc, t_end - t_start, mass, harmonics, mean(&|s| s.load));
+    LoopMetrics {
+        cycle: index,
+        t_start,
+        t_end,
+        friction_loop_area,
+        cof_loop_area,
+        cof_v0_accelerating: avg(&acc),
+        cof_v0_decelerating: avg(&dec),
+        peak_cof,
+        peak_cof_velocity,
+        mean_cof: mean(&|s| s.cof),
+        h0_min,
+        h0_max,
+        mean_asperity_share: mean(&|s| s.asperity_share),
+        mean_fluid_share: mean(&|s| s.hydrodynamic_force / s.load),
+        branch_cof_gap: gap(&ca, &cd),
+        branch_h0_gap: gap(&ha, &hd),
+        inertia_share,
+        inertia_share_smooth,
+    }
+}
+
+/// Σ |area| of the closed polygons between zero crossings (whole cycle when
+/// the velocity never changes sign).
+fn lobe_areas(cyc: &[LoopSample], crossings: &[usize], y: impl Fn(&LoopSample) -> f64) -> f64 {
+    let pt = |s: &LoopSample| (s.velocity, y(s));
+    let zero_point = |j: usize| -> (f64, f64) {
+        let (a, b) = (&cyc[j], &cyc[j + 1]);
+        let dv = b.velocity - a.velocity;
+        let w = if dv == 0.0 { 0.0 } else { -a.velocity / dv };
+        (0.0, y(a) + w * (y(b) - y(a)))
+    };
+    if crossings.is_empty() {
+        let poly: Vec<(f64, f64)> = cyc.iter().map(pt).collect();
+        return shoelace(&poly).abs();
+    }
+    let mut total = 0.0;
+    // Lobes strictly between consecutive crossings; the partial lobes at the
+    // cycle ends are joined across the cycle boundary (the motion is periodic).
+    let mut bounds: Vec<usize> = crossings.to_vec();
+    bounds.push(crossings[0] + cyc.len());
+    for w in bounds.windows(2) {
+        let (c0, c1) = (w[0], w[1]);
+        let mut poly = vec![zero_point(c0)];
+        for j in c0 + 1..=c1 {
+            poly.push(pt(&cyc[j % cyc.len()]));
+        }
+        let c1m = c1 % cyc.len();
+        if c1m + 1 < cyc.len() {
+            poly.push(zero_point(c1m));
+        }
+        total += shoelace(&poly).abs();
+    }
+    total
+}
+
+fn shoelace(poly: &[(f64, f64)]) -> f64 {
+    let n = poly.len();
+    if n < 3 {
+        return 0.0;
+    }
+    let mut s = 0.0;
+    for i in 0..n {
+        let (x1, y1) = poly[i];
+        let (x2, y2) = poly[(i + 1) % n];
+        s += x1 * y2 - x2 * y1;
+    }
+    0.5 * s
+}
+
+/// m max|h0''| / F_ext for the first `harmonics` Fourier harmonics of h0
+/// over one period (discrete projection; exact for uniform samples covering
+/// the period).
+fn smooth_inertia_share(
+    cyc: &[LoopSample],
+    period: f64,
+    mass: f64,
+    harmonics: usize,
+    load: f64,
+) -> f64 {
+    let n = cyc.len();
+    if n < 2 * harmonics + 1 || !(period > 0.0) {
+        return f64::NAN;
+    }
+    let w0 = 2.0 * core::f64::consts::PI / period;
+    let t_ref = cyc[0].t;
+    let mut coef = Vec::with_capacity(harmonics);
+    for k in 1..=harmonics {
+        let (mut a, mut b) = (0.0, 0.0);
+        for s in cyc {
+            let ph = k as f64 * w0 * (s.t - t_ref);
+            a += s.h0 * ph.cos();
+            b += s.h0 * ph.sin();
+        }
+        coef.push((2.0 * a / n as f64, 2.0 * b / n as f64));
+    }
+    let mut max_acc: f64 = 0.0;
+    for s in cyc {
+        let mut acc = 0.0;
+        for (k, (a, b)) in coef.iter().enumerate() {
+            let kw = (k + 1) as f64 * w0;
+            let ph = kw * (s.t - t_ref);
+            acc -= kw * kw * (a * ph.cos() + b * ph.sin());
+        }
+        max_acc = max_acc.max(acc.abs());
+    }
+    mass * max_acc / load
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    fn sample(t: f64, v: f64, cof: f64, h0: f64) -> LoopSample {
+        LoopSample {
+            t,
+            velocity: v,
+            friction: cof * 100.0 * v.signum(),
+            cof,
+            h0,
+            asperity_share: 0.5,
+            inertia_force: 0.0,
+            load: 100.0,
+            hydrodynamic_force: 50.0,
+            asperity_force: 50.0,
+        }
+    }
+
+    #[test]
+    fn loop_area_of_an_ellipse_is_pi_a_b_per_lobe() {
+        // Unidirectional: v = 1 + 0.5 sin, cof = 0.2 + 0.1 cos → ellipse, area π·0.5·0.1.
+        let n = 4000;
+        let s: Vec<LoopSample> = (1..=n)
+            .map(|j| {
+                let ph = 2.0 * std::f64::consts::PI * j as f64 / n as f64;
+                sample(
+                    j as f64 / n as f64,
+                    1.0 + 0.5 * ph.sin(),
+                    0.2 + 0.1 * ph.cos(),
+                    1e-5,
+                )
+            })
+            .collect();
+        let m = cycle_metrics(&s, 0.0, 1.0, 1.0, 3);
+        assert_eq!(m.len(), 1);
+        assert_relative_eq!(
+            m[0].cof_loop_area,
+            std::f64::consts::PI * 0.05,
+            max_relative = 1e-4
+        );
+        assert!(m[0].cof_v0_accelerating.is_none());
+    }
+
+    #[test]
+    fn smooth_inertia_share_recovers_a_harmonic_acceleration() {
+        // h0 = A sin(2π f t): max |h0''| = A (2π f)².
+        let (a, f, n) = (1e-6, 2.0, 1000);
+        let s: Vec<LoopSample> = (1..=n)
+            .map(|j| {
+                let t = j as f64 / (f * n as f64);
+                sample(
+                    t,
+                    (2.0 * std::f64::consts::PI * f * t).sin(),
+                    0.2,
+                    a * (2.0 * std::f64::consts::PI * f * t).sin(),
+                )
+            })
+            .collect();
+        let m = cycle_metrics(&s, 0.0, 1.0 / f, 3.0, 4);
+        let expect = 3.0 * a * (2.0 * std::f64::consts::PI * f).powi(2) / 100.0;
+        assert_relative_eq!(m[0].inertia_share_smooth, expect, max_relative = 1e-6);
+    }
+
+    #[test]
+    fn one_sided_cof_limits_extrapolate_each_branch_to_zero_velocity() {
+        // cof = 0.3 − 0.1|v| on the decelerating side, 0.25 − 0.1|v| accelerating.
+        let n = 1000;
+        let s: Vec<LoopSample> = (1..=n)
+            .map(|j| {
+                let t = j as f64 / n as f64;
+                let ph = 2.0 * std::f64::consts::PI * t;
+                let v = ph.sin();
+                let rising = ph.cos() * v.signum() > 0.0;
+                let c = if rising { 0.25 } else { 0.3 } - 0.1 * v.abs();
+                sample(t, v, c, 1e-5)
+            })
+            .collect();
+        let m = &cycle_metrics(&s, 0.0, 1.0, 1.0, 3)[0];
+        assert_relative_eq!(m.cof_v0_accelerating.unwrap(), 0.25, epsilon = 1e-9);
+        assert_relative_eq!(m.cof_v0_decelerating.unwrap(), 0.3, epsilon = 1e-9);
+        assert_relative_eq!(m.branch_cof_gap.unwrap(), -0.05, epsilon = 1e-3);
+    }
+}
