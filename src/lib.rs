@@ -1,8 +1,13 @@
 //! friction-node: a physics-based, real-time estimate of sliding friction.
 //!
 //! The [`physics`] module is the model core (no I/O, no clock, no logging).
-//! [`analysis`] computes loop metrics from runs. The other modules are the
-//! layers around them.
+//! [`analysis`] computes loop metrics from runs. [`config`] reads the ROS 2
+//! parameter files; [`signal`] the velocity and load inputs.
 
 pub mod analysis;
+pub mod bench;
+pub mod config;
+pub mod offline;
 pub mod physics;
+pub mod signal;
+pub mod text;

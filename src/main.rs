@@ -1,1 +1,308 @@
-fn main() {}
+//! The `friction-node` command line.
+
+use anyhow::{Context, Result};
+use clap::{Parser, Subcommand};
+use friction_node::config::Config;
+use friction_node::offline::{self, AtomicFile, Gap};
+use friction_node::signal::Signal;
+use std::path::PathBuf;
+use std::cell::Cell;
+
+/// Counts heap allocations (per thread) so that `bench` can report
+/// allocations per step.
+struct CountingAlloc;
+
+thread_local! {
+    static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
+}
+
+fn count_allocation() {
+    let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+}
+
+unsafe impl std::alloc::GlobalAlloc for CountingAlloc {
+    unsafe fn alloc(&self, layout: std::alloc::Layout) -> *mut u8 {
+        count_allocation();
+        unsafe { std::alloc::System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: std::alloc::Layout) {
+        unsafe { std::alloc::System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: std::alloc::Layout, size: usize) -> *mut u8 {
+        count_allocation();
+        unsafe { std::alloc::System.realloc(ptr, layout, size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: CountingAlloc = CountingAlloc;
+
+#[derive(Parser)]
+#[command(
+    name = "friction-node",
+    version,
+    about = "Physics-based sliding-friction estimate: transient mixed lubrication (Driesen et al. 2023)",
+    long_about = None
+)]
+struct Cli {
+    #[command(flatten)]
+    common: Common,
+    #[command(subcommand)]
+    command: Command,
+}
+
+/// Accepted before and after the subcommand; overrides accumulate in order
+/// (clap's `global` would replace the earlier ones).
+#[derive(clap::Args, Clone, Default)]
+struct Common {
+    /// ROS 2 parameter file (default: the built-in launch-config/default.yaml).
+    #[arg(long, value_name = "FILE")]
+    config: Option<PathBuf>,
+    /// Override a parameter, e.g. --set contact.load_n=5762 (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    sets: Vec<String>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run the transient model over a velocity (and load) history; write a CSV.
+    Simulate {
+        #[command(flatten)]
+        common: Common,
+        /// Velocity in m/s: const:V | sine:V0,V1,F[,PHASE] | csv:FILE[@COLUMN].
+        #[arg(long, value_name = "SPEC")]
+        velocity: String,
+        /// Load in N (same forms; default: contact.load_n).
+        #[arg(long, value_name = "SPEC")]
+        load: Option<String>,
+        /// Simulated time, s.
+        #[arg(long, value_name = "S")]
+        duration: f64,
+        /// Output CSV.
+        #[arg(long, value_name = "FILE")]
+        out: PathBuf,
+    },
+    /// Steady Stribeck curve over a velocity range; write a CSV.
+    Stribeck {
+        #[command(flatten)]
+        common: Common,
+        #[arg(long, value_name = "V", allow_hyphen_values = true)]
+        v_min: f64,
+        #[arg(long, value_name = "V", allow_hyphen_values = true)]
+        v_max: f64,
+        #[arg(long, value_name = "N", default_value_t = 60)]
+        points: usize,
+        /// Logarithmic spacing (the range must not contain 0).
+        #[arg(long)]
+        log: bool,
+        /// Load in N (default: contact.load_n).
+        #[arg(long, value_name = "N")]
+        load: Option<f64>,
+        #[arg(long, value_name = "FILE")]
+        out: PathBuf,
+    },
+    /// Steady fields along the slider at one velocity; write a CSV.
+    Profile {
+        #[command(flatten)]
+        common: Common,
+        #[arg(long, value_name = "V", allow_hyphen_values = true)]
+        velocity: f64,
+        /// Prescribed minimum separation h0, m.
+        #[arg(
+            long,
+            value_name = "M",
+            conflicts_with = "load",
+            required_unless_present = "load"
+        )]
+        h0: Option<f64>,
+        /// Load in N: h0 from the load balance.
+        #[arg(long, value_name = "N")]
+        load: Option<f64>,
+        #[arg(long, value_name = "FILE")]
+        out: PathBuf,
+    },
+    /// Benchmark one step of the paper's reciprocating case (release build!).
+    Bench {
+        #[command(flatten)]
+        common: Common,
+        /// Grid sizes.
+        #[arg(long, value_delimiter = ',', default_value = "64,256,1024")]
+        cells: Vec<usize>,
+        /// Timed cycles per grid (after one warm-up cycle).
+        #[arg(long, default_value_t = 3)]
+        cycles: usize,
+        /// States at which the reference solver is timed.
+        #[arg(long, default_value_t = 12)]
+        reference_steps: usize,
+        /// Also write the results as CSV.
+        #[arg(long, value_name = "FILE")]
+        out: Option<PathBuf>,
+    },
+}
+
+fn main() {
+    tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env()
+                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("warn")),
+        )
+        .with_writer(std::io::stderr)
+        .init();
+    if let Err(e) = run(Cli::parse()) {
+        eprintln!("error: {e:#}");
+        std::process::exit(2);
+    }
+}
+
+impl Command {
+    fn common(&self) -> &Common {
+        match self {
+            Command::Simulate { common, .. }
+            | Command::Stribeck { common, .. }
+            | Command::Profile { common, .. }
+            | Command::Bench { common, .. } => common,
+        }
+    }
+}
+
+fn run(cli: Cli) -> Result<()> {
+    let sub = cli.command.common().clone();
+    if cli.common.config.is_some() && sub.config.is_some() {
+        anyhow::bail!("--config given twice (before and after the subcommand)");
+    }
+    let path = sub.config.or(cli.common.config);
+    let sets: Vec<String> = cli.common.sets.iter().chain(&sub.sets).cloned().collect();
+    let config = Config::load(path.as_deref(), &sets)?;
+    match cli.command {
+        Command::Simulate {
+            common: _,
+            velocity,
+            load,
+            duration,
+            out,
+        } => {
+            let velocity = Signal::parse(&velocity, "velocity")?;
+            let load = match load {
+                Some(s) => Signal::parse(&s, "load")?,
+                None => Signal::Const(config.contact.load_n),
+            };
+            let mut file = AtomicFile::create(&out)?;
+            file.line(format_args!("{}", offline::SIMULATE_COLUMNS))?;
+            eprintln!(
+                "simulate: velocity {velocity}, load {load}, {duration} s, N = {}, dt = {} s, {:?} solver",
+                config.solver.cells, config.solver.dt_s, config.solver.method
+            );
+            let report = offline::simulate(&config, &velocity, &load, duration, |e, _| {
+                file.line(format_args!("{}", offline::simulate_row(e)))
+            })?;
+            let path = file.commit()?;
+            print!("{report}");
+            println!("wrote {} ({} rows)", path.display(), report.steps);
+        }
+        Command::Stribeck {
+            common: _,
+            v_min,
+            v_max,
+            points,
+            log,
+            load,
+            out,
+        } => {
+            let vs = offline::sweep(v_min, v_max, points, log)?;
+            let load = load.unwrap_or(config.contact.load_n);
+            let mut file = AtomicFile::create(&out)?;
+            let rows = offline::stribeck(&config, &vs, load)?;
+            file.line(format_args!("{}", offline::STRIBECK_COLUMNS))?;
+            for e in &rows {
+                file.line(format_args!("{}", offline::stribeck_row(e)))?;
+            }
+            let path = file.commit()?;
+            let min = rows
+                .iter()
+                .min_by(|a, b| a.cof.total_cmp(&b.cof))
+                .context("empty sweep")?;
+            let failed = rows.iter().filter(|e| !e.status.is_converged()).count();
+            println!(
+                "{} points, load {load} N: COF {:.4} at v = {} m/s … minimum {:.4} at v = {} m/s",
+                rows.len(),
+                rows[0].cof,
+                rows[0].velocity,
+                min.cof,
+                min.velocity
+            );
+            if failed > 0 {
+                println!("warning: {failed} points did not converge (see the status column)");
+            }
+            println!("wrote {}", path.display());
+        }
+        Command::Profile {
+            common: _,
+            velocity,
+            h0,
+            load,
+            out,
+        } => {
+            let gap = match (h0, load) {
+                (Some(h), _) => Gap::H0(h),
+                (None, Some(f)) => Gap::Load(f),
+                (None, None) => unreachable!("clap requires one"),
+            };
+            let mut file = AtomicFile::create(&out)?;
+            let (e, field) = offline::profile(&config, velocity, gap)?;
+            file.line(format_args!("{}", offline::PROFILE_COLUMNS))?;
+            for p in &field {
+                file.line(format_args!("{}", offline::profile_row(p)))?;
+            }
+            let path = file.commit()?;
+            println!("status           {}", e.status.as_str());
+            println!(
+                "h0               {:.4} µm (h_min {:.4} µm)",
+                e.h0 * 1e6,
+                e.h_min * 1e6
+            );
+            println!("p_max            {:.6e} Pa (absolute)", e.max_pressure);
+            println!("hydrodynamic load {:.3} N", e.hydrodynamic_force);
+            println!("asperity load    {:.3} N", e.asperity_force);
+            println!(
+                "friction         {:.3} N (COF {:.5})",
+                e.friction_force, e.cof
+            );
+            println!("wrote {} ({} cells)", path.display(), field.len());
+        }
+        Command::Bench {
+            common: _,
+            cells,
+            cycles,
+            reference_steps,
+            out,
+        } => {
+            if cfg!(debug_assertions) {
+                eprintln!(
+                    "warning: this is a debug build; benchmark with `cargo run --release -- bench`"
+                );
+            }
+            let counter = || ALLOCATIONS.with(Cell::get);
+            let progress = |m: &str| eprintln!("  {m}");
+            let cases = friction_node::bench::run(
+                &config,
+                &friction_node::bench::BenchOptions {
+                    cells,
+                    cycles,
+                    reference_steps,
+                    allocation_counter: Some(&counter),
+                    progress: &progress,
+                },
+            )?;
+            print!("{}", friction_node::bench::table(&cases));
+            if let Some(out) = out {
+                let mut f = AtomicFile::create(&out)?;
+                f.line(format_args!(
+                    "{}",
+                    friction_node::bench::csv(&cases).trim_end()
+                ))?;
+                println!("wrote {}", f.commit()?.display());
+            }
+        }
+    }
+    Ok(())
+}

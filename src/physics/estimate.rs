@@ -100,6 +100,9 @@ pub struct Diagnostics {
     pub backtracks: u32,
     /// The h0 floor (`contact.min_film`) was active.
     pub film_floor_active: bool,
+    /// 0, or the number of backward-Euler sub-steps the step needed after
+    /// Newton failed on the full step (a rare fallback at hard steps).
+    pub substeps: u32,
 }
 
 /// The model's output for one step.

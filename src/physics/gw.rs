@@ -136,7 +136,7 @@ impl HermiteTable {
             return (f0 + d0 * x, d0);
         }
         let u = x * self.per_unit;
-        if !(u < (self.nodes.len() - 1) as f64) {
+        if u.is_nan() || u >= (self.nodes.len() - 1) as f64 {
             // Beyond the table (or NaN, which propagates through u).
             return (0.0 * u, 0.0 * u);
         }

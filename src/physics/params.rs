@@ -232,7 +232,7 @@ impl Default for SolverSettings {
             method: Method::Newton,
             scheme: TimeScheme::Bdf2,
             tolerance: 1e-6,
-            max_iterations: 30,
+            max_iterations: 20,
             reference: ReferenceSettings::default(),
         }
     }

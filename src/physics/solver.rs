@@ -58,6 +58,12 @@ use super::gw::{Greenwood, SummedContact};
 use super::params::{Method, ModelParams, SolverSettings};
 use super::scheme::StepCoefficients;
 
+/// Finest sub-division of a step that failed to converge.
+const MAX_SUBSTEPS: usize = 16;
+
+/// Largest relative change of h0 in one Newton update.
+const H0_TRUST: f64 = 0.25;
+
 /// Updates below this (scaled) are taken without the monotonicity test.
 const SMALL_UPDATE: f64 = 1e-3;
 
@@ -265,6 +271,10 @@ pub struct Solver {
     pub(crate) time: f64,
     pub(crate) velocity: f64,
     pub(crate) hist: [Level; 2],
+    /// Scratch copy of the history while a step is sub-stepped.
+    hist_save: [Level; 2],
+    /// Load of the last accepted step (sub-steps interpolate from it).
+    last_load: Option<f64>,
     /// Number of valid history levels (0, 1 or 2).
     pub(crate) hist_len: usize,
     pub(crate) w: Work,
@@ -320,6 +330,8 @@ impl Solver {
             time: 0.0,
             velocity: 0.0,
             hist: [Level::new(n), Level::new(n)],
+            hist_save: [Level::new(n), Level::new(n)],
+            last_load: None,
             hist_len: 0,
             w: Work::new(n),
             p_old: vec![p_amb; n],
@@ -333,6 +345,15 @@ impl Solver {
 
     pub fn settings(&self) -> &SolverSettings {
         &self.settings
+    }
+
+    /// Switch the algorithm (and its tolerance) while keeping the state, e.g.
+    /// to time the reference solver from exactly the same state.
+    pub fn set_method(&mut self, method: Method, tolerance: f64) {
+        self.settings.method = method;
+        self.settings.tolerance = tolerance;
+        self.settings.reference.fluid_tolerance = tolerance;
+        self.settings.reference.motion_tolerance = tolerance;
     }
 
     pub fn cells(&self) -> usize {
@@ -762,6 +783,28 @@ impl Solver {
             Method::Newton => self.solve(&ctx),
             Method::Reference => self.reference_solve(&ctx),
         };
+        let mut substeps = 0;
+        if out.status != Status::Converged && self.settings.method == Method::Newton {
+            // Fallbacks for the rare hard step (a fast vapour-pocket collapse):
+            // Newton from the last state instead of the extrapolated one, then
+            // the step split into backward-Euler sub-steps.
+            let spent = out.iterations;
+            self.p.copy_from_slice(&self.w.p_backup);
+            self.h0 = match gap {
+                Gap::Prescribed(h) => h,
+                Gap::Balance => h_backup,
+            };
+            out = self.solve(&ctx);
+            out.iterations += spent;
+            let mut m = 2;
+            while out.status != Status::Converged && m <= MAX_SUBSTEPS {
+                let spent = out.iterations;
+                out = self.solve_substepped(&ctx, m, h_backup);
+                out.iterations += spent;
+                substeps = m;
+                m *= 2;
+            }
+        }
         let mut floor = false;
         if out.status != Status::NonFinite && gap == Gap::Balance && self.h0 < self.d.min_film {
             // The floor binds: hold h0 there and give up the load balance.
@@ -782,8 +825,10 @@ impl Solver {
         std::mem::swap(&mut self.p_old, &mut self.w.p_backup);
         self.p_old_valid = true;
         self.velocity = v;
+        self.last_load = Some(load);
         let mut e = self.finish(&ctx, out, true);
         e.diagnostics.film_floor_active = floor;
+        e.diagnostics.substeps = substeps as u32;
         self.last = Some(e);
         e
     }
@@ -817,7 +862,8 @@ impl Solver {
                 out.status = Status::NonFinite;
                 return out;
             };
-            let norm = scaled_norm(&self.w.dp, dh, &self.p, self.h0, self.d.p_amb);
+            let scale = norm_scale(&self.p, self.h0, self.d.p_amb);
+            let norm = scaled_norm(&self.w.dp, dh, scale);
             out.residual = norm;
             if !norm.is_finite() {
                 out.status = Status::NonFinite;
@@ -832,9 +878,10 @@ impl Solver {
                 out.status = Status::Converged;
                 return out;
             }
+            // Trust region on the gap: |Δh0| ≤ 25 % of h0 per iteration.
             let mut lambda: f64 = 1.0;
-            if dh < -0.5 * self.h0 {
-                lambda = 0.5 * self.h0 / (-dh);
+            if dh.abs() > H0_TRUST * self.h0 {
+                lambda = H0_TRUST * self.h0 / dh.abs();
             }
             let mut accepted = false;
             // Deep in the quadratic region the full step is taken untested.
@@ -847,14 +894,14 @@ impl Solver {
                 let pt = std::mem::take(&mut self.w.p_trial);
                 let ok = assemble(&self.d, &self.hist, &pt, h_trial, ctx, &mut self.w);
                 self.w.p_trial = pt;
-                if ok && !test && lambda == 1.0 {
+                if ok && !test && lambda == 1.0 && dh.abs() <= H0_TRUST * self.h0 {
                     accepted = true;
                     self.h0 = h_trial;
                     break;
                 }
                 if ok {
                     let dhb = direction_with_old_factors(&mut self.w);
-                    let nb = scaled_norm(&self.w.dbar, dhb, &self.w.p_trial, h_trial, self.d.p_amb);
+                    let nb = scaled_norm(&self.w.dbar, dhb, scale);
                     if nb.is_finite() && nb <= (1.0 - 0.25 * lambda) * norm {
                         accepted = true;
                         self.h0 = h_trial;
@@ -877,6 +924,57 @@ impl Solver {
             std::mem::swap(&mut self.p, &mut self.w.p_trial);
         }
         out
+    }
+
+    /// March the step in `m` backward-Euler sub-steps of Δt/m from the
+    /// previous state (in `w.p_backup`, `h_start`), with velocity and load
+    /// interpolated. The stored history is saved and restored around it.
+    fn solve_substepped(&mut self, ctx: &Ctx, m: usize, h_start: f64) -> Outcome {
+        let Some((_, dt)) = ctx.time else {
+            return self.solve(ctx);
+        };
+        self.p.copy_from_slice(&self.w.p_backup);
+        self.h0 = h_start;
+        for (save, lvl) in self.hist_save.iter_mut().zip(&self.hist) {
+            save.clone_from(lvl);
+        }
+        // The inertia term's previous slope, rescaled to the sub-step.
+        self.hist[1].h0 = self.hist[0].h0 - (self.hist[0].h0 - self.hist[1].h0) / m as f64;
+        let (v0, f0) = (self.velocity, self.last_load.unwrap_or(ctx.load));
+        let mut total = Outcome {
+            status: Status::Converged,
+            iterations: 0,
+            inner_iterations: 0,
+            residual: 0.0,
+            backtracks: 0,
+        };
+        for j in 1..=m {
+            let w = j as f64 / m as f64;
+            let sub = Ctx {
+                v: v0 + w * (ctx.v - v0),
+                load: f0 + w * (ctx.load - f0),
+                time: Some((StepCoefficients::BDF1, dt / m as f64)),
+                gap: ctx.gap,
+            };
+            let o = self.solve(&sub);
+            total.iterations += o.iterations;
+            total.backtracks += o.backtracks;
+            total.residual = o.residual;
+            if o.status != Status::Converged {
+                total.status = o.status;
+                break;
+            }
+            if j < m {
+                let f_net = self.w.f_net;
+                self.push_history_current(f_net);
+                self.w.linearised = None;
+            }
+        }
+        for (lvl, save) in self.hist.iter_mut().zip(&self.hist_save) {
+            lvl.clone_from(save);
+        }
+        self.w.hist_term_valid = None;
+        total
     }
 
     // ------------------------------------------------------------------
@@ -1014,6 +1112,7 @@ impl Solver {
                 load_residual,
                 backtracks: out.backtracks,
                 film_floor_active: false,
+                substeps: 0,
             },
         }
     }
@@ -1021,17 +1120,20 @@ impl Solver {
 
 /// Scaled max-norm of an update: pressure relative to max(p_amb, max|p|),
 /// h0 relative to itself.
-pub(crate) fn scaled_norm(dp: &[f64], dh: f64, p: &[f64], h0: f64, p_amb: f64) -> f64 {
-    let mut pmax = p_amb;
-    let mut dmax: f64 = 0.0;
-    for (x, d) in p.iter().zip(dp) {
-        pmax = pmax.max(x.abs());
-        dmax = dmax.max(d.abs());
-    }
+pub(crate) fn scaled_norm(dp: &[f64], dh: f64, scale: (f64, f64)) -> f64 {
+    let dmax = dp.iter().fold(0.0f64, |m, d| m.max(d.abs()));
     if dmax.is_nan() {
         return f64::NAN;
     }
-    (dmax / pmax).max(dh.abs() / h0.abs().max(f64::MIN_POSITIVE))
+    (dmax / scale.0).max(dh.abs() / scale.1)
+}
+
+/// Scales of an iterate for [`scaled_norm`]: max(p_amb, max|p|) and h0. A
+/// line search measures the update and the trial correction on the scales
+/// of the *current* iterate, so that the merit is consistent.
+pub(crate) fn norm_scale(p: &[f64], h0: f64, p_amb: f64) -> (f64, f64) {
+    let pmax = p.iter().fold(p_amb, |m, x| m.max(x.abs()));
+    (pmax, h0.abs().max(f64::MIN_POSITIVE))
 }
 
 /// What a face flux needs besides the two neighbouring states.

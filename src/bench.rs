@@ -1,0 +1,171 @@
+//! `friction-node bench`: per-step cost of the paper's reciprocating case
+//! (V1 = 1 m/s, f = 1 Hz, F = 20 762 N, μ = 0.0564 Pa·s), Newton against the
+//! reference algorithm, and allocations per step. A benchmark, not a test:
+//! release build, medians and ratios measured side by side in one run.
+
+use crate::config::Config;
+use crate::offline::{OfflineError, Timing};
+use crate::physics::{Method, Solver};
+use std::time::Instant;
+
+/// Results for one grid size.
+#[derive(Debug, Clone)]
+pub struct BenchCase {
+    pub cells: usize,
+    pub steps: usize,
+    pub newton: Timing,
+    pub newton_mean_iterations: f64,
+    pub newton_max_iterations: u32,
+    /// Newton at the reference's tolerance, on the sampled states.
+    pub newton_equal_tol: Timing,
+    pub reference: Timing,
+    pub reference_samples: usize,
+    pub reference_mean_picard: f64,
+    /// Allocations per Newton step (None without a counting allocator).
+    pub allocations_per_step: Option<f64>,
+}
+
+impl BenchCase {
+    /// Reference median over Newton median, same states and tolerance.
+    pub fn speedup(&self) -> f64 {
+        self.reference.median_us / self.newton_equal_tol.median_us
+    }
+}
+
+/// Options of a benchmark run.
+pub struct BenchOptions<'a> {
+    pub cells: Vec<usize>,
+    pub cycles: usize,
+    pub reference_steps: usize,
+    /// Reads a global allocation counter, when the binary installs one.
+    pub allocation_counter: Option<&'a dyn Fn() -> u64>,
+    pub progress: &'a dyn Fn(&str),
+}
+
+pub fn run(config: &Config, opts: &BenchOptions<'_>) -> Result<Vec<BenchCase>, OfflineError> {
+    let load = config.contact.load_n;
+    let velocity = |t: f64| (2.0 * std::f64::consts::PI * t).sin();
+    let mut out = Vec::new();
+    for &cells in &opts.cells {
+        let mut cfg = config.clone();
+        cfg.solver.cells = cells;
+        cfg.validate()?;
+        let st = cfg.solver_settings();
+        let per_cycle = (1.0 / st.dt).round() as usize;
+        let mut s = Solver::new(&cfg.model(), &st)?;
+        s.initialize_steady(0.0, load);
+        (opts.progress)(&format!("N = {cells}: warm-up cycle"));
+        for k in 1..=per_cycle {
+            s.step(velocity(k as f64 * st.dt), load);
+        }
+        let steps = opts.cycles * per_cycle;
+        let sample_every = (steps / opts.reference_steps.max(1)).max(1);
+        let mut times = Vec::with_capacity(steps);
+        let (mut it_sum, mut it_max) = (0u64, 0u32);
+        let mut allocs = 0u64;
+        let mut samples = Vec::new();
+        (opts.progress)(&format!("N = {cells}: {steps} timed Newton steps"));
+        for j in 0..steps {
+            let k = per_cycle + 1 + j;
+            let t = k as f64 * st.dt;
+            if j % sample_every == sample_every / 2 && samples.len() < opts.reference_steps {
+                samples.push((s.clone(), velocity(t)));
+            }
+            let a0 = opts.allocation_counter.map(|c| c());
+            let start = Instant::now();
+            let e = s.step(velocity(t), load);
+            times.push(start.elapsed().as_nanos() as u64);
+            if let (Some(c), Some(a0)) = (opts.allocation_counter, a0) {
+                allocs += c() - a0;
+            }
+            it_sum += e.diagnostics.iterations as u64;
+            it_max = it_max.max(e.diagnostics.iterations);
+        }
+        // Side by side from identical states at equal tolerance.
+        let tol = cfg.solver.reference.motion_tolerance;
+        let (mut tn, mut tr, mut picard) = (Vec::new(), Vec::new(), 0u64);
+        for (i, (state, v)) in samples.iter().enumerate() {
+            (opts.progress)(&format!(
+                "N = {cells}: reference step {}/{}",
+                i + 1,
+                samples.len()
+            ));
+            let mut a = state.clone();
+            a.set_method(Method::Newton, tol);
+            let start = Instant::now();
+            a.step(*v, load);
+            tn.push(start.elapsed().as_nanos() as u64);
+            let mut b = state.clone();
+            b.set_method(Method::Reference, tol);
+            let start = Instant::now();
+            let e = b.step(*v, load);
+            tr.push(start.elapsed().as_nanos() as u64);
+            picard += e.diagnostics.inner_iterations as u64;
+        }
+        out.push(BenchCase {
+            cells,
+            steps,
+            newton: Timing::from_ns(&times),
+            newton_mean_iterations: it_sum as f64 / steps as f64,
+            newton_max_iterations: it_max,
+            newton_equal_tol: Timing::from_ns(&tn),
+            reference: Timing::from_ns(&tr),
+            reference_samples: tr.len(),
+            reference_mean_picard: picard as f64 / tr.len().max(1) as f64,
+            allocations_per_step: opts
+                .allocation_counter
+                .map(|_| allocs as f64 / steps as f64),
+        });
+    }
+    Ok(out)
+}
+
+/// Human-readable table.
+pub fn table(cases: &[BenchCase]) -> String {
+    let mut s = String::new();
+    s.push_str("     N | Newton µs/step: median    p99  p99.9    max | iter mean/max | allocs/step | µs/step/cell | ref. µs/step (median) | Newton @tol µs | speed-up\n");
+    for c in cases {
+        s.push_str(&format!(
+            "{:>6} | {:>22.1} {:>6.1} {:>6.1} {:>6.1} | {:>8.2}/{:<4} | {:>11} | {:>12.4} | {:>21.0} | {:>14.1} | {:>7.0}×\n",
+            c.cells,
+            c.newton.median_us,
+            c.newton.p99_us,
+            c.newton.p999_us,
+            c.newton.max_us,
+            c.newton_mean_iterations,
+            c.newton_max_iterations,
+            c.allocations_per_step.map_or("n/a".to_string(), |a| format!("{a}")),
+            c.newton.median_us / c.cells as f64,
+            c.reference.median_us,
+            c.newton_equal_tol.median_us,
+            c.speedup(),
+        ));
+    }
+    s
+}
+
+/// CSV of the results.
+pub fn csv(cases: &[BenchCase]) -> String {
+    let mut s = String::from("cells,steps,newton_median_us,newton_p99_us,newton_p999_us,newton_max_us,newton_mean_iterations,newton_max_iterations,allocations_per_step,reference_median_us,reference_samples,reference_mean_picard_iterations,newton_equal_tol_median_us,speedup\n");
+    for c in cases {
+        s.push_str(&format!(
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+            c.cells,
+            c.steps,
+            c.newton.median_us,
+            c.newton.p99_us,
+            c.newton.p999_us,
+            c.newton.max_us,
+            c.newton_mean_iterations,
+            c.newton_max_iterations,
+            c.allocations_per_step
+                .map_or(String::new(), |a| a.to_string()),
+            c.reference.median_us,
+            c.reference_samples,
+            c.reference_mean_picard,
+            c.newton_equal_tol.median_us,
+            c.speedup()
+        ));
+    }
+    s
+}

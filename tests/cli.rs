@@ -1,0 +1,225 @@
+//! The command line, end to end (the real binary).
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_friction-node"))
+}
+
+fn dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("fn-cli-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn run(args: &[&str]) -> (bool, String, String) {
+    let o = bin().args(args).output().unwrap();
+    (
+        o.status.success(),
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn simulate_writes_the_documented_columns_and_summarises_the_last_cycle() {
+    let d = dir("sim");
+    let out = d.join("run.csv");
+    let (ok, stdout, stderr) = run(&[
+        "simulate",
+        "--velocity",
+        "sine:0,1,4",
+        "--duration",
+        "1",
+        "--set",
+        "solver.cells=64",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    let text = std::fs::read_to_string(&out).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap();
+    assert!(header.starts_with(
+        "t_s,velocity_m_s,load_n,h0_m,h_min_m,f_hyd_n,f_asp_n,friction_n,cof,iterations,status"
+    ));
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 1000);
+    assert_eq!(rows[0][0], "0.001");
+    assert!(rows.iter().all(|r| r[10] == "converged"));
+    // Four cycles of 0.25 s: the summary reports the last one.
+    assert!(stdout.contains("last cycle       #4 of 4"), "{stdout}");
+    assert!(stdout.contains("friction loop area"), "{stdout}");
+    assert!(stdout.contains("COF at v = 0"), "{stdout}");
+}
+
+#[test]
+fn load_from_a_csv_column_and_overrides_after_the_subcommand_accumulate() {
+    let d = dir("load");
+    let table = d.join("in.csv");
+    std::fs::write(&table, "t_s,velocity_m_s,load_n\n0,0.2,5762\n1,0.2,10762\n").unwrap();
+    let out = d.join("run.csv");
+    let (ok, _, stderr) = run(&[
+        "--set",
+        "solver.cells=32",
+        "simulate",
+        "--velocity",
+        &format!("csv:{}", table.display()),
+        "--load",
+        &format!("csv:{}@load_n", table.display()),
+        "--duration",
+        "0.5",
+        "--set",
+        "solver.dt_s=0.01",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    let text = std::fs::read_to_string(&out).unwrap();
+    let last: Vec<&str> = text.lines().last().unwrap().split(',').collect();
+    assert_eq!(text.lines().count(), 51);
+    assert_eq!(last[2], "8262");
+}
+
+#[test]
+fn a_malformed_velocity_line_is_reported_with_its_number_and_nothing_is_written() {
+    let d = dir("bad");
+    let v = d.join("v.csv");
+    std::fs::write(&v, "t_s,v\n0,0\n0.5,0.1\n1.0,fast\n").unwrap();
+    let out = d.join("run.csv");
+    std::fs::write(&out, "precious").unwrap();
+    let (ok, _, stderr) = run(&[
+        "simulate",
+        "--velocity",
+        &format!("csv:{}", v.display()),
+        "--duration",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!ok);
+    assert!(
+        stderr.contains("v.csv:4") && stderr.contains("`fast`"),
+        "{stderr}"
+    );
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), "precious");
+    assert_eq!(
+        std::fs::read_dir(&d).unwrap().count(),
+        2,
+        "no temporary file left"
+    );
+}
+
+#[test]
+fn config_errors_name_the_key() {
+    let (ok, _, stderr) = run(&[
+        "--set",
+        "contact.lenght_m=0.1",
+        "simulate",
+        "--velocity",
+        "const:1",
+        "--duration",
+        "1",
+        "--out",
+        "/tmp/never.csv",
+    ]);
+    assert!(!ok);
+    assert!(stderr.contains("contact.lenght_m"), "{stderr}");
+    let d = dir("cfg");
+    let f = d.join("p.yaml");
+    std::fs::write(
+        &f,
+        "friction_node:\n  ros__parameters:\n    roughness:\n      sigma_m: 0.5\n",
+    )
+    .unwrap();
+    let (ok, _, stderr) = run(&[
+        "--config",
+        f.to_str().unwrap(),
+        "profile",
+        "--velocity",
+        "1",
+        "--h0",
+        "1e-5",
+        "--out",
+        "/tmp/never.csv",
+    ]);
+    assert!(!ok);
+    assert!(
+        stderr.contains("roughness.sigma_m") && stderr.contains("0.5"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn an_unwritable_output_is_reported() {
+    let (ok, _, stderr) = run(&[
+        "simulate",
+        "--velocity",
+        "const:0.1",
+        "--duration",
+        "100",
+        "--out",
+        "/nonexistent-dir/run.csv",
+    ]);
+    assert!(!ok);
+    assert!(
+        stderr.contains("cannot write /nonexistent-dir/run.csv"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn stribeck_and_profile_write_their_columns() {
+    let d = dir("sp");
+    let s = d.join("s.csv");
+    let (ok, stdout, stderr) = run(&[
+        "stribeck",
+        "--v-min",
+        "0.01",
+        "--v-max",
+        "3",
+        "--points",
+        "8",
+        "--log",
+        "--set",
+        "solver.cells=64",
+        "--out",
+        s.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("8 points"));
+    let text = std::fs::read_to_string(&s).unwrap();
+    assert!(text.starts_with("velocity_m_s,h0_m,h_min_m,f_hyd_n,f_asp_n,friction_n,cof"));
+    assert_eq!(text.lines().count(), 9);
+    let p = d.join("p.csv");
+    let (ok, stdout, stderr) = run(&[
+        "profile",
+        "--velocity",
+        "1",
+        "--load",
+        "20762",
+        "--out",
+        p.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(
+        stdout.contains("p_max")
+            && stdout.contains("hydrodynamic load")
+            && stdout.contains("asperity load")
+    );
+    let text = std::fs::read_to_string(&p).unwrap();
+    assert!(text.starts_with("x_m,h_m,p_pa,vapour_fraction,p_asp_pa,shear_pa"));
+    assert_eq!(text.lines().count(), 257);
+    let (ok, _, stderr) = run(&[
+        "stribeck",
+        "--v-min",
+        "-1",
+        "--v-max",
+        "1",
+        "--log",
+        "--out",
+        s.to_str().unwrap(),
+    ]);
+    assert!(!ok && stderr.contains("does not contain 0"), "{stderr}");
+}
