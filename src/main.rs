@@ -5,8 +5,8 @@ use clap::{Parser, Subcommand};
 use friction_node::config::Config;
 use friction_node::offline::{self, AtomicFile, Gap};
 use friction_node::signal::Signal;
-use std::path::PathBuf;
 use std::cell::Cell;
+use std::path::PathBuf;
 
 /// Counts heap allocations (per thread) so that `bench` can report
 /// allocations per step.
