@@ -10,4 +10,5 @@ pub mod config;
 pub mod offline;
 pub mod physics;
 pub mod signal;
+pub mod studies;
 pub mod text;

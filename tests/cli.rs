@@ -223,3 +223,75 @@ fn stribeck_and_profile_write_their_columns() {
     ]);
     assert!(!ok && stderr.contains("does not contain 0"), "{stderr}");
 }
+
+#[test]
+fn an_unknown_study_lists_the_valid_ones() {
+    let (ok, _, stderr) = run(&["study", "frequency", "--out", "/tmp/never"]);
+    assert!(!ok);
+    for name in [
+        "stribeck",
+        "amplitude-frequency",
+        "load",
+        "viscosity",
+        "inertia",
+        "unidirectional",
+        "roughness",
+        "hersey",
+        "all",
+    ] {
+        assert!(stderr.contains(name), "{name} missing from: {stderr}");
+    }
+}
+
+#[test]
+fn an_unusable_study_directory_is_reported_before_computing() {
+    let d = dir("studyfile");
+    let file = d.join("not-a-dir");
+    std::fs::write(&file, "x").unwrap();
+    let out = file.join("study");
+    let (ok, stdout, stderr) = run(&["study", "all", "--out", out.to_str().unwrap()]);
+    assert!(!ok);
+    assert!(
+        stderr.contains("cannot write") && stderr.contains("not-a-dir"),
+        "{stderr}"
+    );
+    assert!(
+        !stderr.contains("cases on"),
+        "no computation started: {stderr}"
+    );
+    assert!(stdout.is_empty());
+}
+
+#[test]
+fn a_study_writes_case_csvs_a_summary_plots_and_the_claims() {
+    let d = dir("study");
+    let (ok, stdout, stderr) = run(&[
+        "study",
+        "hersey",
+        "--out",
+        d.to_str().unwrap(),
+        "--set",
+        "solver.cells=32",
+        "--cycles",
+        "2",
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(
+        stdout.contains("hersey") && stdout.contains("8 cases"),
+        "{stdout}"
+    );
+    let s = d.join("hersey");
+    let summary = std::fs::read_to_string(s.join("summary.csv")).unwrap();
+    assert_eq!(summary.lines().count(), 9);
+    assert!(
+        summary.lines().skip(1).all(|l| l.contains(",\"ok\",")),
+        "{summary}"
+    );
+    assert_eq!(std::fs::read_dir(s.join("cases")).unwrap().count(), 8);
+    let claims = std::fs::read_to_string(d.join("claims.md")).unwrap();
+    assert!(claims.contains("## Claim 9"), "{claims}");
+    if cfg!(feature = "plots") {
+        let svg = std::fs::read_to_string(s.join("hersey.svg")).unwrap();
+        assert!(svg.starts_with("<svg") && svg.contains("Hersey"));
+    }
+}
