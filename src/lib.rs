@@ -7,8 +7,13 @@
 pub mod analysis;
 pub mod bench;
 pub mod config;
+pub mod msgs;
+pub mod node;
 pub mod offline;
 pub mod physics;
+#[cfg(feature = "mcap")]
+pub mod record;
 pub mod signal;
 pub mod studies;
 pub mod text;
+pub mod transport;

@@ -121,6 +121,27 @@ enum Command {
         #[arg(long, value_name = "FILE")]
         out: PathBuf,
     },
+    /// Run the real-time node: ROS 2 / iceoryx2 topics, fixed steps, MCAP recording.
+    Run {
+        #[command(flatten)]
+        common: Common,
+        /// Transport (default: node.transport).
+        #[arg(long, value_enum)]
+        transport: Option<TransportArg>,
+        /// Record inputs and outputs to this MCAP file.
+        #[arg(long, value_name = "FILE.mcap")]
+        record: Option<PathBuf>,
+        /// Drive the node with the paper's reciprocating velocity (V1 = 1 m/s,
+        /// f = 1 Hz) on its own topics for this many seconds, then stop.
+        #[arg(long, value_name = "SECONDS")]
+        demo: Option<f64>,
+        /// Stop after this many seconds (default: run until SIGINT/SIGTERM).
+        #[arg(long, value_name = "SECONDS", conflicts_with = "demo")]
+        duration: Option<f64>,
+        /// No live status line.
+        #[arg(long)]
+        quiet: bool,
+    },
     /// Reproduce the paper's parametric studies: CSVs, loop metrics, plots, claims.
     Study {
         #[command(flatten)]
@@ -137,6 +158,17 @@ enum Command {
         /// Worker threads (default: one per core).
         #[arg(long)]
         jobs: Option<usize>,
+    },
+    /// Command → estimate latency through a transport (release build!).
+    BenchLatency {
+        #[command(flatten)]
+        common: Common,
+        #[arg(long, value_enum, default_value = "iceoryx2")]
+        transport: TransportArg,
+        #[arg(long, default_value_t = 10_000)]
+        samples: usize,
+        #[arg(long, default_value_t = 500)]
+        warmup: usize,
     },
     /// Benchmark one step of the paper's reciprocating case (release build!).
     Bench {
@@ -161,7 +193,11 @@ fn main() {
     tracing_subscriber::fmt()
         .with_env_filter(
             tracing_subscriber::EnvFilter::try_from_default_env()
-                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("warn")),
+                // RustDDS logs harmless chatter at participant teardown;
+                // RUST_LOG=rustdds=warn shows it.
+                .unwrap_or_else(|_| {
+                    tracing_subscriber::EnvFilter::new("warn,rustdds=off,ros2_client=error")
+                }),
         )
         .with_writer(std::io::stderr)
         .init();
@@ -169,6 +205,13 @@ fn main() {
         eprintln!("error: {e:#}");
         std::process::exit(2);
     }
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum TransportArg {
+    Ros2,
+    Iceoryx2,
+    Both,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -187,7 +230,9 @@ enum StudyName {
 impl Command {
     fn common(&self) -> &Common {
         match self {
-            Command::Study { common, .. } => common,
+            Command::Study { common, .. }
+            | Command::Run { common, .. }
+            | Command::BenchLatency { common, .. } => common,
             Command::Simulate { common, .. }
             | Command::Stribeck { common, .. }
             | Command::Profile { common, .. }
@@ -300,6 +345,43 @@ fn run(cli: Cli) -> Result<()> {
             );
             println!("wrote {} ({} cells)", path.display(), field.len());
         }
+        Command::BenchLatency {
+            common: _,
+            transport,
+            samples,
+            warmup,
+        } => {
+            if cfg!(debug_assertions) {
+                eprintln!("warning: this is a debug build; benchmark with `cargo run --release -- bench-latency`");
+            }
+            let kind = match transport {
+                TransportArg::Ros2 => friction_node::config::TransportKind::Ros2,
+                TransportArg::Iceoryx2 => friction_node::config::TransportKind::Iceoryx2,
+                TransportArg::Both => {
+                    anyhow::bail!("bench-latency measures one transport: ros2 or iceoryx2")
+                }
+            };
+            let spec = friction_node::node::runner::backend_specs(&config, kind)?.remove(0);
+            eprintln!(
+                "bench-latency: {} round trips through {} (N = {}), lockstep node",
+                samples,
+                spec.name(),
+                config.solver.cells
+            );
+            let r = friction_node::bench::latency(&config, spec, samples, warmup)?;
+            println!(
+                "{}: command → estimate p50 {:.1} µs, p99 {:.1} µs, p99.9 {:.1} µs, max {:.1} µs over {} samples ({} lost); model step p50 {:.1} µs, p99 {:.1} µs",
+                r.transport, r.latency_us[0], r.latency_us[1], r.latency_us[2], r.latency_us[3], r.samples, r.lost, r.step_us[0], r.step_us[1]
+            );
+        }
+        Command::Run {
+            common: _,
+            transport,
+            record,
+            demo,
+            duration,
+            quiet,
+        } => run_node(&config, transport, record, demo, duration, quiet)?,
         Command::Study {
             common: _,
             name,
@@ -514,5 +596,123 @@ fn run_study(
         compute_s,
         rayon::current_num_threads()
     );
+    Ok(())
+}
+
+fn run_node(
+    config: &Config,
+    transport: Option<TransportArg>,
+    record: Option<PathBuf>,
+    demo: Option<f64>,
+    duration: Option<f64>,
+    quiet: bool,
+) -> Result<()> {
+    use friction_node::config::TransportKind;
+    use friction_node::msgs::status_name;
+    use friction_node::node::runner::{self, RunOptions};
+    let opts = RunOptions {
+        transport: transport.map(|t| match t {
+            TransportArg::Ros2 => TransportKind::Ros2,
+            TransportArg::Iceoryx2 => TransportKind::Iceoryx2,
+            TransportArg::Both => TransportKind::Both,
+        }),
+        record,
+        demo_s: demo,
+        duration_s: duration,
+        status_line: !quiet,
+    };
+    let stop = runner::stop_on_signals();
+    eprintln!(
+        "friction-node run: {:?} mode, dt = {} s, N = {}, transport {:?}{}",
+        config.node.step_mode,
+        config.solver.dt_s,
+        config.solver.cells,
+        opts.transport.unwrap_or(config.node.transport),
+        demo.map_or(String::new(), |s| format!(", demo {s} s"))
+    );
+    let r = runner::run_node(config, &opts, stop)?;
+    let s = &r.summary;
+    let us = |ns: u64| ns as f64 / 1e3;
+    println!(
+        "run summary{}",
+        if r.interrupted {
+            " (stopped by signal)"
+        } else {
+            ""
+        }
+    );
+    println!("  transports       {}", r.transports.join(", "));
+    println!(
+        "  steps            {} in {:.2} s ({:?} mode)",
+        s.steps, s.wall_s, config.node.step_mode
+    );
+    println!(
+        "  compute time     p50 {:.1} µs, p99 {:.1} µs, max {:.1} µs",
+        us(s.compute_ns[0]),
+        us(s.compute_ns[1]),
+        us(s.compute_ns[2])
+    );
+    if config.node.step_mode == friction_node::config::StepMode::Timer {
+        println!(
+            "  period jitter    p50 {:.1} µs, p99 {:.1} µs, max {:.1} µs",
+            us(s.jitter_ns[0]),
+            us(s.jitter_ns[1]),
+            us(s.jitter_ns[2])
+        );
+        println!("  deadline misses  {}", s.deadline_misses);
+    }
+    println!(
+        "  commands         {} received, {} rejected; {} steps without a fresh command",
+        s.commands_received, s.commands_rejected, s.command_timeouts
+    );
+    println!(
+        "  drops            {} publish, {} recorder; {} transport errors",
+        s.publish_drops, s.recorder_drops, s.transport_errors
+    );
+    let statuses: Vec<String> = s
+        .status_counts
+        .iter()
+        .enumerate()
+        .filter(|(_, n)| **n > 0)
+        .map(|(c, n)| format!("{} {n}", status_name(c as u8)))
+        .collect();
+    println!("  statuses         {}", statuses.join(", "));
+    if let (Some(rss), Some(peak)) = (r.rss_bytes, r.peak_rss_bytes) {
+        println!(
+            "  memory           RSS {:.1} MB (peak {:.1} MB)",
+            rss as f64 / 1e6,
+            peak as f64 / 1e6
+        );
+    }
+    if !r.realtime_applied.is_empty() {
+        println!("  real time        {}", r.realtime_applied.join(", "));
+    }
+    for w in &r.warnings {
+        println!("  warning          {w}");
+    }
+    if let Some(d) = &r.demo {
+        println!(
+            "  demo driver      {} commands sent, {} estimates received{}",
+            d.commands_sent,
+            d.estimates_received,
+            d.error
+                .as_ref()
+                .map_or(String::new(), |e| format!(" ({e})"))
+        );
+    }
+    if let Some(rec) = &r.recording {
+        match &rec.error {
+            None => println!(
+                "  recording        {}: {} messages, {:.2} MB",
+                rec.path.display(),
+                rec.messages,
+                rec.bytes as f64 / 1e6
+            ),
+            Some(e) => println!("  recording        FAILED ({}): {e}", rec.path.display()),
+        }
+    }
+    if r.recording.as_ref().is_some_and(|rec| rec.error.is_some()) {
+        std::process::exit(1);
+    }
     Ok(())
 }

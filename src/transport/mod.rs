@@ -1,0 +1,223 @@
+//! Transports: how commands reach the loop and estimates leave it.
+//!
+//! A backend has two sides behind small traits: [`NodePort`] (the loop's
+//! side; every method but [`NodePort::wait_for_command`] is non-blocking) and
+//! [`PeerPort`] (drivers, tests and benchmarks: they send commands and read
+//! estimates). One conformance suite (`tests/transport_conformance.rs`) runs
+//! against every backend: in-memory (here), iceoryx2 and ROS 2.
+//!
+//! Backends are opened from a [`BackendSpec`] on the thread that uses them
+//! (iceoryx2 ports are not `Send`).
+
+pub mod memory;
+pub mod names;
+
+#[cfg(feature = "iceoryx2")]
+pub mod iceoryx;
+#[cfg(feature = "ros2")]
+pub mod ros2;
+
+use crate::msgs::{Command, EstimateRecord, StatisticsRecord};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+/// Errors of the transport layer.
+#[derive(Debug, thiserror::Error)]
+pub enum TransportError {
+    #[error("{backend}: cannot {operation}: {message}")]
+    Backend {
+        backend: &'static str,
+        operation: String,
+        message: String,
+    },
+    #[error("the {0} transport is not built in (rebuild with the `{0}` feature)")]
+    NotBuiltIn(&'static str),
+    #[error("{backend}: {what} not matched within {waited:?}")]
+    NotMatched {
+        backend: &'static str,
+        what: &'static str,
+        waited: Duration,
+    },
+}
+
+impl TransportError {
+    pub(crate) fn backend(
+        backend: &'static str,
+        operation: impl Into<String>,
+        message: impl ToString,
+    ) -> Self {
+        TransportError::Backend {
+            backend,
+            operation: operation.into(),
+            message: message.to_string(),
+        }
+    }
+}
+
+/// The loop's side of a transport.
+pub trait NodePort {
+    fn name(&self) -> &'static str;
+    /// Next pending command, if any (non-blocking).
+    fn poll_command(&mut self) -> Result<Option<Command>, TransportError>;
+    /// Publish an estimate (non-blocking); false when it was dropped.
+    fn publish_estimate(&mut self, e: &EstimateRecord) -> bool;
+    /// Publish loop statistics (non-blocking); false when dropped.
+    fn publish_statistics(&mut self, s: &StatisticsRecord) -> bool;
+    /// Block until a command may be pending or `timeout` passes.
+    fn wait_for_command(&mut self, timeout: Duration) -> Result<(), TransportError>;
+}
+
+/// The other side: sends commands, reads estimates.
+pub trait PeerPort {
+    fn name(&self) -> &'static str;
+    fn send(&mut self, c: &Command) -> Result<(), TransportError>;
+    /// Next estimate, if any (non-blocking).
+    fn try_recv(&mut self) -> Result<Option<EstimateRecord>, TransportError>;
+    /// Whether the node's endpoints are matched (discovery done).
+    fn is_matched(&mut self) -> bool;
+}
+
+/// Poll `peer` until it is matched (discovery) or `timeout` passes.
+pub fn wait_matched(peer: &mut dyn PeerPort, timeout: Duration) -> Result<(), TransportError> {
+    let start = Instant::now();
+    while !peer.is_matched() {
+        if start.elapsed() > timeout {
+            return Err(TransportError::NotMatched {
+                backend: peer.name(),
+                what: "the node",
+                waited: timeout,
+            });
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    Ok(())
+}
+
+/// Receive the next estimate, polling until `timeout`.
+pub fn recv_timeout(
+    peer: &mut dyn PeerPort,
+    timeout: Duration,
+) -> Result<Option<EstimateRecord>, TransportError> {
+    let start = Instant::now();
+    let mut spins = 0u32;
+    loop {
+        if let Some(e) = peer.try_recv()? {
+            return Ok(Some(e));
+        }
+        if start.elapsed() > timeout {
+            return Ok(None);
+        }
+        // Spin briefly (sub-µs latency for shared memory), then back off.
+        spins += 1;
+        if spins > 2000 {
+            std::thread::sleep(Duration::from_micros(50));
+        } else {
+            std::hint::spin_loop();
+        }
+    }
+}
+
+/// The latest film profile, shared between the loop (writer) and the I/O
+/// threads (readers) without allocation on the loop: the loop copies into a
+/// preallocated buffer under a `try_lock` and bumps the sequence number.
+#[derive(Debug)]
+pub struct ProfileSlot {
+    seq: AtomicU64,
+    data: Mutex<ProfileData>,
+}
+
+/// Contents of a [`ProfileSlot`].
+#[derive(Debug, Clone, Default)]
+pub struct ProfileData {
+    pub stamp_ns: u64,
+    pub dx_m: f64,
+    pub h_m: Vec<f64>,
+    pub p_pa: Vec<f64>,
+}
+
+impl ProfileSlot {
+    pub fn new(cells: usize) -> Arc<Self> {
+        Arc::new(Self {
+            seq: AtomicU64::new(0),
+            data: Mutex::new(ProfileData {
+                stamp_ns: 0,
+                dx_m: 0.0,
+                h_m: vec![0.0; cells],
+                p_pa: vec![0.0; cells],
+            }),
+        })
+    }
+
+    /// Fill the slot (non-blocking): false when a reader holds it.
+    pub fn try_write(&self, f: impl FnOnce(&mut ProfileData)) -> bool {
+        match self.data.try_lock() {
+            Ok(mut d) => {
+                f(&mut d);
+                self.seq.fetch_add(1, Ordering::Release);
+                true
+            }
+            Err(_) => false,
+        }
+    }
+
+    /// The profile, if newer than `seen` (updates `seen`).
+    pub fn read_if_newer(&self, seen: &mut u64) -> Option<ProfileData> {
+        let s = self.seq.load(Ordering::Acquire);
+        if s == *seen {
+            return None;
+        }
+        let d = self.data.lock().ok()?.clone();
+        *seen = s;
+        Some(d)
+    }
+}
+
+/// How to open a backend (Send; opened on the thread that uses it).
+#[derive(Clone)]
+pub enum BackendSpec {
+    Memory(memory::MemoryLink),
+    #[cfg(feature = "iceoryx2")]
+    Iceoryx2(iceoryx::IceoryxSpec),
+    #[cfg(feature = "ros2")]
+    Ros2(ros2::Ros2Spec),
+}
+
+impl BackendSpec {
+    pub fn name(&self) -> &'static str {
+        match self {
+            BackendSpec::Memory(_) => "memory",
+            #[cfg(feature = "iceoryx2")]
+            BackendSpec::Iceoryx2(_) => "iceoryx2",
+            #[cfg(feature = "ros2")]
+            BackendSpec::Ros2(_) => "ros2",
+        }
+    }
+
+    /// Open the node's side. `profile` is the slot the loop writes film
+    /// profiles into (backends that publish profiles read it).
+    pub fn open_node(
+        &self,
+        profile: Option<Arc<ProfileSlot>>,
+    ) -> Result<Box<dyn NodePort>, TransportError> {
+        let _ = &profile;
+        match self {
+            BackendSpec::Memory(l) => Ok(Box::new(l.node())),
+            #[cfg(feature = "iceoryx2")]
+            BackendSpec::Iceoryx2(s) => Ok(Box::new(iceoryx::IceoryxNode::open(s)?)),
+            #[cfg(feature = "ros2")]
+            BackendSpec::Ros2(s) => Ok(Box::new(ros2::Ros2Node::open(s, profile)?)),
+        }
+    }
+
+    /// Open a peer's side.
+    pub fn open_peer(&self) -> Result<Box<dyn PeerPort>, TransportError> {
+        match self {
+            BackendSpec::Memory(l) => Ok(Box::new(l.peer())),
+            #[cfg(feature = "iceoryx2")]
+            BackendSpec::Iceoryx2(s) => Ok(Box::new(iceoryx::IceoryxPeer::open(s)?)),
+            #[cfg(feature = "ros2")]
+            BackendSpec::Ros2(s) => Ok(Box::new(ros2::Ros2Peer::open(s)?)),
+        }
+    }
+}
