@@ -60,7 +60,10 @@ fn newton_steps_allocate_nothing_through_reversals_and_vapour_collapse() {
         worst = worst.max(n);
     }
     assert_eq!(worst, 0, "a step allocated");
-    assert!(iterations > 2000 * 2, "the steps did real work");
+    assert!(
+        iterations > 2000,
+        "every step iterated at least once: {iterations}"
+    );
     // Rejected input and the theta scheme's history bookkeeping too.
     assert_eq!(
         allocations(|| {

@@ -283,7 +283,12 @@ pub struct Solver {
     pub(crate) w: Work,
     /// Pressure at level n−2 (for the predictor).
     p_old: Vec<f64>,
-    p_old_valid: bool,
+    /// Pressure at level n−3.
+    p_old2: Vec<f64>,
+    /// How many of p_old, p_old2 are valid (0..=2).
+    p_hist: usize,
+    /// h0 at level n−3 (valid when p_hist == 2).
+    h0_n3: f64,
     anchor: (f64, f64, f64),
     last: Option<Estimate>,
 }
@@ -338,7 +343,9 @@ impl Solver {
             hist_len: 0,
             w: Work::new(n),
             p_old: vec![p_amb; n],
-            p_old_valid: false,
+            p_old2: vec![p_amb; n],
+            p_hist: 0,
+            h0_n3: 0.0,
             anchor: (0.0, 0.0, 0.0),
             last: None,
         };
@@ -504,7 +511,7 @@ impl Solver {
         self.push_history_current(0.0);
         self.push_history_current(0.0);
         self.hist_len = 1;
-        self.p_old_valid = false;
+        self.p_hist = 0;
         self.last = None;
     }
 
@@ -544,7 +551,7 @@ impl Solver {
 
     fn fill_history_with_current(&mut self) {
         self.hist_len = 0;
-        self.p_old_valid = false;
+        self.p_hist = 0;
         let f_net = self
             .last
             .map_or(0.0, |e| e.hydrodynamic_force + e.asperity_force - e.load);
@@ -765,8 +772,15 @@ impl Solver {
         };
         self.w.p_backup.copy_from_slice(&self.p);
         let h_backup = self.h0;
-        // Warm start: pressure and h0 extrapolated linearly in time.
-        if self.p_old_valid && self.hist_len >= 2 {
+        // Warm start: pressure and h0 extrapolated in time, quadratically
+        // once three levels exist (error O(Δt³): within the tolerance for
+        // smooth motion, so such steps take one Newton iteration).
+        let quadratic = self.p_hist == 2 && self.hist_len >= 2;
+        if quadratic {
+            for ((p, o), o2) in self.p.iter_mut().zip(&self.p_old).zip(&self.p_old2) {
+                *p = 3.0 * (*p - o) + o2;
+            }
+        } else if self.p_hist >= 1 && self.hist_len >= 2 {
             for (p, o) in self.p.iter_mut().zip(&self.p_old) {
                 *p = 2.0 * *p - o;
             }
@@ -775,7 +789,12 @@ impl Solver {
             Gap::Prescribed(h) => self.h0 = h,
             Gap::Balance => {
                 if self.hist_len >= 2 {
-                    let ext = 2.0 * self.hist[0].h0 - self.hist[1].h0;
+                    let (h1, h2) = (self.hist[0].h0, self.hist[1].h0);
+                    let ext = if quadratic {
+                        3.0 * (h1 - h2) + self.h0_n3
+                    } else {
+                        2.0 * h1 - h2
+                    };
                     if ext > 0.5 * self.h0 && ext.is_finite() {
                         self.h0 = ext;
                     }
@@ -825,8 +844,11 @@ impl Solver {
             self.p.copy_from_slice(&self.w.p_backup);
             self.h0 = h_backup;
         }
+        std::mem::swap(&mut self.p_old2, &mut self.p_old);
         std::mem::swap(&mut self.p_old, &mut self.w.p_backup);
-        self.p_old_valid = true;
+        self.p_hist = (self.p_hist + 1).min(2);
+        // Level n−2 now becomes n−3 for the next step.
+        self.h0_n3 = self.hist[1].h0;
         self.velocity = v;
         self.last_load = Some(load);
         let mut e = self.finish(&ctx, out, true);
