@@ -270,7 +270,7 @@ fn a_failed_full_step_is_retried_from_the_last_state_and_then_sub_stepped() {
         retried += (e.diagnostics.iterations > s.settings().max_iterations) as usize;
     }
     assert!(retried >= 1, "the retry was exercised");
-    // A jump from rest to 5 m/s in one 1 ms step is beyond Newton from
+    // A jump from rest to 10 m/s in one 1 ms step is beyond Newton from
     // either start point with 7 iterations; interpolated backward-Euler
     // sub-steps get there.
     let st = SolverSettings {
@@ -280,11 +280,11 @@ fn a_failed_full_step_is_retried_from_the_last_state_and_then_sub_stepped() {
     };
     let mut s = Solver::new(&ModelParams::default(), &st).unwrap();
     s.initialize_steady(0.0, 20_762.0);
-    let e = s.step(5.0, 20_762.0);
+    let e = s.step(10.0, 20_762.0);
     assert_eq!(e.status, Status::Converged);
     assert!(e.diagnostics.substeps >= 2, "{:?}", e.diagnostics);
     // The result is a state of the model: the next steps continue normally.
     for _ in 0..5 {
-        assert_eq!(s.step(5.0, 20_762.0).status, Status::Converged);
+        assert_eq!(s.step(10.0, 20_762.0).status, Status::Converged);
     }
 }

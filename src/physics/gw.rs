@@ -247,12 +247,8 @@ impl Greenwood {
         });
         let area = HermiteTable::from_fn(count, per_unit, |lam0| {
             g.iter().fold([0.0, 0.0], |[v, dv], gi| {
-                let lam = lam0 + gi * inv_sigma;
-                // dF_1/dΛ = −F_0
-                [
-                    v + self.f1.eval(lam).0,
-                    dv - 0.5 * libm::erfc(lam / core::f64::consts::SQRT_2),
-                ]
+                let (f, df) = self.f1.eval(lam0 + gi * inv_sigma);
+                [v + f, dv + df]
             })
         });
         SummedContact {
