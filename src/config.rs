@@ -418,6 +418,18 @@ pub enum Reliability {
     Reliable,
 }
 
+/// `ros.qos.*.durability`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum Durability {
+    /// Samples go to the readers matched when they are written.
+    #[default]
+    Volatile,
+    /// The writer keeps its last `depth` samples for readers that match
+    /// later (and a reader asks for them).
+    TransientLocal,
+}
+
 /// QoS of one group of topics.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -425,6 +437,7 @@ pub struct QosConfig {
     pub reliability: Reliability,
     /// Keep-last depth.
     pub depth: usize,
+    pub durability: Durability,
 }
 
 impl Default for QosConfig {
@@ -432,6 +445,7 @@ impl Default for QosConfig {
         Self {
             reliability: Reliability::Reliable,
             depth: 10,
+            durability: Durability::Volatile,
         }
     }
 }
@@ -450,6 +464,7 @@ impl Default for QosProfiles {
             commands: QosConfig {
                 reliability: Reliability::BestEffort,
                 depth: 1,
+                durability: Durability::Volatile,
             },
             estimates: QosConfig::default(),
         }
@@ -924,6 +939,124 @@ impl Config {
             true,
             false,
         )?;
+        self.validate_io()
+    }
+
+    /// Ranges of the node, ROS 2 and recording sections.
+    fn validate_io(&self) -> Result<(), ConfigError> {
+        let n = &self.node;
+        range_check(
+            "node.max_abs_velocity_m_s",
+            n.max_abs_velocity_m_s,
+            0.0,
+            100.0,
+            true,
+            false,
+        )?;
+        let vmax = n.max_abs_velocity_m_s;
+        range_check(
+            "node.initial_velocity_m_s",
+            n.initial_velocity_m_s,
+            -vmax,
+            vmax,
+            false,
+            false,
+        )?;
+        range_check(
+            "node.command_timeout_s",
+            n.command_timeout_s,
+            0.0,
+            3600.0,
+            true,
+            false,
+        )?;
+        range_check(
+            "node.timeout_deceleration_m_s2",
+            n.timeout_deceleration_m_s2,
+            0.0,
+            1e4,
+            true,
+            false,
+        )?;
+        range_check("node.min_load_n", n.min_load_n, 0.0, 1e9, true, false)?;
+        range_check(
+            "node.max_load_n",
+            n.max_load_n,
+            n.min_load_n,
+            1e9,
+            false,
+            false,
+        )?;
+        range_check(
+            "node.profile_rate_hz",
+            n.profile_rate_hz,
+            0.0,
+            1000.0,
+            false,
+            false,
+        )?;
+        range_check(
+            "node.statistics_rate_hz",
+            n.statistics_rate_hz,
+            0.0,
+            1000.0,
+            true,
+            false,
+        )?;
+        range_check(
+            "node.queue_capacity",
+            n.queue_capacity as f64,
+            16.0,
+            1e7,
+            false,
+            false,
+        )?;
+        range_check(
+            "node.lockstep_spin_us",
+            n.lockstep_spin_us as f64,
+            0.0,
+            1e6,
+            false,
+            false,
+        )?;
+        range_check(
+            "node.realtime.priority",
+            n.realtime.priority as f64,
+            1.0,
+            99.0,
+            false,
+            false,
+        )?;
+        range_check(
+            "node.realtime.cpu",
+            n.realtime.cpu as f64,
+            -1.0,
+            4095.0,
+            false,
+            false,
+        )?;
+        range_check(
+            "ros.domain_id",
+            self.ros.domain_id as f64,
+            -1.0,
+            232.0,
+            false,
+            false,
+        )?;
+        for (key, q) in [
+            ("ros.qos.commands.depth", &self.ros.qos.commands),
+            ("ros.qos.estimates.depth", &self.ros.qos.estimates),
+        ] {
+            range_check(key, q.depth as f64, 1.0, 1e6, false, false)?;
+        }
+        range_check(
+            "recording.chunk_size_bytes",
+            self.recording.chunk_size_bytes as f64,
+            1024.0,
+            1e9,
+            false,
+            false,
+        )?;
         Ok(())
     }
 
@@ -1210,6 +1343,36 @@ mod tests {
             load(DEFAULT_YAML, &["nokey"]).unwrap_err(),
             ConfigError::BadOverride { .. }
         ));
+    }
+
+    #[test]
+    fn node_ros_and_recording_values_outside_their_ranges_are_named() {
+        for (set, key) in [
+            ("node.command_timeout_s=-1", "node.command_timeout_s"),
+            ("node.max_abs_velocity_m_s=0", "node.max_abs_velocity_m_s"),
+            ("node.initial_velocity_m_s=20", "node.initial_velocity_m_s"),
+            ("node.max_load_n=0.5", "node.max_load_n"),
+            ("node.queue_capacity=2", "node.queue_capacity"),
+            ("node.realtime.priority=0", "node.realtime.priority"),
+            ("ros.domain_id=300", "ros.domain_id"),
+            ("ros.qos.estimates.depth=0", "ros.qos.estimates.depth"),
+            (
+                "recording.chunk_size_bytes=10",
+                "recording.chunk_size_bytes",
+            ),
+        ] {
+            let e = load(DEFAULT_YAML, &[set]).unwrap_err();
+            assert!(
+                matches!(e, ConfigError::OutOfRange { key: ref k, .. } if k == key),
+                "{set}: {e}"
+            );
+        }
+        let c = load(
+            DEFAULT_YAML,
+            &["ros.qos.estimates.durability=transient_local"],
+        )
+        .unwrap();
+        assert_eq!(c.ros.qos.estimates.durability, Durability::TransientLocal);
     }
 
     #[test]

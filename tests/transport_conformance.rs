@@ -7,7 +7,7 @@
 //! non-finite velocity is rejected (flagged, last good velocity held),
 //! duplicate and out-of-order stamps produce no step.
 
-use friction_node::config::{CommandType, Config, Reliability, StepMode};
+use friction_node::config::{CommandType, Config, Durability, Reliability, StepMode};
 use friction_node::msgs::{estimate_constants as codes, Command, CommandKind, EstimateRecord};
 use friction_node::node::{LiveStatus, Loop, RunSummary};
 use friction_node::offline;
@@ -33,10 +33,15 @@ fn lockstep_config() -> Config {
     c.solver.cells = 64;
     c.node.step_mode = StepMode::Lockstep;
     c.node.profile_rate_hz = 0.0;
-    // Lockstep must not lose commands.
+    // Lockstep must not lose commands. DDS matching is per side: the peer
+    // may see the node's writer before the node's writer has matched the
+    // peer's reader (and vice versa); transient-local durability delivers
+    // what was written before that.
     c.ros.qos.commands.reliability = Reliability::Reliable;
     c.ros.qos.commands.depth = 1000;
+    c.ros.qos.commands.durability = Durability::TransientLocal;
     c.ros.qos.estimates.depth = 1000;
+    c.ros.qos.estimates.durability = Durability::TransientLocal;
     // A domain of this process (tests of one binary share it; names differ).
     c.ros.domain_id = 100 + (std::process::id() % 100) as i64;
     c.ros.namespace = format!("/{}", unique("fn_test"));

@@ -15,7 +15,7 @@
 //! same-host unicast announcements.
 
 use super::{NodePort, PeerPort, ProfileSlot, TransportError};
-use crate::config::{CommandType, Config, DiscoveryRange, QosConfig, Reliability};
+use crate::config::{self, CommandType, Config, DiscoveryRange, QosConfig, Reliability};
 use crate::msgs::{
     Command, CommandKind, EstimateRecord, FilmProfile, Float64, FrictionEstimate, Header,
     LoopStatistics, StatisticsRecord, Time, TwistStamped,
@@ -122,7 +122,10 @@ impl Ros2Spec {
 
 fn qos(q: &QosConfig) -> QosProfile {
     let base = QosProfile::subscription_default()
-        .durability(Durability::Volatile)
+        .durability(match q.durability {
+            config::Durability::Volatile => Durability::Volatile,
+            config::Durability::TransientLocal => Durability::TransientLocal,
+        })
         .history(History::KeepLast { depth: q.depth });
     match q.reliability {
         Reliability::BestEffort => base.reliability_best_effort(),
@@ -574,14 +577,26 @@ impl PeerPort for Ros2Peer {
     }
 
     fn is_matched(&mut self) -> bool {
+        // The wait futures resolve at once when a match exists; polled once
+        // they answer without the error ros2-client logs for a writer or
+        // reader it has not matched yet (get_*_count does).
+        use futures::FutureExt;
+        let node = &self.node;
         let vel = match (&self.velocity_f64, &self.velocity_twist) {
-            (Some(p), _) => p.get_subscription_count(&self.node),
-            (_, Some(p)) => p.get_subscription_count(&self.node),
-            _ => 0,
+            (Some(p), _) => p.wait_for_subscription(node).now_or_never().is_some(),
+            (_, Some(p)) => p.wait_for_subscription(node).now_or_never().is_some(),
+            _ => false,
         };
-        vel >= 1
-            && self.load.get_subscription_count(&self.node) >= 1
-            && self.estimate.get_publisher_count(&self.node) >= 1
+        vel && self
+            .load
+            .wait_for_subscription(node)
+            .now_or_never()
+            .is_some()
+            && self
+                .estimate
+                .wait_for_publisher(node)
+                .now_or_never()
+                .is_some()
     }
 }
 
