@@ -11,8 +11,12 @@ pub mod msgs;
 pub mod node;
 pub mod offline;
 pub mod physics;
+#[cfg(feature = "plots")]
+pub mod plot;
 #[cfg(feature = "mcap")]
 pub mod record;
+#[cfg(feature = "mcap")]
+pub mod replay;
 pub mod signal;
 pub mod studies;
 pub mod text;

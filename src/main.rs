@@ -142,6 +142,35 @@ enum Command {
         #[arg(long)]
         quiet: bool,
     },
+    /// Re-run the model over the velocity recorded in a ROS 2 MCAP bag.
+    Replay {
+        #[command(flatten)]
+        common: Common,
+        /// The bag to replay.
+        #[arg(value_name = "BAG.mcap")]
+        bag: PathBuf,
+        /// Velocity topic (std_msgs/Float64, geometry_msgs/TwistStamped or
+        /// sensor_msgs/JointState); default: detected. For a friction-node bag
+        /// the default is its recorded estimates (the determinism oracle).
+        #[arg(long, value_name = "NAME")]
+        topic: Option<String>,
+        /// JointState: the joint whose velocity drives the slider.
+        #[arg(long, value_name = "NAME")]
+        joint: Option<String>,
+        /// Load topic (std_msgs/Float64); default: one ending in normal_load.
+        #[arg(long, value_name = "NAME")]
+        load_topic: Option<String>,
+        /// Output: OUT.mcap (ROS 2 profile) or OUT.csv (the simulate columns).
+        #[arg(long, value_name = "OUT.mcap|OUT.csv")]
+        out: PathBuf,
+        /// Also write a report (loop metrics, plots, markdown) into DIR.
+        #[arg(long, value_name = "DIR")]
+        report: Option<PathBuf>,
+        /// Exit with status 3 unless the re-simulation is bit-identical to
+        /// the recorded estimates.
+        #[arg(long)]
+        expect_identical: bool,
+    },
     /// Reproduce the paper's parametric studies: CSVs, loop metrics, plots, claims.
     Study {
         #[command(flatten)]
@@ -232,7 +261,8 @@ impl Command {
         match self {
             Command::Study { common, .. }
             | Command::Run { common, .. }
-            | Command::BenchLatency { common, .. } => common,
+            | Command::BenchLatency { common, .. }
+            | Command::Replay { common, .. } => common,
             Command::Simulate { common, .. }
             | Command::Stribeck { common, .. }
             | Command::Profile { common, .. }
@@ -248,8 +278,38 @@ fn run(cli: Cli) -> Result<()> {
     }
     let path = sub.config.or(cli.common.config);
     let sets: Vec<String> = cli.common.sets.iter().chain(&sub.sets).cloned().collect();
+    if let Command::Replay {
+        bag,
+        topic,
+        joint,
+        load_topic,
+        out,
+        report,
+        expect_identical,
+        ..
+    } = cli.command
+    {
+        #[cfg(feature = "mcap")]
+        return replay(
+            bag,
+            topic,
+            joint,
+            load_topic,
+            out,
+            report,
+            expect_identical,
+            path,
+            sets,
+        );
+        #[cfg(not(feature = "mcap"))]
+        {
+            let _ = (bag, topic, joint, load_topic, out, report, expect_identical);
+            anyhow::bail!("replay needs the `mcap` feature");
+        }
+    }
     let config = Config::load(path.as_deref(), &sets)?;
     match cli.command {
+        Command::Replay { .. } => unreachable!("handled above"),
         Command::Simulate {
             common: _,
             velocity,
@@ -713,6 +773,156 @@ fn run_node(
     }
     if r.recording.as_ref().is_some_and(|rec| rec.error.is_some()) {
         std::process::exit(1);
+    }
+    Ok(())
+}
+
+#[cfg(feature = "mcap")]
+#[allow(clippy::too_many_arguments)]
+fn replay(
+    bag_path: PathBuf,
+    topic: Option<String>,
+    joint: Option<String>,
+    load_topic: Option<String>,
+    out: PathBuf,
+    report: Option<PathBuf>,
+    expect_identical: bool,
+    config: Option<PathBuf>,
+    overrides: Vec<String>,
+) -> Result<()> {
+    use friction_node::replay::{self, Bag, InputMode, OutputFormat, OutputStream, ReplayOptions};
+    use indicatif::{ProgressBar, ProgressStyle};
+    let started = std::time::Instant::now();
+    let Some(format) = OutputFormat::from_path(&out) else {
+        anyhow::bail!(
+            "--out {}: the output must end in .mcap or .csv",
+            out.display()
+        );
+    };
+    // Validate the input completely before touching any output.
+    let bag = Bag::open(&bag_path)?;
+    let opts = ReplayOptions {
+        topic,
+        joint,
+        load_topic,
+        config,
+        overrides,
+    };
+    let prepared = replay::prepare(&bag, &opts)?;
+    if let Some(r) = &report {
+        friction_node::studies::report::prepare_output_dir(r)?;
+    }
+    let steps = prepared
+        .commands
+        .iter()
+        .filter(|c| c.kind == friction_node::msgs::CommandKind::Velocity)
+        .count();
+    eprintln!(
+        "replay {}: {} ({} velocity messages → {} steps of {} s), configuration {}",
+        bag_path.display(),
+        match &prepared.mode {
+            InputMode::Topics { velocity, .. } => format!("topic {velocity}"),
+            InputMode::RecordedEstimates { topic } => format!("recorded estimates {topic}"),
+        },
+        prepared.velocity_messages,
+        steps,
+        prepared.config.solver.dt_s,
+        prepared.config_source,
+    );
+    if let Some(d) = &prepared.scan.damage {
+        eprintln!("warning: the bag is damaged {d}; replaying everything before it");
+    }
+    if !prepared.gaps.is_empty() {
+        eprintln!(
+            "warning: {} velocity gaps longer than node.command_timeout_s = {} s (the node's timeout rule applied): {}",
+            prepared.gaps.len(),
+            prepared.config.node.command_timeout_s,
+            replay::gap_list(&prepared.gaps, prepared.commands.first().map_or(0, |c| c.stamp_ns))
+        );
+    }
+    // Written to a temporary sibling while the model runs; moved into place
+    // only when complete.
+    let mut stream = OutputStream::start(&out, format, &prepared, &bag_path)?;
+    let bar = ProgressBar::new(prepared.commands.len() as u64);
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{elapsed_precise} [{bar:40}] {pos}/{len} commands, {per_sec}",
+        )
+        .expect("template")
+        .progress_chars("=> "),
+    );
+    let model_started = std::time::Instant::now();
+    let result = replay::run(
+        &prepared,
+        &mut |done, _| bar.set_position(done as u64),
+        &mut |e, rec| stream.push(e, rec),
+    )?;
+    let model_wall = model_started.elapsed().as_secs_f64();
+    bar.finish_and_clear();
+    let written = stream.finish(result.oracle.as_ref())?;
+    let wall = started.elapsed().as_secs_f64();
+    let e = &result.estimates;
+    let span = match (e.first(), e.last()) {
+        (Some(a), Some(b)) => (b.1.stamp_ns.saturating_sub(a.1.stamp_ns)) as f64 / 1e9,
+        _ => 0.0,
+    };
+    println!(
+        "steps            {} over {:.3} s of bag time",
+        e.len(),
+        span
+    );
+    let rate = |w: f64| if w > 0.0 { span / w } else { f64::NAN };
+    println!(
+        "replay time      {:.3} s ({:.0}× real time; reading, model and writing), model {:.3} s ({:.0}×)",
+        wall,
+        rate(wall),
+        model_wall,
+        rate(model_wall)
+    );
+    println!("commands         {} rejected", result.commands_rejected);
+    if let Some(d) = &prepared.scan.damage {
+        println!("damaged bag      stopped {d}");
+    }
+    let mut identical = true;
+    if let Some(o) = &result.oracle {
+        identical = o.identical;
+        if o.identical {
+            println!(
+                "determinism      bit-identical to the recorded estimates ({} steps)",
+                o.compared
+            );
+        } else {
+            println!(
+                "determinism      DIFFERS from the recording over {} steps:",
+                o.compared
+            );
+            for (f, d, k) in &o.deviations {
+                println!("                 {f:<22} up to {d:.3e} (first largest at step {k})");
+            }
+            if let Some((a, b)) = o.count_mismatch {
+                println!("                 {a} steps recorded, {b} replayed");
+            }
+        }
+    }
+    println!("wrote {}", written.display());
+    if let Some(r) = &report {
+        let files = replay::write_report(r, &bag_path, &prepared, &result, wall)?;
+        println!(
+            "report           {} ({} files)",
+            r.join("summary.md").display(),
+            files.len()
+        );
+    }
+    if expect_identical && (result.oracle.is_none() || !identical) {
+        eprintln!(
+            "error: --expect-identical: {}",
+            if result.oracle.is_none() {
+                "the bag has no recorded estimates to compare with"
+            } else {
+                "the re-simulation differs"
+            }
+        );
+        std::process::exit(3);
     }
     Ok(())
 }

@@ -122,6 +122,12 @@ pub const SIMULATE_COLUMNS: &str = "t_s,velocity_m_s,load_n,h0_m,h_min_m,f_hyd_n
 
 /// One `simulate` row (re-reading the CSV gives the same bits).
 pub fn simulate_row(e: &Estimate) -> String {
+    simulate_row_with_status(e, e.status.as_str())
+}
+
+/// A `simulate` row with the status column given (replay reports the
+/// node's status codes, which include command flags).
+pub fn simulate_row_with_status(e: &Estimate, status: &str) -> String {
     format!(
         "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
         Num(e.time),
@@ -134,7 +140,7 @@ pub fn simulate_row(e: &Estimate) -> String {
         Num(e.friction_force),
         Num(e.cof),
         e.diagnostics.iterations,
-        e.status.as_str(),
+        status,
         Num(e.viscous_force),
         Num(e.asperity_load_share),
         Num(e.inertia_force),

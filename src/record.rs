@@ -56,17 +56,21 @@ pub struct RecorderReport {
 /// rosbag2's `offered_qos_profiles` metadata for one publisher.
 pub fn offered_qos_yaml(q: &QosConfig) -> String {
     // rosbag2 enums: history 1 keep_last; reliability 1 reliable, 2 best
-    // effort; durability 2 volatile; liveliness 1 automatic.
+    // effort; durability 1 transient local, 2 volatile; liveliness 1
+    // automatic.
     let reliability = match q.reliability {
         Reliability::Reliable => 1,
         Reliability::BestEffort => 2,
     };
+    let durability = match q.durability {
+        crate::config::Durability::TransientLocal => 1,
+        crate::config::Durability::Volatile => 2,
+    };
     let inf = "    sec: 2147483647\n    nsec: 4294967295\n";
     format!(
-        "- history: 1\n  depth: {}\n  reliability: {reliability}\n  durability: 2\n  deadline:\n{inf}  lifespan:\n{inf}  liveliness: 1\n  liveliness_lease_duration:\n{inf}  avoid_ros_namespace_conventions: false\n",
+        "- history: 1\n  depth: {}\n  reliability: {reliability}\n  durability: {durability}\n  deadline:\n{inf}  lifespan:\n{inf}  liveliness: 1\n  liveliness_lease_duration:\n{inf}  avoid_ros_namespace_conventions: false\n",
         q.depth
     )
-    .replace("\n    sec", "\n    sec")
 }
 
 struct Channels {
@@ -99,56 +103,13 @@ impl Recorder {
         names: &TopicNames,
         profile: Option<Arc<ProfileSlot>>,
     ) -> Result<Self, RecorderError> {
-        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir).map_err(|source| RecorderError::Create {
-                path: path.to_path_buf(),
-                source,
-            })?;
-        }
-        let file = std::fs::File::create(path).map_err(|source| RecorderError::Create {
-            path: path.to_path_buf(),
-            source,
-        })?;
-        let mcap_err = |e: mcap::McapError| RecorderError::Mcap {
-            path: path.to_path_buf(),
-            message: e.to_string(),
-        };
-        let compression = match config.recording.compression {
-            Compression::None => None,
-            Compression::Zstd => Some(mcap::Compression::Zstd),
-            Compression::Lz4 => Some(mcap::Compression::Lz4),
-        };
-        let mut w = mcap::WriteOptions::new()
-            .profile("ros2")
-            .library(concat!("friction-node ", env!("CARGO_PKG_VERSION")))
-            .compression(compression)
-            .chunk_size(Some(config.recording.chunk_size_bytes))
-            .create(BufWriter::new(file))
-            .map_err(mcap_err)?;
-        let channels = add_channels(&mut w, config, names).map_err(mcap_err)?;
-        let mut meta = BTreeMap::new();
-        meta.insert("config_yaml".to_string(), config.to_yaml());
-        meta.insert("version".to_string(), env!("CARGO_PKG_VERSION").to_string());
-        meta.insert(
-            "step_mode".to_string(),
-            format!("{:?}", config.node.step_mode).to_lowercase(),
-        );
-        meta.insert("started_ns".to_string(), crate::node::wall_ns().to_string());
-        w.write_metadata(&mcap::records::Metadata {
-            name: "friction_node".into(),
-            metadata: meta,
-        })
-        .map_err(mcap_err)?;
+        let bag = BagWriter::create(path, config, names, BTreeMap::new())?;
         let queue = Arc::new(ArrayQueue::new(config.node.queue_capacity));
         let stop = Arc::new(AtomicBool::new(false));
         let error = Arc::new(Mutex::new(None));
         let messages = Arc::new(AtomicU64::new(0));
         let ctx = WriterCtx {
-            w: Some(w),
-            channels,
-            frame_id: config.node.frame_id.clone(),
-            command_type: config.ros.command_type,
-            sequence: 0,
+            bag: Some(bag),
             path: path.to_path_buf(),
             error: error.clone(),
             messages: messages.clone(),
@@ -246,23 +207,108 @@ fn add_channels(
     })
 }
 
-struct WriterCtx {
-    w: Option<McapWriter>,
+/// A synchronous MCAP writer in the ROS 2 profile for the node's topics
+/// (the recorder's thread and `replay` both use it).
+pub struct BagWriter {
+    w: McapWriter,
     channels: Channels,
     frame_id: String,
     command_type: CommandType,
     sequence: u32,
+    messages: u64,
     path: PathBuf,
-    error: Arc<Mutex<Option<String>>>,
-    messages: Arc<AtomicU64>,
 }
 
-impl WriterCtx {
-    fn write<T: serde::Serialize>(&mut self, channel: u16, log_ns: u64, publish_ns: u64, msg: &T) {
-        let Some(w) = self.w.as_mut() else { return };
-        let result = msgs::to_cdr(msg).and_then(|data| {
-            self.sequence = self.sequence.wrapping_add(1);
-            w.write_to_known_channel(
+impl BagWriter {
+    /// Create `path` with the schemas, channels and the `friction_node`
+    /// metadata record (resolved config, plus `extra` keys).
+    pub fn create(
+        path: &Path,
+        config: &Config,
+        names: &TopicNames,
+        extra: BTreeMap<String, String>,
+    ) -> Result<Self, RecorderError> {
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir).map_err(|source| RecorderError::Create {
+                path: path.to_path_buf(),
+                source,
+            })?;
+        }
+        let file = std::fs::File::create(path).map_err(|source| RecorderError::Create {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let mcap_err = |e: mcap::McapError| RecorderError::Mcap {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        };
+        let compression = match config.recording.compression {
+            Compression::None => None,
+            Compression::Zstd => Some(mcap::Compression::Zstd),
+            Compression::Lz4 => Some(mcap::Compression::Lz4),
+        };
+        let mut w = mcap::WriteOptions::new()
+            .profile("ros2")
+            .library(concat!("friction-node ", env!("CARGO_PKG_VERSION")))
+            .compression(compression)
+            .chunk_size(Some(config.recording.chunk_size_bytes))
+            .create(BufWriter::new(file))
+            .map_err(mcap_err)?;
+        let channels = add_channels(&mut w, config, names).map_err(mcap_err)?;
+        let mut meta = extra;
+        meta.insert("config_yaml".to_string(), config.to_yaml());
+        meta.insert("version".to_string(), env!("CARGO_PKG_VERSION").to_string());
+        meta.insert(
+            "step_mode".to_string(),
+            format!("{:?}", config.node.step_mode).to_lowercase(),
+        );
+        meta.insert("started_ns".to_string(), crate::node::wall_ns().to_string());
+        w.write_metadata(&mcap::records::Metadata {
+            name: "friction_node".into(),
+            metadata: meta,
+        })
+        .map_err(mcap_err)?;
+        Ok(Self {
+            w,
+            channels,
+            frame_id: config.node.frame_id.clone(),
+            command_type: config.ros.command_type,
+            sequence: 0,
+            messages: 0,
+            path: path.to_path_buf(),
+        })
+    }
+
+    /// Messages written so far.
+    pub fn messages(&self) -> u64 {
+        self.messages
+    }
+
+    /// Write a metadata record.
+    pub fn write_metadata(
+        &mut self,
+        name: &str,
+        metadata: BTreeMap<String, String>,
+    ) -> Result<(), String> {
+        self.w
+            .write_metadata(&mcap::records::Metadata {
+                name: name.into(),
+                metadata,
+            })
+            .map_err(|e| e.to_string())
+    }
+
+    fn write<T: serde::Serialize>(
+        &mut self,
+        channel: u16,
+        log_ns: u64,
+        publish_ns: u64,
+        msg: &T,
+    ) -> Result<(), String> {
+        let data = msgs::to_cdr(msg)?;
+        self.sequence = self.sequence.wrapping_add(1);
+        self.w
+            .write_to_known_channel(
                 &mcap::records::MessageHeader {
                     channel_id: channel,
                     sequence: self.sequence,
@@ -271,36 +317,14 @@ impl WriterCtx {
                 },
                 &data,
             )
-            .map_err(|e| e.to_string())
-        });
-        match result {
-            Ok(()) => {
-                self.messages.fetch_add(1, Ordering::Relaxed);
-            }
-            Err(e) => self.fail(e),
-        }
+            .map_err(|e| e.to_string())?;
+        self.messages += 1;
+        Ok(())
     }
 
-    /// Stop recording after an error; the loop is unaffected.
-    fn fail(&mut self, message: String) {
-        tracing::error!(
-            "recording {} failed: {message}; the node goes on without recording",
-            self.path.display()
-        );
-        if let Ok(mut slot) = self.error.lock() {
-            slot.get_or_insert(message);
-        }
-        // Keep what is on disk readable up to the last complete chunk; the
-        // writer's drop then tries (and may fail) to write the footer.
-        if let Some(mut w) = self.w.take() {
-            let _ = w.flush();
-            drop(w);
-        }
-    }
-
-    fn item(&mut self, item: RecordItem) {
-        let now = crate::node::wall_ns();
-        match item {
+    /// Write one item the loop produced, logged at `log_ns`.
+    pub fn write_item(&mut self, item: &RecordItem, log_ns: u64) -> Result<(), String> {
+        match *item {
             RecordItem::Command {
                 command,
                 received_ns,
@@ -308,29 +332,29 @@ impl WriterCtx {
             RecordItem::Estimate(e) => {
                 self.write(
                     self.channels.friction,
-                    now,
+                    log_ns,
                     e.stamp_ns,
                     &e.to_wire(&self.frame_id),
-                );
+                )?;
                 self.write(
                     self.channels.friction_force,
-                    now,
+                    log_ns,
                     e.stamp_ns,
                     &Float64 {
                         data: e.friction_force_n,
                     },
-                );
+                )
             }
             RecordItem::Statistics(s) => self.write(
                 self.channels.statistics,
-                now,
+                log_ns,
                 s.stamp_ns,
                 &s.to_wire(&self.frame_id),
             ),
         }
     }
 
-    fn command(&mut self, c: &Command, received_ns: u64) {
+    fn command(&mut self, c: &Command, received_ns: u64) -> Result<(), String> {
         match (c.kind, self.command_type) {
             (CommandKind::Load, _) => self.write(
                 self.channels.load,
@@ -357,6 +381,72 @@ impl WriterCtx {
             }
         }
     }
+
+    /// Write a film profile.
+    pub fn write_profile(
+        &mut self,
+        p: crate::transport::ProfileData,
+        log_ns: u64,
+    ) -> Result<(), String> {
+        let m = msgs::FilmProfile {
+            header: Header {
+                stamp: Time::from_ns(p.stamp_ns),
+                frame_id: self.frame_id.clone(),
+            },
+            dx_m: p.dx_m,
+            h_m: p.h_m,
+            p_pa: p.p_pa,
+        };
+        let stamp = p.stamp_ns;
+        self.write(self.channels.film_profile, log_ns, stamp, &m)
+    }
+
+    /// Close the open chunk (what is on disk is then readable after a crash).
+    pub fn flush(&mut self) -> Result<(), String> {
+        self.w.flush().map_err(|e| e.to_string())
+    }
+
+    /// Write the summary and footer.
+    pub fn finish(mut self) -> Result<u64, String> {
+        self.w.finish().map_err(|e| e.to_string())?;
+        drop(self.w);
+        Ok(std::fs::metadata(&self.path).map_or(0, |m| m.len()))
+    }
+}
+
+/// The recorder thread's state: the writer (gone after a failure) and what
+/// it reports.
+struct WriterCtx {
+    bag: Option<BagWriter>,
+    path: PathBuf,
+    error: Arc<Mutex<Option<String>>>,
+    messages: Arc<AtomicU64>,
+}
+
+impl WriterCtx {
+    /// Stop recording after an error; the loop is unaffected.
+    fn fail(&mut self, message: String) {
+        tracing::error!(
+            "recording {} failed: {message}; the node goes on without recording",
+            self.path.display()
+        );
+        if let Ok(mut slot) = self.error.lock() {
+            slot.get_or_insert(message);
+        }
+        // Keep what is on disk readable up to the last complete chunk; the
+        // writer's drop then tries (and may fail) to write the footer.
+        if let Some(mut b) = self.bag.take() {
+            let _ = b.flush();
+        }
+    }
+
+    fn with(&mut self, f: impl FnOnce(&mut BagWriter) -> Result<(), String>) {
+        let Some(b) = self.bag.as_mut() else { return };
+        match f(b) {
+            Ok(()) => self.messages.store(b.messages(), Ordering::Relaxed),
+            Err(e) => self.fail(e),
+        }
+    }
 }
 
 fn writer_thread(
@@ -372,34 +462,18 @@ fn writer_thread(
         let mut idle = true;
         while let Some(item) = queue.pop() {
             idle = false;
-            ctx.item(item);
+            let now = crate::node::wall_ns();
+            ctx.with(|b| b.write_item(&item, now));
         }
         if let Some(slot) = &profile {
             if let Some(p) = slot.read_if_newer(&mut seen) {
-                let m = msgs::FilmProfile {
-                    header: Header {
-                        stamp: Time::from_ns(p.stamp_ns),
-                        frame_id: ctx.frame_id.clone(),
-                    },
-                    dx_m: p.dx_m,
-                    h_m: p.h_m,
-                    p_pa: p.p_pa,
-                };
-                ctx.write(
-                    ctx.channels.film_profile,
-                    crate::node::wall_ns(),
-                    p.stamp_ns,
-                    &m,
-                );
+                let now = crate::node::wall_ns();
+                ctx.with(|b| b.write_profile(p, now));
             }
         }
         if last_flush.elapsed() > Duration::from_secs(1) {
             // Close the open chunk: a crash loses at most a second.
-            if let Some(w) = ctx.w.as_mut() {
-                if let Err(e) = w.flush() {
-                    ctx.fail(e.to_string());
-                }
-            }
+            ctx.with(|b| b.flush());
             last_flush = Instant::now();
         }
         if stopping && queue.is_empty() {
@@ -414,12 +488,15 @@ fn writer_thread(
         messages: ctx.messages.load(Ordering::Relaxed),
         ..Default::default()
     };
-    if let Some(mut w) = ctx.w.take() {
-        if let Err(e) = w.finish() {
-            ctx.fail(e.to_string());
+    if let Some(b) = ctx.bag.take() {
+        match b.finish() {
+            Ok(bytes) => report.bytes = bytes,
+            Err(e) => ctx.fail(e),
         }
     }
+    if report.bytes == 0 {
+        report.bytes = std::fs::metadata(&ctx.path).map_or(0, |m| m.len());
+    }
     report.error = ctx.error.lock().ok().and_then(|e| e.clone());
-    report.bytes = std::fs::metadata(&ctx.path).map_or(0, |m| m.len());
     report
 }

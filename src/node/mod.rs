@@ -205,6 +205,18 @@ impl Loop {
         &self.solver
     }
 
+    /// Apply one command as lockstep mode does (replay drives the loop this
+    /// way): a velocity command steps the model unless its stamp is not newer
+    /// than the last one; a load command updates the load.
+    pub fn feed(&mut self, c: Command) {
+        self.lockstep_command(c);
+    }
+
+    /// Counters so far (replay).
+    pub fn summary(&self) -> &RunSummary {
+        &self.summary
+    }
+
     /// Run until `stop` is set or `duration` has passed (in the loop's mode).
     pub fn run(&mut self, stop: &AtomicBool, duration: Option<Duration>) -> RunSummary {
         self.started = Instant::now();

@@ -1,0 +1,555 @@
+//! Replay over the fixture bags in bags/ (regenerated only by
+//! bags/regenerate.sh): one recorded by friction-node, one written by the
+//! Python mcap-ros2-support writer. Bad bags are made here from them.
+#![cfg(feature = "mcap")]
+
+use friction_node::msgs::{self, CommandKind};
+use friction_node::replay::{self, Bag, InputMode, ReplayError, ReplayOptions, VelocityKind};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+const NODE_BAG: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/bags/node_lockstep.mcap");
+const FOREIGN_BAG: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/bags/foreign_joint_states.mcap"
+);
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_friction-node"))
+}
+
+fn dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("fn-replay-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn run(args: &[&str]) -> (i32, String, String) {
+    let o = bin().args(args).output().unwrap();
+    (
+        o.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+fn opts(topic: Option<&str>, joint: Option<&str>) -> ReplayOptions {
+    ReplayOptions {
+        topic: topic.map(Into::into),
+        joint: joint.map(Into::into),
+        ..Default::default()
+    }
+}
+
+fn prepare(bag: &str, o: &ReplayOptions) -> Result<replay::PreparedReplay, ReplayError> {
+    replay::prepare(&Bag::open(Path::new(bag))?, o)
+}
+
+/// A bag with the given (topic, schema name, schema text) channels, each
+/// holding one CDR message `data` per entry of `messages`.
+fn write_bag(path: &Path, channels: &[(&str, &str, &str)], messages: &[(usize, Vec<u8>)]) {
+    let mut w = mcap::Writer::new(std::io::BufWriter::new(
+        std::fs::File::create(path).unwrap(),
+    ))
+    .unwrap();
+    let ids: Vec<u16> = channels
+        .iter()
+        .map(|(topic, name, text)| {
+            let s = w.add_schema(name, "ros2msg", text.as_bytes()).unwrap();
+            w.add_channel(s, topic, "cdr", &BTreeMap::new()).unwrap()
+        })
+        .collect();
+    for (k, (c, data)) in messages.iter().enumerate() {
+        let t = 1_000_000_000 + k as u64 * 1_000_000;
+        w.write_to_known_channel(
+            &mcap::records::MessageHeader {
+                channel_id: ids[*c],
+                sequence: k as u32,
+                log_time: t,
+                publish_time: t,
+            },
+            data,
+        )
+        .unwrap();
+    }
+    w.finish().unwrap();
+}
+
+fn float64(v: f64) -> Vec<u8> {
+    msgs::to_cdr(&msgs::Float64 { data: v }).unwrap()
+}
+
+#[test]
+fn a_foreign_joint_state_bag_replays_the_named_joint_on_the_model_time_grid() {
+    let p = prepare(FOREIGN_BAG, &opts(Some("/joint_states"), Some("slider"))).unwrap();
+    assert_eq!(p.config_source, "built-in default");
+    match &p.mode {
+        InputMode::Topics {
+            velocity,
+            kind,
+            load,
+        } => {
+            assert_eq!(velocity, "/joint_states");
+            assert!(matches!(kind, VelocityKind::JointState { joint, .. } if joint == "slider"));
+            assert_eq!(load.as_deref(), Some("/slider/normal_load"));
+        }
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(p.velocity_messages, 1001, "2 s at 500 Hz");
+    let vel: Vec<_> = p
+        .commands
+        .iter()
+        .filter(|c| c.kind == CommandKind::Velocity)
+        .collect();
+    assert_eq!(vel.len(), 2001, "2 s on the 1 ms grid");
+    let t0 = vel[0].stamp_ns;
+    for c in &vel {
+        let t = (c.stamp_ns - t0) as f64 / 1e9;
+        // Linear interpolation of 2 ms samples of 0.6 sin 2πt: error ≤ v''h²/8.
+        let exact = 0.6 * (2.0 * std::f64::consts::PI * t).sin();
+        assert!(
+            (c.value - exact).abs() <= 1.2e-5,
+            "t = {t}: {} vs {exact}",
+            c.value
+        );
+    }
+    let loads: Vec<(f64, f64)> = p
+        .commands
+        .iter()
+        .filter(|c| c.kind == CommandKind::Load)
+        .map(|c| ((c.stamp_ns - t0) as f64 / 1e9, c.value))
+        .collect();
+    assert_eq!(
+        loads,
+        vec![(0.0, 5762.0), (1.0, 4000.0)],
+        "the load set points, held"
+    );
+    assert!(p.gaps.is_empty());
+
+    let r = replay::run(&p, &mut |_, _| {}, &mut |_, _| {}).unwrap();
+    assert_eq!(r.estimates.len(), 2001);
+    assert!(
+        r.oracle.is_none(),
+        "a foreign bag has nothing to compare with"
+    );
+    assert_eq!(r.commands_rejected, 0);
+    for (e, rec) in &r.estimates {
+        assert_eq!(
+            rec.status,
+            msgs::estimate_constants::STATUS_CONVERGED,
+            "{e:?}"
+        );
+        assert!(e.friction_force.is_finite() && e.h0 > 0.0);
+    }
+    // The load step reaches the model: before 1 s 5762 N, after 4000 N.
+    assert_eq!(r.estimates[999].1.load_n, 5762.0);
+    assert_eq!(r.estimates[1000].1.load_n, 4000.0);
+}
+
+#[test]
+fn a_joint_state_with_several_joints_needs_a_joint_name() {
+    let e = prepare(FOREIGN_BAG, &opts(Some("/joint_states"), None)).unwrap_err();
+    assert!(matches!(e, ReplayError::JointRequired { .. }), "{e}");
+    let m = e.to_string();
+    assert!(
+        m.contains("base_yaw, slider, gripper") && m.contains("--joint"),
+        "{m}"
+    );
+    let e = prepare(FOREIGN_BAG, &opts(Some("/joint_states"), Some("elbow"))).unwrap_err();
+    assert!(matches!(e, ReplayError::JointMissing { .. }), "{e}");
+    assert!(e.to_string().contains("`elbow`"), "{e}");
+}
+
+#[test]
+fn several_velocity_topics_are_listed_until_one_is_chosen() {
+    let e = prepare(FOREIGN_BAG, &opts(None, None)).unwrap_err();
+    let m = e.to_string();
+    assert!(matches!(e, ReplayError::AmbiguousVelocity { .. }), "{m}");
+    assert!(
+        m.contains("/joint_states") && m.contains("/cmd_vel") && m.contains("--topic"),
+        "{m}"
+    );
+    // TwistStamped: linear.x at 100 Hz, header stamps.
+    let p = prepare(FOREIGN_BAG, &opts(Some("/cmd_vel"), None)).unwrap();
+    assert!(matches!(
+        &p.mode,
+        InputMode::Topics {
+            kind: VelocityKind::TwistStamped,
+            ..
+        }
+    ));
+    assert_eq!(p.velocity_messages, 201);
+    assert_eq!(
+        p.commands
+            .iter()
+            .filter(|c| c.kind == CommandKind::Velocity)
+            .count(),
+        2001
+    );
+    let e = prepare(FOREIGN_BAG, &opts(Some("/diagnostics_text"), None)).unwrap_err();
+    assert!(matches!(e, ReplayError::UnsupportedType { .. }), "{e}");
+    assert!(e.to_string().contains("std_msgs/msg/String"), "{e}");
+    let e = prepare(FOREIGN_BAG, &opts(Some("/nope"), None)).unwrap_err();
+    assert!(
+        e.to_string().contains("`/nope` is not in the bag") && e.to_string().contains("/cmd_vel"),
+        "{e}"
+    );
+}
+
+#[test]
+fn the_node_fixture_replays_within_one_part_per_million_of_its_recording() {
+    // Bit-identity holds for the binary that recorded it (tested below on a
+    // fresh recording); across solver versions and CPUs the fixture must
+    // still agree to the solver's tolerance.
+    let p = prepare(NODE_BAG, &ReplayOptions::default()).unwrap();
+    assert_eq!(p.config_source, "recorded in the bag");
+    assert!(
+        matches!(&p.mode, InputMode::RecordedEstimates { .. }),
+        "{:?}",
+        p.mode
+    );
+    assert_eq!(p.recorded.len(), 2000);
+    let r = replay::run(&p, &mut |_, _| {}, &mut |_, _| {}).unwrap();
+    let o = r.oracle.expect("a friction-node bag is compared");
+    assert_eq!(o.compared, 2000);
+    assert_eq!(o.count_mismatch, None);
+    let load = p.recorded[0].load_n;
+    for (field, dev, at) in &o.deviations {
+        let bound = match *field {
+            "friction_force_n" | "hydrodynamic_force_n" | "asperity_force_n" => 1e-6 * load,
+            "cof" | "asperity_load_share" => 1e-6,
+            "h0_m" | "h_min_m" => 1e-6 * p.recorded[*at].h0_m,
+            "iterations" => continue,
+            other => panic!("{other} differs by {dev} at step {at}"),
+        };
+        assert!(*dev <= bound, "{field} differs by {dev:e} at step {at} (bound {bound:e}); bags/regenerate.sh after a deliberate change");
+    }
+}
+
+#[test]
+fn a_fresh_recording_replays_bit_identically_and_so_does_the_replay_output() {
+    let d = dir("fresh");
+    let bag = d.join("lockstep.mcap");
+    let base = format!("fn_replay_{}", std::process::id());
+    let (code, _, err) = run(&[
+        "run",
+        "--demo",
+        "0.5",
+        "--config",
+        concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/launch-config/lockstep-iceoryx2.yaml"
+        ),
+        "--set",
+        "solver.cells=64",
+        "--set",
+        &format!("iceoryx2.cmd_velocity_service={base}/cmd"),
+        "--set",
+        &format!("iceoryx2.normal_load_service={base}/load"),
+        "--set",
+        &format!("iceoryx2.friction_service={base}/friction"),
+        "--set",
+        &format!("iceoryx2.cmd_event_service={base}/event"),
+        "--record",
+        bag.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let out = d.join("replayed.mcap");
+    let (code, stdout, err) = run(&[
+        "replay",
+        bag.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--expect-identical",
+    ]);
+    assert_eq!(code, 0, "{stdout}{err}");
+    assert!(
+        stdout.contains("bit-identical to the recorded estimates (500 steps)"),
+        "{stdout}"
+    );
+    // The output is a friction-node bag in its own right.
+    let again = d.join("again.csv");
+    let (code, stdout, err) = run(&[
+        "replay",
+        out.to_str().unwrap(),
+        "--out",
+        again.to_str().unwrap(),
+        "--expect-identical",
+    ]);
+    assert_eq!(code, 0, "{stdout}{err}");
+    assert!(stdout.contains("bit-identical"), "{stdout}");
+    // A different configuration is not: the oracle says by how much.
+    let (code, stdout, _) = run(&[
+        "replay",
+        bag.to_str().unwrap(),
+        "--set",
+        "contact.boundary_friction=0.2",
+        "--out",
+        again.to_str().unwrap(),
+        "--expect-identical",
+    ]);
+    assert_eq!(code, 3, "{stdout}");
+    assert!(
+        stdout.contains("DIFFERS") && stdout.contains("friction_force_n"),
+        "{stdout}"
+    );
+}
+
+#[test]
+fn a_bag_without_a_velocity_topic_lists_what_it_has() {
+    let d = dir("none");
+    let bag = d.join("strings.mcap");
+    let text = msgs::to_cdr(&"hello".to_string()).unwrap();
+    write_bag(
+        &bag,
+        &[("/chatter", "std_msgs/msg/String", "string data\n")],
+        &[(0, text)],
+    );
+    let e = prepare(bag.to_str().unwrap(), &ReplayOptions::default()).unwrap_err();
+    let m = e.to_string();
+    assert!(matches!(e, ReplayError::NoVelocityTopic { .. }), "{m}");
+    assert!(
+        m.contains("/chatter") && m.contains("std_msgs/msg/String") && m.contains("1 messages"),
+        "{m}"
+    );
+    let out = d.join("out.csv");
+    let (code, _, err) = run(&[
+        "replay",
+        bag.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_ne!(code, 0);
+    assert!(err.contains("/chatter"), "{err}");
+    assert!(!out.exists());
+}
+
+#[test]
+fn a_schema_that_does_not_match_its_type_names_the_topic() {
+    let d = dir("schema");
+    let bag = d.join("bad_schema.mcap");
+    write_bag(
+        &bag,
+        &[(
+            "/axis/velocity",
+            "std_msgs/msg/Float64",
+            "float32 data\nuint8 flags\n",
+        )],
+        &[(0, float64(0.1)), (0, float64(0.2))],
+    );
+    let e = prepare(bag.to_str().unwrap(), &ReplayOptions::default()).unwrap_err();
+    let m = e.to_string();
+    assert!(matches!(e, ReplayError::SchemaMismatch { .. }), "{m}");
+    assert!(
+        m.contains("`/axis/velocity`") && m.contains("float32 data"),
+        "{m}"
+    );
+}
+
+#[test]
+fn a_message_that_does_not_decode_is_damage_named_by_topic_and_index() {
+    let d = dir("decode");
+    let bag = d.join("short.mcap");
+    let channels = [("/axis/velocity", "std_msgs/msg/Float64", "float64 data\n")];
+    let garbage = vec![0, 1, 0, 0, 1];
+    let good: Vec<(usize, Vec<u8>)> = (0..20).map(|k| (0, float64(0.01 * k as f64))).collect();
+    let mut msgs = good.clone();
+    msgs.push((0, garbage.clone()));
+    msgs.extend(good);
+    write_bag(&bag, &channels, &msgs);
+    let p = prepare(bag.to_str().unwrap(), &ReplayOptions::default()).unwrap();
+    assert_eq!(p.velocity_messages, 20, "the messages before the bad one");
+    let damage = p.scan.damage.expect("damage");
+    assert_eq!(damage.after_messages, 20);
+    assert!(
+        damage.error.contains("`/axis/velocity`, message 21"),
+        "{}",
+        damage.error
+    );
+    // Nothing before it: the decode error itself.
+    write_bag(&bag, &channels, &[(0, garbage)]);
+    let e = prepare(bag.to_str().unwrap(), &ReplayOptions::default()).unwrap_err();
+    assert!(matches!(e, ReplayError::Decode { index: 1, .. }), "{e}");
+    assert!(e.to_string().contains("/axis/velocity"), "{e}");
+}
+
+#[test]
+fn a_truncated_bag_replays_up_to_the_damage_and_says_where() {
+    let d = dir("truncated");
+    let bytes = std::fs::read(NODE_BAG).unwrap();
+    let bag = d.join("truncated.mcap");
+    std::fs::write(&bag, &bytes[..bytes.len() * 7 / 10]).unwrap();
+    let p = prepare(bag.to_str().unwrap(), &ReplayOptions::default()).unwrap();
+    let damage = p.scan.damage.clone().expect("damage reported");
+    assert!(
+        damage.after_messages > 0 && damage.last_log_time_ns.is_some(),
+        "{damage:?}"
+    );
+    let steps = p.recorded.len();
+    assert!(
+        steps > 500 && steps < 2000,
+        "{steps} steps before the damage"
+    );
+    let r = replay::run(&p, &mut |_, _| {}, &mut |_, _| {}).unwrap();
+    assert_eq!(r.estimates.len(), steps);
+    let out = d.join("out.csv");
+    let (code, stdout, err) = run(&[
+        "replay",
+        bag.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("damaged") && stdout.contains("damaged bag      stopped after"),
+        "{stdout}{err}"
+    );
+    let rows = std::fs::read_to_string(&out).unwrap().lines().count();
+    assert_eq!(rows, steps + 1);
+}
+
+#[test]
+fn a_corrupt_chunk_stops_the_replay_there() {
+    let d = dir("corrupt");
+    let mut bytes = std::fs::read(FOREIGN_BAG).unwrap();
+    // Scribble over the middle of the middle chunk's compressed records.
+    let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
+    let chunk = &summary.chunk_indexes[summary.chunk_indexes.len() / 2];
+    let mid = (chunk.chunk_start_offset + chunk.chunk_length / 2) as usize;
+    for b in &mut bytes[mid..mid + 64] {
+        *b ^= 0x5a;
+    }
+    let bag = d.join("corrupt.mcap");
+    std::fs::write(&bag, &bytes).unwrap();
+    let p = prepare(
+        bag.to_str().unwrap(),
+        &opts(Some("/joint_states"), Some("slider")),
+    )
+    .unwrap();
+    let damage = p.scan.damage.clone().expect("damage reported");
+    assert!(
+        p.velocity_messages > 0 && p.velocity_messages < 1001,
+        "{}",
+        p.velocity_messages
+    );
+    assert!(!damage.error.is_empty());
+}
+
+#[test]
+fn invalid_input_writes_nothing_and_an_existing_output_survives() {
+    let d = dir("atomic");
+    let out = d.join("run.csv");
+    std::fs::write(&out, "precious\n").unwrap();
+    let not_a_bag = d.join("notes.mcap");
+    std::fs::write(&not_a_bag, "not an mcap file").unwrap();
+    for args in [
+        vec![
+            "replay",
+            not_a_bag.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        vec!["replay", FOREIGN_BAG, "--out", out.to_str().unwrap()],
+        vec![
+            "replay",
+            FOREIGN_BAG,
+            "--topic",
+            "/joint_states",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        vec![
+            "replay",
+            NODE_BAG,
+            "--set",
+            "solver.cells=3",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        vec![
+            "replay",
+            "/nonexistent/bag.mcap",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+    ] {
+        let (code, _, err) = run(&args);
+        assert_ne!(code, 0, "{args:?}");
+        assert!(err.starts_with("error:"), "{args:?}: {err}");
+        assert_eq!(
+            std::fs::read_to_string(&out).unwrap(),
+            "precious\n",
+            "{args:?}"
+        );
+    }
+    let (code, _, err) = run(&[
+        "replay",
+        NODE_BAG,
+        "--out",
+        d.join("run.txt").to_str().unwrap(),
+    ]);
+    assert_ne!(code, 0);
+    assert!(err.contains(".mcap or .csv"), "{err}");
+    let leftovers: Vec<_> = std::fs::read_dir(&d)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(leftovers.len(), 2, "{leftovers:?}");
+}
+
+#[test]
+fn the_report_has_a_summary_cycle_metrics_and_figures() {
+    let d = dir("report");
+    let out = d.join("run.mcap");
+    let rep = d.join("report");
+    let (code, stdout, err) = run(&[
+        "replay",
+        FOREIGN_BAG,
+        "--topic",
+        "/joint_states",
+        "--joint",
+        "slider",
+        "--out",
+        out.to_str().unwrap(),
+        "--report",
+        rep.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(stdout.contains("report"), "{stdout}");
+    let md = std::fs::read_to_string(rep.join("summary.md")).unwrap();
+    assert!(
+        md.contains("joint `slider`") && md.contains("load `/slider/normal_load`"),
+        "{md}"
+    );
+    assert!(md.contains("## Loop metrics"), "{md}");
+    let cycles = std::fs::read_to_string(rep.join("cycles.csv")).unwrap();
+    let lines: Vec<&str> = cycles.lines().collect();
+    assert!(lines[0].starts_with("cycle,t_start_s,t_end_s,friction_loop_area_n_m_s"));
+    assert!(lines.len() >= 2, "{cycles}");
+    #[cfg(feature = "plots")]
+    for f in [
+        "friction_velocity.svg",
+        "time_series.svg",
+        "regime_share.svg",
+    ] {
+        let svg = std::fs::read_to_string(rep.join(f)).unwrap();
+        assert!(svg.contains("<svg") && svg.contains("polyline"), "{f}");
+        assert!(md.contains(&format!("]({f})")), "{f} linked");
+    }
+    // The MCAP output carries the inputs and the estimates on the node's
+    // topics, ROS 2 profile.
+    let bytes = std::fs::read(&out).unwrap();
+    let summary = mcap::Summary::read(&bytes).unwrap().expect("finalised");
+    let topics: Vec<String> = summary.channels.values().map(|c| c.topic.clone()).collect();
+    assert!(
+        topics.iter().any(|t| t.ends_with("/friction")),
+        "{topics:?}"
+    );
+    assert!(
+        topics.iter().any(|t| t.ends_with("/cmd_velocity")),
+        "{topics:?}"
+    );
+}
