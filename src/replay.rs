@@ -147,6 +147,22 @@ pub struct ChannelInfo {
     pub messages: u64,
 }
 
+impl ChannelInfo {
+    fn new(c: &mcap::Channel<'_>, messages: u64) -> Self {
+        let schema = c.schema.as_ref();
+        Self {
+            topic: c.topic.clone(),
+            schema_name: schema.map_or(String::new(), |s| s.name.clone()),
+            schema_encoding: schema.map_or(String::new(), |s| s.encoding.clone()),
+            schema_text: schema.map_or(String::new(), |s| {
+                String::from_utf8_lossy(&s.data).into_owned()
+            }),
+            message_encoding: c.message_encoding.clone(),
+            messages,
+        }
+    }
+}
+
 /// What a first pass over the bag found.
 #[derive(Debug, Clone)]
 pub struct BagScan {
@@ -233,20 +249,8 @@ impl Bag {
             .channels
             .iter()
             .map(|(id, c)| {
-                let info = ChannelInfo {
-                    topic: c.topic.clone(),
-                    schema_name: c.schema.as_ref().map_or(String::new(), |s| s.name.clone()),
-                    schema_encoding: c
-                        .schema
-                        .as_ref()
-                        .map_or(String::new(), |s| s.encoding.clone()),
-                    schema_text: c.schema.as_ref().map_or(String::new(), |s| {
-                        String::from_utf8_lossy(&s.data).into_owned()
-                    }),
-                    message_encoding: c.message_encoding.clone(),
-                    messages: stats.channel_message_counts.get(id).copied().unwrap_or(0),
-                };
-                (*id, info)
+                let n = stats.channel_message_counts.get(id).copied().unwrap_or(0);
+                (*id, ChannelInfo::new(c, n))
             })
             .collect();
         Some(BagScan {
@@ -273,22 +277,7 @@ impl Bag {
                     let c = &m.channel;
                     scan.channels
                         .entry(c.id)
-                        .or_insert_with(|| ChannelInfo {
-                            topic: c.topic.clone(),
-                            schema_name: c
-                                .schema
-                                .as_ref()
-                                .map_or(String::new(), |s| s.name.clone()),
-                            schema_encoding: c
-                                .schema
-                                .as_ref()
-                                .map_or(String::new(), |s| s.encoding.clone()),
-                            schema_text: c.schema.as_ref().map_or(String::new(), |s| {
-                                String::from_utf8_lossy(&s.data).into_owned()
-                            }),
-                            message_encoding: c.message_encoding.clone(),
-                            messages: 0,
-                        })
+                        .or_insert_with(|| ChannelInfo::new(c, 0))
                         .messages += 1;
                 }
                 Err(e) => {
@@ -1452,27 +1441,16 @@ pub fn write_report(
     let cyc = cycles(r, p.config.contact.mass_kg);
     let mut f = AtomicFile::create(&dir.join("cycles.csv"))?;
     f.line(format_args!(
-        "cycle,t_start_s,t_end_s,friction_loop_area_n_m_s,cof_loop_area_m_s,cof_v0_accelerating,cof_v0_decelerating,peak_cof,peak_cof_velocity_m_s,mean_cof,h0_min_m,h0_max_m,mean_asperity_share,inertia_share,inertia_share_smooth"
+        "cycle,t_start_s,t_end_s,{}",
+        crate::analysis::metrics::LOOP_METRIC_COLUMNS
     ))?;
-    let opt = |x: Option<f64>| x.map_or(String::new(), |v| Num(v).to_string());
     for m in &cyc {
         f.line(format_args!(
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{}",
             m.cycle + 1,
             Num(m.t_start),
             Num(m.t_end),
-            Num(m.friction_loop_area),
-            Num(m.cof_loop_area),
-            opt(m.cof_v0_accelerating),
-            opt(m.cof_v0_decelerating),
-            Num(m.peak_cof),
-            Num(m.peak_cof_velocity),
-            Num(m.mean_cof),
-            Num(m.h0_min),
-            Num(m.h0_max),
-            Num(m.mean_asperity_share),
-            Num(m.inertia_share),
-            Num(m.inertia_share_smooth)
+            m.csv_fields()
         ))?;
     }
     files.push(f.commit()?);

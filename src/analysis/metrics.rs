@@ -73,6 +73,40 @@ pub struct LoopMetrics {
     pub inertia_share_smooth: f64,
 }
 
+/// CSV columns of [`LoopMetrics::csv_fields`] (studies' summary, replay's
+/// cycles.csv).
+pub const LOOP_METRIC_COLUMNS: &str = "friction_loop_area_n_m_s,cof_loop_area_m_s,cof_v0_accelerating,cof_v0_decelerating,peak_cof,peak_cof_velocity_m_s,mean_cof,h0_min_m,h0_max_m,mean_asperity_share,mean_fluid_share,branch_cof_gap,branch_h0_gap_m,inertia_share,inertia_share_smooth";
+
+impl LoopMetrics {
+    /// The metrics as CSV fields in the order of [`LOOP_METRIC_COLUMNS`]
+    /// (shortest round-trip floats; empty for undefined values).
+    pub fn csv_fields(&self) -> String {
+        use crate::text::Num;
+        let opt = |x: Option<f64>| x.map_or(String::new(), |v| Num(v).to_string());
+        format!(
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            Num(self.friction_loop_area),
+            Num(self.cof_loop_area),
+            opt(self.cof_v0_accelerating),
+            opt(self.cof_v0_decelerating),
+            Num(self.peak_cof),
+            Num(self.peak_cof_velocity),
+            Num(self.mean_cof),
+            Num(self.h0_min),
+            Num(self.h0_max),
+            Num(self.mean_asperity_share),
+            Num(self.mean_fluid_share),
+            opt(self.branch_cof_gap),
+            opt(self.branch_h0_gap),
+            Num(self.inertia_share),
+            Num(self.inertia_share_smooth)
+        )
+    }
+
+    /// Number of columns in [`LOOP_METRIC_COLUMNS`].
+    pub const COLUMNS: usize = 15;
+}
+
 /// Split `samples` into cycles of `period` starting at `t0` and compute the
 /// metrics of every complete cycle. `mass` (kg) is used for the smooth
 /// inertia share; `harmonics` is the number of Fourier harmonics kept.

@@ -4,6 +4,7 @@
 
 use super::claims::{Claim, Verdict};
 use super::{CaseResult, StudyResult};
+use crate::analysis::LoopMetrics;
 use crate::offline::{self, AtomicFile, OfflineError};
 use crate::text::Num;
 use std::path::{Path, PathBuf};
@@ -25,11 +26,9 @@ pub fn prepare_output_dir(dir: &Path) -> Result<(), OfflineError> {
 }
 
 /// Columns of the summary CSV.
-pub const SUMMARY_COLUMNS: &str = "study,case,panel,series,v0_m_s,v1_m_s,f_hz,load_n,viscosity_pa_s,mass_kg,sigma_m,cycles,steps,status,substepped_steps,max_iterations,friction_loop_area_n_m_s,cof_loop_area_m_s,cof_v0_accelerating,cof_v0_decelerating,peak_cof,peak_cof_velocity_m_s,mean_cof,h0_min_m,h0_max_m,mean_asperity_share,mean_fluid_share,branch_cof_gap,branch_h0_gap_m,inertia_share,inertia_share_smooth";
-
-fn opt(x: Option<f64>) -> String {
-    x.map_or(String::new(), |v| Num(v).to_string())
-}
+/// Columns of the summary CSV before the loop metrics
+/// ([`crate::analysis::metrics::LOOP_METRIC_COLUMNS`]).
+pub const SUMMARY_CASE_COLUMNS: &str = "study,case,panel,series,v0_m_s,v1_m_s,f_hz,load_n,viscosity_pa_s,mass_kg,sigma_m,cycles,steps,status,substepped_steps,max_iterations";
 
 /// One summary row.
 pub fn summary_row(r: &CaseResult) -> String {
@@ -58,25 +57,8 @@ pub fn summary_row(r: &CaseResult) -> String {
         r.max_iterations
     );
     match &r.metrics {
-        None => format!("{head}{}", ",".repeat(15)),
-        Some(m) => format!(
-            "{head},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
-            Num(m.friction_loop_area),
-            Num(m.cof_loop_area),
-            opt(m.cof_v0_accelerating),
-            opt(m.cof_v0_decelerating),
-            Num(m.peak_cof),
-            Num(m.peak_cof_velocity),
-            Num(m.mean_cof),
-            Num(m.h0_min),
-            Num(m.h0_max),
-            Num(m.mean_asperity_share),
-            Num(m.mean_fluid_share),
-            opt(m.branch_cof_gap),
-            opt(m.branch_h0_gap),
-            Num(m.inertia_share),
-            Num(m.inertia_share_smooth)
-        ),
+        None => format!("{head}{}", ",".repeat(LoopMetrics::COLUMNS)),
+        Some(m) => format!("{head},{}", m.csv_fields()),
     }
 }
 
@@ -104,7 +86,10 @@ pub fn write_study(dir: &Path, r: &StudyResult) -> Result<Vec<PathBuf>, OfflineE
     }
     if !r.cases.is_empty() {
         let mut f = AtomicFile::create(&sdir.join("summary.csv"))?;
-        f.line(format_args!("{SUMMARY_COLUMNS}"))?;
+        f.line(format_args!(
+            "{SUMMARY_CASE_COLUMNS},{}",
+            crate::analysis::metrics::LOOP_METRIC_COLUMNS
+        ))?;
         for c in &r.cases {
             f.line(format_args!("{}", summary_row(c)))?;
         }

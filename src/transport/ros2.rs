@@ -18,7 +18,8 @@ use super::{NodePort, PeerPort, ProfileSlot, TransportError};
 use crate::config::{self, CommandType, Config, DiscoveryRange, QosConfig, Reliability};
 use crate::msgs::{
     Command, CommandKind, EstimateRecord, FilmProfile, Float64, FrictionEstimate, Header,
-    LoopStatistics, StatisticsRecord, Time, TwistStamped,
+    LoopStatistics, MsgType, StatisticsRecord, Time, TwistStamped, FILM_PROFILE, FLOAT64,
+    FRICTION_ESTIMATE, LOOP_STATISTICS, TWIST_STAMPED,
 };
 use crossbeam_queue::ArrayQueue;
 use ros2_client::dds::rustdds::mio1::{Events, Interest, Poll, Token, Waker};
@@ -182,6 +183,32 @@ fn topic(
         .map_err(|e| err(format!("create topic `{name}`"), e))
 }
 
+/// Create the topic and a publisher on it; `what` names it in errors.
+fn advertise<M: serde::Serialize>(
+    node: &mut Node,
+    name: &str,
+    ty: &MsgType,
+    q: &QosProfile,
+    what: &str,
+) -> Result<Publisher<M>, TransportError> {
+    let t = topic(node, name, ty.package, ty.name, q)?;
+    node.create_publisher(&t, None)
+        .map_err(|e| err(format!("advertise {what}"), e))
+}
+
+/// Create the topic and a subscription on it; `what` names it in errors.
+fn subscribe<M: 'static>(
+    node: &mut Node,
+    name: &str,
+    ty: &MsgType,
+    q: &QosProfile,
+    what: &str,
+) -> Result<Subscription<M>, TransportError> {
+    let t = topic(node, name, ty.package, ty.name, q)?;
+    node.create_subscription(&t, None)
+        .map_err(|e| err(format!("subscribe to {what}"), e))
+}
+
 enum VelocitySub {
     Float64(Subscription<Float64>),
     Twist(Subscription<TwistStamped>),
@@ -305,66 +332,43 @@ fn io_thread(
         let mut node = ros_node(&ctx, &spec.namespace, &spec.node_name)?;
         let cq = qos(&spec.command_qos);
         let eq = qos(&spec.estimate_qos);
+        let n = &mut node;
         let mut velocity = match spec.command_type {
-            CommandType::Float64 => {
-                let t = topic(&mut node, &spec.cmd_velocity, "std_msgs", "Float64", &cq)?;
-                VelocitySub::Float64(
-                    node.create_subscription(&t, None)
-                        .map_err(|e| err("subscribe to the velocity", e))?,
-                )
-            }
-            CommandType::TwistStamped => {
-                let t = topic(
-                    &mut node,
-                    &spec.cmd_velocity,
-                    "geometry_msgs",
-                    "TwistStamped",
-                    &cq,
-                )?;
-                VelocitySub::Twist(
-                    node.create_subscription(&t, None)
-                        .map_err(|e| err("subscribe to the velocity", e))?,
-                )
-            }
+            CommandType::Float64 => VelocitySub::Float64(subscribe(
+                n,
+                &spec.cmd_velocity,
+                &FLOAT64,
+                &cq,
+                "the velocity",
+            )?),
+            CommandType::TwistStamped => VelocitySub::Twist(subscribe(
+                n,
+                &spec.cmd_velocity,
+                &TWIST_STAMPED,
+                &cq,
+                "the velocity",
+            )?),
         };
-        let lt = topic(&mut node, &spec.normal_load, "std_msgs", "Float64", &cq)?;
-        let mut load: Subscription<Float64> = node
-            .create_subscription(&lt, None)
-            .map_err(|e| err("subscribe to the load", e))?;
-        let ft = topic(
-            &mut node,
-            &spec.friction,
-            "friction_msgs",
-            "FrictionEstimate",
-            &eq,
-        )?;
-        let friction: Publisher<FrictionEstimate> = node
-            .create_publisher(&ft, None)
-            .map_err(|e| err("advertise the estimate", e))?;
-        let fft = topic(&mut node, &spec.friction_force, "std_msgs", "Float64", &eq)?;
-        let force: Publisher<Float64> = node
-            .create_publisher(&fft, None)
-            .map_err(|e| err("advertise the friction force", e))?;
-        let pt = topic(
-            &mut node,
+        let mut load: Subscription<Float64> =
+            subscribe(n, &spec.normal_load, &FLOAT64, &cq, "the load")?;
+        let friction: Publisher<FrictionEstimate> =
+            advertise(n, &spec.friction, &FRICTION_ESTIMATE, &eq, "the estimate")?;
+        let force: Publisher<Float64> =
+            advertise(n, &spec.friction_force, &FLOAT64, &eq, "the friction force")?;
+        let film: Publisher<FilmProfile> = advertise(
+            n,
             &spec.film_profile,
-            "friction_msgs",
-            "FilmProfile",
+            &FILM_PROFILE,
             &eq,
+            "the film profile",
         )?;
-        let film: Publisher<FilmProfile> = node
-            .create_publisher(&pt, None)
-            .map_err(|e| err("advertise the film profile", e))?;
-        let st = topic(
-            &mut node,
+        let stats: Publisher<LoopStatistics> = advertise(
+            n,
             &spec.loop_statistics,
-            "friction_msgs",
-            "LoopStatistics",
+            &LOOP_STATISTICS,
             &eq,
+            "the statistics",
         )?;
-        let stats: Publisher<LoopStatistics> = node
-            .create_publisher(&st, None)
-            .map_err(|e| err("advertise the statistics", e))?;
         let poll = Poll::new().map_err(|e| err("create a poll", e))?;
         match &mut velocity {
             VelocitySub::Float64(s) => poll.registry().register(s, VELOCITY, Interest::READABLE),
@@ -490,43 +494,30 @@ impl Ros2Peer {
         let mut node = ros_node(&ctx, &spec.namespace, &name)?;
         let cq = qos(&spec.command_qos);
         let eq = qos(&spec.estimate_qos);
+        let n = &mut node;
         let (mut vf, mut vt) = (None, None);
         match spec.command_type {
             CommandType::Float64 => {
-                let t = topic(&mut node, &spec.cmd_velocity, "std_msgs", "Float64", &cq)?;
-                vf = Some(
-                    node.create_publisher(&t, None)
-                        .map_err(|e| err("advertise the velocity", e))?,
-                );
+                vf = Some(advertise(
+                    n,
+                    &spec.cmd_velocity,
+                    &FLOAT64,
+                    &cq,
+                    "the velocity",
+                )?);
             }
             CommandType::TwistStamped => {
-                let t = topic(
-                    &mut node,
+                vt = Some(advertise(
+                    n,
                     &spec.cmd_velocity,
-                    "geometry_msgs",
-                    "TwistStamped",
+                    &TWIST_STAMPED,
                     &cq,
-                )?;
-                vt = Some(
-                    node.create_publisher(&t, None)
-                        .map_err(|e| err("advertise the velocity", e))?,
-                );
+                    "the velocity",
+                )?);
             }
         }
-        let lt = topic(&mut node, &spec.normal_load, "std_msgs", "Float64", &cq)?;
-        let load = node
-            .create_publisher(&lt, None)
-            .map_err(|e| err("advertise the load", e))?;
-        let ft = topic(
-            &mut node,
-            &spec.friction,
-            "friction_msgs",
-            "FrictionEstimate",
-            &eq,
-        )?;
-        let estimate = node
-            .create_subscription(&ft, None)
-            .map_err(|e| err("subscribe to the estimate", e))?;
+        let load = advertise(n, &spec.normal_load, &FLOAT64, &cq, "the load")?;
+        let estimate = subscribe(n, &spec.friction, &FRICTION_ESTIMATE, &eq, "the estimate")?;
         Ok(Self {
             node,
             _ctx: ctx,
