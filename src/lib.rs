@@ -5,11 +5,16 @@
 //! parameter files; [`signal`] the velocity and load inputs.
 
 pub mod analysis;
+#[cfg(feature = "mcap")]
+pub mod bag;
 pub mod bench;
+pub mod clock;
 pub mod config;
+pub mod fit;
 pub mod msgs;
 pub mod node;
 pub mod offline;
+pub mod output;
 pub mod physics;
 #[cfg(feature = "plots")]
 pub mod plot;
@@ -18,6 +23,7 @@ pub mod record;
 #[cfg(feature = "mcap")]
 pub mod replay;
 pub mod signal;
+pub mod stats;
 pub mod studies;
 pub mod text;
 pub mod transport;

@@ -1,33 +1,29 @@
 //! Offline runs: `simulate`, `stribeck` and `profile`, writing CSV.
 //!
-//! Output files are written to a temporary sibling and renamed into place
-//! when complete: an existing file is never half-overwritten, and an
-//! unwritable destination is reported before any computation.
+//! Output files are written through [`crate::output::AtomicFile`]: an
+//! existing file is never half-overwritten, and an unwritable destination is
+//! reported before any computation.
 
-use crate::analysis::{cycle_metrics, LoopMetrics, LoopSample};
+use crate::analysis::{CycleCollector, LoopMetrics, LoopSample};
 use crate::config::{Config, ConfigError};
+use crate::output::OutputError;
 use crate::physics::{Estimate, SetupError, Solver, Status};
 use crate::signal::{Signal, SignalError};
 use crate::text::Num;
-use std::io::{BufWriter, Write};
-use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-/// Errors of the offline layer.
+/// A simulation (offline run, study case, benchmark) could not be set up,
+/// was given a bad argument, or could not write its output.
 #[derive(Debug, thiserror::Error)]
-pub enum OfflineError {
+pub enum SimulationError {
     #[error(transparent)]
     Config(#[from] ConfigError),
     #[error(transparent)]
     Setup(#[from] SetupError),
     #[error(transparent)]
     Signal(#[from] SignalError),
-    #[error("cannot write {}", path.display())]
-    Output {
-        path: PathBuf,
-        #[source]
-        source: std::io::Error,
-    },
+    #[error(transparent)]
+    Output(#[from] OutputError),
     #[error("invalid argument `{name}` = {value}: {message}")]
     Argument {
         name: &'static str,
@@ -36,100 +32,32 @@ pub enum OfflineError {
     },
 }
 
-fn arg_err(name: &'static str, value: impl ToString, message: impl Into<String>) -> OfflineError {
-    OfflineError::Argument {
+fn arg_err(
+    name: &'static str,
+    value: impl ToString,
+    message: impl Into<String>,
+) -> SimulationError {
+    SimulationError::Argument {
         name,
         value: value.to_string(),
         message: message.into(),
     }
 }
 
-/// A file written atomically: rows go to `<name>.tmp-<pid>` in the same
-/// directory, renamed over `path` by [`AtomicFile::commit`]; dropped
-/// uncommitted, the temporary file is removed.
-pub struct AtomicFile {
-    path: PathBuf,
-    tmp: PathBuf,
-    out: Option<BufWriter<std::fs::File>>,
-}
-
-impl AtomicFile {
-    pub fn create(path: &Path) -> Result<Self, OfflineError> {
-        let io = |source| OfflineError::Output {
-            path: path.to_path_buf(),
-            source,
-        };
-        if path.is_dir() {
-            return Err(io(std::io::Error::new(
-                std::io::ErrorKind::IsADirectory,
-                "the output path is a directory",
-            )));
-        }
-        let name = path.file_name().ok_or_else(|| {
-            io(std::io::Error::new(
-                std::io::ErrorKind::InvalidInput,
-                "no file name",
-            ))
-        })?;
-        let mut tmp_name = name.to_os_string();
-        tmp_name.push(format!(".tmp-{}", std::process::id()));
-        let tmp = path.with_file_name(tmp_name);
-        let file = std::fs::File::create(&tmp).map_err(io)?;
-        Ok(Self {
-            path: path.to_path_buf(),
-            tmp,
-            out: Some(BufWriter::new(file)),
-        })
-    }
-
-    pub fn path(&self) -> &Path {
-        &self.path
-    }
-
-    pub fn writer(&mut self) -> &mut BufWriter<std::fs::File> {
-        self.out.as_mut().expect("not committed")
-    }
-
-    /// Write a line, mapping the error to the destination path.
-    pub fn line(&mut self, args: std::fmt::Arguments<'_>) -> Result<(), OfflineError> {
-        let path = self.path.clone();
-        writeln!(self.writer(), "{args}").map_err(|source| OfflineError::Output { path, source })
-    }
-
-    pub fn commit(mut self) -> Result<PathBuf, OfflineError> {
-        let io = |source| OfflineError::Output {
-            path: self.path.clone(),
-            source,
-        };
-        let out = self.out.take().expect("commit once");
-        let file = out.into_inner().map_err(|e| io(e.into_error()))?;
-        file.sync_all().map_err(io)?;
-        std::fs::rename(&self.tmp, &self.path).map_err(io)?;
-        Ok(self.path.clone())
-    }
-}
-
-impl Drop for AtomicFile {
-    fn drop(&mut self) {
-        if self.out.is_some() {
-            let _ = std::fs::remove_file(&self.tmp);
-        }
-    }
-}
-
 /// Columns of `simulate` (the first eleven are a stable interface).
-pub const SIMULATE_COLUMNS: &str = "t_s,velocity_m_s,load_n,h0_m,h_min_m,f_hyd_n,f_asp_n,friction_n,cof,iterations,status,viscous_n,asperity_load_share,inertia_n,regime,residual,load_residual,max_pressure_pa,cavitated_fraction,contact_area_ratio,substeps";
+pub const SIMULATE_COLUMNS: &str = "t_s,velocity_m_s,load_n,h0_m,h_min_m,f_hyd_n,f_asp_n,friction_n,cof,iterations,status,viscous_n,asperity_load_share,inertia_n,regime,residual,load_residual,max_pressure_pa,cavitated_fraction,contact_area_ratio,substeps,temperature_c,contact_friction_n";
 
-/// One `simulate` row (re-reading the CSV gives the same bits).
-pub fn simulate_row(e: &Estimate) -> String {
-    simulate_row_with_status(e, e.status.as_str())
+/// One `simulate` row at lubricant temperature `t_c` (re-reading the CSV
+/// gives the same bits).
+pub fn simulate_row(e: &Estimate, t_c: f64) -> String {
+    simulate_row_with_status(e, e.status.as_str(), t_c)
 }
 
 /// A `simulate` row with the status column given (replay reports the
-/// node's status codes, which include command flags).
-pub fn simulate_row_with_status(e: &Estimate, status: &str) -> String {
+/// node's status codes).
+pub fn simulate_row_with_status(e: &Estimate, status: &str, t_c: f64) -> String {
     format!(
-        "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+        "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
         Num(e.time),
         Num(e.velocity),
         Num(e.load),
@@ -151,6 +79,8 @@ pub fn simulate_row_with_status(e: &Estimate, status: &str) -> String {
         Num(e.cavitated_fraction),
         Num(e.contact_area_ratio),
         e.diagnostics.substeps,
+        Num(t_c),
+        Num(e.contact_friction_force),
     )
 }
 
@@ -164,6 +94,17 @@ pub struct Timing {
 }
 
 impl Timing {
+    /// From a whole-run histogram (bounded memory for any run length).
+    pub fn from_histogram(h: &crate::stats::Histogram) -> Self {
+        let us = |ns: u64| ns as f64 / 1e3;
+        Self {
+            median_us: us(h.quantile(0.5)),
+            p99_us: us(h.quantile(0.99)),
+            p999_us: us(h.quantile(0.999)),
+            max_us: us(h.max()),
+        }
+    }
+
     pub fn from_ns(ns: &[u64]) -> Self {
         if ns.is_empty() {
             return Self::default();
@@ -184,14 +125,14 @@ impl Timing {
 /// What a `simulate` run reports.
 #[derive(Debug, Clone)]
 pub struct SimulateReport {
-    pub steps: usize,
+    pub steps: u64,
     pub duration_s: f64,
-    pub status_counts: Vec<(Status, usize)>,
+    pub status_counts: Vec<(Status, u64)>,
     pub mean_iterations: f64,
     pub max_iterations: u32,
-    pub film_floor_steps: usize,
+    pub film_floor_steps: u64,
     /// Steps that needed the sub-stepping fallback.
-    pub substepped_steps: usize,
+    pub substepped_steps: u64,
     pub timing: Timing,
     /// Period of the velocity input, when periodic.
     pub period_s: Option<f64>,
@@ -200,13 +141,13 @@ pub struct SimulateReport {
 }
 
 /// Count statuses in a stable order.
-fn count_statuses(counts: &mut [(Status, usize)], s: Status) {
+fn count_statuses(counts: &mut [(Status, u64)], s: Status) {
     if let Some(c) = counts.iter_mut().find(|(k, _)| *k == s) {
         c.1 += 1;
     }
 }
 
-fn all_statuses() -> Vec<(Status, usize)> {
+fn all_statuses() -> Vec<(Status, u64)> {
     [
         Status::Converged,
         Status::MaxIterations,
@@ -218,24 +159,121 @@ fn all_statuses() -> Vec<(Status, usize)> {
     .collect()
 }
 
+/// Check a velocity and a load signal against the envelope the node
+/// accepts (`node.max_abs_velocity_m_s`, `node.min_load_n`…`node.max_load_n`):
+/// a signal outside it is a user error, named before anything runs.
+pub fn check_signals(
+    config: &Config,
+    velocity: &Signal,
+    load: &Signal,
+) -> Result<(), SimulationError> {
+    let vmax = config.node.max_abs_velocity_m_s;
+    if velocity.max_abs().is_nan() || velocity.max_abs() > vmax {
+        return Err(arg_err(
+            "--velocity",
+            velocity,
+            format!(
+                "reaches |v| = {} m/s, beyond node.max_abs_velocity_m_s = {vmax} m/s",
+                Num(velocity.max_abs())
+            ),
+        ));
+    }
+    let (lo, hi) = (config.node.min_load_n, config.node.max_load_n);
+    let (fmin, fmax) = load.range();
+    if fmin.is_nan() || fmax.is_nan() || fmin < lo || fmax > hi {
+        return Err(arg_err(
+            "--load",
+            load,
+            format!(
+                "spans [{}, {}] N; a load must lie in [node.min_load_n, node.max_load_n] = [{lo}, {hi}] N",
+                Num(fmin),
+                Num(fmax)
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The inputs of a transient run: velocity (m/s), load (N) and lubricant
+/// temperature (°C; None: the reference temperature) against time.
+#[derive(Debug, Clone)]
+pub struct Inputs<'a> {
+    pub velocity: &'a Signal,
+    pub load: &'a Signal,
+    pub temperature: Option<&'a Signal>,
+}
+
+/// Check a temperature signal: within [-60, 300] °C and above Vogel's C.
+pub fn check_temperature(config: &Config, t: &Signal) -> Result<(), SimulationError> {
+    let (lo, hi) = t.range();
+    let floor = match config.viscosity_model() {
+        crate::physics::ViscosityModel::Vogel(v) => v.c_c.max(-60.0),
+        crate::physics::ViscosityModel::Constant => -60.0,
+    };
+    if lo.is_nan() || hi.is_nan() || lo <= floor || lo < -60.0 || hi > 300.0 {
+        return Err(arg_err(
+            "--temperature",
+            t,
+            format!(
+                "spans [{}, {}] °C; a temperature must lie in [-60, 300] °C and above lubricant.vogel_c_c",
+                Num(lo),
+                Num(hi)
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// Run the transient model over `duration_s` and stream every estimate to
-/// `on_step` (with the solver's wall time for the step, ns).
+/// `on_step` (with the solver's wall time for the step, ns, and the
+/// temperature, °C). Memory stays bounded for any duration: timings go to a
+/// histogram and loop metrics are computed cycle by cycle.
 pub fn simulate(
     config: &Config,
     velocity: &Signal,
     load: &Signal,
     duration_s: f64,
-    mut on_step: impl FnMut(&Estimate, u64) -> Result<(), OfflineError>,
-) -> Result<SimulateReport, OfflineError> {
-    if !(duration_s.is_finite() && duration_s > 0.0) {
+    on_step: impl FnMut(&Estimate, u64) -> Result<(), SimulationError>,
+) -> Result<SimulateReport, SimulationError> {
+    let mut on_step = on_step;
+    simulate_inputs(
+        config,
+        &Inputs {
+            velocity,
+            load,
+            temperature: None,
+        },
+        duration_s,
+        |e, ns, _| on_step(e, ns),
+    )
+}
+
+/// [`simulate`] with a temperature input: with `lubricant.viscosity_model:
+/// vogel` the viscosity follows it every step (no allocation).
+pub fn simulate_inputs(
+    config: &Config,
+    inputs: &Inputs<'_>,
+    duration_s: f64,
+    mut on_step: impl FnMut(&Estimate, u64, f64) -> Result<(), SimulationError>,
+) -> Result<SimulateReport, SimulationError> {
+    let (velocity, load) = (inputs.velocity, inputs.load);
+    if !(duration_s.is_finite() && duration_s > 0.0 && duration_s <= 1e7) {
         return Err(arg_err(
             "--duration",
             duration_s,
-            "must be a positive number of seconds",
+            "must be a number of seconds in (0, 1e7]",
         ));
     }
+    check_signals(config, velocity, load)?;
+    if let Some(t) = inputs.temperature {
+        check_temperature(config, t)?;
+    }
+    let t_ref = config.lubricant.reference_temperature_c;
+    let temperature_at = |t: f64| inputs.temperature.map_or(t_ref, |s| s.at(t));
+    let follows = inputs.temperature.is_some()
+        && config.viscosity_model() != crate::physics::ViscosityModel::Constant;
     let settings = config.solver_settings();
-    let steps = (duration_s / settings.dt).round() as usize;
+    let steps = (duration_s / settings.dt).round() as u64;
     if steps == 0 {
         return Err(arg_err(
             "--duration",
@@ -244,33 +282,36 @@ pub fn simulate(
         ));
     }
     let mut solver = Solver::new(&config.model(), &settings)?;
+    if follows {
+        solver.set_liquid_viscosity(config.viscosity_at(temperature_at(0.0)));
+    }
     solver.initialize_steady(velocity.at(0.0), load.at(0.0));
     let period = velocity.period();
-    let mut samples = Vec::new();
-    let mut times = Vec::with_capacity(steps);
+    let mut cycles = period.map(|p| CycleCollector::new(0.0, p, config.contact.mass_kg, 6));
+    let mut times = crate::stats::Histogram::new();
     let mut counts = all_statuses();
-    let (mut it_sum, mut it_max, mut floor, mut sub) = (0u64, 0u32, 0usize, 0usize);
+    let (mut it_sum, mut it_max, mut floor, mut sub) = (0u64, 0u32, 0u64, 0u64);
     for k in 1..=steps {
         let t = k as f64 * settings.dt;
         let (v, f) = (velocity.at(t), load.at(t));
+        let temperature = temperature_at(t);
+        if follows {
+            solver.set_liquid_viscosity(config.viscosity_at(temperature));
+        }
         let start = Instant::now();
         let e = solver.step(v, f);
-        let ns = start.elapsed().as_nanos() as u64;
-        times.push(ns);
+        let ns = u64::try_from(start.elapsed().as_nanos()).unwrap_or(u64::MAX);
+        times.record(ns);
         count_statuses(&mut counts, e.status);
         it_sum += e.diagnostics.iterations as u64;
         it_max = it_max.max(e.diagnostics.iterations);
-        floor += e.diagnostics.film_floor_active as usize;
-        sub += (e.diagnostics.substeps > 0) as usize;
-        if period.is_some() {
-            samples.push(LoopSample::from(&e));
+        floor += e.diagnostics.film_floor_active as u64;
+        sub += (e.diagnostics.substeps > 0) as u64;
+        if let Some(c) = cycles.as_mut() {
+            c.push(LoopSample::from(&e));
         }
-        on_step(&e, ns)?;
+        on_step(&e, ns, temperature)?;
     }
-    let cycles = match period {
-        Some(p) => cycle_metrics(&samples, 0.0, p, config.contact.mass_kg, 6),
-        None => Vec::new(),
-    };
     Ok(SimulateReport {
         steps,
         duration_s: steps as f64 * settings.dt,
@@ -279,9 +320,9 @@ pub fn simulate(
         max_iterations: it_max,
         film_floor_steps: floor,
         substepped_steps: sub,
-        timing: Timing::from_ns(&times),
+        timing: Timing::from_histogram(&times),
         period_s: period,
-        cycles,
+        cycles: cycles.map_or_else(Vec::new, CycleCollector::finish),
     })
 }
 
@@ -380,7 +421,12 @@ impl std::fmt::Display for SimulateReport {
 }
 
 /// Velocities of a Stribeck sweep.
-pub fn sweep(v_min: f64, v_max: f64, points: usize, log: bool) -> Result<Vec<f64>, OfflineError> {
+pub fn sweep(
+    v_min: f64,
+    v_max: f64,
+    points: usize,
+    log: bool,
+) -> Result<Vec<f64>, SimulationError> {
     if !(v_min.is_finite() && v_max.is_finite()) || v_min >= v_max {
         return Err(arg_err(
             "--v-min/--v-max",
@@ -418,7 +464,7 @@ pub fn stribeck(
     config: &Config,
     velocities: &[f64],
     load: f64,
-) -> Result<Vec<Estimate>, OfflineError> {
+) -> Result<Vec<Estimate>, SimulationError> {
     let mut out: Vec<Option<Estimate>> = vec![None; velocities.len()];
     let mut order: Vec<usize> = (0..velocities.len()).collect();
     order.sort_by(|&a, &b| velocities[a].abs().total_cmp(&velocities[b].abs()));
@@ -460,7 +506,7 @@ pub fn stribeck_row(e: &Estimate) -> String {
 
 /// How h0 is fixed in a `profile` run.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Gap {
+pub enum ProfileGap {
     H0(f64),
     Load(f64),
 }
@@ -472,20 +518,20 @@ pub const PROFILE_COLUMNS: &str = "x_m,h_m,p_pa,vapour_fraction,p_asp_pa,shear_p
 pub fn profile(
     config: &Config,
     velocity: f64,
-    gap: Gap,
-) -> Result<(Estimate, Vec<crate::physics::FieldPoint>), OfflineError> {
+    gap: ProfileGap,
+) -> Result<(Estimate, Vec<crate::physics::FieldPoint>), SimulationError> {
     if !velocity.is_finite() {
         return Err(arg_err("--velocity", velocity, "must be finite"));
     }
     let mut solver = Solver::new(&config.model(), &config.solver_settings())?;
     let e = match gap {
-        Gap::H0(h) => {
+        ProfileGap::H0(h) => {
             if !(h.is_finite() && h > 0.0 && h < 1e-3) {
                 return Err(arg_err("--h0", h, "must be a gap in metres, in (0, 1e-3)"));
             }
             solver.steady_prescribed_gap(velocity, h, config.contact.load_n)
         }
-        Gap::Load(f) => {
+        ProfileGap::Load(f) => {
             if !(f.is_finite() && f > 0.0) {
                 return Err(arg_err("--load", f, "must be a positive force in newtons"));
             }

@@ -1,7 +1,7 @@
 //! SVG figures (plotters, pure Rust, no system fonts), shared by the study
 //! reports and the replay report.
 
-use crate::offline::OfflineError;
+use crate::output::{write_file, OutputError};
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 
@@ -66,11 +66,8 @@ fn tick(v: f64, span: f64, log: bool) -> String {
     }
 }
 
-pub fn plot_err(path: &Path, e: impl std::fmt::Display) -> OfflineError {
-    OfflineError::Output {
-        path: path.to_path_buf(),
-        source: std::io::Error::other(e.to_string()),
-    }
+pub fn plot_err(path: &Path, e: impl std::fmt::Display) -> OutputError {
+    OutputError::other(path, e)
 }
 
 /// At most `max` points, evenly spaced (keeps the last point).
@@ -221,12 +218,15 @@ pub fn figure(
     title: &str,
     panels: &[Panel],
     ax: &Axes<'_>,
-) -> Result<PathBuf, OfflineError> {
+) -> Result<PathBuf, OutputError> {
     let cols = panels.len().clamp(1, 3);
     let rows = panels.len().div_ceil(cols).max(1);
     let (w, h) = (460 * cols as u32, 40 + 380 * rows as u32);
+    // Rendered in memory, then written atomically (a failed write is an
+    // error, never a half-written figure).
+    let mut svg = String::new();
     {
-        let root = SVGBackend::new(path, (w, h)).into_drawing_area();
+        let root = SVGBackend::with_string(&mut svg, (w, h)).into_drawing_area();
         root.fill(&WHITE).map_err(|e| plot_err(path, e))?;
         let (top, rest) = root.split_vertically(40);
         top.titled(title, ("sans-serif", 20))
@@ -243,5 +243,5 @@ pub fn figure(
         }
         root.present().map_err(|e| plot_err(path, e))?;
     }
-    Ok(path.to_path_buf())
+    write_file(path, svg.as_bytes())
 }

@@ -11,6 +11,7 @@
 //! A CSV may start with a header line; `#` starts a comment; times must
 //! increase strictly. A malformed line is reported with its line number.
 
+use crate::text::Num;
 use std::path::{Path, PathBuf};
 
 /// A scalar function of time.
@@ -164,6 +165,21 @@ impl Signal {
         }
     }
 
+    /// Smallest and largest value over all time.
+    pub fn range(&self) -> (f64, f64) {
+        match self {
+            Signal::Const(c) => (*c, *c),
+            Signal::Sine {
+                offset, amplitude, ..
+            } => (offset - amplitude.abs(), offset + amplitude.abs()),
+            Signal::Table { y, .. } => y
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+                    (a.min(*v), b.max(*v))
+                }),
+        }
+    }
+
     /// Largest |value| (for sanity checks and plots).
     pub fn max_abs(&self) -> f64 {
         match self {
@@ -179,16 +195,22 @@ impl Signal {
 impl std::fmt::Display for Signal {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            Signal::Const(c) => write!(f, "const:{c}"),
+            Signal::Const(c) => write!(f, "const:{}", Num(*c)),
             Signal::Sine {
                 offset,
                 amplitude,
                 frequency_hz,
                 phase_rad,
             } => {
-                write!(f, "sine:{offset},{amplitude},{frequency_hz}")?;
+                write!(
+                    f,
+                    "sine:{},{},{}",
+                    Num(*offset),
+                    Num(*amplitude),
+                    Num(*frequency_hz)
+                )?;
                 if *phase_rad != 0.0 {
-                    write!(f, ",{phase_rad}")?;
+                    write!(f, ",{}", Num(*phase_rad))?;
                 }
                 Ok(())
             }
@@ -205,6 +227,18 @@ fn read_table(path: &Path, column: Option<&str>, what: &str) -> Result<Signal, S
         path: path.to_path_buf(),
         source,
     })?;
+    parse_table(&text, path, column, what)
+}
+
+/// Parse the text of a `csv:` table (see the module documentation); `path`
+/// names it in messages.
+pub fn parse_table(
+    text: &str,
+    path: &Path,
+    column: Option<&str>,
+    what: &str,
+) -> Result<Signal, SignalError> {
+    let _ = what;
     let err = |line: usize, message: String| SignalError::Csv {
         path: path.to_path_buf(),
         line,
@@ -214,6 +248,8 @@ fn read_table(path: &Path, column: Option<&str>, what: &str) -> Result<Signal, S
     let mut saw_data = false;
     let mut header_seen = false;
     let (mut ts, mut ys) = (Vec::new(), Vec::new());
+    // A byte-order mark (spreadsheet exports) is not part of the first line.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     for (k, raw) in text.lines().enumerate() {
         let lineno = k + 1;
         let line = raw.split('#').next().unwrap_or("").trim();

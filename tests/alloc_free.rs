@@ -117,3 +117,48 @@ fn theta_scheme_steady_solves_and_reference_steps_allocate_nothing() {
         0
     );
 }
+
+#[test]
+fn the_loop_allocates_nothing_while_a_transport_refuses_every_output_for_ten_minutes() {
+    use friction_node::clock::SimClock;
+    use friction_node::config::{Config, StepMode};
+    use friction_node::msgs::{Command, CommandKind};
+    use friction_node::node::{LiveStatus, Loop};
+    use friction_node::transport::memory::MemoryLink;
+    use friction_node::transport::PeerPort;
+    use std::sync::atomic::AtomicBool;
+    use std::sync::Arc;
+    use std::time::Duration;
+    let mut cfg = Config::default();
+    cfg.solver.cells = 8;
+    cfg.node.step_mode = StepMode::Timer;
+    cfg.node.profile_rate_hz = 0.0;
+    // Nobody reads: the estimate queue is full after 16 steps, statistics
+    // overwrite each other.
+    let link = MemoryLink::new(16);
+    link.peer()
+        .send(&Command {
+            kind: CommandKind::Velocity,
+            value: 0.3,
+            stamp_ns: 1,
+        })
+        .unwrap();
+    let clock = Arc::new(SimClock::new(1_763_900_000_000_000_000));
+    let mut l = Loop::new(
+        &cfg,
+        vec![Box::new(link.node())],
+        None,
+        None,
+        Arc::new(LiveStatus::default()),
+    )
+    .unwrap()
+    .with_clock(clock);
+    let stop = AtomicBool::new(false);
+    l.run(&stop, Some(Duration::from_secs(1)));
+    let mut steps = 0;
+    let n = allocations(|| {
+        steps = l.run(&stop, Some(Duration::from_secs(600))).steps;
+    });
+    assert_eq!(steps, 601_000, "the loop kept its pace");
+    assert_eq!(n, 0, "{n} allocations in ten simulated minutes");
+}

@@ -3,8 +3,9 @@
 //! Python mcap-ros2-support writer. Bad bags are made here from them.
 #![cfg(feature = "mcap")]
 
+use friction_node::bag::{Bag, BagError, SampleKind};
 use friction_node::msgs::{self, CommandKind};
-use friction_node::replay::{self, Bag, InputMode, ReplayError, ReplayOptions, VelocityKind};
+use friction_node::replay::{self, InputMode, ReplayError, ReplayOptions};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -90,9 +91,11 @@ fn a_foreign_joint_state_bag_replays_the_named_joint_on_the_model_time_grid() {
             velocity,
             kind,
             load,
+            temperature,
         } => {
+            assert_eq!(*temperature, None);
             assert_eq!(velocity, "/joint_states");
-            assert!(matches!(kind, VelocityKind::JointState { joint, .. } if joint == "slider"));
+            assert!(matches!(kind, SampleKind::JointVelocity(joint) if joint == "slider"));
             assert_eq!(load.as_deref(), Some("/slider/normal_load"));
         }
         other => panic!("{other:?}"),
@@ -151,14 +154,20 @@ fn a_foreign_joint_state_bag_replays_the_named_joint_on_the_model_time_grid() {
 #[test]
 fn a_joint_state_with_several_joints_needs_a_joint_name() {
     let e = prepare(FOREIGN_BAG, &opts(Some("/joint_states"), None)).unwrap_err();
-    assert!(matches!(e, ReplayError::JointRequired { .. }), "{e}");
+    assert!(
+        matches!(e, ReplayError::Bag(BagError::JointRequired { .. })),
+        "{e}"
+    );
     let m = e.to_string();
     assert!(
         m.contains("base_yaw, slider, gripper") && m.contains("--joint"),
         "{m}"
     );
     let e = prepare(FOREIGN_BAG, &opts(Some("/joint_states"), Some("elbow"))).unwrap_err();
-    assert!(matches!(e, ReplayError::JointMissing { .. }), "{e}");
+    assert!(
+        matches!(e, ReplayError::Bag(BagError::JointMissing { .. })),
+        "{e}"
+    );
     assert!(e.to_string().contains("`elbow`"), "{e}");
 }
 
@@ -176,7 +185,7 @@ fn several_velocity_topics_are_listed_until_one_is_chosen() {
     assert!(matches!(
         &p.mode,
         InputMode::Topics {
-            kind: VelocityKind::TwistStamped,
+            kind: SampleKind::TwistLinearX,
             ..
         }
     ));
@@ -189,7 +198,10 @@ fn several_velocity_topics_are_listed_until_one_is_chosen() {
         2001
     );
     let e = prepare(FOREIGN_BAG, &opts(Some("/diagnostics_text"), None)).unwrap_err();
-    assert!(matches!(e, ReplayError::UnsupportedType { .. }), "{e}");
+    assert!(
+        matches!(e, ReplayError::Bag(BagError::UnsupportedType { .. })),
+        "{e}"
+    );
     assert!(e.to_string().contains("std_msgs/msg/String"), "{e}");
     let e = prepare(FOREIGN_BAG, &opts(Some("/nope"), None)).unwrap_err();
     assert!(
@@ -342,7 +354,10 @@ fn a_schema_that_does_not_match_its_type_names_the_topic() {
     );
     let e = prepare(bag.to_str().unwrap(), &ReplayOptions::default()).unwrap_err();
     let m = e.to_string();
-    assert!(matches!(e, ReplayError::SchemaMismatch { .. }), "{m}");
+    assert!(
+        matches!(e, ReplayError::Bag(BagError::SchemaMismatch { .. })),
+        "{m}"
+    );
     assert!(
         m.contains("`/axis/velocity`") && m.contains("float32 data"),
         "{m}"
@@ -372,7 +387,10 @@ fn a_message_that_does_not_decode_is_damage_named_by_topic_and_index() {
     // Nothing before it: the decode error itself.
     write_bag(&bag, &channels, &[(0, garbage)]);
     let e = prepare(bag.to_str().unwrap(), &ReplayOptions::default()).unwrap_err();
-    assert!(matches!(e, ReplayError::Decode { index: 1, .. }), "{e}");
+    assert!(
+        matches!(e, ReplayError::Bag(BagError::Decode { index: 1, .. })),
+        "{e}"
+    );
     assert!(e.to_string().contains("/axis/velocity"), "{e}");
 }
 

@@ -186,26 +186,79 @@ fn cold_steady_start_at_high_speed_converges_by_continuation() {
 }
 
 #[test]
-fn non_finite_input_is_a_status_and_keeps_the_last_good_state() {
+fn an_input_outside_the_envelope_is_a_status_keeps_the_state_and_reports_the_last_good_estimate() {
     let mut s = Solver::new(&ModelParams::default(), &settings(64)).unwrap();
     s.initialize_steady(0.3, 20_762.0);
     let good = s.step(0.31, 20_762.0);
     let p_before = s.pressure().to_vec();
-    for (v, f) in [
-        (f64::NAN, 20_762.0),
-        (0.3, f64::INFINITY),
-        (f64::NEG_INFINITY, 1.0),
-        (0.3, -5.0),
-    ] {
+    let dt = 1e-3;
+    for (k, (v, f, status)) in [
+        (f64::NAN, 20_762.0, Status::NonFiniteInput),
+        (0.3, f64::INFINITY, Status::NonFiniteInput),
+        (f64::NEG_INFINITY, 1.0, Status::NonFiniteInput),
+        (0.3, -5.0, Status::InputOutOfRange),
+        (0.3, 0.0, Status::InputOutOfRange),
+        (1e300, 20_762.0, Status::InputOutOfRange),
+        (-101.0, 20_762.0, Status::InputOutOfRange),
+        (0.3, 2e9, Status::InputOutOfRange),
+    ]
+    .into_iter()
+    .enumerate()
+    {
         let e = s.step(v, f);
-        assert_eq!(e.status, Status::NonFiniteInput);
-        assert_eq!(s.pressure(), &p_before[..]);
+        assert_eq!(e.status, status, "v {v}, load {f}");
+        assert_eq!(s.pressure(), &p_before[..], "state kept");
         assert_eq!(s.h0(), good.h0);
-        assert_eq!(e.time, good.time);
+        // Time advances whatever the status; the estimate is the last good one.
+        assert_relative_eq!(
+            e.time,
+            good.time + (k + 1) as f64 * dt,
+            max_relative = 1e-12
+        );
+        assert_eq!(
+            (e.velocity, e.load, e.friction_force),
+            (good.velocity, good.load, good.friction_force)
+        );
     }
     let next = s.step(0.32, 20_762.0);
     assert_eq!(next.status, Status::Converged);
     assert!(next.h0.is_finite());
+}
+
+#[test]
+fn a_rejected_first_input_reports_a_defined_zero() {
+    let mut s = Solver::new(&ModelParams::default(), &settings(32)).unwrap();
+    let e = s.step(f64::NAN, 20_762.0);
+    assert_eq!(e.status, Status::NonFiniteInput);
+    assert_eq!(
+        (e.friction_force, e.cof, e.load, e.velocity),
+        (0.0, 0.0, 0.0, 0.0)
+    );
+    assert!(e.h0.is_finite());
+}
+
+#[test]
+fn a_long_step_over_lost_time_is_backward_euler_and_bdf2_resumes_after_it() {
+    // The node's answer to a stall: one step over the lost time. It lands
+    // near the fixed-step solution and the following steps converge.
+    let mut a = Solver::new(&ModelParams::default(), &settings(64)).unwrap();
+    a.initialize_steady(0.5, 20_762.0);
+    let mut b = a.clone();
+    for _ in 0..50 {
+        a.step(0.5, 20_762.0);
+    }
+    let long = b.step_over(0.5, 20_762.0, 0.05);
+    assert_eq!(long.status, Status::Converged);
+    assert_relative_eq!(long.time, a.time(), max_relative = 1e-12);
+    // Constant input from a steady state: both stay at the steady state.
+    assert_relative_eq!(long.h0, a.h0(), max_relative = 1e-6);
+    for _ in 0..5 {
+        assert_eq!(b.step(0.5, 20_762.0).status, Status::Converged);
+    }
+    assert_eq!(
+        b.step_over(0.5, 20_762.0, -1.0).status,
+        Status::InputOutOfRange
+    );
 }
 
 #[test]

@@ -2,4 +2,4 @@
 
 pub mod metrics;
 
-pub use metrics::{cycle_metrics, LoopMetrics, LoopSample};
+pub use metrics::{cycle_metrics, CycleCollector, LoopMetrics, LoopSample};

@@ -1,14 +1,14 @@
 //! Running the node: transports, recorder, real-time setup, signals, the
 //! demo driver and the live status line around the [`Loop`].
 
+use super::driver::DemoReport;
 use super::{rt, LiveStatus, Loop, NodeError, RunSummary};
-use crate::config::{Config, StepMode, TransportKind};
-use crate::msgs::{Command, CommandKind};
+use crate::config::{Config, TransportKind};
 use crate::transport::{self, BackendSpec, NodePort, ProfileSlot, TransportError};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 /// What to run.
 #[derive(Debug, Clone, Default)]
@@ -17,8 +17,10 @@ pub struct RunOptions {
     pub transport: Option<TransportKind>,
     /// Record to this file (overrides `recording.*`).
     pub record: Option<PathBuf>,
-    /// Drive the node with the paper's reciprocating velocity for this long, s.
+    /// Drive the node with a velocity profile on its own topics for this long, s.
     pub demo_s: Option<f64>,
+    /// The profile the demo driver commands.
+    pub profile: super::driver::Profile,
     /// Stop after this long, s (None: until SIGINT/SIGTERM).
     pub duration_s: Option<f64>,
     /// Print a live status line on stderr.
@@ -34,14 +36,9 @@ pub enum RunError {
     Transport(#[from] TransportError),
     #[error("invalid option: {0}")]
     Option(String),
-}
-
-/// What the demo driver did.
-#[derive(Debug, Clone, Default)]
-pub struct DemoReport {
-    pub commands_sent: u64,
-    pub estimates_received: u64,
-    pub error: Option<String>,
+    #[cfg(feature = "mcap")]
+    #[error(transparent)]
+    Recorder(#[from] crate::record::RecorderError),
 }
 
 /// Everything a run reports.
@@ -52,6 +49,8 @@ pub struct RunReport {
     pub realtime_applied: Vec<String>,
     pub warnings: Vec<String>,
     pub recording: Option<RecordingOutcome>,
+    /// Snapshot files written.
+    pub snapshots: Vec<PathBuf>,
     pub demo: Option<DemoReport>,
     pub rss_bytes: Option<u64>,
     pub peak_rss_bytes: Option<u64>,
@@ -64,31 +63,22 @@ pub struct RecordingOutcome {
     pub path: PathBuf,
     pub messages: u64,
     pub bytes: u64,
+    /// Files written (split recordings), and deleted to keep to the budget.
+    pub files: u64,
+    pub files_deleted: u64,
+    /// Messages not recorded after a write error.
+    pub lost: u64,
     pub error: Option<String>,
 }
 
-/// The file name used when none is given: `bags/friction_node_<UTC>.mcap`.
-pub fn default_recording_path(dir: &Path) -> PathBuf {
-    let secs = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map_or(0, |d| d.as_secs());
-    let (d, s) = (secs / 86_400, secs % 86_400);
-    // Civil date from days since 1970-01-01 (Howard Hinnant's algorithm).
-    let z = d as i64 + 719_468;
-    let era = z.div_euclid(146_097);
-    let doe = z - era * 146_097;
-    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
-    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-    let mp = (5 * doy + 2) / 153;
-    let day = doy - (153 * mp + 2) / 5 + 1;
-    let month = if mp < 10 { mp + 3 } else { mp - 9 };
-    let year = yoe + era * 400 + (month <= 2) as i64;
-    dir.join(format!(
-        "friction_node_{year:04}{month:02}{day:02}T{:02}{:02}{:02}Z.mcap",
-        s / 3600,
-        (s % 3600) / 60,
-        s % 60
-    ))
+/// The recording used when none is given: `bags/friction_node_<UTC>.mcap`,
+/// or that name without `.mcap` (a directory) for a split recording.
+pub fn default_recording_path(dir: &Path, split: bool) -> PathBuf {
+    let name = format!(
+        "friction_node_{}",
+        crate::clock::utc_stamp(crate::clock::system_wall_ns())
+    );
+    dir.join(if split { name } else { name + ".mcap" })
 }
 
 /// The backends a transport choice stands for.
@@ -114,77 +104,6 @@ pub fn backend_specs(
     }
     let _ = config;
     Ok(out)
-}
-
-fn demo_driver(
-    spec: BackendSpec,
-    mode: StepMode,
-    dt: f64,
-    seconds: f64,
-    ready: std::sync::mpsc::Sender<Result<(), String>>,
-    stop: Arc<AtomicBool>,
-) -> DemoReport {
-    let mut report = DemoReport::default();
-    let mut peer = match spec.open_peer() {
-        Ok(p) => p,
-        Err(e) => {
-            let _ = ready.send(Err(e.to_string()));
-            report.error = Some(e.to_string());
-            return report;
-        }
-    };
-    if let Err(e) = transport::wait_matched(peer.as_mut(), Duration::from_secs(20)) {
-        let _ = ready.send(Err(e.to_string()));
-        report.error = Some(e.to_string());
-        return report;
-    }
-    let _ = ready.send(Ok(()));
-    // The paper's reciprocating case: v = V1 sin(2π f t), V1 = 1 m/s, f = 1 Hz.
-    let v = |t: f64| (2.0 * std::f64::consts::PI * t).sin();
-    let steps = (seconds / dt).round() as u64;
-    let start = Instant::now();
-    let t0 = super::wall_ns();
-    for k in 1..=steps {
-        if stop.load(Ordering::Relaxed) {
-            break;
-        }
-        let t = k as f64 * dt;
-        if mode == StepMode::Timer {
-            // A plain sleep: the driver must not compete with the loop's spin.
-            let due = start + Duration::from_secs_f64(t - dt);
-            let now = Instant::now();
-            if due > now {
-                std::thread::sleep(due - now);
-            }
-        }
-        let c = Command {
-            kind: CommandKind::Velocity,
-            value: v(t),
-            stamp_ns: t0 + (t * 1e9) as u64,
-        };
-        if let Err(e) = peer.send(&c) {
-            report.error.get_or_insert(e.to_string());
-            continue;
-        }
-        report.commands_sent += 1;
-        if mode == StepMode::Lockstep {
-            if let Ok(Some(_)) = transport::recv_timeout(peer.as_mut(), Duration::from_secs(2)) {
-                report.estimates_received += 1;
-            }
-        }
-        while let Ok(Some(_)) = peer.try_recv() {
-            report.estimates_received += 1;
-        }
-    }
-    // Estimates still in flight.
-    let until = Instant::now() + Duration::from_millis(300);
-    while Instant::now() < until {
-        match peer.try_recv() {
-            Ok(Some(_)) => report.estimates_received += 1,
-            _ => std::thread::sleep(Duration::from_millis(5)),
-        }
-    }
-    report
 }
 
 fn status_thread(
@@ -252,55 +171,81 @@ pub fn run_node(
     }
     let profile =
         (config.node.profile_rate_hz > 0.0).then(|| ProfileSlot::new(config.solver.cells));
-    // Recording: a failure to start is reported, the node runs anyway.
+    // Recording: checked and created before anything runs; a path that
+    // cannot be recorded into is an error now, not a surprise later.
+    let split = config.recording.splits();
     let record_path = opts.record.clone().or_else(|| {
         config.recording.enabled.then(|| {
             if config.recording.path.is_empty() {
-                default_recording_path(std::path::Path::new("bags"))
+                default_recording_path(Path::new("bags"), split)
             } else {
                 PathBuf::from(&config.recording.path)
             }
         })
     });
     #[cfg(feature = "mcap")]
-    let recorder = match &record_path {
-        Some(p) => match crate::record::Recorder::start(
-            p,
+    let recorder = if record_path.is_some() || config.recording.snapshot_s > 0 {
+        let snapshot_dir = record_path
+            .as_deref()
+            .and_then(|p| p.parent())
+            .filter(|p| !p.as_os_str().is_empty())
+            .map_or_else(|| PathBuf::from("bags"), Path::to_path_buf);
+        let plan = crate::record::RecordPlan {
+            path: record_path.clone(),
+            snapshot_dir,
+        };
+        let r = crate::record::Recorder::start(
+            plan,
             config,
             &transport::names::TopicNames::from_config(config),
             profile.clone(),
-        ) {
-            Ok(r) => Some(r),
-            Err(e) => {
-                tracing::error!("{e}; running without recording");
-                report.recording = Some(RecordingOutcome {
-                    path: p.clone(),
-                    error: Some(e.to_string()),
-                    ..Default::default()
-                });
-                None
+            Arc::new(crate::clock::SystemClock::new()),
+        )?;
+        if config.recording.snapshot_s > 0 {
+            let flag = r.snapshot_request();
+            if let Err(e) = signal_hook::flag::register(signal_hook::consts::SIGUSR1, flag) {
+                report
+                    .warnings
+                    .push(format!("snapshots on SIGUSR1 are not available: {e}"));
             }
-        },
-        None => None,
+            tracing::info!(
+                "snapshot ring: the last {} s of every topic, up to about {} MB (recording.snapshot_s)",
+                config.recording.snapshot_s,
+                crate::config::snapshot_bytes(config) / 1_000_000
+            );
+        }
+        Some(r)
+    } else {
+        None
     };
     #[cfg(not(feature = "mcap"))]
-    if let Some(p) = &record_path {
-        report.recording = Some(RecordingOutcome {
-            path: p.clone(),
-            error: Some("built without the `mcap` feature".into()),
-            ..Default::default()
-        });
-    }
-    let mut ports: Vec<Box<dyn NodePort>> = Vec::new();
-    for s in &specs {
-        ports.push(s.open_node(profile.clone())?);
+    if record_path.is_some() || config.recording.snapshot_s > 0 {
+        return Err(RunError::Option(
+            "recording needs the `mcap` feature".into(),
+        ));
     }
     #[cfg(feature = "mcap")]
     let queue = recorder.as_ref().map(|r| r.queue());
     #[cfg(not(feature = "mcap"))]
     let queue = None;
+    #[cfg(feature = "mcap")]
+    let snapshot_flag = recorder.as_ref().map(|r| r.snapshot_request());
+    #[cfg(not(feature = "mcap"))]
+    let snapshot_flag = None;
+    let mut ports: Vec<Box<dyn NodePort>> = Vec::new();
+    for s in &specs {
+        ports.push(s.open_node(transport::PortIo {
+            profile: profile.clone(),
+            record: queue.clone(),
+            snapshot: snapshot_flag.clone(),
+        })?);
+    }
     let live = Arc::new(LiveStatus::default());
     let mut l = Loop::new(config, ports, queue, profile, live.clone())?;
+    #[cfg(feature = "mcap")]
+    if let Some(r) = &recorder {
+        l = l.with_recorder(r.counters());
+    }
     // The demo driver publishes on the first transport's real topics.
     let mut driver = None;
     if let Some(seconds) = opts.demo_s {
@@ -312,8 +257,9 @@ pub fn run_node(
         let (tx, rx) = std::sync::mpsc::channel();
         let spec = specs[0].clone();
         let (mode, dt, s2) = (config.node.step_mode, config.solver.dt_s, stop.clone());
+        let profile = opts.profile;
         driver = Some(std::thread::spawn(move || {
-            demo_driver(spec, mode, dt, seconds, tx, s2)
+            super::driver::drive(spec, mode, dt, seconds, profile, tx, s2)
         }));
         match rx.recv_timeout(Duration::from_secs(30)) {
             Ok(Ok(())) => {}
@@ -334,6 +280,11 @@ pub fn run_node(
         .status_line
         .then(|| status_thread(live.clone(), status_stop.clone(), config.solver.dt_s));
     let duration = opts.demo_s.or(opts.duration_s).map(Duration::from_secs_f64);
+    // One line when the loop starts: what scripts and tests wait for.
+    eprintln!(
+        "friction-node: loop running ({:?} mode)",
+        config.node.step_mode
+    );
     report.summary = l.run(&stop, duration);
     report.interrupted = stop.load(Ordering::Relaxed);
     status_stop.store(true, Ordering::Relaxed);
@@ -347,12 +298,18 @@ pub fn run_node(
     #[cfg(feature = "mcap")]
     if let Some(r) = recorder {
         let rep = r.finish();
-        report.recording = Some(RecordingOutcome {
-            path: rep.path,
-            messages: rep.messages,
-            bytes: rep.bytes,
-            error: rep.error,
-        });
+        report.snapshots = rep.snapshots.clone();
+        if let Some(path) = rep.path.clone() {
+            report.recording = Some(RecordingOutcome {
+                path,
+                messages: rep.messages,
+                bytes: rep.bytes,
+                files: rep.files,
+                files_deleted: rep.files_deleted,
+                lost: rep.lost,
+                error: rep.error,
+            });
+        }
     }
     report.rss_bytes = rt::resident_bytes();
     report.peak_rss_bytes = rt::peak_resident_bytes();

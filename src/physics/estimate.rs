@@ -9,7 +9,8 @@
 //! | `hydrodynamic_force` | F_hyd = B ∫ (p − p_amb) dx | N |
 //! | `asperity_force` | F_asp = B ∫ p_asp dx | N |
 //! | `viscous_force` | F_visc = B ∫ (−(h/2) ∂x p + μ v / h) dx | N |
-//! | `friction_force` | F_f = F_visc + μ_bl F_asp tanh(v/v_reg) | N |
+//! | `friction_force` | F_f + F_dt: the contact plus the drivetrain terms | N |
+//! | `contact_friction_force` | F_f = F_visc + μ_bl F_asp tanh(v/v_reg) | N |
 //! | `cof` | (|F_visc| + μ_bl F_asp) / F_ext | – |
 //! | `asperity_load_share` | F_asp / F_ext | – |
 //! | `inertia_force` | m h0'' | N |
@@ -32,8 +33,13 @@ pub enum Status {
     /// previous state was kept.
     NonFinite,
     /// The velocity or load handed to the step was not finite; nothing was
-    /// computed and the previous state was kept.
+    /// computed, the previous state was kept, the last good estimate is
+    /// reported.
     NonFiniteInput,
+    /// The velocity or load (or a step length) was outside the physical
+    /// envelope (|v| ≤ 100 m/s, 0 < load ≤ 1e9 N); handled as
+    /// [`Status::NonFiniteInput`].
+    InputOutOfRange,
 }
 
 impl Status {
@@ -44,6 +50,7 @@ impl Status {
             Status::MaxIterations => "max_iterations",
             Status::NonFinite => "non_finite",
             Status::NonFiniteInput => "non_finite_input",
+            Status::InputOutOfRange => "input_out_of_range",
         }
     }
 
@@ -117,6 +124,7 @@ pub struct Estimate {
     pub asperity_force: f64,
     pub viscous_force: f64,
     pub friction_force: f64,
+    pub contact_friction_force: f64,
     pub cof: f64,
     pub asperity_load_share: f64,
     pub inertia_force: f64,

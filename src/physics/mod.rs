@@ -16,6 +16,8 @@
 //! | [`solver`] | discretised Reynolds + load balance, Newton, steady mode |
 //! | [`reference`] | the paper's Algorithm 1 (Picard + secant) |
 //! | [`estimate`] | per-step output, status and diagnostics |
+//! | [`drivetrain`] | losses beside the contact (bearings, seals, gears) |
+//! | [`viscosity`] | the liquid's viscosity against temperature (Vogel) |
 //!
 //! ```
 //! use friction_node::physics::{ModelParams, SolverSettings, Solver};
@@ -26,6 +28,7 @@
 //! assert!(e.cof > 0.2 && e.cof < 0.31);
 //! ```
 
+pub mod drivetrain;
 pub mod eos;
 pub mod error;
 pub mod estimate;
@@ -36,7 +39,9 @@ pub mod params;
 pub mod reference;
 pub mod scheme;
 pub mod solver;
+pub mod viscosity;
 
+pub use drivetrain::Drivetrain;
 pub use error::SetupError;
 pub use estimate::{Diagnostics, Estimate, Regime, Status};
 pub use params::{
@@ -44,3 +49,4 @@ pub use params::{
     Roughness, SolverSettings, TimeScheme,
 };
 pub use solver::{FieldPoint, Solver};
+pub use viscosity::{ViscosityModel, VogelModel};

@@ -26,6 +26,14 @@
 
 use super::error::SetupError;
 
+/// The physical envelope of a step's inputs: |v| above this is rejected, m/s.
+pub const MAX_ABS_VELOCITY: f64 = 100.0;
+/// The physical envelope of a step's inputs: a load above this (or ≤ 0) is
+/// rejected, N.
+pub const MAX_LOAD: f64 = 1e9;
+/// The longest single variable-length step ([`super::Solver::step_over`]), s.
+pub const MAX_STEP_OVER: f64 = 3600.0;
+
 /// Global profile `hg(x)` of the slider.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Profile {
@@ -149,6 +157,8 @@ pub struct ModelParams {
     pub lubricant: Lubricant,
     pub roughness: Roughness,
     pub contact: Contact,
+    /// Losses beside the contact (zero by default).
+    pub drivetrain: super::drivetrain::Drivetrain,
 }
 
 /// Which algorithm advances the model.
@@ -322,6 +332,10 @@ impl ModelParams {
         non_negative("contact.boundary_friction", c.boundary_friction)?;
         positive("contact.sign_regularization", c.sign_regularization)?;
         non_negative("contact.min_film", c.min_film)?;
+        let d = &self.drivetrain;
+        non_negative("drivetrain.coulomb", d.coulomb)?;
+        non_negative("drivetrain.viscous", d.viscous)?;
+        non_negative("drivetrain.load_coefficient", d.load_coefficient)?;
         Ok(())
     }
 }

@@ -24,7 +24,7 @@
 //! benchmark baseline; it is slow by construction.
 
 use super::estimate::Status;
-use super::solver::{Ctx, Gap, Outcome, Solver};
+use super::solver::{Ctx, H0Mode, Outcome, Solver};
 
 impl Solver {
     pub(crate) fn reference_solve(&mut self, ctx: &Ctx) -> Outcome {
@@ -36,7 +36,7 @@ impl Solver {
             residual: f64::NAN,
             backtracks: 0,
         };
-        if let Gap::Prescribed(h) = ctx.gap {
+        if let H0Mode::Prescribed(h) = ctx.gap {
             let (_, it, conv) = self.picard(h, ctx);
             self.h0 = h;
             out.inner_iterations = it;

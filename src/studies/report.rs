@@ -5,24 +5,13 @@
 use super::claims::{Claim, Verdict};
 use super::{CaseResult, StudyResult};
 use crate::analysis::LoopMetrics;
-use crate::offline::{self, AtomicFile, OfflineError};
+use crate::offline;
+use crate::output::{AtomicFile, OutputError};
 use crate::text::Num;
 use std::path::{Path, PathBuf};
 
-fn io_err(path: &Path) -> impl Fn(std::io::Error) -> OfflineError + '_ {
-    move |source| OfflineError::Output {
-        path: path.to_path_buf(),
-        source,
-    }
-}
-
-/// Make sure `dir` exists and is writable (before any computation).
-pub fn prepare_output_dir(dir: &Path) -> Result<(), OfflineError> {
-    std::fs::create_dir_all(dir).map_err(io_err(dir))?;
-    let probe = dir.join(format!(".write-test-{}", std::process::id()));
-    std::fs::write(&probe, b"").map_err(io_err(dir))?;
-    std::fs::remove_file(&probe).map_err(io_err(dir))?;
-    Ok(())
+fn io_err(path: &Path) -> impl Fn(std::io::Error) -> OutputError + '_ {
+    move |source| OutputError::new(path, source)
 }
 
 /// Columns of the summary CSV.
@@ -63,7 +52,7 @@ pub fn summary_row(r: &CaseResult) -> String {
 }
 
 /// Write everything of one study under `dir/<study>/`; returns the files.
-pub fn write_study(dir: &Path, r: &StudyResult) -> Result<Vec<PathBuf>, OfflineError> {
+pub fn write_study(dir: &Path, r: &StudyResult) -> Result<Vec<PathBuf>, OutputError> {
     let sdir = dir.join(r.study.name());
     std::fs::create_dir_all(sdir.join("cases")).map_err(io_err(&sdir))?;
     std::fs::create_dir_all(sdir.join("steady")).map_err(io_err(&sdir))?;
@@ -72,7 +61,10 @@ pub fn write_study(dir: &Path, r: &StudyResult) -> Result<Vec<PathBuf>, OfflineE
         let mut f = AtomicFile::create(&sdir.join("cases").join(format!("{}.csv", c.case.id)))?;
         f.line(format_args!("{}", offline::SIMULATE_COLUMNS))?;
         for e in &c.last_cycle {
-            f.line(format_args!("{}", offline::simulate_row(e)))?;
+            f.line(format_args!(
+                "{}",
+                offline::simulate_row(e, c.case.config.lubricant.reference_temperature_c)
+            ))?;
         }
         files.push(f.commit()?);
     }
@@ -202,7 +194,7 @@ mod plots {
             .collect()
     }
 
-    pub fn study(dir: &Path, r: &StudyResult) -> Result<Vec<PathBuf>, OfflineError> {
+    pub fn study(dir: &Path, r: &StudyResult) -> Result<Vec<PathBuf>, OutputError> {
         let mut files = Vec::new();
         let name = r.study.name();
         let fig = r.study.figure();
@@ -440,7 +432,7 @@ mod plots {
     use super::*;
 
     /// Built without the `plots` feature: no figures.
-    pub fn study(_dir: &Path, _r: &StudyResult) -> Result<Vec<PathBuf>, OfflineError> {
+    pub fn study(_dir: &Path, _r: &StudyResult) -> Result<Vec<PathBuf>, OutputError> {
         Ok(Vec::new())
     }
 }

@@ -2,8 +2,11 @@
 //! process. The reference backend of the conformance suite, and the node's
 //! transport when it is embedded in another program.
 
-use super::{NodePort, PeerPort, TransportError};
-use crate::msgs::{Command, EstimateRecord, StatisticsRecord};
+use super::{
+    record_input, NodePort, PeerPort, PortCounters, RecordQueue, SharedCounters, TransportError,
+};
+use crate::clock::system_wall_ns;
+use crate::msgs::{Command, EstimateRecord, RecordItem, StatisticsRecord};
 use crossbeam_queue::ArrayQueue;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -26,7 +29,17 @@ impl MemoryLink {
     }
 
     pub fn node(&self) -> MemoryNode {
-        MemoryNode { link: self.clone() }
+        self.node_recording(None)
+    }
+
+    /// The loop's side, handing every command it delivers to `record`.
+    pub fn node_recording(&self, record: RecordQueue) -> MemoryNode {
+        MemoryNode {
+            link: self.clone(),
+            record,
+            counters: SharedCounters::default(),
+            clock: None,
+        }
     }
 
     pub fn peer(&self) -> MemoryPeer {
@@ -42,6 +55,19 @@ impl MemoryLink {
 /// The loop's side.
 pub struct MemoryNode {
     link: MemoryLink,
+    record: RecordQueue,
+    counters: SharedCounters,
+    /// Stamps received commands for the recorder (default: the system's).
+    clock: Option<std::sync::Arc<dyn crate::clock::Clock>>,
+}
+
+impl MemoryNode {
+    /// Stamp received commands with this clock's wall time (tests on
+    /// simulated time).
+    pub fn with_clock(mut self, clock: std::sync::Arc<dyn crate::clock::Clock>) -> Self {
+        self.clock = Some(clock);
+        self
+    }
 }
 
 impl NodePort for MemoryNode {
@@ -50,16 +76,39 @@ impl NodePort for MemoryNode {
     }
 
     fn poll_command(&mut self) -> Result<Option<Command>, TransportError> {
-        Ok(self.link.commands.pop())
+        let c = self.link.commands.pop();
+        if let Some(command) = c {
+            SharedCounters::bump(&self.counters.received);
+            if self.record.is_some() {
+                let received_ns = self
+                    .clock
+                    .as_ref()
+                    .map_or_else(system_wall_ns, |c| c.wall_ns());
+                let item = RecordItem::Command {
+                    command,
+                    received_ns,
+                };
+                record_input(&self.record, item, &self.counters);
+            }
+        }
+        Ok(c)
     }
 
     fn publish_estimate(&mut self, e: &EstimateRecord) -> bool {
+        // A full queue is a drop, which the loop counts.
         self.link.estimates.push(*e).is_ok()
     }
 
     fn publish_statistics(&mut self, s: &StatisticsRecord) -> bool {
-        self.link.statistics.force_push(*s);
+        // The newest statistics replace the oldest when nobody reads them.
+        if self.link.statistics.force_push(*s).is_some() {
+            SharedCounters::bump(&self.counters.statistics_failures);
+        }
         true
+    }
+
+    fn counters(&self) -> PortCounters {
+        self.counters.snapshot()
     }
 
     fn wait_for_command(&mut self, timeout: Duration) -> Result<(), TransportError> {
@@ -95,6 +144,10 @@ impl PeerPort for MemoryPeer {
 
     fn try_recv(&mut self) -> Result<Option<EstimateRecord>, TransportError> {
         Ok(self.link.estimates.pop())
+    }
+
+    fn try_recv_statistics(&mut self) -> Result<Option<StatisticsRecord>, TransportError> {
+        Ok(self.link.statistics.pop())
     }
 
     fn is_matched(&mut self) -> bool {

@@ -17,7 +17,8 @@ pub mod iceoryx;
 #[cfg(feature = "ros2")]
 pub mod ros2;
 
-use crate::msgs::{Command, EstimateRecord, StatisticsRecord};
+use crate::msgs::{Command, EstimateRecord, RecordItem, StatisticsRecord};
+use crossbeam_queue::ArrayQueue;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -55,6 +56,84 @@ impl TransportError {
     }
 }
 
+/// What a port counted itself (the loop adds its own counts).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct PortCounters {
+    /// Commands the transport delivered (taken from DDS, shared memory, …).
+    pub received: u64,
+    /// Delivered commands discarded by a full receive queue (or lost in a
+    /// full shared-memory buffer) before the loop took them.
+    pub overwritten: u64,
+    /// Outputs the transport's I/O failed to send.
+    pub publish_failures: u64,
+    /// LoopStatistics the transport failed to send.
+    pub statistics_failures: u64,
+    /// Received samples the recorder queue had no room for.
+    pub recorder_drops: u64,
+}
+
+impl PortCounters {
+    pub fn add(&mut self, o: &PortCounters) {
+        self.received += o.received;
+        self.overwritten += o.overwritten;
+        self.publish_failures += o.publish_failures;
+        self.statistics_failures += o.statistics_failures;
+        self.recorder_drops += o.recorder_drops;
+    }
+}
+
+/// [`PortCounters`] shared between a port's threads.
+#[derive(Debug, Default)]
+pub struct SharedCounters {
+    pub received: AtomicU64,
+    pub overwritten: AtomicU64,
+    pub publish_failures: AtomicU64,
+    pub statistics_failures: AtomicU64,
+    pub recorder_drops: AtomicU64,
+}
+
+impl SharedCounters {
+    pub fn snapshot(&self) -> PortCounters {
+        let l = |a: &AtomicU64| a.load(Ordering::Relaxed);
+        PortCounters {
+            received: l(&self.received),
+            overwritten: l(&self.overwritten),
+            publish_failures: l(&self.publish_failures),
+            statistics_failures: l(&self.statistics_failures),
+            recorder_drops: l(&self.recorder_drops),
+        }
+    }
+
+    pub fn bump(a: &AtomicU64) {
+        a.fetch_add(1, Ordering::Relaxed);
+    }
+}
+
+/// Where a port puts what it received, for the recorder (None: not recording).
+pub type RecordQueue = Option<Arc<ArrayQueue<RecordItem>>>;
+
+/// What a node port is given besides its spec.
+#[derive(Clone, Default)]
+pub struct PortIo {
+    /// The slot the loop writes film profiles into (backends that publish
+    /// profiles read it).
+    pub profile: Option<Arc<ProfileSlot>>,
+    /// The recorder's queue: the port puts every command it receives into
+    /// it, as received.
+    pub record: RecordQueue,
+    /// Set when a peer asks for a snapshot (ROS 2 `~/snapshot`).
+    pub snapshot: Option<Arc<std::sync::atomic::AtomicBool>>,
+}
+
+/// Hand a received sample to the recorder, counting a full queue.
+pub fn record_input(queue: &RecordQueue, item: RecordItem, counters: &SharedCounters) {
+    if let Some(q) = queue {
+        if q.push(item).is_err() {
+            SharedCounters::bump(&counters.recorder_drops);
+        }
+    }
+}
+
 /// The loop's side of a transport.
 pub trait NodePort {
     fn name(&self) -> &'static str;
@@ -66,6 +145,8 @@ pub trait NodePort {
     fn publish_statistics(&mut self, s: &StatisticsRecord) -> bool;
     /// Block until a command may be pending or `timeout` passes.
     fn wait_for_command(&mut self, timeout: Duration) -> Result<(), TransportError>;
+    /// What the port counted (commands delivered and lost, send failures).
+    fn counters(&self) -> PortCounters;
 }
 
 /// The other side: sends commands, reads estimates.
@@ -74,6 +155,8 @@ pub trait PeerPort {
     fn send(&mut self, c: &Command) -> Result<(), TransportError>;
     /// Next estimate, if any (non-blocking).
     fn try_recv(&mut self) -> Result<Option<EstimateRecord>, TransportError>;
+    /// Next loop statistics, if any (non-blocking).
+    fn try_recv_statistics(&mut self) -> Result<Option<StatisticsRecord>, TransportError>;
     /// Whether the node's endpoints are matched (discovery done).
     fn is_matched(&mut self) -> bool;
 }
@@ -194,19 +277,14 @@ impl BackendSpec {
         }
     }
 
-    /// Open the node's side. `profile` is the slot the loop writes film
-    /// profiles into (backends that publish profiles read it).
-    pub fn open_node(
-        &self,
-        profile: Option<Arc<ProfileSlot>>,
-    ) -> Result<Box<dyn NodePort>, TransportError> {
-        let _ = &profile;
+    /// Open the node's side.
+    pub fn open_node(&self, io: PortIo) -> Result<Box<dyn NodePort>, TransportError> {
         match self {
-            BackendSpec::Memory(l) => Ok(Box::new(l.node())),
+            BackendSpec::Memory(l) => Ok(Box::new(l.node_recording(io.record))),
             #[cfg(feature = "iceoryx2")]
-            BackendSpec::Iceoryx2(s) => Ok(Box::new(iceoryx::IceoryxNode::open(s)?)),
+            BackendSpec::Iceoryx2(s) => Ok(Box::new(iceoryx::IceoryxNode::open(s, io.record)?)),
             #[cfg(feature = "ros2")]
-            BackendSpec::Ros2(s) => Ok(Box::new(ros2::Ros2Node::open(s, profile)?)),
+            BackendSpec::Ros2(s) => Ok(Box::new(ros2::Ros2Node::open(s, io)?)),
         }
     }
 

@@ -15,15 +15,18 @@ pub fn resolve_topic(topic: &str, namespace: &str, node: &str) -> String {
     }
 }
 
-/// The node's six topics, resolved.
+/// The node's topics, resolved.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct TopicNames {
     pub cmd_velocity: String,
     pub normal_load: String,
+    pub temperature: String,
     pub friction: String,
     pub friction_force: String,
     pub film_profile: String,
     pub loop_statistics: String,
+    /// `~/snapshot` (std_msgs/Empty): asks for a snapshot of the last minutes.
+    pub snapshot: String,
 }
 
 impl TopicNames {
@@ -33,10 +36,12 @@ impl TopicNames {
         Self {
             cmd_velocity: t(&r.topics.cmd_velocity),
             normal_load: t(&r.topics.normal_load),
+            temperature: t(&r.topics.temperature),
             friction: t(&r.topics.friction),
             friction_force: t(&r.topics.friction_force),
             film_profile: t(&r.topics.film_profile),
             loop_statistics: t(&r.topics.loop_statistics),
+            snapshot: t("~/snapshot"),
         }
     }
 }

@@ -1,10 +1,11 @@
-//! `friction-node bench`: per-step cost of the paper's reciprocating case
+//! Benchmarks (release builds; medians and ratios measured side by side in
+//! one run). `mod.rs`: `friction-node bench`, per-step cost of the paper's reciprocating case
 //! (V1 = 1 m/s, f = 1 Hz, F = 20 762 N, μ = 0.0564 Pa·s), Newton against the
 //! reference algorithm, and allocations per step. A benchmark, not a test:
 //! release build, medians and ratios measured side by side in one run.
 
 use crate::config::Config;
-use crate::offline::{OfflineError, Timing};
+use crate::offline::{SimulationError, Timing};
 use crate::physics::{Method, Solver};
 use std::time::Instant;
 
@@ -42,7 +43,7 @@ pub struct BenchOptions<'a> {
     pub progress: &'a dyn Fn(&str),
 }
 
-pub fn run(config: &Config, opts: &BenchOptions<'_>) -> Result<Vec<BenchCase>, OfflineError> {
+pub fn run(config: &Config, opts: &BenchOptions<'_>) -> Result<Vec<BenchCase>, SimulationError> {
     let load = config.contact.load_n;
     let velocity = |t: f64| (2.0 * std::f64::consts::PI * t).sin();
     let mut out = Vec::new();
@@ -170,110 +171,8 @@ pub fn csv(cases: &[BenchCase]) -> String {
     s
 }
 
-/// Command → estimate latency through a transport (lockstep node, model step
-/// included), measured by a peer in this process.
-#[derive(Debug, Clone)]
-pub struct LatencyReport {
-    pub transport: &'static str,
-    pub samples: usize,
-    /// p50, p99, p99.9, max of command → estimate, µs.
-    pub latency_us: [f64; 4],
-    /// The node's model step, p50 / p99, µs.
-    pub step_us: [f64; 2],
-    pub lost: usize,
-}
+mod latency;
+#[cfg(feature = "mcap")]
+pub mod recorder;
 
-/// Measure the latency of `spec` with `samples` round trips after `warmup`.
-pub fn latency(
-    config: &Config,
-    spec: crate::transport::BackendSpec,
-    samples: usize,
-    warmup: usize,
-) -> Result<LatencyReport, crate::node::runner::RunError> {
-    use crate::msgs::{Command, CommandKind};
-    use crate::node::{LiveStatus, Loop};
-    use std::sync::atomic::{AtomicBool, Ordering};
-    use std::sync::Arc;
-    use std::time::Duration;
-    let mut cfg = config.clone();
-    cfg.node.step_mode = crate::config::StepMode::Lockstep;
-    cfg.node.profile_rate_hz = 0.0;
-    cfg.ros.qos.commands.reliability = crate::config::Reliability::Reliable;
-    cfg.ros.qos.commands.depth = 100;
-    let stop = Arc::new(AtomicBool::new(false));
-    let (tx, rx) = std::sync::mpsc::channel();
-    let (s2, spec2, cfg2) = (stop.clone(), spec.clone(), cfg.clone());
-    let node = std::thread::spawn(move || -> Result<crate::node::RunSummary, String> {
-        let port = spec2.open_node(None).map_err(|e| e.to_string())?;
-        let mut l = Loop::new(
-            &cfg2,
-            vec![port],
-            None,
-            None,
-            Arc::new(LiveStatus::default()),
-        )
-        .map_err(|e| e.to_string())?;
-        let _ = tx.send(());
-        Ok(l.run(&s2, None))
-    });
-    let _ = rx.recv_timeout(Duration::from_secs(30));
-    let mut peer = spec.open_peer()?;
-    crate::transport::wait_matched(peer.as_mut(), Duration::from_secs(20))?;
-    let dt = cfg.solver.dt_s;
-    let mut times = Vec::with_capacity(samples);
-    let mut lost = 0;
-    let stamp0 = crate::node::wall_ns();
-    for k in 0..warmup + samples {
-        let t = (k + 1) as f64 * dt;
-        let c = Command {
-            kind: CommandKind::Velocity,
-            value: (2.0 * std::f64::consts::PI * t).sin(),
-            stamp_ns: stamp0 + k as u64 * 1_000_000,
-        };
-        let start = Instant::now();
-        peer.send(&c)?;
-        // Busy-poll: the peer is a tight control loop waiting for its answer.
-        let got = loop {
-            if let Some(e) = peer.try_recv()? {
-                break Some(e);
-            }
-            if start.elapsed() > Duration::from_secs(2) {
-                break None;
-            }
-            std::hint::spin_loop();
-        };
-        let ns = start.elapsed().as_nanos() as u64;
-        match got {
-            Some(_) if k >= warmup => times.push(ns),
-            Some(_) => {}
-            None => lost += 1,
-        }
-    }
-    stop.store(true, Ordering::Relaxed);
-    let summary = node
-        .join()
-        .map_err(|_| crate::node::runner::RunError::Option("the node thread panicked".into()))?
-        .map_err(crate::node::runner::RunError::Option)?;
-    let mut sorted = times.clone();
-    sorted.sort_unstable();
-    let q = |p: f64| {
-        sorted
-            .get(((p * (sorted.len().max(1) - 1) as f64).round()) as usize)
-            .map_or(f64::NAN, |v| *v as f64 / 1e3)
-    };
-    Ok(LatencyReport {
-        transport: spec.name(),
-        samples: times.len(),
-        latency_us: [
-            q(0.5),
-            q(0.99),
-            q(0.999),
-            sorted.last().map_or(f64::NAN, |v| *v as f64 / 1e3),
-        ],
-        step_us: [
-            summary.compute_ns[0] as f64 / 1e3,
-            summary.compute_ns[1] as f64 / 1e3,
-        ],
-        lost,
-    })
-}
+pub use latency::{latency, LatencyReport};

@@ -1,4 +1,45 @@
-//! Fixed-memory statistics for the loop (no allocation after construction).
+//! Fixed-memory statistics for the loop (no allocation after construction),
+//! and the recorder's counters the loop reports.
+
+use crate::msgs::{Note, RecordingStatus};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Mutex;
+
+/// Counters the recorder shares with the loop (statistics) and the report.
+#[derive(Debug, Default)]
+pub struct RecorderCounters {
+    pub messages: AtomicU64,
+    /// Files started (1 without splitting).
+    pub files: AtomicU64,
+    /// Files deleted to keep to the budget.
+    pub files_deleted: AtomicU64,
+    /// Messages lost because writing had failed (until it resumed).
+    pub lost: AtomicU64,
+    pub snapshots: AtomicU64,
+    /// The latest snapshot file and its span, s.
+    pub last_snapshot: Mutex<(Note, f64)>,
+}
+
+impl RecorderCounters {
+    /// A snapshot of the counters (never blocks: a busy snapshot slot
+    /// reports an empty note).
+    pub fn status(&self) -> RecordingStatus {
+        let l = |a: &AtomicU64| a.load(Ordering::Relaxed);
+        let (last_snapshot, last_snapshot_span_s) = self
+            .last_snapshot
+            .try_lock()
+            .map(|g| *g)
+            .unwrap_or_default();
+        RecordingStatus {
+            files: l(&self.files),
+            files_deleted: l(&self.files_deleted),
+            lost: l(&self.lost),
+            snapshots: l(&self.snapshots),
+            last_snapshot,
+            last_snapshot_span_s,
+        }
+    }
+}
 
 /// The samples of one statistics window (ns).
 #[derive(Debug, Clone)]
@@ -49,7 +90,7 @@ impl Window {
 /// one overflow bin; the maximum is exact.
 #[derive(Debug, Clone)]
 pub struct Histogram {
-    bins: Vec<u32>,
+    bins: Vec<u64>,
     count: u64,
     max: u64,
 }
@@ -93,13 +134,19 @@ impl Histogram {
     }
 
     pub fn record(&mut self, ns: u64) {
-        self.bins[Self::bin(ns)] += 1;
+        let b = &mut self.bins[Self::bin(ns)];
+        *b = b.saturating_add(1);
         self.count += 1;
         self.max = self.max.max(ns);
     }
 
     pub fn count(&self) -> u64 {
         self.count
+    }
+
+    /// The largest sample (exact).
+    pub fn max(&self) -> u64 {
+        self.max
     }
 
     /// The q-quantile: the centre of its bin (within 200 ns of the sample
@@ -111,7 +158,7 @@ impl Histogram {
         let target = ((self.count - 1) as f64 * q).round() as u64 + 1;
         let mut acc = 0u64;
         for (i, c) in self.bins.iter().enumerate() {
-            acc += *c as u64;
+            acc += *c;
             if acc >= target {
                 return Self::value(i).min(self.max);
             }

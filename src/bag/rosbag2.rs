@@ -1,0 +1,154 @@
+//! rosbag2 directories: `metadata.yaml` (what `ros2 bag record` writes, and
+//! the node's split recordings) and the storage files it lists.
+//!
+//! Reading accepts every field rosbag2 writes (unknown ones are ignored);
+//! writing produces version 5 of the format with storage identifier `mcap`.
+
+use super::BagError;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// `metadata.yaml`.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct MetadataFile {
+    pub rosbag2_bagfile_information: Metadata,
+}
+
+/// Nanoseconds, as rosbag2 writes durations.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub struct Nanoseconds {
+    pub nanoseconds: u64,
+}
+
+/// Nanoseconds since the Unix epoch, as rosbag2 writes times.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub struct Since {
+    pub nanoseconds_since_epoch: u64,
+}
+
+/// One topic and its message count.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default)]
+pub struct TopicWithCount {
+    pub topic_metadata: TopicMetadata,
+    pub message_count: u64,
+}
+
+/// A topic's name, type, serialization and offered QoS (a YAML string).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default)]
+pub struct TopicMetadata {
+    pub name: String,
+    #[serde(rename = "type")]
+    pub type_name: String,
+    pub serialization_format: String,
+    pub offered_qos_profiles: String,
+}
+
+/// One storage file of the bag.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default)]
+pub struct FileInfo {
+    pub path: String,
+    pub starting_time: Since,
+    pub duration: Nanoseconds,
+    pub message_count: u64,
+}
+
+/// `rosbag2_bagfile_information`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Metadata {
+    pub version: u32,
+    pub storage_identifier: String,
+    pub duration: Nanoseconds,
+    pub starting_time: Since,
+    pub message_count: u64,
+    pub topics_with_message_count: Vec<TopicWithCount>,
+    pub compression_format: String,
+    pub compression_mode: String,
+    pub relative_file_paths: Vec<String>,
+    pub files: Vec<FileInfo>,
+    pub ros_distro: String,
+}
+
+impl Default for Metadata {
+    fn default() -> Self {
+        Self {
+            version: 5,
+            storage_identifier: "mcap".into(),
+            duration: Nanoseconds::default(),
+            starting_time: Since::default(),
+            message_count: 0,
+            topics_with_message_count: Vec::new(),
+            compression_format: String::new(),
+            compression_mode: String::new(),
+            relative_file_paths: Vec::new(),
+            files: Vec::new(),
+            ros_distro: String::new(),
+        }
+    }
+}
+
+impl Metadata {
+    /// The YAML text of `metadata.yaml`.
+    pub fn to_yaml(&self) -> String {
+        serde_norway::to_string(&MetadataFile {
+            rosbag2_bagfile_information: self.clone(),
+        })
+        .expect("metadata serializes")
+    }
+}
+
+/// Read a directory's `metadata.yaml` and return it with the storage files
+/// in order (each must exist).
+pub fn open_directory(dir: &Path) -> Result<(Metadata, Vec<PathBuf>), BagError> {
+    let not_bag = |message: String| BagError::NotABag {
+        path: dir.to_path_buf(),
+        message,
+    };
+    let meta_path = dir.join("metadata.yaml");
+    let text = std::fs::read_to_string(&meta_path).map_err(|e| {
+        not_bag(format!(
+            "a bag directory needs a rosbag2 metadata.yaml ({}: {e})",
+            meta_path.display()
+        ))
+    })?;
+    let file: MetadataFile = serde_norway::from_str(&text)
+        .map_err(|e| not_bag(format!("metadata.yaml is not rosbag2 metadata: {e}")))?;
+    let m = file.rosbag2_bagfile_information;
+    if m.storage_identifier != "mcap" {
+        return Err(not_bag(format!(
+            "storage `{}` is not supported here (only mcap)",
+            m.storage_identifier
+        )));
+    }
+    let names: Vec<String> = if m.relative_file_paths.is_empty() {
+        m.files.iter().map(|f| f.path.clone()).collect()
+    } else {
+        m.relative_file_paths.clone()
+    };
+    if names.is_empty() {
+        return Err(not_bag("metadata.yaml lists no files".into()));
+    }
+    let mut files = Vec::with_capacity(names.len());
+    for n in &names {
+        // rosbag2 writes paths relative to the directory (older versions
+        // prefix the directory's own name).
+        let direct = dir.join(n);
+        let p = if direct.exists() {
+            direct
+        } else {
+            match Path::new(n).file_name() {
+                Some(base) if dir.join(base).exists() => dir.join(base),
+                _ => {
+                    return Err(not_bag(format!(
+                        "metadata.yaml lists `{n}`, which is not in the directory"
+                    )))
+                }
+            }
+        };
+        files.push(p);
+    }
+    Ok((m, files))
+}

@@ -1,0 +1,115 @@
+//! `friction-node bench-latency`: command → estimate through a transport,
+//! model step included, against a lockstep node.
+
+use crate::config::Config;
+use std::time::Instant;
+
+/// Command → estimate latency through a transport (lockstep node, model step
+/// included), measured by a peer in this process.
+#[derive(Debug, Clone)]
+pub struct LatencyReport {
+    pub transport: &'static str,
+    pub samples: usize,
+    /// p50, p99, p99.9, max of command → estimate, µs.
+    pub latency_us: [f64; 4],
+    /// The node's model step, p50 / p99, µs.
+    pub step_us: [f64; 2],
+    pub lost: usize,
+}
+
+/// Measure the latency of `spec` with `samples` round trips after `warmup`.
+pub fn latency(
+    config: &Config,
+    spec: crate::transport::BackendSpec,
+    samples: usize,
+    warmup: usize,
+) -> Result<LatencyReport, crate::node::runner::RunError> {
+    use crate::msgs::{Command, CommandKind};
+    use crate::node::{LiveStatus, Loop};
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::Arc;
+    use std::time::Duration;
+    let mut cfg = config.clone();
+    cfg.node.step_mode = crate::config::StepMode::Lockstep;
+    cfg.node.profile_rate_hz = 0.0;
+    cfg.ros.qos.commands.reliability = crate::config::Reliability::Reliable;
+    cfg.ros.qos.commands.depth = 100;
+    let stop = Arc::new(AtomicBool::new(false));
+    let (tx, rx) = std::sync::mpsc::channel();
+    let (s2, spec2, cfg2) = (stop.clone(), spec.clone(), cfg.clone());
+    let node = std::thread::spawn(move || -> Result<crate::node::RunSummary, String> {
+        let port = spec2
+            .open_node(Default::default())
+            .map_err(|e| e.to_string())?;
+        let mut l = Loop::new(
+            &cfg2,
+            vec![port],
+            None,
+            None,
+            Arc::new(LiveStatus::default()),
+        )
+        .map_err(|e| e.to_string())?;
+        let _ = tx.send(());
+        Ok(l.run(&s2, None))
+    });
+    let _ = rx.recv_timeout(Duration::from_secs(30));
+    let mut peer = spec.open_peer()?;
+    crate::transport::wait_matched(peer.as_mut(), Duration::from_secs(20))?;
+    let dt = cfg.solver.dt_s;
+    let mut times = Vec::with_capacity(samples);
+    let mut lost = 0;
+    let stamp0 = crate::clock::system_wall_ns();
+    for k in 0..warmup + samples {
+        let t = (k + 1) as f64 * dt;
+        let c = Command {
+            kind: CommandKind::Velocity,
+            value: (2.0 * std::f64::consts::PI * t).sin(),
+            stamp_ns: stamp0 + k as u64 * 1_000_000,
+        };
+        let start = Instant::now();
+        peer.send(&c)?;
+        // Busy-poll: the peer is a tight control loop waiting for its answer.
+        let got = loop {
+            if let Some(e) = peer.try_recv()? {
+                break Some(e);
+            }
+            if start.elapsed() > Duration::from_secs(2) {
+                break None;
+            }
+            std::hint::spin_loop();
+        };
+        let ns = start.elapsed().as_nanos() as u64;
+        match got {
+            Some(_) if k >= warmup => times.push(ns),
+            Some(_) => {}
+            None => lost += 1,
+        }
+    }
+    stop.store(true, Ordering::Relaxed);
+    let summary = node
+        .join()
+        .map_err(|_| crate::node::runner::RunError::Option("the node thread panicked".into()))?
+        .map_err(crate::node::runner::RunError::Option)?;
+    let mut sorted = times.clone();
+    sorted.sort_unstable();
+    let q = |p: f64| {
+        sorted
+            .get(((p * (sorted.len().max(1) - 1) as f64).round()) as usize)
+            .map_or(f64::NAN, |v| *v as f64 / 1e3)
+    };
+    Ok(LatencyReport {
+        transport: spec.name(),
+        samples: times.len(),
+        latency_us: [
+            q(0.5),
+            q(0.99),
+            q(0.999),
+            sorted.last().map_or(f64::NAN, |v| *v as f64 / 1e3),
+        ],
+        step_us: [
+            summary.compute_ns[0] as f64 / 1e3,
+            summary.compute_ns[1] as f64 / 1e3,
+        ],
+        lost,
+    })
+}

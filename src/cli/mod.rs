@@ -1,0 +1,107 @@
+//! The command line: argument types (`args.rs`) and one file per group of
+//! subcommands. `main.rs` parses, dispatches and maps errors to exit codes.
+
+pub mod args;
+pub mod bench;
+pub mod fit;
+pub mod node;
+pub mod offline;
+#[cfg(feature = "mcap")]
+pub mod replay;
+pub mod study;
+
+use anyhow::Result;
+use args::{Cli, Command};
+use friction_node::config::Config;
+
+/// Run one parsed command line.
+pub fn dispatch(cli: Cli, allocations: &dyn Fn() -> u64) -> Result<()> {
+    let sub = cli.command.common().clone();
+    if cli.common.config.is_some() && sub.config.is_some() {
+        anyhow::bail!("--config given twice (before and after the subcommand)");
+    }
+    let path = sub.config.or(cli.common.config);
+    let sets: Vec<String> = cli.common.sets.iter().chain(&sub.sets).cloned().collect();
+    if let Command::Replay { args, .. } = cli.command {
+        #[cfg(feature = "mcap")]
+        return replay::run(args, path, sets);
+        #[cfg(not(feature = "mcap"))]
+        {
+            let _ = args;
+            anyhow::bail!("replay needs the `mcap` feature");
+        }
+    }
+    let config = Config::load(path.as_deref(), &sets)?;
+    match cli.command {
+        Command::Replay { .. } => unreachable!("handled above"),
+        Command::Simulate {
+            velocity,
+            load,
+            temperature,
+            duration,
+            out,
+            ..
+        } => offline::simulate(
+            &config,
+            &velocity,
+            load.as_deref(),
+            temperature.as_deref(),
+            duration,
+            &out,
+        ),
+        Command::Stribeck {
+            v_min,
+            v_max,
+            points,
+            log,
+            load,
+            out,
+            ..
+        } => offline::stribeck(&config, v_min, v_max, points, log, load, &out),
+        Command::Profile {
+            velocity,
+            h0,
+            load,
+            out,
+            ..
+        } => offline::profile(&config, velocity, h0, load, &out),
+        Command::BenchLatency {
+            transport,
+            samples,
+            warmup,
+            ..
+        } => bench::latency(&config, transport, samples, warmup),
+        Command::Run {
+            transport,
+            record,
+            demo,
+            duration,
+            quiet,
+            ..
+        } => node::run(&config, transport, record, demo, duration, quiet),
+        Command::Soak {
+            transport,
+            duration,
+            seed,
+            rss_csv,
+            every,
+            ..
+        } => node::soak(&config, Some(transport), duration, seed, &rss_csv, every),
+        Command::Study {
+            name,
+            out,
+            cycles,
+            jobs,
+            ..
+        } => study::run(&config, name, &out, cycles, jobs),
+        Command::Fit { args, .. } => fit::run(&config, &args),
+        Command::BenchRecorder { hours, out, .. } => bench::recorder(&config, hours, out),
+        Command::Bench {
+            cells,
+            cycles,
+            reference_steps,
+            out,
+            ..
+        } => bench::step(&config, cells, cycles, reference_steps, out, allocations),
+    }
+}

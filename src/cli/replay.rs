@@ -1,0 +1,166 @@
+//! `replay`: the model over the velocity recorded in a bag.
+
+use super::args::{FormatArg, ReplayArgs};
+use anyhow::{Context, Result};
+use std::path::PathBuf;
+
+pub fn run(args: ReplayArgs, config: Option<PathBuf>, overrides: Vec<String>) -> Result<()> {
+    use friction_node::bag::Bag;
+    use friction_node::replay::{self, InputMode, OutputFormat, OutputStream, ReplayOptions};
+    use indicatif::{ProgressBar, ProgressStyle};
+    let ReplayArgs {
+        bag: bag_path,
+        topic,
+        joint,
+        load_topic,
+        temperature_topic,
+        out,
+        format,
+        report,
+        expect_identical,
+    } = args;
+    let started = std::time::Instant::now();
+    let format = match (format, OutputFormat::from_path(&out)) {
+        (Some(FormatArg::Csv), _) => OutputFormat::Csv,
+        (Some(FormatArg::Mcap), _) => OutputFormat::Mcap,
+        (None, Some(f)) => f,
+        (None, None) => anyhow::bail!(
+            "--out {}: the output must end in .mcap or .csv, or give --format csv|mcap",
+            out.display()
+        ),
+    };
+    // Validate the input completely before touching any output.
+    let in_bag = || format!("bag {}", bag_path.display());
+    let bag = Bag::open(&bag_path)?;
+    let opts = ReplayOptions {
+        topic,
+        joint,
+        load_topic,
+        temperature_topic,
+        config,
+        overrides,
+    };
+    let prepared = replay::prepare(&bag, &opts).with_context(in_bag)?;
+    if let Some(r) = &report {
+        friction_node::output::prepare_dir(r)?;
+    }
+    let steps = prepared
+        .commands
+        .iter()
+        .filter(|c| c.kind == friction_node::msgs::CommandKind::Velocity)
+        .count();
+    eprintln!(
+        "replay {}: {} ({} velocity messages → {} steps of {} s), configuration {}",
+        bag_path.display(),
+        match &prepared.mode {
+            InputMode::Topics { velocity, .. } => format!("topic {velocity}"),
+            InputMode::RecordedEstimates { topic } => format!("recorded estimates {topic}"),
+        },
+        prepared.velocity_messages,
+        steps,
+        prepared.config.solver.dt_s,
+        prepared.config_source,
+    );
+    if let Some(d) = &prepared.scan.damage {
+        eprintln!("warning: the bag is damaged {d}; replaying everything before it");
+    }
+    if !prepared.gaps.is_empty() {
+        eprintln!(
+            "warning: {} velocity gaps longer than node.command_timeout_s = {} s (the node's timeout rule applied): {}",
+            prepared.gaps.len(),
+            prepared.config.node.command_timeout_s,
+            replay::gap_list(&prepared.gaps, prepared.commands.first().map_or(0, |c| c.stamp_ns))
+        );
+    }
+    // Written to a temporary sibling while the model runs; moved into place
+    // only when complete.
+    let mut stream = OutputStream::start(&out, format, &prepared, &bag_path)?;
+    let bar = ProgressBar::new(prepared.commands.len() as u64);
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{elapsed_precise} [{bar:40}] {pos}/{len} commands, {per_sec}",
+        )
+        .expect("template")
+        .progress_chars("=> "),
+    );
+    let model_started = std::time::Instant::now();
+    let result = replay::run(
+        &prepared,
+        &mut |done, _| bar.set_position(done as u64),
+        &mut |e, rec| stream.push(e, rec),
+    )?;
+    let model_wall = model_started.elapsed().as_secs_f64();
+    bar.finish_and_clear();
+    let written = stream.finish(result.oracle.as_ref())?;
+    let wall = started.elapsed().as_secs_f64();
+    let e = &result.estimates;
+    let span = match (e.first(), e.last()) {
+        (Some(a), Some(b)) => (b.1.stamp_ns.saturating_sub(a.1.stamp_ns)) as f64 / 1e9,
+        _ => 0.0,
+    };
+    println!(
+        "steps            {} over {:.3} s of bag time",
+        e.len(),
+        span
+    );
+    let rate = |w: f64| if w > 0.0 { span / w } else { f64::NAN };
+    println!(
+        "replay time      {:.3} s ({:.0}× real time; reading, model and writing), model {:.3} s ({:.0}×)",
+        wall,
+        rate(wall),
+        model_wall,
+        rate(model_wall)
+    );
+    if prepared.scan.files.len() > 1 {
+        println!(
+            "bag              rosbag2 directory: {} split files, replayed in order as one run",
+            prepared.scan.files.len()
+        );
+    }
+    println!("commands         {} rejected", result.commands_rejected);
+    if let Some(d) = &prepared.scan.damage {
+        println!("damaged bag      stopped {d}");
+    }
+    let mut identical = true;
+    if let Some(o) = &result.oracle {
+        identical = o.identical;
+        if o.identical {
+            println!(
+                "determinism      bit-identical to the recorded estimates ({} steps)",
+                o.compared
+            );
+        } else {
+            println!(
+                "determinism      DIFFERS from the recording over {} steps:",
+                o.compared
+            );
+            for (f, d, k) in &o.deviations {
+                println!("                 {f:<22} up to {d:.3e} (first largest at step {k})");
+            }
+            if let Some((a, b)) = o.count_mismatch {
+                println!("                 {a} steps recorded, {b} replayed");
+            }
+        }
+    }
+    println!("wrote {}", written.display());
+    if let Some(r) = &report {
+        let files = replay::write_report(r, &bag_path, &prepared, &result, wall)?;
+        println!(
+            "report           {} ({} files)",
+            r.join("summary.md").display(),
+            files.len()
+        );
+    }
+    if expect_identical && (result.oracle.is_none() || !identical) {
+        eprintln!(
+            "error: --expect-identical: {}",
+            if result.oracle.is_none() {
+                "the bag has no recorded estimates to compare with"
+            } else {
+                "the re-simulation differs"
+            }
+        );
+        std::process::exit(3);
+    }
+    Ok(())
+}

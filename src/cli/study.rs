@@ -1,0 +1,179 @@
+//! `study`: the paper's parametric studies, every case in parallel.
+
+use super::args::StudyName;
+use anyhow::Result;
+use friction_node::config::Config;
+
+pub fn run(
+    config: &Config,
+    name: StudyName,
+    out: &std::path::Path,
+    cycles: usize,
+    jobs: Option<usize>,
+) -> Result<()> {
+    use friction_node::studies::{self, claims, report, StudyKind, StudyOptions, StudyResult};
+    use indicatif::{ProgressBar, ProgressStyle};
+    use rayon::prelude::*;
+    if cycles < 1 {
+        anyhow::bail!("--cycles must be at least 1 (the paper's loops need 3)");
+    }
+    friction_node::output::prepare_dir(out)?;
+    let kinds: Vec<StudyKind> = match name {
+        StudyName::All => StudyKind::ALL.to_vec(),
+        other => {
+            let n = <StudyName as clap::ValueEnum>::to_possible_value(&other).expect("named");
+            vec![StudyKind::from_name(n.get_name()).expect("study names match")]
+        }
+    };
+    if let Some(j) = jobs {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(j.max(1))
+            .build_global()
+            .ok();
+    }
+    let opts = StudyOptions {
+        cycles,
+        ..Default::default()
+    };
+    let started = std::time::Instant::now();
+    // Every steady curve and case of every study, as one job list.
+    enum Job {
+        Steady(StudyKind, studies::SteadySpec),
+        Case(studies::Case),
+    }
+    let mut jobs_list = Vec::new();
+    let mut total = 0u64;
+    for &k in &kinds {
+        let cases = studies::cases(k, config, &opts);
+        for s in studies::steady_specs(k, config, &cases, &opts) {
+            total += s.velocities.len() as u64 * 20;
+            jobs_list.push(Job::Steady(k, s));
+        }
+        for c in cases {
+            total += c.steps() as u64;
+            jobs_list.push(Job::Case(c));
+        }
+    }
+    let n_cases = jobs_list
+        .iter()
+        .filter(|j| matches!(j, Job::Case(_)))
+        .count();
+    eprintln!(
+        "study {}: {} cases on {} threads, N = {}, dt = {} s, {} cycles per case",
+        kinds
+            .iter()
+            .map(|k| k.name())
+            .collect::<Vec<_>>()
+            .join(", "),
+        n_cases,
+        rayon::current_num_threads(),
+        config.solver.cells,
+        config.solver.dt_s,
+        cycles
+    );
+    let bar = ProgressBar::new(total);
+    bar.set_style(
+        ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {percent:>3}% {msg}")
+            .expect("template")
+            .progress_chars("=> "),
+    );
+    enum Done {
+        Steady(
+            StudyKind,
+            Result<studies::SteadyCurve, friction_node::offline::SimulationError>,
+        ),
+        Case(Box<studies::CaseResult>),
+    }
+    let done: Vec<Done> = jobs_list
+        .into_par_iter()
+        .map(|j| match j {
+            Job::Steady(k, s) => {
+                let r = studies::steady_curve(&s);
+                bar.inc(s.velocities.len() as u64 * 20);
+                Done::Steady(k, r)
+            }
+            Job::Case(c) => {
+                bar.set_message(format!("{} {}", c.study.name(), c.id));
+                Done::Case(Box::new(studies::run_case(&c, &|n| bar.inc(n as u64))))
+            }
+        })
+        .collect();
+    bar.finish_and_clear();
+    let mut results: claims::Results = kinds
+        .iter()
+        .map(|&k| {
+            (
+                k,
+                StudyResult {
+                    study: k,
+                    cases: Vec::new(),
+                    steady: Vec::new(),
+                },
+            )
+        })
+        .collect();
+    for d in done {
+        match d {
+            Done::Steady(k, r) => results.get_mut(&k).expect("study").steady.push(r?),
+            Done::Case(c) => results
+                .get_mut(&c.case.study)
+                .expect("study")
+                .cases
+                .push(*c),
+        }
+    }
+    let compute_s = started.elapsed().as_secs_f64();
+    let mut failed = Vec::new();
+    for r in results.values() {
+        let files = report::write_study(out, r)?;
+        let bad: Vec<String> = r
+            .cases
+            .iter()
+            .filter_map(|c| c.failure.as_ref().map(|f| format!("{} ({f})", c.case.id)))
+            .collect();
+        println!(
+            "{:<20} {:>3} cases, {} files in {}{}",
+            r.study.name(),
+            r.cases.len(),
+            files.len(),
+            out.join(r.study.name()).display(),
+            if bad.is_empty() {
+                String::new()
+            } else {
+                format!(" — FAILED: {}", bad.join(", "))
+            }
+        );
+        failed.extend(bad);
+    }
+    let evaluated = claims::evaluate(&results, config.contact.boundary_friction);
+    if evaluated
+        .iter()
+        .any(|c| c.verdict() != claims::Verdict::NotEvaluated)
+    {
+        let path = out.join("claims.md");
+        friction_node::output::write_file(
+            &path,
+            report::claims_markdown(&evaluated, &failed).as_bytes(),
+        )?;
+        println!("\nclaims (MODEL.md §8), details in {}:", path.display());
+        for c in &evaluated {
+            if c.verdict() != claims::Verdict::NotEvaluated {
+                let passed = c.checks.iter().filter(|k| k.pass).count();
+                println!(
+                    "  {}. {:<18} {}/{} checks",
+                    c.number,
+                    c.verdict().as_str(),
+                    passed,
+                    c.checks.len()
+                );
+            }
+        }
+    }
+    println!(
+        "done in {:.1} s ({:.1} s computing on {} threads)",
+        started.elapsed().as_secs_f64(),
+        compute_s,
+        rayon::current_num_threads()
+    );
+    Ok(())
+}

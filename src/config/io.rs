@@ -1,0 +1,353 @@
+//! The node's sections of the configuration: `node`, `ros`, `iceoryx2`,
+//! `recording`.
+
+use super::DEFAULT_NODE_NAME;
+use serde::{Deserialize, Serialize};
+
+/// `node.step_mode`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum StepMode {
+    /// Fixed real-time steps against absolute deadlines; zero-order hold of
+    /// the latest command.
+    Timer,
+    /// One step per received velocity command, stamped with the command's
+    /// time (deterministic: tests and replay).
+    Lockstep,
+}
+
+/// `node.transport` (the `run --transport` flag overrides it).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum TransportKind {
+    Ros2,
+    Iceoryx2,
+    Both,
+}
+
+/// `node.timeout_behaviour`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TimeoutBehaviour {
+    /// Keep the last velocity.
+    Hold,
+    /// Decelerate to zero at `node.timeout_deceleration_m_s2`.
+    RampToZero,
+}
+
+/// `node.realtime.*`: applied when enabled and permitted, with a warning
+/// otherwise.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RealtimeConfig {
+    /// Run the loop thread under SCHED_FIFO.
+    pub fifo: bool,
+    /// SCHED_FIFO priority, 1..99.
+    pub priority: i32,
+    /// mlockall(MCL_CURRENT | MCL_FUTURE).
+    pub lock_memory: bool,
+    /// Pin the loop thread to this CPU; -1 = no pinning.
+    pub cpu: i32,
+}
+
+impl Default for RealtimeConfig {
+    fn default() -> Self {
+        Self {
+            fifo: false,
+            priority: 80,
+            lock_memory: false,
+            cpu: -1,
+        }
+    }
+}
+
+/// `node.*`: the fixed-step loop.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct NodeConfig {
+    pub step_mode: StepMode,
+    pub transport: TransportKind,
+    /// Velocity of the steady state the node starts from, m/s.
+    pub initial_velocity_m_s: f64,
+    /// A velocity command older than this is stale, s.
+    pub command_timeout_s: f64,
+    pub timeout_behaviour: TimeoutBehaviour,
+    pub timeout_deceleration_m_s2: f64,
+    /// Commands with |v| above this are rejected, m/s.
+    pub max_abs_velocity_m_s: f64,
+    /// Load commands outside [min, max] are rejected, N.
+    pub min_load_n: f64,
+    pub max_load_n: f64,
+    /// FilmProfile publication rate, Hz (0 = off).
+    pub profile_rate_hz: f64,
+    /// LoopStatistics publication rate, Hz.
+    pub statistics_rate_hz: f64,
+    /// Capacity of each output queue (transport I/O, recorder).
+    pub queue_capacity: usize,
+    /// header.frame_id of the published messages.
+    pub frame_id: String,
+    /// Lockstep: busy-poll for commands this long before blocking on the
+    /// transport's wake-up, µs (0 = always block; a spin trades one core for
+    /// a lower wake-up latency).
+    pub lockstep_spin_us: u64,
+    /// Timer mode: a loop that wakes up late catches up the lost steps one
+    /// by one (model time = wall time) when it is at most this far behind,
+    /// s; further behind, it advances the lost time in one backward-Euler
+    /// step and restarts BDF2.
+    pub max_catch_up_s: f64,
+    pub realtime: RealtimeConfig,
+}
+
+impl Default for NodeConfig {
+    fn default() -> Self {
+        Self {
+            step_mode: StepMode::Timer,
+            transport: TransportKind::Ros2,
+            initial_velocity_m_s: 0.0,
+            command_timeout_s: 0.1,
+            timeout_behaviour: TimeoutBehaviour::Hold,
+            timeout_deceleration_m_s2: 1.0,
+            max_abs_velocity_m_s: 10.0,
+            min_load_n: 1.0,
+            max_load_n: 1e7,
+            profile_rate_hz: 10.0,
+            statistics_rate_hz: 1.0,
+            queue_capacity: 4096,
+            frame_id: "slider".into(),
+            lockstep_spin_us: 0,
+            max_catch_up_s: 0.1,
+            realtime: RealtimeConfig::default(),
+        }
+    }
+}
+
+/// `ros.discovery_range`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum DiscoveryRange {
+    /// From ROS_AUTOMATIC_DISCOVERY_RANGE / ROS_LOCALHOST_ONLY (default
+    /// SUBNET when neither is set, as in ROS 2).
+    Env,
+    /// Loopback only (what shipped configs, tests and CI use).
+    Localhost,
+    /// Every interface (real robot networks).
+    Subnet,
+    /// No discovery beyond this host's loopback.
+    Off,
+}
+
+/// `ros.command_type`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CommandType {
+    /// std_msgs/msg/Float64, m/s.
+    Float64,
+    /// geometry_msgs/msg/TwistStamped, linear.x in m/s.
+    TwistStamped,
+}
+
+/// `ros.qos.*`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Reliability {
+    BestEffort,
+    Reliable,
+}
+
+/// `ros.qos.*.durability`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum Durability {
+    /// Samples go to the readers matched when they are written.
+    #[default]
+    Volatile,
+    /// The writer keeps its last `depth` samples for readers that match
+    /// later (and a reader asks for them).
+    TransientLocal,
+}
+
+/// QoS of one group of topics.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct QosConfig {
+    pub reliability: Reliability,
+    /// Keep-last depth.
+    pub depth: usize,
+    pub durability: Durability,
+}
+
+impl Default for QosConfig {
+    fn default() -> Self {
+        Self {
+            reliability: Reliability::Reliable,
+            depth: 10,
+            durability: Durability::Volatile,
+        }
+    }
+}
+
+/// `ros.qos`: commands best effort keep-last 1, estimates reliable depth 10.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct QosProfiles {
+    pub commands: QosConfig,
+    pub estimates: QosConfig,
+}
+
+impl Default for QosProfiles {
+    fn default() -> Self {
+        Self {
+            commands: QosConfig {
+                reliability: Reliability::BestEffort,
+                depth: 1,
+                durability: Durability::Volatile,
+            },
+            estimates: QosConfig::default(),
+        }
+    }
+}
+
+/// `ros.topics`: `~/` is the node's private namespace.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct TopicsConfig {
+    pub cmd_velocity: String,
+    pub normal_load: String,
+    /// `sensor_msgs/msg/Temperature` of the lubricant, °C.
+    pub temperature: String,
+    pub friction: String,
+    pub friction_force: String,
+    pub film_profile: String,
+    pub loop_statistics: String,
+}
+
+impl Default for TopicsConfig {
+    fn default() -> Self {
+        Self {
+            cmd_velocity: "~/cmd_velocity".into(),
+            normal_load: "~/normal_load".into(),
+            temperature: "~/temperature".into(),
+            friction: "~/friction".into(),
+            friction_force: "~/friction_force".into(),
+            film_profile: "~/film_profile".into(),
+            loop_statistics: "~/loop_statistics".into(),
+        }
+    }
+}
+
+/// `ros.*`: ROS 2 conventions.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RosConfig {
+    pub node_name: String,
+    pub namespace: String,
+    /// DDS domain; -1 = ROS_DOMAIN_ID (or 0 when unset).
+    pub domain_id: i64,
+    pub discovery_range: DiscoveryRange,
+    pub command_type: CommandType,
+    pub topics: TopicsConfig,
+    pub qos: QosProfiles,
+}
+
+impl Default for RosConfig {
+    fn default() -> Self {
+        Self {
+            node_name: DEFAULT_NODE_NAME.into(),
+            namespace: "/".into(),
+            domain_id: -1,
+            discovery_range: DiscoveryRange::Localhost,
+            command_type: CommandType::Float64,
+            topics: TopicsConfig::default(),
+            qos: QosProfiles::default(),
+        }
+    }
+}
+
+/// `iceoryx2.*`: service names of the zero-copy IPC transport.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Iceoryx2Config {
+    pub cmd_velocity_service: String,
+    pub normal_load_service: String,
+    pub temperature_service: String,
+    pub friction_service: String,
+    pub loop_statistics_service: String,
+    /// Event service that wakes a lockstep node when a command is sent.
+    pub cmd_event_service: String,
+}
+
+impl Default for Iceoryx2Config {
+    fn default() -> Self {
+        Self {
+            cmd_velocity_service: "friction_node/cmd_velocity".into(),
+            normal_load_service: "friction_node/normal_load".into(),
+            temperature_service: "friction_node/temperature".into(),
+            friction_service: "friction_node/friction".into(),
+            loop_statistics_service: "friction_node/loop_statistics".into(),
+            cmd_event_service: "friction_node/cmd_event".into(),
+        }
+    }
+}
+
+/// `recording.compression`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Compression {
+    None,
+    Zstd,
+    Lz4,
+}
+
+/// `recording.split.*`: rosbag2-style split files (0 = off).
+#[derive(Debug, Clone, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SplitConfig {
+    /// Start a new file when the current one reaches this size, bytes.
+    pub max_bytes: u64,
+    /// Start a new file when the current one spans this much recorded time, s.
+    pub max_duration_s: u64,
+}
+
+/// `recording.*`: MCAP recording (the `run --record PATH` flag enables it).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RecordingConfig {
+    pub enabled: bool,
+    /// File (no split) or directory (split) to write; empty =
+    /// bags/friction_node_<UTC time>.mcap (or that name without `.mcap`).
+    pub path: String,
+    /// Chunk size, bytes: a crash loses at most the open chunk.
+    pub chunk_size_bytes: u64,
+    pub compression: Compression,
+    pub split: SplitConfig,
+    /// Split recordings: delete the oldest files when the directory's files
+    /// exceed this many bytes (0 = no limit).
+    pub budget_bytes: u64,
+    /// Keep the last this many seconds of every topic in memory, written
+    /// as one MCAP file on request (SIGUSR1, `~/snapshot`); 0 = off.
+    pub snapshot_s: u64,
+    /// The most memory the snapshot ring may use, bytes.
+    pub snapshot_max_bytes: u64,
+}
+
+impl RecordingConfig {
+    /// Whether the recording is a directory of split files.
+    pub fn splits(&self) -> bool {
+        self.split.max_bytes > 0 || self.split.max_duration_s > 0
+    }
+}
+
+impl Default for RecordingConfig {
+    fn default() -> Self {
+        Self {
+            enabled: false,
+            path: String::new(),
+            chunk_size_bytes: 256 * 1024,
+            compression: Compression::Zstd,
+            split: SplitConfig::default(),
+            budget_bytes: 0,
+            snapshot_s: 0,
+            snapshot_max_bytes: 256 << 20,
+        }
+    }
+}

@@ -1,0 +1,137 @@
+//! Reading a configuration: parameter-file text (the ROS 2 shapes), then
+//! `dotted.key=value` overrides applied to the YAML tree before it is read,
+//! so they are checked exactly like file keys.
+
+use super::{Config, ConfigError, Origin, DEFAULT_NODE_NAME, DEFAULT_YAML};
+use serde_norway::Value;
+use std::path::Path;
+
+impl Config {
+    /// Read a parameter file (or the embedded default when `path` is None),
+    /// apply `dotted.key=value` overrides, deserialize and validate.
+    pub fn load(path: Option<&Path>, overrides: &[String]) -> Result<Config, ConfigError> {
+        let (text, origin) = match path {
+            Some(p) => (
+                std::fs::read_to_string(p).map_err(|source| ConfigError::Io {
+                    path: p.to_path_buf(),
+                    source,
+                })?,
+                Origin::File(p.to_path_buf()),
+            ),
+            None => (DEFAULT_YAML.to_string(), Origin::Embedded),
+        };
+        Self::from_yaml(&text, &origin, overrides)
+    }
+
+    /// Parse parameter-file text (see [`Config::load`]).
+    pub fn from_yaml(
+        text: &str,
+        origin: &Origin,
+        overrides: &[String],
+    ) -> Result<Config, ConfigError> {
+        let doc: Value = serde_norway::from_str(text).map_err(|e| ConfigError::Syntax {
+            origin: origin.to_string(),
+            message: e.to_string(),
+        })?;
+        let mut params = ros_parameters(doc, origin)?;
+        for o in overrides {
+            apply_override(&mut params, o)?;
+        }
+        let cfg: Config = serde_path_to_error::deserialize(params).map_err(|e| {
+            let key = e.path().to_string();
+            let message = e.inner().to_string();
+            if message.starts_with("unknown field") {
+                ConfigError::UnknownKey { key, message }
+            } else {
+                ConfigError::InvalidValue { key, message }
+            }
+        })?;
+        cfg.validate()?;
+        Ok(cfg)
+    }
+}
+
+/// Extract the `ros__parameters` mapping of the single node entry.
+fn ros_parameters(doc: Value, origin: &Origin) -> Result<Value, ConfigError> {
+    let layout = |message: String| ConfigError::Layout {
+        origin: origin.to_string(),
+        message,
+    };
+    let Value::Mapping(top) = doc else {
+        return Err(layout(format!(
+            "expected `{DEFAULT_NODE_NAME}: {{ros__parameters: {{...}}}}` at the top level"
+        )));
+    };
+    if top.len() != 1 {
+        let keys: Vec<String> = top
+            .keys()
+            .map(|k| {
+                serde_norway::to_string(k)
+                    .unwrap_or_default()
+                    .trim()
+                    .to_string()
+            })
+            .collect();
+        return Err(layout(format!(
+            "expected exactly one top-level node entry (`{DEFAULT_NODE_NAME}` or `/**`), found {keys:?}"
+        )));
+    }
+    let (name, body) = top.into_iter().next().expect("one entry");
+    let name = name.as_str().unwrap_or("").to_string();
+    let name_ok = name == "/**" || name.rsplit('/').next() == Some(DEFAULT_NODE_NAME);
+    if !name_ok {
+        return Err(layout(format!(
+            "top-level key `{name}` is not this node: use `{DEFAULT_NODE_NAME}` (optionally namespaced, e.g. `/robot/{DEFAULT_NODE_NAME}`) or `/**`"
+        )));
+    }
+    let Value::Mapping(mut body) = body else {
+        return Err(layout(format!("`{name}` must contain `ros__parameters:`")));
+    };
+    let params = body
+        .remove("ros__parameters")
+        .ok_or_else(|| layout(format!("`{name}` has no `ros__parameters:` entry")))?;
+    if let Some(k) = body.keys().next() {
+        return Err(ConfigError::UnknownKey {
+            key: format!("{name}.{}", k.as_str().unwrap_or("?")),
+            message: "only `ros__parameters` is allowed under the node entry".into(),
+        });
+    }
+    match params {
+        Value::Null => Ok(Value::Mapping(Default::default())),
+        v @ Value::Mapping(_) => Ok(v),
+        _ => Err(layout("`ros__parameters` must be a mapping".into())),
+    }
+}
+
+/// Apply one `dotted.key=value` override (the value is a YAML scalar or flow
+/// sequence, e.g. `0.05`, `true`, `reference`, `[0.01, 0.02]`).
+pub fn apply_override(params: &mut Value, arg: &str) -> Result<(), ConfigError> {
+    let bad = |message: &str| ConfigError::BadOverride {
+        arg: arg.to_string(),
+        message: message.to_string(),
+    };
+    let (key, value) = arg
+        .split_once('=')
+        .ok_or_else(|| bad("expected dotted.key=value"))?;
+    let key = key.trim();
+    if key.is_empty() || key.split('.').any(|p| p.is_empty()) {
+        return Err(bad("the key must be a dotted path such as contact.load_n"));
+    }
+    let value: Value = serde_norway::from_str(value.trim())
+        .map_err(|e| bad(&format!("value is not a YAML scalar: {e}")))?;
+    let mut node = params;
+    let parts: Vec<&str> = key.split('.').collect();
+    for (i, part) in parts.iter().enumerate() {
+        let Value::Mapping(map) = node else {
+            return Err(bad(&format!("`{}` is not a section", parts[..i].join("."))));
+        };
+        if i + 1 == parts.len() {
+            map.insert(Value::String((*part).into()), value);
+            return Ok(());
+        }
+        node = map
+            .entry(Value::String((*part).into()))
+            .or_insert_with(|| Value::Mapping(Default::default()));
+    }
+    unreachable!("the loop returns at the last part")
+}

@@ -1,0 +1,201 @@
+//! Configuration: one YAML format for everything, in the ROS 2
+//! parameter-file shape.
+//!
+//! ```yaml
+//! friction_node:            # the node name (or /**)
+//!   ros__parameters:
+//!     contact:
+//!       load_n: 20762.0
+//! ```
+//!
+//! Every key carries its SI unit in its name. Every default equals the
+//! paper's Tables A2–A4 and `MODEL.md` (they are taken from the physics
+//! core's `Default` impls, so there is one source of truth).
+//! `launch-config/default.yaml` documents every key; it is embedded in the
+//! binary and used when no `--config` is given.
+//!
+//! Unknown keys are rejected with their full dotted name; values outside
+//! their physical range are rejected with the key, the value and the range
+//! ([`Config::validate`]). Overrides `dotted.key=value` are applied to the
+//! YAML tree before it is read, so they are checked exactly like file keys.
+//!
+//! | file | content |
+//! |---|---|
+//! | `model.rs` | the model's sections (`contact`, `texture`, `lubricant`, `roughness`, `solver`) |
+//! | `io.rs` | the node's sections (`node`, `ros`, `iceoryx2`, `recording`) |
+//! | `load.rs` | parameter files, their ROS 2 shapes, `--set` overrides |
+//! | `validate.rs` | physical ranges and ROS 2 names, one function per section |
+//! | `error.rs` | [`ConfigError`] and the [`Origin`] of a configuration |
+
+mod error;
+mod io;
+mod load;
+mod model;
+mod validate;
+
+pub use error::{ConfigError, Origin};
+pub use io::*;
+pub use load::apply_override;
+pub use model::*;
+pub use validate::{check_namespace, check_node_name, check_topic, snapshot_bytes};
+
+use crate::physics::{
+    Contact, Geometry, Lubricant, Method, ModelParams, Pocket, Profile, ReferenceSettings,
+    Roughness, SolverSettings, TimeScheme,
+};
+use serde::{Deserialize, Serialize};
+use serde_norway::Value;
+
+/// The shipped default parameter file (also the documentation of every key).
+pub const DEFAULT_YAML: &str = include_str!("../../launch-config/default.yaml");
+
+/// Top-level keys accepted as the node entry of a parameter file.
+pub const DEFAULT_NODE_NAME: &str = "friction_node";
+
+/// The whole configuration (the `ros__parameters` mapping).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Config {
+    pub contact: ContactConfig,
+    pub texture: TextureConfig,
+    pub lubricant: LubricantConfig,
+    pub roughness: RoughnessConfig,
+    pub solver: SolverConfig,
+    pub drivetrain: DrivetrainConfig,
+    pub node: NodeConfig,
+    pub ros: RosConfig,
+    pub iceoryx2: Iceoryx2Config,
+    pub recording: RecordingConfig,
+}
+
+impl Config {
+    /// The physics core's parameters.
+    pub fn model(&self) -> ModelParams {
+        let c = &self.contact;
+        let t = &self.texture;
+        ModelParams {
+            geometry: Geometry {
+                length: c.length_m,
+                width: c.width_m,
+                profile: match c.profile {
+                    ProfileKind::Parabolic => Profile::Parabolic {
+                        depth: c.profile_depth_m,
+                    },
+                    ProfileKind::Linear => Profile::Linear {
+                        depth: c.profile_depth_m,
+                    },
+                    ProfileKind::Flat => Profile::Flat,
+                },
+                pockets: (0..t.pocket_start_m.len())
+                    .map(|i| Pocket {
+                        start: t.pocket_start_m[i],
+                        width: t.pocket_width_m[i],
+                        depth: t.pocket_depth_m[i],
+                    })
+                    .collect(),
+            },
+            lubricant: Lubricant {
+                viscosity: self.lubricant.viscosity_pa_s,
+                density: self.lubricant.density_kg_m3,
+                gas_viscosity: self.lubricant.gas_viscosity_pa_s,
+                gas_density: self.lubricant.gas_density_kg_m3,
+                ambient_pressure: self.lubricant.ambient_pressure_pa,
+                saturation_pressure: self.lubricant.saturation_pressure_pa,
+                vapour_pressure: self.lubricant.vapour_pressure_pa,
+                vapour_fraction_saturation: self.lubricant.vapour_fraction_at_saturation,
+                vapour_fraction_vapour: self.lubricant.vapour_fraction_at_vapour_pressure,
+            },
+            roughness: Roughness {
+                sigma: self.roughness.sigma_m,
+                asperity_density: self.roughness.asperity_density_per_m2,
+                asperity_radius: self.roughness.asperity_radius_m,
+                effective_modulus: self.roughness.effective_modulus_pa,
+                flow_factors: self.roughness.flow_factors,
+                lay_gamma: self.roughness.lay_gamma,
+            },
+            drivetrain: crate::physics::Drivetrain {
+                coulomb: self.drivetrain.coulomb_n,
+                viscous: self.drivetrain.viscous_n_s_m,
+                load_coefficient: self.drivetrain.load_coefficient,
+            },
+            contact: Contact {
+                mass: c.mass_kg,
+                boundary_friction: c.boundary_friction,
+                sign_regularization: c.sign_regularization_m_s,
+                min_film: c.min_film_m,
+            },
+        }
+    }
+
+    /// How the liquid's viscosity follows the temperature.
+    pub fn viscosity_model(&self) -> crate::physics::ViscosityModel {
+        match self.lubricant.viscosity_model {
+            ViscosityModelKind::Constant => crate::physics::ViscosityModel::Constant,
+            ViscosityModelKind::Vogel => {
+                crate::physics::ViscosityModel::Vogel(crate::physics::VogelModel {
+                    b_c: self.lubricant.vogel_b_c,
+                    c_c: self.lubricant.vogel_c_c,
+                })
+            }
+        }
+    }
+
+    /// The liquid's viscosity at `t_c` °C, Pa·s.
+    pub fn viscosity_at(&self, t_c: f64) -> f64 {
+        self.viscosity_model().viscosity(
+            self.lubricant.viscosity_pa_s,
+            self.lubricant.reference_temperature_c,
+            t_c,
+        )
+    }
+
+    /// The solver's settings.
+    pub fn solver_settings(&self) -> SolverSettings {
+        let s = &self.solver;
+        let r = &s.reference;
+        SolverSettings {
+            cells: s.cells,
+            dt: s.dt_s,
+            method: match s.method {
+                MethodKind::Newton => Method::Newton,
+                MethodKind::Reference => Method::Reference,
+            },
+            scheme: match s.scheme {
+                SchemeKind::Bdf2 => TimeScheme::Bdf2,
+                SchemeKind::Theta => TimeScheme::Theta {
+                    theta1: s.theta1,
+                    theta2: s.theta2,
+                },
+            },
+            tolerance: s.tolerance,
+            max_iterations: s.max_iterations,
+            reference: ReferenceSettings {
+                fluid_relaxation: r.fluid_relaxation,
+                fluid_relaxation_min: r.fluid_relaxation_min,
+                max_fluid_iterations: r.max_fluid_iterations,
+                fluid_tolerance: r.fluid_tolerance,
+                motion_relaxation: r.motion_relaxation,
+                max_motion_iterations: r.max_motion_iterations,
+                motion_tolerance: r.motion_tolerance,
+            },
+        }
+    }
+
+    /// The resolved configuration as a ROS 2 parameter file.
+    pub fn to_yaml(&self) -> String {
+        let mut root = serde_norway::Mapping::new();
+        let mut node = serde_norway::Mapping::new();
+        node.insert(
+            Value::String("ros__parameters".into()),
+            serde_norway::to_value(self).expect("config serializes"),
+        );
+        root.insert(
+            Value::String(DEFAULT_NODE_NAME.into()),
+            Value::Mapping(node),
+        );
+        serde_norway::to_string(&Value::Mapping(root)).expect("config serializes")
+    }
+}
+
+#[cfg(test)]
+mod tests;

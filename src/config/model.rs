@@ -1,0 +1,243 @@
+//! The model's sections of the configuration: `contact`, `texture`,
+//! `lubricant`, `roughness`, `solver`. Every default comes from the physics
+//! core's `Default` impls (one source of truth); units are in the key names.
+
+use crate::physics::{
+    Contact, Geometry, Lubricant, Profile, ReferenceSettings, Roughness, SolverSettings, TimeScheme,
+};
+use serde::{Deserialize, Serialize};
+
+/// `contact.*`: slider geometry, mass, load and boundary friction.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ContactConfig {
+    pub length_m: f64,
+    pub width_m: f64,
+    pub mass_kg: f64,
+    pub load_n: f64,
+    pub profile: ProfileKind,
+    pub profile_depth_m: f64,
+    pub boundary_friction: f64,
+    pub sign_regularization_m_s: f64,
+    pub min_film_m: f64,
+}
+
+/// Shape of the global profile.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ProfileKind {
+    Parabolic,
+    Linear,
+    Flat,
+}
+
+/// The paper's load for the reciprocating studies (Table A4 says 5 kN, the
+/// figures use the text's 20 762 N; MODEL.md §8 decides for the text).
+pub const DEFAULT_LOAD_N: f64 = 20_762.0;
+
+impl Default for ContactConfig {
+    fn default() -> Self {
+        let g = Geometry::default();
+        let c = Contact::default();
+        let (profile, depth) = match g.profile {
+            Profile::Parabolic { depth } => (ProfileKind::Parabolic, depth),
+            Profile::Linear { depth } => (ProfileKind::Linear, depth),
+            Profile::Flat => (ProfileKind::Flat, 0.0),
+        };
+        Self {
+            length_m: g.length,
+            width_m: g.width,
+            mass_kg: c.mass,
+            load_n: DEFAULT_LOAD_N,
+            profile,
+            profile_depth_m: depth,
+            boundary_friction: c.boundary_friction,
+            sign_regularization_m_s: c.sign_regularization,
+            min_film_m: c.min_film,
+        }
+    }
+}
+
+/// `texture.*`: rectangular pockets as parallel arrays (ROS 2 parameters
+/// cannot hold lists of structs).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct TextureConfig {
+    pub pocket_start_m: Vec<f64>,
+    pub pocket_width_m: Vec<f64>,
+    pub pocket_depth_m: Vec<f64>,
+}
+
+/// `lubricant.*`: liquid, gas and the cavitation equation of state.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct LubricantConfig {
+    pub viscosity_pa_s: f64,
+    /// The temperature at which `viscosity_pa_s` holds, °C (with a constant
+    /// viscosity it only labels the estimates).
+    pub reference_temperature_c: f64,
+    /// How the viscosity follows the temperature input.
+    pub viscosity_model: ViscosityModelKind,
+    /// Vogel's B, °C (K): μ = A exp(B / (T − C)).
+    pub vogel_b_c: f64,
+    /// Vogel's C, °C.
+    pub vogel_c_c: f64,
+    pub density_kg_m3: f64,
+    pub gas_viscosity_pa_s: f64,
+    pub gas_density_kg_m3: f64,
+    pub ambient_pressure_pa: f64,
+    pub saturation_pressure_pa: f64,
+    pub vapour_pressure_pa: f64,
+    pub vapour_fraction_at_saturation: f64,
+    pub vapour_fraction_at_vapour_pressure: f64,
+}
+
+impl Default for LubricantConfig {
+    fn default() -> Self {
+        let l = Lubricant::default();
+        Self {
+            viscosity_pa_s: l.viscosity,
+            reference_temperature_c: 40.0,
+            viscosity_model: ViscosityModelKind::Constant,
+            // SAE 30 (see physics::viscosity::VogelModel::SAE).
+            vogel_b_c: 970.6,
+            vogel_c_c: -96.0,
+            density_kg_m3: l.density,
+            gas_viscosity_pa_s: l.gas_viscosity,
+            gas_density_kg_m3: l.gas_density,
+            ambient_pressure_pa: l.ambient_pressure,
+            saturation_pressure_pa: l.saturation_pressure,
+            vapour_pressure_pa: l.vapour_pressure,
+            vapour_fraction_at_saturation: l.vapour_fraction_saturation,
+            vapour_fraction_at_vapour_pressure: l.vapour_fraction_vapour,
+        }
+    }
+}
+
+/// `lubricant.viscosity_model`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ViscosityModelKind {
+    /// `viscosity_pa_s` at every temperature.
+    Constant,
+    /// Vogel's equation through `viscosity_pa_s` at `reference_temperature_c`.
+    Vogel,
+}
+
+/// `drivetrain.*`: losses beside the contact, added to its friction (all
+/// zero by default).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct DrivetrainConfig {
+    /// Constant friction, signed with the velocity, N.
+    pub coulomb_n: f64,
+    /// Friction proportional to the velocity, N·s/m.
+    pub viscous_n_s_m: f64,
+    /// Friction proportional to the normal load (rolling elements).
+    pub load_coefficient: f64,
+}
+
+/// `roughness.*`: GW contact and flow factors.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RoughnessConfig {
+    pub sigma_m: f64,
+    pub asperity_density_per_m2: f64,
+    pub asperity_radius_m: f64,
+    pub effective_modulus_pa: f64,
+    pub flow_factors: bool,
+    pub lay_gamma: f64,
+}
+
+impl Default for RoughnessConfig {
+    fn default() -> Self {
+        let r = Roughness::default();
+        Self {
+            sigma_m: r.sigma,
+            asperity_density_per_m2: r.asperity_density,
+            asperity_radius_m: r.asperity_radius,
+            effective_modulus_pa: r.effective_modulus,
+            flow_factors: r.flow_factors,
+            lay_gamma: r.lay_gamma,
+        }
+    }
+}
+
+/// `solver.method`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum MethodKind {
+    Newton,
+    Reference,
+}
+
+/// `solver.scheme`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SchemeKind {
+    Bdf2,
+    Theta,
+}
+
+/// `solver.*`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SolverConfig {
+    pub cells: usize,
+    pub dt_s: f64,
+    pub method: MethodKind,
+    pub scheme: SchemeKind,
+    pub theta1: f64,
+    pub theta2: f64,
+    pub tolerance: f64,
+    pub max_iterations: u32,
+    pub reference: ReferenceConfig,
+}
+
+impl Default for SolverConfig {
+    fn default() -> Self {
+        let s = SolverSettings::default();
+        let TimeScheme::Theta { theta1, theta2 } = TimeScheme::PAPER else {
+            unreachable!()
+        };
+        Self {
+            cells: s.cells,
+            dt_s: s.dt,
+            method: MethodKind::Newton,
+            scheme: SchemeKind::Bdf2,
+            theta1,
+            theta2,
+            tolerance: s.tolerance,
+            max_iterations: s.max_iterations,
+            reference: ReferenceConfig::default(),
+        }
+    }
+}
+
+/// `solver.reference.*`: the paper's Algorithm 1.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ReferenceConfig {
+    pub fluid_relaxation: f64,
+    pub fluid_relaxation_min: f64,
+    pub max_fluid_iterations: u32,
+    pub fluid_tolerance: f64,
+    pub motion_relaxation: f64,
+    pub max_motion_iterations: u32,
+    pub motion_tolerance: f64,
+}
+
+impl Default for ReferenceConfig {
+    fn default() -> Self {
+        let r = ReferenceSettings::default();
+        Self {
+            fluid_relaxation: r.fluid_relaxation,
+            fluid_relaxation_min: r.fluid_relaxation_min,
+            max_fluid_iterations: r.max_fluid_iterations,
+            fluid_tolerance: r.fluid_tolerance,
+            motion_relaxation: r.motion_relaxation,
+            max_motion_iterations: r.max_motion_iterations,
+            motion_tolerance: r.motion_tolerance,
+        }
+    }
+}

@@ -1,0 +1,170 @@
+//! Topics of a bag as a measurement table.
+//!
+//! The friction samples set the grid (they are the measurement); the
+//! velocity is interpolated linearly at their stamps (samples outside the
+//! velocity's span are dropped), the load and the temperature are held
+//! (the latest value at or before the stamp; the first one before it).
+//! Columns: `t_s` (from the first friction sample), `velocity_m_s`,
+//! `friction_n`, and `load_n`, `temperature_c` when their topics are given.
+
+use super::table::Table;
+use super::FitError;
+use crate::bag::{read_topics, Bag, BagError, SampleKind, TopicDecoder};
+use std::path::Path;
+
+/// Which topics hold what.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct BagTopics {
+    pub velocity: String,
+    /// `std_msgs/msg/Float64`, or `sensor_msgs/msg/JointState` effort.
+    pub friction: String,
+    /// The joint of JointState topics (optional when there is one).
+    pub joint: Option<String>,
+    /// `std_msgs/msg/Float64`, N.
+    pub load: Option<String>,
+    /// `sensor_msgs/msg/Temperature`, °C.
+    pub temperature: Option<String>,
+}
+
+fn friction_kind(schema: &str, joint: Option<&str>) -> Option<SampleKind> {
+    match schema {
+        "std_msgs/msg/Float64" => Some(SampleKind::Float64),
+        "sensor_msgs/msg/JointState" => Some(SampleKind::JointEffort(
+            joint.unwrap_or_default().to_string(),
+        )),
+        _ => None,
+    }
+}
+
+fn held(samples: &[(u64, f64)], stamp: u64, j: &mut usize) -> f64 {
+    while *j + 1 < samples.len() && samples[*j + 1].0 <= stamp {
+        *j += 1;
+    }
+    samples[*j].1
+}
+
+/// Read the topics of `path` into a table; the second value notes damage
+/// (reading stopped there; the table holds what came before).
+pub fn read(path: &Path, topics: &BagTopics) -> Result<(Table, Option<String>), FitError> {
+    let bag = Bag::open(path)?;
+    let scan = bag.scan()?;
+    let joint = topics.joint.as_deref();
+    let vc = scan.require(&topics.velocity)?;
+    let vkind = SampleKind::velocity_for(&vc.schema_name, joint).ok_or_else(|| {
+        BagError::UnsupportedType {
+            topic: vc.topic.clone(),
+            type_name: vc.schema_name.clone(),
+            expected: crate::bag::decode::VELOCITY_TYPES.into(),
+        }
+    })?;
+    let fc = scan.require(&topics.friction)?;
+    let fkind = friction_kind(&fc.schema_name, joint).ok_or_else(|| BagError::UnsupportedType {
+        topic: fc.topic.clone(),
+        type_name: fc.schema_name.clone(),
+        expected: "std_msgs/msg/Float64 or sensor_msgs/msg/JointState (effort)".into(),
+    })?;
+    let mut decoders = vec![TopicDecoder::new(vc, vkind)?, TopicDecoder::new(fc, fkind)?];
+    if let Some(l) = &topics.load {
+        decoders.push(TopicDecoder::new(scan.require(l)?, SampleKind::Float64)?);
+    }
+    if let Some(t) = &topics.temperature {
+        decoders.push(TopicDecoder::new(
+            scan.require(t)?,
+            SampleKind::Temperature,
+        )?);
+    }
+    let mut read = read_topics(&bag, &mut decoders)?;
+    for s in &mut read.samples {
+        s.sort_by_key(|x| x.0);
+    }
+    let names = ["velocity", "friction", "load", "temperature"];
+    let given = [
+        Some(&topics.velocity),
+        Some(&topics.friction),
+        topics.load.as_ref(),
+        topics.temperature.as_ref(),
+    ];
+    let mut k = 0;
+    for (name, topic) in names.iter().zip(given) {
+        if let Some(t) = topic {
+            if read.samples[k].is_empty() {
+                return Err(FitError::Data {
+                    what: format!("{} ({name} topic `{t}`)", path.display()),
+                    message: "no message could be read".into(),
+                });
+            }
+            k += 1;
+        }
+    }
+    let vel = &read.samples[0];
+    let (v_first, v_last) = (vel[0].0, vel[vel.len() - 1].0);
+    let grid: Vec<(u64, f64)> = read.samples[1]
+        .iter()
+        .copied()
+        .filter(|(s, _)| (v_first..=v_last).contains(s))
+        .collect();
+    let Some(&(t0, _)) = grid.first() else {
+        return Err(FitError::Data {
+            what: path.display().to_string(),
+            message: format!(
+                "no friction sample on `{}` lies within the span of the velocity on `{}`",
+                topics.friction, topics.velocity
+            ),
+        });
+    };
+    let mut columns: Vec<Vec<f64>> = (0..3).map(|_| Vec::with_capacity(grid.len())).collect();
+    let mut j = 0usize;
+    for &(stamp, f) in &grid {
+        while j + 2 < vel.len() && vel[j + 1].0 <= stamp {
+            j += 1;
+        }
+        let v = if vel.len() == 1 {
+            vel[0].1
+        } else {
+            let (a, b) = (vel[j], vel[j + 1]);
+            let w = if b.0 > a.0 {
+                (stamp.saturating_sub(a.0)) as f64 / (b.0 - a.0) as f64
+            } else {
+                1.0
+            };
+            a.1 + w.clamp(0.0, 1.0) * (b.1 - a.1)
+        };
+        columns[0].push((stamp - t0) as f64 / 1e9);
+        columns[1].push(v);
+        columns[2].push(f);
+    }
+    let mut names = vec![
+        "t_s".to_string(),
+        "velocity_m_s".into(),
+        "friction_n".into(),
+    ];
+    for (k, name) in [(2usize, "load_n"), (3, "temperature_c")] {
+        let present = if k == 2 {
+            topics.load.is_some()
+        } else {
+            topics.temperature.is_some()
+        };
+        if present {
+            let idx = if k == 3 && topics.load.is_none() {
+                2
+            } else {
+                k
+            };
+            let s = &read.samples[idx];
+            let mut j = 0;
+            columns.push(grid.iter().map(|(st, _)| held(s, *st, &mut j)).collect());
+            names.push(name.into());
+        }
+    }
+    let note = read
+        .damage
+        .map(|d| format!("{}: reading stopped {d}", path.display()));
+    Ok((
+        Table {
+            source: path.to_path_buf(),
+            names,
+            columns,
+        },
+        note,
+    ))
+}

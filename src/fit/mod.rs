@@ -1,0 +1,88 @@
+//! Calibration: fit the model's unknowns (any numeric configuration key,
+//! and the coefficients of the input maps) to recorded friction, and fit
+//! the classic models (Coulomb + viscous, Stribeck, LuGre) to the same data
+//! with the same optimiser, so that the comparison is honest.
+//!
+//! The method is bounded nonlinear least squares on the friction residual
+//! r_k = F_model(t_k; p) − F_measured(t_k):
+//!
+//! | step | how |
+//! |---|---|
+//! | scaling | each parameter on its log scale (positive bounds) or linear scale, mapped to an unbounded variable by the sine transform s = lo + (hi − lo)(1 + sin u)/2 |
+//! | global phase | a seeded Latin-hypercube set of starts over the scaled bounds, each scored by one simulation |
+//! | local phase | Levenberg–Marquardt (MINPACK, `levenberg-marquardt` on nalgebra) from the given start and the best distinct global starts; Jacobian by forward differences of whole simulations, run in parallel |
+//! | statistics | standard errors s²(JᵀJ)⁻¹ and correlations from the Jacobian in scaled coordinates at the optimum; flags at bounds and for |corr| > 0.95 |
+//!
+//! Transient data are simulated from the steady state of the first sample
+//! (as `simulate` does), on the solver's fixed step, with the inputs
+//! interpolated linearly between samples and the friction read at the sample
+//! times; steady curves are solved point by point with the steady solver.
+//!
+//! | file | content |
+//! |---|---|
+//! | `table.rs` | CSV tables (header or `--columns`, any separator) |
+//! | `series.rs` | column expressions and maps → the model's inputs |
+//! | `bag_input.rs` | topics of a bag → a table |
+//! | `params.rs` | fitted parameters: bounds, scales, configuration keys |
+//! | `physics_model.rs` | our model as a predictor (transient and steady) |
+//! | `baselines.rs` | Coulomb + viscous, Stribeck, LuGre |
+//! | `problem.rs` | residuals, the parallel Jacobian, the LM run |
+//! | `search.rs` | the global phase and the distinct optima |
+//! | `stats.rs` | standard errors, correlations, flags |
+//! | `report.rs` | the summary, the tables, plots, the fitted YAML |
+
+#[cfg(feature = "mcap")]
+pub mod bag_input;
+pub mod baselines;
+pub mod params;
+pub mod physics_model;
+pub mod problem;
+pub mod report;
+pub mod search;
+pub mod series;
+pub mod stats;
+pub mod table;
+
+pub use baselines::{Baseline, BaselineKind};
+pub use params::{ParamSpec, Parameter};
+pub use physics_model::PhysicsModel;
+pub use problem::{Data, FitOutcome, Model, Options};
+pub use series::{Mapping, Series, Source};
+pub use table::{Delimiter, Table};
+
+use std::path::PathBuf;
+
+/// Errors of calibration: inputs, keys, bounds and data. A fit that does
+/// not converge is not an error (it is an outcome with a status).
+#[derive(Debug, thiserror::Error)]
+pub enum FitError {
+    #[error("cannot read {}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{}, line {line}: {message}", path.display())]
+    Table {
+        path: PathBuf,
+        line: usize,
+        message: String,
+    },
+    #[error("{what} `{text}`: {message}")]
+    Expression {
+        what: String,
+        text: String,
+        message: String,
+    },
+    #[error("{what}: {message}")]
+    Data { what: String, message: String },
+    #[error("--fit {key}: {message}")]
+    Key { key: String, message: String },
+    #[error("--bounds {key}: {message}")]
+    Bounds { key: String, message: String },
+    #[error(transparent)]
+    Config(#[from] crate::config::ConfigError),
+    #[cfg(feature = "mcap")]
+    #[error(transparent)]
+    Bag(#[from] crate::bag::BagError),
+}

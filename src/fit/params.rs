@@ -1,0 +1,394 @@
+//! Fitted parameters: their bounds, their scale and how they reach the
+//! configuration.
+//!
+//! A parameter is a numeric configuration key (`roughness.sigma_m`, any
+//! key of the parameter file whose value is a real number) or a map
+//! coefficient of the input expressions (`k` in `--load 'k * p_bar'`). The
+//! optimiser works on the scaled value s: ln p when both bounds are
+//! positive (a positive physical quantity is fitted in relative terms),
+//! p otherwise; and on an unbounded u with s = lo + (hi − lo)(1 + sin u)/2.
+
+use super::FitError;
+use crate::config::{Config, ConfigError};
+use serde_norway::Value;
+
+/// What the command line asked for one fitted parameter.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ParamSpec {
+    pub name: String,
+    /// `--bounds NAME=LO:HI`.
+    pub bounds: Option<(f64, f64)>,
+    /// `--start NAME=VALUE` (default: the configuration's value, or the
+    /// map coefficient's `--map` value).
+    pub start: Option<f64>,
+}
+
+/// One fitted parameter.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Parameter {
+    pub name: String,
+    pub start: f64,
+    pub lo: f64,
+    pub hi: f64,
+    /// Fitted on ln p.
+    pub log: bool,
+}
+
+/// A start this close to a bound (as a fraction of the scaled range) is
+/// moved inside: the sine transform is stationary at its bounds.
+const START_MARGIN: f64 = 0.02;
+
+impl Parameter {
+    /// A parameter on `[lo, hi]`, on the log scale when `lo > 0`.
+    pub fn new(name: &str, start: f64, lo: f64, hi: f64) -> Self {
+        Self {
+            name: name.to_string(),
+            start,
+            lo,
+            hi,
+            log: lo > 0.0,
+        }
+    }
+
+    pub fn scaled(&self, p: f64) -> f64 {
+        if self.log {
+            p.ln()
+        } else {
+            p
+        }
+    }
+
+    pub fn unscaled(&self, s: f64) -> f64 {
+        if self.log {
+            s.exp()
+        } else {
+            s
+        }
+    }
+
+    pub fn scaled_bounds(&self) -> (f64, f64) {
+        (self.scaled(self.lo), self.scaled(self.hi))
+    }
+
+    /// Position of `p` within the scaled bounds, 0 … 1.
+    pub fn fraction(&self, p: f64) -> f64 {
+        let (a, b) = self.scaled_bounds();
+        ((self.scaled(p) - a) / (b - a)).clamp(0.0, 1.0)
+    }
+
+    pub fn from_fraction(&self, f: f64) -> f64 {
+        let (a, b) = self.scaled_bounds();
+        self.unscaled(a + (b - a) * f.clamp(0.0, 1.0))
+            .clamp(self.lo, self.hi)
+    }
+
+    /// The unbounded variable of `p` (a start at a bound is moved inside).
+    pub fn to_internal(&self, p: f64) -> f64 {
+        let f = self.fraction(p).clamp(START_MARGIN, 1.0 - START_MARGIN);
+        (2.0 * f - 1.0).asin()
+    }
+
+    pub fn from_internal(&self, u: f64) -> f64 {
+        self.from_fraction(0.5 * (1.0 + u.sin()))
+    }
+
+    /// Whether `p` sits at a bound (within 0.1 % of the scaled range).
+    pub fn at_bound(&self, p: f64) -> bool {
+        let f = self.fraction(p);
+        !(1e-3..=1.0 - 1e-3).contains(&f)
+    }
+}
+
+/// Scales of the data, for default bounds of terms that start at zero.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DataScale {
+    /// max |F|, N.
+    pub friction_n: f64,
+    /// max |v|, m/s.
+    pub velocity_m_s: f64,
+    /// Smallest load, N.
+    pub load_min_n: f64,
+}
+
+/// The configuration as a tree of keys, to read and set numeric keys by
+/// their dotted name.
+#[derive(Debug, Clone)]
+pub struct ConfigKeys {
+    tree: Value,
+}
+
+fn lookup<'a>(tree: &'a Value, key: &str) -> Option<&'a Value> {
+    key.split('.').try_fold(tree, |node, part| match node {
+        Value::Mapping(m) => m.get(part),
+        _ => None,
+    })
+}
+
+fn lookup_mut<'a>(tree: &'a mut Value, key: &str) -> Option<&'a mut Value> {
+    key.split('.').try_fold(tree, |node, part| match node {
+        Value::Mapping(m) => m.get_mut(part),
+        _ => None,
+    })
+}
+
+impl ConfigKeys {
+    pub fn new(config: &Config) -> Self {
+        Self {
+            tree: serde_norway::to_value(config).expect("a configuration serializes"),
+        }
+    }
+
+    /// The value of a real-valued key; names what is wrong otherwise.
+    pub fn value(&self, key: &str) -> Result<f64, FitError> {
+        let err = |message: String| FitError::Key {
+            key: key.to_string(),
+            message,
+        };
+        match lookup(&self.tree, key) {
+            None => Err(err(
+                "is not a key of the configuration (see launch-config/default.yaml)".into(),
+            )),
+            Some(Value::Number(n)) if n.is_f64() => Ok(n.as_f64().expect("f64")),
+            Some(Value::Number(n)) => Err(err(format!(
+                "is an integer setting ({n}), not a continuous parameter"
+            ))),
+            Some(Value::Mapping(_)) => Err(err("is a section, not a number".into())),
+            Some(v) => Err(err(format!(
+                "is not numeric (its value is {})",
+                serde_norway::to_string(v).unwrap_or_default().trim()
+            ))),
+        }
+    }
+
+    /// The configuration with `keys` set to `values`, validated.
+    pub fn with(&self, keys: &[String], values: &[f64]) -> Result<Config, ConfigError> {
+        let mut tree = self.tree.clone();
+        for (k, v) in keys.iter().zip(values) {
+            if let Some(slot) = lookup_mut(&mut tree, k) {
+                *slot = Value::Number((*v).into());
+            }
+        }
+        let config: Config =
+            serde_norway::from_value(tree).map_err(|e| ConfigError::InvalidValue {
+                key: keys.join(","),
+                message: e.to_string(),
+            })?;
+        config.validate()?;
+        Ok(config)
+    }
+
+    fn valid(&self, key: &str, v: f64) -> Result<(), ConfigError> {
+        self.with(&[key.to_string()], &[v]).map(|_| ())
+    }
+
+    /// Resolve a `--fit` key: its start, its bounds (given, checked against
+    /// the key's valid range, or a decade either side of the start, shrunk
+    /// into the valid range), its scale.
+    pub fn parameter(&self, spec: &ParamSpec, scale: &DataScale) -> Result<Parameter, FitError> {
+        let key = spec.name.as_str();
+        let current = self.value(key)?;
+        let start = spec.start.unwrap_or(current);
+        let (lo, hi) = match spec.bounds {
+            Some((lo, hi)) => {
+                check_bounds(key, lo, hi)?;
+                for v in [lo, hi] {
+                    self.valid(key, v).map_err(|e| FitError::Bounds {
+                        key: key.into(),
+                        message: format!("{v} is outside the key's valid range: {e}"),
+                    })?;
+                }
+                (lo, hi)
+            }
+            None => self.default_bounds(key, start, scale)?,
+        };
+        if let Some(s) = spec.start {
+            self.valid(key, s).map_err(|e| FitError::Key {
+                key: key.into(),
+                message: format!("--start {s} is not valid: {e}"),
+            })?;
+        }
+        if !(lo..=hi).contains(&start) {
+            return Err(FitError::Bounds {
+                key: key.into(),
+                message: format!("the start {start} lies outside [{lo}, {hi}]"),
+            });
+        }
+        Ok(Parameter::new(key, start, lo, hi))
+    }
+
+    fn default_bounds(
+        &self,
+        key: &str,
+        start: f64,
+        scale: &DataScale,
+    ) -> Result<(f64, f64), FitError> {
+        if start > 0.0 {
+            let shrink = |factor: f64| -> f64 {
+                // start·factor^(2^-k), the first that is valid.
+                let mut f = factor;
+                for _ in 0..30 {
+                    if self.valid(key, start * f).is_ok() {
+                        return start * f;
+                    }
+                    f = f.sqrt();
+                }
+                start
+            };
+            let (lo, hi) = (shrink(0.1), shrink(10.0));
+            if lo < hi {
+                return Ok((lo, hi));
+            }
+        }
+        // Terms that are off by default: bounds from the data's scales.
+        let s = scale;
+        let hi = match key {
+            "drivetrain.coulomb_n" => Some(2.0 * s.friction_n),
+            "drivetrain.viscous_n_s_m" => Some(2.0 * s.friction_n / s.velocity_m_s.max(1e-9)),
+            "drivetrain.load_coefficient" => {
+                Some((2.0 * s.friction_n / s.load_min_n.max(1e-9)).min(10.0))
+            }
+            _ => None,
+        };
+        match hi {
+            Some(h) if h > 0.0 && h.is_finite() => Ok((0.0, h)),
+            _ => Err(FitError::Bounds {
+                key: key.into(),
+                message: format!("starts at {start}: give its range with --bounds {key}=LO:HI"),
+            }),
+        }
+    }
+}
+
+/// Bounds must be finite and increasing.
+pub fn check_bounds(key: &str, lo: f64, hi: f64) -> Result<(), FitError> {
+    if !(lo.is_finite() && hi.is_finite()) {
+        return Err(FitError::Bounds {
+            key: key.into(),
+            message: format!("{lo}:{hi} must be finite numbers"),
+        });
+    }
+    if lo >= hi {
+        return Err(FitError::Bounds {
+            key: key.into(),
+            message: format!("{lo}:{hi} is inverted or empty (LO must be below HI)"),
+        });
+    }
+    Ok(())
+}
+
+/// A map coefficient as a fitted parameter: `--bounds` or, for a positive
+/// start, a decade either side.
+pub fn map_parameter(spec: &ParamSpec, map_start: f64) -> Result<Parameter, FitError> {
+    let key = spec.name.as_str();
+    let start = spec.start.unwrap_or(map_start);
+    let (lo, hi) = match spec.bounds {
+        Some((lo, hi)) => {
+            check_bounds(key, lo, hi)?;
+            (lo, hi)
+        }
+        None if start > 0.0 => (start / 10.0, start * 10.0),
+        None => {
+            return Err(FitError::Bounds {
+                key: key.into(),
+                message: format!(
+                "the map coefficient starts at {start}: give its range with --bounds {key}=LO:HI"
+            ),
+            })
+        }
+    };
+    if !(lo..=hi).contains(&start) {
+        return Err(FitError::Bounds {
+            key: key.into(),
+            message: format!("the start {start} lies outside [{lo}, {hi}]"),
+        });
+    }
+    Ok(Parameter::new(key, start, lo, hi))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    const SCALE: DataScale = DataScale {
+        friction_n: 100.0,
+        velocity_m_s: 0.5,
+        load_min_n: 1000.0,
+    };
+
+    fn spec(name: &str) -> ParamSpec {
+        ParamSpec {
+            name: name.into(),
+            ..Default::default()
+        }
+    }
+
+    #[test]
+    fn the_sine_transform_round_trips_inside_the_bounds_on_the_log_scale() {
+        let p = Parameter::new("roughness.sigma_m", 5e-6, 5e-7, 5e-5);
+        assert!(p.log);
+        for v in [6e-7, 5e-6, 4e-5] {
+            assert_relative_eq!(p.from_internal(p.to_internal(v)), v, max_relative = 1e-12);
+        }
+        // The geometric middle is the middle of the scaled range.
+        assert_relative_eq!(p.fraction(5e-6), 0.5, epsilon = 1e-12);
+        assert!(p.at_bound(5e-7) && !p.at_bound(5e-6));
+        // Any u maps inside the bounds.
+        for u in [-100.0, -1.0, 0.0, 3.0, 1e6] {
+            let v = p.from_internal(u);
+            assert!((p.lo..=p.hi).contains(&v));
+        }
+    }
+
+    #[test]
+    fn keys_resolve_to_their_value_and_a_decade_either_side_inside_the_valid_range() {
+        let keys = ConfigKeys::new(&Config::default());
+        let p = keys.parameter(&spec("roughness.sigma_m"), &SCALE).unwrap();
+        assert_relative_eq!(p.start, 5e-6);
+        assert_relative_eq!(p.lo, 5e-7, max_relative = 1e-12);
+        assert_relative_eq!(p.hi, 5e-5, max_relative = 1e-12);
+        // boundary_friction 0.3: valid up to 2, so hi shrinks below 3.
+        let p = keys
+            .parameter(&spec("contact.boundary_friction"), &SCALE)
+            .unwrap();
+        assert!(p.hi <= 2.0 && p.hi > 0.3, "{p:?}");
+        // Drivetrain terms start at 0: bounds from the data.
+        let p = keys
+            .parameter(&spec("drivetrain.viscous_n_s_m"), &SCALE)
+            .unwrap();
+        assert_eq!((p.lo, p.hi, p.log), (0.0, 400.0, false));
+        let c = keys.with(&["roughness.sigma_m".into()], &[3.5e-6]).unwrap();
+        assert_eq!(c.roughness.sigma_m, 3.5e-6);
+    }
+
+    #[test]
+    fn bad_keys_and_bounds_are_named() {
+        let keys = ConfigKeys::new(&Config::default());
+        let e = |s: ParamSpec| keys.parameter(&s, &SCALE).unwrap_err().to_string();
+        assert!(
+            e(spec("roughness.sigma")).contains("not a key"),
+            "{}",
+            e(spec("roughness.sigma"))
+        );
+        assert!(e(spec("solver.cells")).contains("integer"));
+        assert!(e(spec("contact.profile")).contains("not numeric"));
+        assert!(e(spec("contact")).contains("section"));
+        let with = |lo, hi| ParamSpec {
+            bounds: Some((lo, hi)),
+            ..spec("contact.boundary_friction")
+        };
+        assert!(e(with(0.5, 0.1)).contains("inverted"));
+        let m = e(with(0.1, 3.0));
+        assert!(
+            m.contains("outside the key's valid range") && m.contains("[0, 2]"),
+            "{m}"
+        );
+        let m = e(ParamSpec {
+            start: Some(0.05),
+            ..with(0.1, 1.0)
+        });
+        assert!(m.contains("outside [0.1, 1]"), "{m}");
+        let m = map_parameter(&spec("c0"), 0.0).unwrap_err().to_string();
+        assert!(m.contains("--bounds c0=LO:HI"), "{m}");
+    }
+}

@@ -1,0 +1,224 @@
+//! Our model as a predictor: the configuration with the fitted keys set,
+//! run over a series.
+//!
+//! - A time series is simulated from the steady state of its first sample
+//!   (as `simulate` does) on the solver's fixed step `solver.dt_s`; the
+//!   inputs (velocity, load, temperature) are interpolated linearly between
+//!   samples, and the friction is read at the sample times by linear
+//!   interpolation between steps. With `lubricant.viscosity_model: vogel`
+//!   and a temperature the viscosity follows it every step.
+//! - A steady curve is solved point by point with the steady solver, each
+//!   point warm-started from the previous one.
+
+use super::params::{ConfigKeys, DataScale, ParamSpec, Parameter};
+use super::problem::Model;
+use super::series::Series;
+use super::FitError;
+use crate::config::Config;
+use crate::physics::{Solver, Status, ViscosityModel};
+
+/// The physics model with some configuration keys fitted.
+pub struct PhysicsModel {
+    keys: ConfigKeys,
+    names: Vec<String>,
+    params: Vec<Parameter>,
+}
+
+impl PhysicsModel {
+    /// `specs` must name real-valued keys of `base`.
+    pub fn new(base: &Config, specs: &[ParamSpec], scale: &DataScale) -> Result<Self, FitError> {
+        let keys = ConfigKeys::new(base);
+        let params = specs
+            .iter()
+            .map(|s| keys.parameter(s, scale))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Self {
+            names: params.iter().map(|p| p.name.clone()).collect(),
+            keys,
+            params,
+        })
+    }
+
+    /// Number of fitted configuration keys.
+    pub fn parameters_len(&self) -> usize {
+        self.params.len()
+    }
+
+    /// The configuration at parameter values `x`.
+    pub fn config(&self, x: &[f64]) -> Result<Config, crate::config::ConfigError> {
+        self.keys.with(&self.names, x)
+    }
+}
+
+impl Model for PhysicsModel {
+    fn label(&self) -> String {
+        "friction-node".into()
+    }
+
+    fn parameters(&self) -> &[Parameter] {
+        &self.params
+    }
+
+    fn predict(&self, x: &[f64], series: &Series) -> Result<Vec<f64>, String> {
+        let config = self.config(x).map_err(|e| e.to_string())?;
+        if series.steady {
+            steady(&config, series)
+        } else {
+            transient(&config, series)
+        }
+    }
+}
+
+/// Linear interpolation in a sampled signal with a moving cursor (times
+/// are asked in increasing order).
+struct Cursor<'a> {
+    t: &'a [f64],
+    y: &'a [f64],
+    j: usize,
+}
+
+impl<'a> Cursor<'a> {
+    fn new(t: &'a [f64], y: &'a [f64]) -> Self {
+        Self { t, y, j: 0 }
+    }
+
+    fn at(&mut self, t: f64) -> f64 {
+        let n = self.t.len();
+        while self.j + 2 < n && self.t[self.j + 1] <= t {
+            self.j += 1;
+        }
+        let (t0, t1) = (self.t[self.j], self.t[self.j + 1]);
+        let w = ((t - t0) / (t1 - t0)).clamp(0.0, 1.0);
+        self.y[self.j] + w * (self.y[self.j + 1] - self.y[self.j])
+    }
+}
+
+fn follows_temperature(config: &Config, s: &Series) -> bool {
+    s.temperature.is_some() && config.viscosity_model() != ViscosityModel::Constant
+}
+
+fn transient(config: &Config, s: &Series) -> Result<Vec<f64>, String> {
+    let settings = config.solver_settings();
+    let dt = settings.dt;
+    let mut solver = Solver::new(&config.model(), &settings).map_err(|e| e.to_string())?;
+    let n = s.len();
+    let t0 = s.t[0];
+    let steps = ((s.t[n - 1] - t0) / dt).ceil() as u64;
+    let default_load = vec![config.contact.load_n; n];
+    let load = s.load.as_deref().unwrap_or(&default_load);
+    let follows = follows_temperature(config, s);
+    let mut v_at = Cursor::new(&s.t, &s.velocity);
+    let mut f_at = Cursor::new(&s.t, load);
+    let mut temp_at = s.temperature.as_deref().map(|y| Cursor::new(&s.t, y));
+    if follows {
+        let temp = temp_at.as_mut().expect("follows").at(t0);
+        solver.set_liquid_viscosity(config.viscosity_at(temp));
+    }
+    let first = solver.initialize_steady(v_at.at(t0), f_at.at(t0));
+    let mut out = vec![f64::NAN; n];
+    out[0] = first.friction_force;
+    let (mut t_prev, mut f_prev) = (t0, first.friction_force);
+    let mut k = 1;
+    for step in 1..=steps {
+        let t = t0 + step as f64 * dt;
+        if follows {
+            let temp = temp_at.as_mut().expect("follows").at(t);
+            solver.set_liquid_viscosity(config.viscosity_at(temp));
+        }
+        let e = solver.step(v_at.at(t), f_at.at(t));
+        if !e.friction_force.is_finite()
+            || !matches!(e.status, Status::Converged | Status::MaxIterations)
+        {
+            return Err(format!(
+                "the step at t = {t:.4} s ended {} ({} iterations)",
+                e.status.as_str(),
+                e.diagnostics.iterations
+            ));
+        }
+        while k < n && s.t[k] <= t + 1e-12 * dt {
+            let w = ((s.t[k] - t_prev) / (t - t_prev)).clamp(0.0, 1.0);
+            out[k] = f_prev + w * (e.friction_force - f_prev);
+            k += 1;
+        }
+        (t_prev, f_prev) = (t, e.friction_force);
+    }
+    for o in out.iter_mut().skip(k) {
+        *o = f_prev;
+    }
+    Ok(out)
+}
+
+fn steady(config: &Config, s: &Series) -> Result<Vec<f64>, String> {
+    let mut solver =
+        Solver::new(&config.model(), &config.solver_settings()).map_err(|e| e.to_string())?;
+    let follows = follows_temperature(config, s);
+    (0..s.len())
+        .map(|k| {
+            if follows {
+                let temp = s.temperature.as_ref().expect("follows")[k];
+                solver.set_liquid_viscosity(config.viscosity_at(temp));
+            }
+            let e = solver.steady(s.velocity[k], s.load_at(k, config.contact.load_n));
+            if e.status.is_converged() && e.friction_force.is_finite() {
+                Ok(e.friction_force)
+            } else {
+                Err(format!(
+                    "the steady state at v = {} m/s did not converge ({})",
+                    s.velocity[k],
+                    e.status.as_str()
+                ))
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    fn series(t: Vec<f64>, v: Vec<f64>, steady: bool) -> Series {
+        let n = t.len();
+        Series {
+            name: "s".into(),
+            steady,
+            friction: vec![0.0; n],
+            t,
+            velocity: v,
+            load: None,
+            temperature: None,
+            fit: vec![true; n],
+        }
+    }
+
+    #[test]
+    fn a_transient_prediction_on_the_step_grid_equals_the_solver_run_directly() {
+        let mut config = Config::default();
+        config.solver.cells = 64;
+        let t: Vec<f64> = (0..=200).map(|k| k as f64 * 1e-3).collect();
+        let v: Vec<f64> = t.iter().map(|t| 0.3 * (6.0 * t).sin() + 0.05).collect();
+        let s = series(t.clone(), v.clone(), false);
+        let got = transient(&config, &s).unwrap();
+        let mut solver = Solver::new(&config.model(), &config.solver_settings()).unwrap();
+        let first = solver.initialize_steady(v[0], config.contact.load_n);
+        assert_eq!(got[0], first.friction_force);
+        for k in 1..t.len() {
+            let e = solver.step(v[k], config.contact.load_n);
+            assert_relative_eq!(got[k], e.friction_force, max_relative = 1e-9);
+        }
+    }
+
+    #[test]
+    fn a_steady_prediction_is_the_steady_solver_point_by_point() {
+        let mut config = Config::default();
+        config.solver.cells = 64;
+        let v = vec![0.01, 0.1, 1.0];
+        let s = series(vec![0.0, 1.0, 2.0], v.clone(), true);
+        let got = steady(&config, &s).unwrap();
+        let mut solver = Solver::new(&config.model(), &config.solver_settings()).unwrap();
+        for (k, v) in v.iter().enumerate() {
+            let e = solver.steady(*v, config.contact.load_n);
+            assert_relative_eq!(got[k], e.friction_force, max_relative = 1e-9);
+        }
+    }
+}

@@ -1,0 +1,399 @@
+//! What a fit tells its user: the parameter table (standard errors, 95 %
+//! intervals, flags), correlations, the distinct optima, the residuals,
+//! the baselines table; `summary.md`, `fit.csv` and plots in a report
+//! directory; the fitted parameter file.
+
+use super::problem::{FitOutcome, SeriesFit};
+use super::stats::CORRELATION_FLAG;
+use crate::config::Config;
+use crate::output::{AtomicFile, OutputError};
+use crate::text::Num;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+fn g(v: f64) -> String {
+    if v.is_finite() {
+        format!("{v:.4e}")
+    } else {
+        format!("{v}")
+    }
+}
+
+/// Parameters: value, SE, 95 % interval, bounds, flags.
+pub fn parameter_table(o: &FitOutcome) -> String {
+    let mut s = String::from(
+        "| parameter | value | std. error | 95 % interval | bounds | flag |\n|---|---|---|---|---|---|\n",
+    );
+    for (j, p) in o.params.iter().enumerate() {
+        let st = &o.statistics;
+        let flag = if st.at_bound[j] {
+            "at a bound"
+        } else if !st.standard_error[j].is_finite() {
+            "not identifiable"
+        } else {
+            ""
+        };
+        let _ = writeln!(
+            s,
+            "| `{}` | {} | {} | [{}, {}] | [{}, {}]{} | {flag} |",
+            p.name,
+            g(o.best[j]),
+            g(st.standard_error[j]),
+            g(st.interval95[j].0),
+            g(st.interval95[j].1),
+            g(p.lo),
+            g(p.hi),
+            if p.log { " log" } else { "" },
+        );
+    }
+    s
+}
+
+/// The correlation matrix with pairs above the flag named.
+pub fn correlation_table(o: &FitOutcome) -> String {
+    let names: Vec<&str> = o.params.iter().map(|p| p.name.as_str()).collect();
+    let mut s = format!(
+        "| | {} |\n|---|{}\n",
+        names.join(" | "),
+        "---|".repeat(names.len())
+    );
+    for (i, row) in o.statistics.correlation.iter().enumerate() {
+        let cells: Vec<String> = row.iter().map(|r| format!("{r:+.3}")).collect();
+        let _ = writeln!(s, "| {} | {} |", names[i], cells.join(" | "));
+    }
+    let pairs = o.statistics.correlated_pairs();
+    if !pairs.is_empty() {
+        s.push('\n');
+        for (i, j, r) in pairs {
+            let _ = writeln!(
+                s,
+                "- `{}` and `{}` are correlated ({r:+.3}, |ρ| > {CORRELATION_FLAG}): these data do not separate them",
+                names[i], names[j]
+            );
+        }
+    }
+    if o.statistics.rank_deficient {
+        s.push_str("- JᵀJ is singular: some parameters do not change the residual at all\n");
+    }
+    s
+}
+
+/// The distinct optima, best first.
+pub fn optima_table(o: &FitOutcome) -> String {
+    let mut s = format!(
+        "| # | cost ½Σr² (N²) | {} | outcome |\n|---|---|{}---|\n",
+        o.params
+            .iter()
+            .map(|p| format!("`{}`", p.name))
+            .collect::<Vec<_>>()
+            .join(" | "),
+        "---|".repeat(o.params.len())
+    );
+    for (k, r) in o.optima.iter().take(3).enumerate() {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} |",
+            k + 1,
+            g(r.cost),
+            r.x.iter().map(|v| g(*v)).collect::<Vec<_>>().join(" | "),
+            r.termination
+        );
+    }
+    s
+}
+
+/// Residual summary lines.
+pub fn residual_lines(o: &FitOutcome) -> String {
+    let mut s = format!(
+        "training RMS {:.4} N, max |residual| {:.4} N (σ = {:.4} N)\n",
+        o.train_rms, o.train_max, o.statistics.sigma
+    );
+    if let Some(h) = o.holdout_rms {
+        let _ = writeln!(
+            s,
+            "held-out RMS {h:.4} N (held-out part of the training data)"
+        );
+    }
+    if let Some(v) = o.validate_rms {
+        let _ = writeln!(s, "validation RMS {v:.4} N (--validate data)");
+    }
+    let _ = writeln!(
+        s,
+        "{} simulations, {:.1} ms each on average, {:.1} s in all",
+        o.simulations,
+        1e3 * o.simulation_mean_s,
+        o.wall_s
+    );
+    s
+}
+
+/// One row of the baselines table.
+#[derive(Debug, Clone)]
+pub struct ModelRow {
+    pub label: String,
+    pub parameters: Vec<(String, f64)>,
+    pub train_rms: f64,
+    pub held_out_rms: Option<f64>,
+    pub converged: bool,
+}
+
+impl From<&FitOutcome> for ModelRow {
+    fn from(o: &FitOutcome) -> Self {
+        Self {
+            label: o.label.clone(),
+            parameters: o
+                .params
+                .iter()
+                .zip(&o.best)
+                .map(|(p, v)| (p.name.clone(), *v))
+                .collect(),
+            train_rms: o.train_rms,
+            held_out_rms: o.held_out_rms(),
+            converged: o.converged,
+        }
+    }
+}
+
+/// Model | parameters | training RMS | held-out RMS (relative to `floor_n`
+/// when given).
+pub fn models_table(rows: &[ModelRow], scale_n: f64) -> String {
+    let mut s = String::from(
+        "| model | n | parameters | training RMS (N) | held-out RMS (N) | held-out / friction scale |\n|---|---|---|---|---|---|\n",
+    );
+    for r in rows {
+        let params: Vec<String> = r
+            .parameters
+            .iter()
+            .map(|(n, v)| format!("{n}={}", Num(round4(*v))))
+            .collect();
+        let _ = writeln!(
+            s,
+            "| {}{} | {} | {} | {:.4} | {} | {} |",
+            r.label,
+            if r.converged { "" } else { " (not converged)" },
+            r.parameters.len(),
+            params.join(", "),
+            r.train_rms,
+            r.held_out_rms.map_or("–".into(), |h| format!("{h:.4}")),
+            r.held_out_rms
+                .map_or("–".into(), |h| format!("{:.1} %", 100.0 * h / scale_n)),
+        );
+    }
+    s
+}
+
+/// Four significant digits.
+fn round4(v: f64) -> f64 {
+    if v == 0.0 || !v.is_finite() {
+        return v;
+    }
+    let e = v.abs().log10().floor() as i32 - 3;
+    let m = 10f64.powi(-e);
+    (v * m).round() / m
+}
+
+/// The fitted parameter file: the complete configuration, a header naming
+/// the fit, and the map coefficients (which are not configuration keys) as
+/// comments.
+pub fn fitted_yaml(
+    config: &Config,
+    o: &FitOutcome,
+    sources: &[String],
+    map: &[(String, f64)],
+) -> String {
+    let mut s = format!(
+        "# Fitted by friction-node fit on {}\n# {} — training RMS {:.4} N{}\n",
+        sources.join(", "),
+        if o.converged {
+            "converged"
+        } else {
+            "NOT CONVERGED: the best point found"
+        },
+        o.train_rms,
+        o.held_out_rms()
+            .map_or(String::new(), |h| format!(", held-out RMS {h:.4} N"))
+    );
+    for (j, p) in o.params.iter().enumerate() {
+        let _ = writeln!(
+            s,
+            "# {} = {} ± {}",
+            p.name,
+            Num(o.best[j]),
+            g(o.statistics.standard_error[j])
+        );
+    }
+    if !map.is_empty() {
+        s.push_str("# input map coefficients (not configuration keys):");
+        for (n, v) in map {
+            let _ = write!(s, " {n}={}", Num(*v));
+        }
+        s.push('\n');
+    }
+    s + &config.to_yaml()
+}
+
+/// `fit.csv`: every sample of every source with the prediction.
+fn write_samples(
+    path: &Path,
+    train: &[SeriesFit],
+    validate: &[SeriesFit],
+) -> Result<PathBuf, OutputError> {
+    let mut f = AtomicFile::create(path)?;
+    f.line(format_args!(
+        "source,role,t_s,velocity_m_s,load_n,measured_n,predicted_n,residual_n"
+    ))?;
+    for (fits, train) in [(train, true), (validate, false)] {
+        for sf in fits {
+            let s = &sf.series;
+            for k in 0..s.len() {
+                let role = match (train, s.fit[k]) {
+                    (true, true) => "fit",
+                    (true, false) => "held_out",
+                    _ => "validate",
+                };
+                f.line(format_args!(
+                    "{},{role},{},{},{},{},{},{}",
+                    s.name.replace(',', ";"),
+                    Num(s.t[k]),
+                    Num(s.velocity[k]),
+                    s.load
+                        .as_ref()
+                        .map_or(String::new(), |l| Num(l[k]).to_string()),
+                    Num(s.friction[k]),
+                    Num(sf.predicted[k]),
+                    Num(sf.predicted[k] - s.friction[k]),
+                ))?;
+            }
+        }
+    }
+    f.commit()
+}
+
+/// The whole markdown summary of one fit.
+pub fn summary(o: &FitOutcome, extra: &str) -> String {
+    format!(
+        "# Fit of {}: {}\n\n{}\n## Parameters\n\n{}\n## Correlations\n\n{}\n## Distinct optima (best first)\n\n{}\n{}",
+        o.label,
+        if o.converged { "converged" } else { "NOT converged (best point found)" },
+        residual_lines(o),
+        parameter_table(o),
+        correlation_table(o),
+        optima_table(o),
+        extra
+    )
+}
+
+/// Write `summary.md`, `fit.csv` and the plots into `dir` (which exists).
+pub fn write_report(dir: &Path, o: &FitOutcome, extra: &str) -> Result<Vec<PathBuf>, OutputError> {
+    let files = vec![
+        crate::output::write_file(&dir.join("summary.md"), summary(o, extra).as_bytes())?,
+        write_samples(&dir.join("fit.csv"), &o.train, &o.validate)?,
+    ];
+    #[cfg(feature = "plots")]
+    let files = [files, plots::write(dir, o)?].concat();
+    Ok(files)
+}
+
+#[cfg(feature = "plots")]
+mod plots {
+    use super::*;
+    use crate::plot::{figure, Axes, Line, Panel, COLORS};
+    use plotters::prelude::SeriesLabelPosition;
+
+    fn line(label: &str, c: usize, points: Vec<(f64, f64)>, dashed: bool) -> Line {
+        Line {
+            label: Some(label.into()),
+            points,
+            color: COLORS[c % COLORS.len()],
+            dashed,
+        }
+    }
+
+    fn panels(
+        fits: &[SeriesFit],
+        role: &str,
+        x: impl Fn(&SeriesFit, usize) -> f64,
+        resid: bool,
+    ) -> Vec<Panel> {
+        fits.iter()
+            .map(|f| {
+                let n = f.series.len();
+                let pts = |y: &dyn Fn(usize) -> f64| (0..n).map(|k| (x(f, k), y(k))).collect();
+                let name = Path::new(&f.series.name)
+                    .file_name()
+                    .map_or(f.series.name.clone(), |s| s.to_string_lossy().into_owned());
+                let lines = if resid {
+                    vec![line(
+                        "residual",
+                        2,
+                        pts(&|k| f.predicted[k] - f.series.friction[k]),
+                        false,
+                    )]
+                } else {
+                    vec![
+                        line("measured", 0, pts(&|k| f.series.friction[k]), false),
+                        line("model", 1, pts(&|k| f.predicted[k]), true),
+                    ]
+                };
+                Panel {
+                    title: format!("{name} ({role})"),
+                    lines,
+                }
+            })
+            .collect()
+    }
+
+    pub fn write(dir: &Path, o: &FitOutcome) -> Result<Vec<PathBuf>, OutputError> {
+        let ax = |x: &'static str, y: &'static str| Axes {
+            x,
+            y,
+            log_x: false,
+            log_y: false,
+            legend: SeriesLabelPosition::UpperRight,
+            legend_everywhere: true,
+        };
+        let mut all = panels(&o.train, "training", |f, k| f.series.t[k], false);
+        all.extend(panels(
+            &o.validate,
+            "validation",
+            |f, k| f.series.t[k],
+            false,
+        ));
+        let mut vel = panels(&o.train, "training", |f, k| f.series.velocity[k], false);
+        vel.extend(panels(
+            &o.validate,
+            "validation",
+            |f, k| f.series.velocity[k],
+            false,
+        ));
+        let mut res = panels(&o.train, "training", |f, k| f.series.t[k], true);
+        res.extend(panels(
+            &o.validate,
+            "validation",
+            |f, k| f.series.t[k],
+            true,
+        ));
+        let steady = o.train.iter().all(|f| f.series.steady);
+        let tx = if steady { "point" } else { "time (s)" };
+        Ok(vec![
+            figure(
+                &dir.join("friction_time.svg"),
+                &format!("{}: measured and fitted friction", o.label),
+                &all,
+                &ax(tx, "friction (N)"),
+            )?,
+            figure(
+                &dir.join("friction_velocity.svg"),
+                &format!("{}: friction against velocity", o.label),
+                &vel,
+                &ax("velocity (m/s)", "friction (N)"),
+            )?,
+            figure(
+                &dir.join("residual.svg"),
+                &format!("{}: residual (model − measured)", o.label),
+                &res,
+                &ax(tx, "residual (N)"),
+            )?,
+        ])
+    }
+}

@@ -1,0 +1,132 @@
+//! The global phase and the distinct optima.
+//!
+//! A seeded Latin hypercube over the scaled bounds (each parameter's range
+//! cut into as many strata as there are points, one point per stratum) is
+//! scored by one simulation per point, in parallel. Local runs start from
+//! the given start and from the best global points that are not close to a
+//! start already taken; their end points, sorted by cost and with
+//! near-duplicates merged, are the distinct optima.
+
+use super::problem::{local_run, LocalRun, Options, Problem};
+use rand::rngs::StdRng;
+use rand::seq::SliceRandom;
+use rand::{RngExt, SeedableRng};
+use rayon::prelude::*;
+
+/// `points` points in the unit cube of dimension `dims`, one per stratum of
+/// every coordinate.
+pub fn latin_hypercube(points: usize, dims: usize, seed: u64) -> Vec<Vec<f64>> {
+    let mut rng = StdRng::seed_from_u64(seed);
+    let mut out = vec![Vec::with_capacity(dims); points];
+    for _ in 0..dims {
+        let mut strata: Vec<usize> = (0..points).collect();
+        strata.shuffle(&mut rng);
+        for (point, s) in out.iter_mut().zip(strata) {
+            point.push((s as f64 + rng.random::<f64>()) / points as f64);
+        }
+    }
+    out
+}
+
+/// Largest per-parameter distance in fractions of the scaled ranges.
+fn distance(problem: &Problem<'_>, a: &[f64], b: &[f64]) -> f64 {
+    problem
+        .params
+        .iter()
+        .zip(a.iter().zip(b))
+        .map(|(p, (x, y))| (p.fraction(*x) - p.fraction(*y)).abs())
+        .fold(0.0, f64::max)
+}
+
+/// Starts closer than this (fraction of the range) are the same start.
+const DISTINCT_START: f64 = 0.1;
+/// Optima closer than this are the same optimum.
+const DISTINCT_OPTIMUM: f64 = 0.02;
+
+/// Global phase, local runs, distinct optima (best first; never empty).
+pub fn search(problem: &Problem<'_>, options: &Options) -> Vec<LocalRun> {
+    let x0 = problem.start();
+    let mut starts = vec![x0.clone()];
+    if options.global_points > 0 && options.starts > 1 {
+        let cube = latin_hypercube(options.global_points, problem.params.len(), options.seed);
+        let mut scored: Vec<(f64, Vec<f64>)> = cube
+            .par_iter()
+            .map(|f| {
+                let x: Vec<f64> = problem
+                    .params
+                    .iter()
+                    .zip(f)
+                    .map(|(p, v)| p.from_fraction(*v))
+                    .collect();
+                (problem.cost(&x), x)
+            })
+            .collect();
+        scored.sort_by(|a, b| a.0.total_cmp(&b.0));
+        options.say(&format!(
+            "global phase: {} points (seed {}), best cost {:.4e}",
+            scored.len(),
+            options.seed,
+            scored[0].0
+        ));
+        for (_, x) in scored {
+            if starts.len() >= options.starts {
+                break;
+            }
+            if starts
+                .iter()
+                .all(|s| distance(problem, s, &x) > DISTINCT_START)
+            {
+                starts.push(x);
+            }
+        }
+    }
+    let total = starts.len();
+    let mut runs: Vec<LocalRun> = starts
+        .iter()
+        .enumerate()
+        .map(|(k, x)| {
+            let run = local_run(problem, x, options.max_evaluations);
+            options.say(&format!(
+                "local run {}/{total} ({}): cost {:.4e}, {} evaluations, {}",
+                k + 1,
+                if k == 0 {
+                    "given start"
+                } else {
+                    "global point"
+                },
+                run.cost,
+                run.evaluations,
+                run.termination
+            ));
+            run
+        })
+        .collect();
+    runs.sort_by(|a, b| a.cost.total_cmp(&b.cost));
+    let mut distinct: Vec<LocalRun> = Vec::new();
+    for r in runs {
+        if distinct
+            .iter()
+            .all(|d| distance(problem, &d.x, &r.x) > DISTINCT_OPTIMUM)
+        {
+            distinct.push(r);
+        }
+    }
+    distinct
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_latin_hypercube_puts_one_point_in_every_stratum_and_repeats_with_its_seed() {
+        let a = latin_hypercube(10, 3, 7);
+        for d in 0..3 {
+            let mut strata: Vec<usize> = a.iter().map(|p| (p[d] * 10.0) as usize).collect();
+            strata.sort_unstable();
+            assert_eq!(strata, (0..10).collect::<Vec<_>>());
+        }
+        assert_eq!(a, latin_hypercube(10, 3, 7));
+        assert_ne!(a, latin_hypercube(10, 3, 8));
+    }
+}

@@ -1,0 +1,28 @@
+//! Messages. `msg/msg/*.msg` (the ROS 2 package `friction_msgs`) is the
+//! source of truth for message layout; the wire structs mirror it field by
+//! field (a test checks names, order and types against the `.msg` text) and
+//! convert to and from the loop's heap-free records. The standard ROS types
+//! the node reads or writes are mirrored too.
+//!
+//! Units are SI and part of each field's name; stamps are ROS time
+//! (`builtin_interfaces/Time`), nanoseconds in the records (`stamp_ns`).
+//!
+//! | file | content |
+//! |---|---|
+//! | `wire.rs` | the ROS 2 wire structs (serde, `.msg` field order) |
+//! | `types.rs` | [`MsgType`]: package, name, definition, `ros2msg` schema |
+//! | `records.rs` | heap-free records of the loop and their conversions |
+//! | `cdr.rs` | CDR with its encapsulation header |
+
+mod cdr;
+mod records;
+mod types;
+mod wire;
+
+pub use cdr::{from_cdr, to_cdr};
+pub use records::*;
+pub use types::*;
+pub use wire::*;
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,418 @@
+//! Heap-free records the loop produces (Copy), and their conversions to and
+//! from the wire types.
+
+use super::types::{msg_fields, FRICTION_ESTIMATE, FRICTION_ESTIMATE_V1};
+use super::wire::{
+    estimate_constants as codes, FrictionEstimate, FrictionEstimateV1, Header, LoopStatistics, Time,
+};
+use crate::physics::{Estimate, Regime, Status};
+
+/// One estimate as the loop produces it (Copy, no heap).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct EstimateRecord {
+    pub stamp_ns: u64,
+    pub velocity_m_s: f64,
+    pub load_n: f64,
+    pub temperature_c: f64,
+    pub friction_force_n: f64,
+    pub contact_friction_force_n: f64,
+    pub cof: f64,
+    pub h0_m: f64,
+    pub h_min_m: f64,
+    pub hydrodynamic_force_n: f64,
+    pub asperity_force_n: f64,
+    pub asperity_load_share: f64,
+    pub regime: u8,
+    /// `STATUS_*`: the solver's outcome.
+    pub status: u8,
+    /// `COMMAND_*`: the command's state.
+    pub command_status: u8,
+    pub iterations: u32,
+    pub compute_time_ns: u64,
+    pub late_ns: u64,
+}
+
+pub fn regime_code(r: Regime) -> u8 {
+    match r {
+        Regime::Boundary => codes::REGIME_BOUNDARY,
+        Regime::Mixed => codes::REGIME_MIXED,
+        Regime::Hydrodynamic => codes::REGIME_HYDRODYNAMIC,
+    }
+}
+
+pub fn status_code(s: Status) -> u8 {
+    match s {
+        Status::Converged => codes::STATUS_CONVERGED,
+        Status::MaxIterations => codes::STATUS_MAX_ITERATIONS,
+        Status::NonFinite => codes::STATUS_NON_FINITE,
+        Status::NonFiniteInput => codes::STATUS_NON_FINITE_INPUT,
+        Status::InputOutOfRange => codes::STATUS_INPUT_OUT_OF_RANGE,
+    }
+}
+
+/// Name of a solver status code (logs, CSV).
+pub fn status_name(code: u8) -> &'static str {
+    match code {
+        codes::STATUS_CONVERGED => "converged",
+        codes::STATUS_MAX_ITERATIONS => "max_iterations",
+        codes::STATUS_NON_FINITE => "non_finite",
+        codes::STATUS_NON_FINITE_INPUT => "non_finite_input",
+        codes::STATUS_INPUT_OUT_OF_RANGE => "input_out_of_range",
+        _ => "unknown",
+    }
+}
+
+/// Name of a command status code (logs, CSV).
+pub fn command_status_name(code: u8) -> &'static str {
+    match code {
+        codes::COMMAND_FRESH => "fresh",
+        codes::COMMAND_HELD => "held",
+        codes::COMMAND_TIMED_OUT => "timed_out",
+        codes::COMMAND_REJECTED => "rejected",
+        _ => "unknown",
+    }
+}
+
+impl EstimateRecord {
+    /// The record of a core estimate; the node's fields (temperature,
+    /// drivetrain, command status, lateness) are set by the caller
+    /// (temperature 0 °C until then: records compare equal, unlike NaN).
+    pub fn from_estimate(e: &Estimate, stamp_ns: u64, compute_time_ns: u64) -> Self {
+        Self {
+            stamp_ns,
+            velocity_m_s: e.velocity,
+            load_n: e.load,
+            temperature_c: 0.0,
+            friction_force_n: e.friction_force,
+            contact_friction_force_n: e.contact_friction_force,
+            cof: e.cof,
+            h0_m: e.h0,
+            h_min_m: e.h_min,
+            hydrodynamic_force_n: e.hydrodynamic_force,
+            asperity_force_n: e.asperity_force,
+            asperity_load_share: e.asperity_load_share,
+            regime: regime_code(e.regime),
+            status: status_code(e.status),
+            command_status: codes::COMMAND_FRESH,
+            iterations: e.diagnostics.iterations,
+            compute_time_ns,
+            late_ns: 0,
+        }
+    }
+
+    pub fn to_wire(&self, frame_id: &str) -> FrictionEstimate {
+        FrictionEstimate {
+            header: Header {
+                stamp: Time::from_ns(self.stamp_ns),
+                frame_id: frame_id.to_string(),
+            },
+            velocity_m_s: self.velocity_m_s,
+            load_n: self.load_n,
+            temperature_c: self.temperature_c,
+            friction_force_n: self.friction_force_n,
+            contact_friction_force_n: self.contact_friction_force_n,
+            cof: self.cof,
+            h0_m: self.h0_m,
+            h_min_m: self.h_min_m,
+            hydrodynamic_force_n: self.hydrodynamic_force_n,
+            asperity_force_n: self.asperity_force_n,
+            asperity_load_share: self.asperity_load_share,
+            regime: self.regime,
+            status: self.status,
+            command_status: self.command_status,
+            iterations: self.iterations,
+            compute_time_ns: self.compute_time_ns,
+            late_ns: self.late_ns,
+        }
+    }
+
+    pub fn from_wire(m: &FrictionEstimate) -> Self {
+        Self {
+            stamp_ns: m.header.stamp.to_ns(),
+            velocity_m_s: m.velocity_m_s,
+            load_n: m.load_n,
+            temperature_c: m.temperature_c,
+            friction_force_n: m.friction_force_n,
+            contact_friction_force_n: m.contact_friction_force_n,
+            cof: m.cof,
+            h0_m: m.h0_m,
+            h_min_m: m.h_min_m,
+            hydrodynamic_force_n: m.hydrodynamic_force_n,
+            asperity_force_n: m.asperity_force_n,
+            asperity_load_share: m.asperity_load_share,
+            regime: m.regime,
+            status: m.status,
+            command_status: m.command_status,
+            iterations: m.iterations,
+            compute_time_ns: m.compute_time_ns,
+            late_ns: m.late_ns,
+        }
+    }
+
+    /// A record of the layout before `command_status`: its single status
+    /// carried the command flags (4 timeout, 5 rejected), now split.
+    pub fn from_wire_v1(m: &FrictionEstimateV1) -> Self {
+        let (status, command_status) = match m.status {
+            codes::LEGACY_STATUS_COMMAND_TIMEOUT => {
+                (codes::STATUS_CONVERGED, codes::COMMAND_TIMED_OUT)
+            }
+            codes::LEGACY_STATUS_COMMAND_REJECTED => {
+                (codes::STATUS_CONVERGED, codes::COMMAND_REJECTED)
+            }
+            s => (s, codes::COMMAND_FRESH),
+        };
+        Self {
+            stamp_ns: m.header.stamp.to_ns(),
+            velocity_m_s: m.velocity_m_s,
+            load_n: m.load_n,
+            temperature_c: f64::NAN,
+            friction_force_n: m.friction_force_n,
+            contact_friction_force_n: m.friction_force_n,
+            cof: m.cof,
+            h0_m: m.h0_m,
+            h_min_m: m.h_min_m,
+            hydrodynamic_force_n: m.hydrodynamic_force_n,
+            asperity_force_n: m.asperity_force_n,
+            asperity_load_share: m.asperity_load_share,
+            regime: m.regime,
+            status,
+            command_status,
+            iterations: m.iterations,
+            compute_time_ns: m.compute_time_ns,
+            late_ns: 0,
+        }
+    }
+}
+
+fn top_fields(schema_text: &str) -> Vec<(String, String)> {
+    msg_fields(schema_text.split("\n====").next().unwrap_or(""))
+}
+
+/// Whether a `ros2msg` schema text is that of `FrictionEstimate`, in the
+/// current layout or the one before `command_status`.
+pub fn check_estimate_schema(schema_text: &str) -> Result<(), String> {
+    let got = top_fields(schema_text);
+    if got == msg_fields(FRICTION_ESTIMATE.definition)
+        || got == msg_fields(FRICTION_ESTIMATE_V1.definition)
+    {
+        Ok(())
+    } else {
+        Err(format!(
+            "fields {:?} are neither those of friction_msgs/msg/FrictionEstimate nor of its earlier layout",
+            got.iter().map(|(_, n)| n.as_str()).collect::<Vec<_>>()
+        ))
+    }
+}
+
+/// Whether a recorded estimate schema is the layout before `command_status`.
+pub fn is_legacy_estimate_schema(schema_text: &str) -> bool {
+    top_fields(schema_text) == msg_fields(FRICTION_ESTIMATE_V1.definition)
+}
+
+/// Decode a recorded `FrictionEstimate` of either layout.
+pub fn decode_estimate(bytes: &[u8], legacy: bool) -> Result<EstimateRecord, String> {
+    if legacy {
+        super::from_cdr::<FrictionEstimateV1>(bytes).map(|m| EstimateRecord::from_wire_v1(&m))
+    } else {
+        super::from_cdr::<FrictionEstimate>(bytes).map(|m| EstimateRecord::from_wire(&m))
+    }
+}
+
+/// A short text held inline (Copy, no heap): a path in the statistics.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Note {
+    len: u8,
+    bytes: [u8; 255],
+}
+
+impl Default for Note {
+    fn default() -> Self {
+        Self {
+            len: 0,
+            bytes: [0; 255],
+        }
+    }
+}
+
+impl Note {
+    /// The text, cut at 255 bytes (on a character boundary).
+    pub fn new(s: &str) -> Self {
+        let mut end = s.len().min(255);
+        while !s.is_char_boundary(end) {
+            end -= 1;
+        }
+        let mut n = Self::default();
+        n.bytes[..end].copy_from_slice(&s.as_bytes()[..end]);
+        n.len = end as u8;
+        n
+    }
+
+    pub fn as_str(&self) -> &str {
+        std::str::from_utf8(&self.bytes[..usize::from(self.len)]).unwrap_or("")
+    }
+}
+
+/// What the recorder reports into the loop statistics.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct RecordingStatus {
+    pub files: u64,
+    pub files_deleted: u64,
+    pub lost: u64,
+    pub snapshots: u64,
+    pub last_snapshot: Note,
+    pub last_snapshot_span_s: f64,
+}
+
+/// Loop statistics as the loop produces them.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct StatisticsRecord {
+    pub stamp_ns: u64,
+    pub steps: u64,
+    pub deadline_misses: u64,
+    pub catch_up_steps: u64,
+    pub time_jumps: u64,
+    pub clock_jumps: u64,
+    pub commands_received: u64,
+    pub commands_applied: u64,
+    pub commands_overwritten: u64,
+    pub commands_rejected: u64,
+    pub command_timeouts: u64,
+    pub publish_drops: u64,
+    pub publish_failures: u64,
+    pub statistics_not_sent: u64,
+    pub recorder_drops: u64,
+    pub recording: RecordingStatus,
+    pub compute_time_ns: [u64; 3],
+    pub period_jitter_ns: [u64; 3],
+}
+
+impl StatisticsRecord {
+    pub fn to_wire(&self, frame_id: &str) -> LoopStatistics {
+        LoopStatistics {
+            header: Header {
+                stamp: Time::from_ns(self.stamp_ns),
+                frame_id: frame_id.to_string(),
+            },
+            steps: self.steps,
+            deadline_misses: self.deadline_misses,
+            catch_up_steps: self.catch_up_steps,
+            time_jumps: self.time_jumps,
+            clock_jumps: self.clock_jumps,
+            commands_received: self.commands_received,
+            commands_applied: self.commands_applied,
+            commands_overwritten: self.commands_overwritten,
+            commands_rejected: self.commands_rejected,
+            command_timeouts: self.command_timeouts,
+            publish_drops: self.publish_drops,
+            publish_failures: self.publish_failures,
+            statistics_not_sent: self.statistics_not_sent,
+            recorder_drops: self.recorder_drops,
+            recording_files: self.recording.files,
+            recording_files_deleted: self.recording.files_deleted,
+            recording_lost: self.recording.lost,
+            snapshots: self.recording.snapshots,
+            last_snapshot: self.recording.last_snapshot.as_str().to_string(),
+            last_snapshot_span_s: self.recording.last_snapshot_span_s,
+            compute_time_p50_ns: self.compute_time_ns[0],
+            compute_time_p99_ns: self.compute_time_ns[1],
+            compute_time_max_ns: self.compute_time_ns[2],
+            period_jitter_p50_ns: self.period_jitter_ns[0],
+            period_jitter_p99_ns: self.period_jitter_ns[1],
+            period_jitter_max_ns: self.period_jitter_ns[2],
+        }
+    }
+
+    pub fn from_wire(m: &LoopStatistics) -> Self {
+        Self {
+            stamp_ns: m.header.stamp.to_ns(),
+            steps: m.steps,
+            deadline_misses: m.deadline_misses,
+            catch_up_steps: m.catch_up_steps,
+            time_jumps: m.time_jumps,
+            clock_jumps: m.clock_jumps,
+            commands_received: m.commands_received,
+            commands_applied: m.commands_applied,
+            commands_overwritten: m.commands_overwritten,
+            commands_rejected: m.commands_rejected,
+            command_timeouts: m.command_timeouts,
+            publish_drops: m.publish_drops,
+            publish_failures: m.publish_failures,
+            statistics_not_sent: m.statistics_not_sent,
+            recorder_drops: m.recorder_drops,
+            recording: RecordingStatus {
+                files: m.recording_files,
+                files_deleted: m.recording_files_deleted,
+                lost: m.recording_lost,
+                snapshots: m.snapshots,
+                last_snapshot: Note::new(&m.last_snapshot),
+                last_snapshot_span_s: m.last_snapshot_span_s,
+            },
+            compute_time_ns: [
+                m.compute_time_p50_ns,
+                m.compute_time_p99_ns,
+                m.compute_time_max_ns,
+            ],
+            period_jitter_ns: [
+                m.period_jitter_p50_ns,
+                m.period_jitter_p99_ns,
+                m.period_jitter_max_ns,
+            ],
+        }
+    }
+}
+
+/// What a command carries.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CommandKind {
+    /// Sliding velocity, m/s.
+    Velocity,
+    /// Normal load, N.
+    Load,
+    /// Lubricant temperature, °C.
+    Temperature,
+}
+
+/// A command as received from a transport (Copy, no heap).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Command {
+    pub kind: CommandKind,
+    pub value: f64,
+    /// The sender's stamp (header stamp, or the sample's source time), ns.
+    pub stamp_ns: u64,
+}
+
+/// A received sample exactly as it came off the wire: recorded unchanged.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RawSample {
+    pub kind: CommandKind,
+    /// The CDR bytes, encapsulation header included.
+    pub cdr: Vec<u8>,
+    /// The publisher's stamp (source timestamp, else the header's), ns.
+    pub publish_ns: u64,
+    /// When the node took it from the transport (wall clock), ns.
+    pub received_ns: u64,
+}
+
+/// What the loop and the transports hand to the recorder.
+// Items travel through preallocated lock-free queues: boxing the larger
+// variants would allocate on the loop.
+#[allow(clippy::large_enum_variant)]
+#[derive(Debug, Clone, PartialEq)]
+pub enum RecordItem {
+    /// A received command (transports without a serialized form: memory,
+    /// iceoryx2) and when it arrived (wall clock, ns); recorded as the
+    /// configured command type.
+    Command { command: Command, received_ns: u64 },
+    /// A received ROS 2 sample, recorded byte for byte.
+    Raw(RawSample),
+    /// An estimate and when it was published (wall clock, ns).
+    Estimate {
+        record: EstimateRecord,
+        logged_ns: u64,
+    },
+    /// Loop statistics and when they were published (wall clock, ns).
+    Statistics {
+        record: StatisticsRecord,
+        logged_ns: u64,
+    },
+}

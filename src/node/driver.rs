@@ -1,0 +1,150 @@
+//! The demo and soak driver: a peer on the node's own topics commanding a
+//! velocity profile, in real time (timer mode) or command by command
+//! (lockstep).
+
+use crate::config::StepMode;
+use crate::msgs::{Command, CommandKind};
+use crate::transport::{self, BackendSpec};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// What the demo driver did.
+#[derive(Debug, Clone, Default)]
+pub struct DemoReport {
+    pub commands_sent: u64,
+    pub estimates_received: u64,
+    pub error: Option<String>,
+}
+
+/// What the driver commands.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum Profile {
+    /// The paper's reciprocating case: v = V1 sin(2π f t), V1 = 1 m/s, f = 1 Hz.
+    #[default]
+    Paper,
+    /// A reproducible random motion (seeded): a new target velocity in
+    /// [-1.5, 1.5] m/s every 0.2–3 s, followed with a 0.15 s lag, so that
+    /// reversals, dwells and speed changes of every size occur.
+    Random { seed: u64 },
+}
+
+impl Profile {
+    fn start(self) -> ProfileState {
+        ProfileState {
+            profile: self,
+            rng: match self {
+                Profile::Random { seed } => seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1,
+                Profile::Paper => 1,
+            },
+            v: 0.0,
+            target: 0.0,
+            next_change: 0.0,
+        }
+    }
+}
+
+/// A profile being played.
+struct ProfileState {
+    profile: Profile,
+    rng: u64,
+    v: f64,
+    target: f64,
+    next_change: f64,
+}
+
+impl ProfileState {
+    /// xorshift64*: uniform in [0, 1).
+    fn uniform(&mut self) -> f64 {
+        self.rng ^= self.rng >> 12;
+        self.rng ^= self.rng << 25;
+        self.rng ^= self.rng >> 27;
+        (self.rng.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// The velocity at time `t` (called once per step of `dt`).
+    fn at(&mut self, t: f64, dt: f64) -> f64 {
+        match self.profile {
+            Profile::Paper => (2.0 * std::f64::consts::PI * t).sin(),
+            Profile::Random { .. } => {
+                if t >= self.next_change {
+                    self.target = 3.0 * self.uniform() - 1.5;
+                    self.next_change = t + 0.2 + 2.8 * self.uniform();
+                }
+                self.v += (self.target - self.v) * (dt / 0.15).min(1.0);
+                self.v
+            }
+        }
+    }
+}
+
+pub fn drive(
+    spec: BackendSpec,
+    mode: StepMode,
+    dt: f64,
+    seconds: f64,
+    profile: Profile,
+    ready: std::sync::mpsc::Sender<Result<(), String>>,
+    stop: Arc<AtomicBool>,
+) -> DemoReport {
+    let mut report = DemoReport::default();
+    let mut peer = match spec.open_peer() {
+        Ok(p) => p,
+        Err(e) => {
+            let _ = ready.send(Err(e.to_string()));
+            report.error = Some(e.to_string());
+            return report;
+        }
+    };
+    if let Err(e) = transport::wait_matched(peer.as_mut(), Duration::from_secs(20)) {
+        let _ = ready.send(Err(e.to_string()));
+        report.error = Some(e.to_string());
+        return report;
+    }
+    let _ = ready.send(Ok(()));
+    let mut velocity = profile.start();
+    let steps = (seconds / dt).round() as u64;
+    let start = Instant::now();
+    let t0 = crate::clock::system_wall_ns();
+    for k in 1..=steps {
+        if stop.load(Ordering::Relaxed) {
+            break;
+        }
+        let t = k as f64 * dt;
+        if mode == StepMode::Timer {
+            // A plain sleep: the driver must not compete with the loop's spin.
+            let due = start + Duration::from_secs_f64(t - dt);
+            let now = Instant::now();
+            if due > now {
+                std::thread::sleep(due - now);
+            }
+        }
+        let c = Command {
+            kind: CommandKind::Velocity,
+            value: velocity.at(t, dt),
+            stamp_ns: t0 + (t * 1e9) as u64,
+        };
+        if let Err(e) = peer.send(&c) {
+            report.error.get_or_insert(e.to_string());
+            continue;
+        }
+        report.commands_sent += 1;
+        if mode == StepMode::Lockstep {
+            if let Ok(Some(_)) = transport::recv_timeout(peer.as_mut(), Duration::from_secs(2)) {
+                report.estimates_received += 1;
+            }
+        }
+        while let Ok(Some(_)) = peer.try_recv() {
+            report.estimates_received += 1;
+        }
+    }
+    // Estimates still in flight.
+    let until = Instant::now() + Duration::from_millis(300);
+    while Instant::now() < until {
+        match peer.try_recv() {
+            Ok(Some(_)) => report.estimates_received += 1,
+            _ => std::thread::sleep(Duration::from_millis(5)),
+        }
+    }
+    report
+}

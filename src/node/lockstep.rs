@@ -1,0 +1,74 @@
+//! Lockstep mode: one step per velocity command, stamped with the
+//! command's stamp; and [`Loop::feed`], the same path driven directly
+//! (replay).
+
+use super::Loop;
+use crate::msgs::{Command, CommandKind};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
+
+impl Loop {
+    /// Apply one command as lockstep mode does: a velocity command steps the
+    /// model unless its stamp is not newer than the last one; a load command
+    /// updates the load.
+    pub fn feed(&mut self, c: Command) {
+        self.lockstep_command(c);
+    }
+
+    /// Lockstep: process every command pending on the ports once; returns
+    /// how many there were.
+    pub fn poll_once(&mut self) -> usize {
+        let mut n = 0;
+        for i in 0..self.ports.len() {
+            while let Some(c) = self.poll(i) {
+                n += 1;
+                self.lockstep_command(c);
+            }
+        }
+        n
+    }
+
+    pub(super) fn run_lockstep(&mut self, stop: &AtomicBool, duration_ns: Option<u64>) {
+        let end = duration_ns.map(|d| self.started_ns.saturating_add(d));
+        let mut last_command = self.clock.now_ns();
+        while !stop.load(Ordering::Relaxed) && end.is_none_or(|e| self.clock.now_ns() < e) {
+            let any = self.poll_once() > 0;
+            let now = self.clock.now_ns();
+            if any {
+                last_command = now;
+            } else if now.saturating_sub(last_command) < self.s.lockstep_spin_ns {
+                std::hint::spin_loop();
+            } else {
+                let wait = Duration::from_millis(if self.ports.len() == 1 { 20 } else { 1 });
+                if self.ports[0].wait_for_command(wait).is_err() {
+                    self.summary.transport_errors += 1;
+                }
+            }
+        }
+    }
+
+    fn lockstep_command(&mut self, c: Command) {
+        match c.kind {
+            CommandKind::Load => self.load_command(c.value),
+            CommandKind::Temperature => self.temperature_command(c.value),
+            CommandKind::Velocity => {
+                if self.last_stamp.is_some_and(|last| c.stamp_ns <= last) {
+                    // Duplicate or out of order: counted, no step.
+                    self.summary.commands_rejected += 1;
+                    self.live.commands_rejected.fetch_add(1, Ordering::Relaxed);
+                    return;
+                }
+                self.last_stamp = Some(c.stamp_ns);
+                if self.velocity_ok(c.value) {
+                    self.velocity = c.value;
+                    self.fresh = true;
+                    self.accept();
+                } else {
+                    self.reject();
+                }
+                self.timed_out = false;
+                self.step(self.velocity, c.stamp_ns, 0);
+            }
+        }
+    }
+}

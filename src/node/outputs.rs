@@ -1,0 +1,152 @@
+//! One model step and its outputs: the estimate to every port and the
+//! recorder, the film profile, the loop statistics.
+
+use super::Loop;
+use crate::config::StepMode;
+use crate::msgs::{EstimateRecord, RecordItem, StatisticsRecord};
+use crate::physics::Estimate;
+use std::sync::atomic::Ordering;
+
+impl Loop {
+    /// One fixed step with velocity `v`, stamped `stamp_ns`, `late_ns`
+    /// after its deadline.
+    pub(super) fn step(&mut self, v: f64, stamp_ns: u64, late_ns: u64) {
+        let start = self.clock.now_ns();
+        let e = self.solver.step(v, self.load);
+        let compute = self.clock.now_ns().saturating_sub(start);
+        self.publish(&e, stamp_ns, compute, late_ns);
+    }
+
+    /// `steps` lost periods advanced in one long step.
+    pub(super) fn step_over(&mut self, steps: u64, stamp_ns: u64, late_ns: u64) {
+        let start = self.clock.now_ns();
+        let dt = self.s.dt * steps as f64;
+        let e = self.solver.step_over(self.applied, self.load, dt);
+        let compute = self.clock.now_ns().saturating_sub(start);
+        self.publish(&e, stamp_ns, compute, late_ns);
+    }
+
+    fn publish(&mut self, e: &Estimate, stamp_ns: u64, compute: u64, late_ns: u64) {
+        let mut rec = EstimateRecord::from_estimate(e, stamp_ns, compute);
+        rec.temperature_c = self.temperature_c;
+        rec.command_status = self.take_command_status();
+        rec.late_ns = late_ns;
+        self.summary.steps += 1;
+        self.summary.status_counts[usize::from(rec.status).min(7)] += 1;
+        self.summary.command_status_counts[usize::from(rec.command_status).min(3)] += 1;
+        for p in self.ports.iter_mut() {
+            if !p.publish_estimate(&rec) {
+                self.summary.publish_drops += 1;
+            }
+        }
+        if let Some(q) = &self.record {
+            let logged_ns = self.logged_ns(stamp_ns);
+            if q.push(RecordItem::Estimate {
+                record: rec,
+                logged_ns,
+            })
+            .is_err()
+            {
+                self.summary.recorder_drops += 1;
+            }
+        }
+        let n = self.summary.steps;
+        if self.s.profile_every > 0 && n.is_multiple_of(self.s.profile_every) {
+            if let Some(slot) = &self.profile {
+                let solver = &self.solver;
+                slot.try_write(|d| {
+                    d.stamp_ns = stamp_ns;
+                    d.dx_m = solver.dx();
+                    for (i, f) in solver.field().enumerate() {
+                        d.h_m[i] = f.h;
+                        d.p_pa[i] = f.p;
+                    }
+                });
+            }
+        }
+        self.window_compute.push(compute);
+        self.hist_compute.record(compute);
+        if self.s.mode == StepMode::Timer {
+            self.window_jitter.push(late_ns);
+            self.hist_jitter.record(late_ns);
+        }
+        if self.s.statistics_every > 0 && n.is_multiple_of(self.s.statistics_every) {
+            self.publish_statistics(stamp_ns);
+        }
+        let l = &self.live;
+        l.steps.store(n, Ordering::Relaxed);
+        l.velocity_bits
+            .store(rec.velocity_m_s.to_bits(), Ordering::Relaxed);
+        l.friction_bits
+            .store(rec.friction_force_n.to_bits(), Ordering::Relaxed);
+        l.cof_bits.store(rec.cof.to_bits(), Ordering::Relaxed);
+        l.h0_bits.store(rec.h0_m.to_bits(), Ordering::Relaxed);
+        l.compute_ns.store(compute, Ordering::Relaxed);
+        l.status.store(u64::from(rec.status), Ordering::Relaxed);
+        l.drops.store(
+            self.summary.publish_drops + self.summary.recorder_drops,
+            Ordering::Relaxed,
+        );
+    }
+
+    /// The recording's log time of an output stamped `stamp_ns`: the stamp
+    /// itself in timer mode (it is the step's wall time), the wall clock in
+    /// lockstep (stamps are the sender's).
+    fn logged_ns(&self, stamp_ns: u64) -> u64 {
+        match self.s.mode {
+            StepMode::Timer => stamp_ns,
+            StepMode::Lockstep => self.clock.wall_ns(),
+        }
+    }
+
+    fn publish_statistics(&mut self, stamp_ns: u64) {
+        let mut total = self.summary.clone();
+        self.add_port_counters(&mut total);
+        let s = StatisticsRecord {
+            stamp_ns,
+            steps: total.steps,
+            deadline_misses: total.deadline_misses,
+            catch_up_steps: total.catch_up_steps,
+            time_jumps: total.time_jumps,
+            clock_jumps: self.stamps.jumps,
+            commands_received: total.commands_received,
+            commands_applied: total.commands_applied,
+            commands_overwritten: total.commands_overwritten,
+            commands_rejected: total.commands_rejected,
+            command_timeouts: total.command_timeouts,
+            publish_drops: total.publish_drops,
+            publish_failures: total.publish_failures,
+            statistics_not_sent: total.statistics_not_sent,
+            recorder_drops: total.recorder_drops,
+            recording: self
+                .recorder
+                .as_ref()
+                .map(|c| c.status())
+                .unwrap_or_default(),
+            compute_time_ns: self.window_compute.percentiles(),
+            period_jitter_ns: if self.s.mode == StepMode::Timer {
+                self.window_jitter.percentiles()
+            } else {
+                [0; 3]
+            },
+        };
+        self.window_compute.clear();
+        self.window_jitter.clear();
+        for p in self.ports.iter_mut() {
+            if !p.publish_statistics(&s) {
+                self.summary.statistics_not_sent += 1;
+            }
+        }
+        if let Some(q) = &self.record {
+            let logged_ns = self.logged_ns(stamp_ns);
+            if q.push(RecordItem::Statistics {
+                record: s,
+                logged_ns,
+            })
+            .is_err()
+            {
+                self.summary.recorder_drops += 1;
+            }
+        }
+    }
+}

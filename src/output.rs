@@ -1,0 +1,258 @@
+//! Writing output files so that a failure is never silent and nothing is
+//! left half-written.
+//!
+//! - A regular file is written to a temporary sibling (`<name>.tmp-<pid>-<n>`)
+//!   and renamed over the destination only when every write, the flush and
+//!   the sync succeeded ([`AtomicFile::commit`]); dropped uncommitted, the
+//!   temporary file is removed.
+//! - A destination that exists and is not a regular file (a character device
+//!   such as `/dev/null` or `/dev/full`, a FIFO) is written in place: there
+//!   is nothing to replace atomically, and renaming over a device would
+//!   destroy it. Every write and the final flush are still checked.
+//! - A directory, a missing parent directory or an unwritable place is an
+//!   error naming the path, reported before any computation when the caller
+//!   creates the file first (as the commands do).
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// A file could not be written.
+#[derive(Debug, thiserror::Error)]
+#[error("cannot write {}: {cause}", path.display())]
+pub struct OutputError {
+    pub path: PathBuf,
+    pub cause: std::io::Error,
+}
+
+impl OutputError {
+    pub fn new(path: &Path, cause: std::io::Error) -> Self {
+        Self {
+            path: path.to_path_buf(),
+            cause,
+        }
+    }
+
+    /// An error with a message of ours.
+    pub fn other(path: &Path, message: impl std::fmt::Display) -> Self {
+        Self::new(path, std::io::Error::other(message.to_string()))
+    }
+}
+
+static COUNTER: AtomicU64 = AtomicU64::new(0);
+
+/// A temporary sibling of `path`, unique within this process.
+pub fn tmp_sibling(path: &Path) -> PathBuf {
+    let mut name = path
+        .file_name()
+        .map(|n| n.to_os_string())
+        .unwrap_or_default();
+    name.push(format!(
+        ".tmp-{}-{}",
+        std::process::id(),
+        COUNTER.fetch_add(1, Ordering::Relaxed)
+    ));
+    path.with_file_name(name)
+}
+
+/// Whether `path` exists and is something other than a regular file or a
+/// directory (a device, a FIFO, a socket): written in place.
+pub fn is_special(path: &Path) -> bool {
+    std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir())
+}
+
+/// A file written atomically (see the module documentation).
+pub struct AtomicFile {
+    path: PathBuf,
+    /// None when writing in place.
+    tmp: Option<PathBuf>,
+    out: Option<BufWriter<File>>,
+}
+
+impl AtomicFile {
+    /// Create the temporary file (or open the special file); errors name `path`.
+    pub fn create(path: &Path) -> Result<Self, OutputError> {
+        let err = |source| OutputError::new(path, source);
+        if path.is_dir() {
+            return Err(err(std::io::Error::new(
+                std::io::ErrorKind::IsADirectory,
+                "the output path is a directory",
+            )));
+        }
+        if path.file_name().is_none() {
+            return Err(err(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                "the output path has no file name",
+            )));
+        }
+        if is_special(path) {
+            let file = std::fs::OpenOptions::new()
+                .write(true)
+                .open(path)
+                .map_err(err)?;
+            return Ok(Self {
+                path: path.to_path_buf(),
+                tmp: None,
+                out: Some(BufWriter::new(file)),
+            });
+        }
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            if !dir.is_dir() {
+                return Err(err(std::io::Error::new(
+                    std::io::ErrorKind::NotFound,
+                    format!("the directory {} does not exist", dir.display()),
+                )));
+            }
+        }
+        let tmp = tmp_sibling(path);
+        let file = std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(&tmp)
+            .map_err(err)?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            tmp: Some(tmp),
+            out: Some(BufWriter::new(file)),
+        })
+    }
+
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    fn writer(&mut self) -> Result<&mut BufWriter<File>, OutputError> {
+        let path = self.path.clone();
+        self.out
+            .as_mut()
+            .ok_or_else(|| OutputError::other(&path, "the file was already committed"))
+    }
+
+    /// Write a line (the newline is added).
+    pub fn line(&mut self, args: std::fmt::Arguments<'_>) -> Result<(), OutputError> {
+        let path = self.path.clone();
+        writeln!(self.writer()?, "{args}").map_err(|e| OutputError::new(&path, e))
+    }
+
+    /// Write bytes.
+    pub fn bytes(&mut self, data: &[u8]) -> Result<(), OutputError> {
+        let path = self.path.clone();
+        self.writer()?
+            .write_all(data)
+            .map_err(|e| OutputError::new(&path, e))
+    }
+
+    /// Flush, sync and move into place; the destination changes only now.
+    pub fn commit(mut self) -> Result<PathBuf, OutputError> {
+        let path = self.path.clone();
+        let err = |source| OutputError::new(&path, source);
+        let out = self.out.take().expect("commit once");
+        let file = out.into_inner().map_err(|e| err(e.into_error()))?;
+        match &self.tmp {
+            Some(tmp) => {
+                file.sync_all().map_err(err)?;
+                drop(file);
+                std::fs::rename(tmp, &path).map_err(err)?;
+                self.tmp = None;
+            }
+            None => {
+                // Devices may not support fsync (EINVAL); the flush above
+                // already reported a failed write (ENOSPC on /dev/full).
+                let _ = file.sync_all();
+            }
+        }
+        Ok(path)
+    }
+}
+
+impl Drop for AtomicFile {
+    fn drop(&mut self) {
+        if let Some(tmp) = self.tmp.take() {
+            self.out = None;
+            let _ = std::fs::remove_file(tmp);
+        }
+    }
+}
+
+/// Write a whole file atomically.
+pub fn write_file(path: &Path, data: &[u8]) -> Result<PathBuf, OutputError> {
+    let mut f = AtomicFile::create(path)?;
+    f.bytes(data)?;
+    f.commit()
+}
+
+/// Make sure `dir` exists and is writable (before any computation).
+pub fn prepare_dir(dir: &Path) -> Result<(), OutputError> {
+    let err = |source| OutputError::new(dir, source);
+    if dir.exists() && !dir.is_dir() {
+        return Err(err(std::io::Error::new(
+            std::io::ErrorKind::NotADirectory,
+            "exists and is not a directory",
+        )));
+    }
+    std::fs::create_dir_all(dir).map_err(err)?;
+    let probe = tmp_sibling(&dir.join(".write-test"));
+    std::fs::write(&probe, b"").map_err(err)?;
+    std::fs::remove_file(&probe).map_err(err)?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn dir(name: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("fn-output-{}-{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    #[test]
+    fn a_committed_file_replaces_the_old_one_and_an_abandoned_one_leaves_nothing() {
+        let d = dir("atomic");
+        let p = d.join("out.csv");
+        std::fs::write(&p, "old\n").unwrap();
+        let mut f = AtomicFile::create(&p).unwrap();
+        f.line(format_args!("new")).unwrap();
+        assert_eq!(std::fs::read_to_string(&p).unwrap(), "old\n");
+        f.commit().unwrap();
+        assert_eq!(std::fs::read_to_string(&p).unwrap(), "new\n");
+        let mut f = AtomicFile::create(&p).unwrap();
+        f.line(format_args!("half")).unwrap();
+        drop(f);
+        assert_eq!(std::fs::read_to_string(&p).unwrap(), "new\n");
+        assert_eq!(
+            std::fs::read_dir(&d).unwrap().count(),
+            1,
+            "no temporary left"
+        );
+    }
+
+    #[test]
+    fn a_full_device_is_an_error_and_a_null_device_is_not_replaced() {
+        if Path::new("/dev/full").exists() {
+            let mut f = AtomicFile::create(Path::new("/dev/full")).unwrap();
+            let big = vec![b'x'; 1 << 16];
+            let r = f.bytes(&big).and_then(|_| f.commit().map(|_| ()));
+            let e = r.unwrap_err();
+            assert!(e.to_string().contains("/dev/full"), "{e}");
+        }
+        if Path::new("/dev/null").exists() {
+            write_file(Path::new("/dev/null"), b"x").unwrap();
+            assert!(is_special(Path::new("/dev/null")), "still a device");
+        }
+    }
+
+    #[test]
+    fn a_missing_directory_or_a_directory_path_is_named() {
+        let e = AtomicFile::create(Path::new("/nonexistent-dir-xyz/out.csv"))
+            .err()
+            .unwrap();
+        assert!(e.to_string().contains("does not exist"), "{e}");
+        let d = dir("isdir");
+        let e = AtomicFile::create(&d).err().unwrap();
+        assert!(e.to_string().contains("is a directory"), "{e}");
+    }
+}

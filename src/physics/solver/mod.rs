@@ -1,0 +1,383 @@
+//! The coupled solver: transient Reynolds + mixture EOS + GW + load balance.
+//!
+//! ## Equations (MODEL.md §2, §5)
+//!
+//! ```text
+//! ∂x( φx ρ h³/(12 μ) ∂x p ) = (v/2) ∂x(ρ h) + (v/2) σ ∂x(ρ φs) + ∂t(ρ h)
+//! m h0'' = F_hyd + F_asp − F_ext
+//! ```
+//!
+//! | symbol | meaning | unit |
+//! |---|---|---|
+//! | p | absolute pressure, p(0) = p(L) = p_amb | Pa |
+//! | h | film thickness h0 + hg + ht | m |
+//! | v | sliding velocity (one surface moves) | m/s |
+//! | q | lubricant mass flux per unit width | kg/(m·s) |
+//! | F_hyd, F_asp, F_ext | hydrodynamic, asperity, external load | N |
+//! | m | equivalent mass | kg |
+//!
+//! ## Discretisation
+//!
+//! Finite volumes on N cells. The mass flux through face f is
+//!
+//! ```text
+//! q_f = −φx h_f³/(12 d_f) · ½(ρ/μ|_L + ρ/μ|_R) · (p_R − p_L) + (v/2)(h_f + σ φs) ρ_up
+//! ```
+//!
+//! with `d_f = Δx` (interior) or `Δx/2` (boundary face, ghost at p_amb) and
+//! `ρ_up` the density of the upwind cell. Only the density is upwinded: h is
+//! exact at the face, so in full film (ρ ≈ ρl) the scheme is second order and
+//! in cavitated zones it is monotone. Cell i's residual is
+//!
+//! ```text
+//! R_i = Δx Σ_k a_k (ρ h̄)_i^(n−k) / Δt + Σ_k w_k (q_(i+1) − q_i)^(n−k) − s_i
+//! G   = m Σ_k c_k h0^(n−k) / Δt² − Σ_k w_k (F_hyd + F_asp − F_ext)^(n−k)
+//! ```
+//!
+//! (`s_i` an optional external mass source, zero unless set.)
+//!
+//! ## Where each part lives
+//!
+//! | file | content |
+//! |---|---|
+//! | `mod.rs` | [`Solver`]: state, discretisation data, accessors |
+//! | `history.rs` | time levels: starting states and the history of past levels |
+//! | `step.rs` | one time step: input checks, predictor, Newton and its fallbacks |
+//! | `steady.rs` | steady states (Stribeck points) and continuation |
+//! | `newton.rs` | Newton iteration, line search, sub-stepping |
+//! | `assembly.rs` | residual and Jacobian of one iterate |
+//! | `bordered.rs` | the tridiagonal-plus-border linear solve |
+//! | `postprocess.rs` | forces, friction and diagnostics of a solved state |
+
+mod assembly;
+mod bordered;
+mod history;
+mod newton;
+mod postprocess;
+mod steady;
+mod step;
+
+pub(crate) use assembly::Work;
+
+use super::eos::MixtureEos;
+use super::error::SetupError;
+use super::estimate::{Estimate, Status};
+use super::flow_factors::FlowFactors;
+use super::geometry::Grid;
+use super::gw::{Greenwood, SummedContact};
+use super::params::{Method, ModelParams, SolverSettings};
+use super::scheme::StepCoefficients;
+use newton::CONTRACTION_MAX;
+
+/// Immutable discretisation data.
+#[derive(Debug, Clone)]
+pub(crate) struct Disc {
+    pub grid: Grid,
+    pub eos: MixtureEos,
+    pub gw: Greenwood,
+    /// GW contact summed over the cells, as a function of h0.
+    pub contact: SummedContact,
+    pub ff: Option<FlowFactors>,
+    pub sigma: f64,
+    pub p_amb: f64,
+    /// ρ, ρ/μ at the boundary pressure.
+    pub rho_b: f64,
+    pub gr_b: f64,
+    pub mass: f64,
+    pub mu_bl: f64,
+    pub v_reg: f64,
+    pub min_film: f64,
+    pub drivetrain: crate::physics::drivetrain::Drivetrain,
+}
+
+/// One stored time level.
+#[derive(Debug, Clone)]
+pub(crate) struct Level {
+    pub rho_h: Vec<f64>,
+    pub div: Vec<f64>,
+    pub f_net: f64,
+    pub h0: f64,
+}
+
+impl Level {
+    /// Copy another level's values into this one's buffers (no allocation).
+    pub(crate) fn copy_from(&mut self, other: &Level) {
+        self.rho_h.copy_from_slice(&other.rho_h);
+        self.div.copy_from_slice(&other.div);
+        self.f_net = other.f_net;
+        self.h0 = other.h0;
+    }
+
+    fn new(n: usize) -> Self {
+        Self {
+            rho_h: vec![0.0; n],
+            div: vec![0.0; n],
+            f_net: 0.0,
+            h0: 0.0,
+        }
+    }
+}
+
+/// How h0 is determined in a solve.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum H0Mode {
+    /// Load balance decides h0.
+    Balance,
+    /// h0 is given.
+    Prescribed(f64),
+}
+
+/// Everything that is fixed during one solve.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Ctx {
+    pub v: f64,
+    pub load: f64,
+    /// None: steady (no time derivatives, no inertia).
+    pub time: Option<(StepCoefficients, f64)>,
+    pub gap: H0Mode,
+}
+
+impl Ctx {
+    pub fn w0(&self) -> f64 {
+        self.time.map_or(1.0, |(c, _)| c.w[0])
+    }
+}
+
+/// Result of one nonlinear solve.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Outcome {
+    pub status: Status,
+    pub iterations: u32,
+    pub inner_iterations: u32,
+    pub residual: f64,
+    pub backtracks: u32,
+}
+
+/// One point of a field along x (see [`Solver::field`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FieldPoint {
+    /// Cell centre, m.
+    pub x: f64,
+    /// Film thickness, m.
+    pub h: f64,
+    /// Absolute pressure, Pa.
+    pub p: f64,
+    /// Vapour volume fraction.
+    pub vapour_fraction: f64,
+    /// Asperity contact pressure, Pa.
+    pub asperity_pressure: f64,
+    /// Fluid shear stress on the slider, −(h/2) ∂x p + μ v / h, Pa.
+    pub shear: f64,
+}
+
+/// The friction model, advanced one fixed step at a time.
+#[derive(Debug, Clone)]
+pub struct Solver {
+    pub(crate) d: Disc,
+    pub(crate) settings: SolverSettings,
+    pub(crate) p: Vec<f64>,
+    pub(crate) h0: f64,
+    pub(crate) time: f64,
+    pub(crate) velocity: f64,
+    pub(crate) hist: [Level; 2],
+    /// Scratch copy of the history while a step is sub-stepped.
+    hist_save: [Level; 2],
+    /// Load of the last accepted step (sub-steps interpolate from it).
+    last_load: Option<f64>,
+    /// Number of valid history levels (0, 1 or 2).
+    pub(crate) hist_len: usize,
+    pub(crate) w: Work,
+    /// Pressure at level n−2 (for the predictor).
+    p_old: Vec<f64>,
+    /// Pressure at level n−3.
+    p_old2: Vec<f64>,
+    /// How many of p_old, p_old2 are valid (0..=2).
+    p_hist: usize,
+    /// h0 at level n−3 (valid when p_hist == 2).
+    h0_n3: f64,
+    /// Newton contraction constant K (see the module doc).
+    contraction: f64,
+    anchor: (f64, f64, f64),
+    last: Option<Estimate>,
+}
+
+impl Solver {
+    /// Build the solver: validates the parameters and allocates every buffer.
+    /// Start it with [`Solver::initialize_steady`] or [`Solver::initialize_gap`]
+    /// (a first [`Solver::step`] without either starts from the steady state).
+    pub fn new(model: &ModelParams, settings: &SolverSettings) -> Result<Self, SetupError> {
+        model.check()?;
+        settings.check()?;
+        let n = settings.cells;
+        let grid = Grid::new(&model.geometry, n);
+        let eos = MixtureEos::new(&model.lubricant);
+        let gw = Greenwood::new(&model.roughness);
+        let ff = if model.roughness.flow_factors {
+            Some(FlowFactors::new(
+                model.roughness.lay_gamma,
+                model.roughness.sigma,
+            )?)
+        } else {
+            None
+        };
+        let p_amb = model.lubricant.ambient_pressure;
+        let sb = eos.eval(p_amb);
+        let contact = gw.summed(&grid.g_cell);
+        let d = Disc {
+            grid,
+            eos,
+            gw,
+            contact,
+            ff,
+            sigma: model.roughness.sigma,
+            p_amb,
+            rho_b: sb.rho,
+            gr_b: sb.rho / sb.mu,
+            mass: model.contact.mass,
+            mu_bl: model.contact.boundary_friction,
+            v_reg: model.contact.sign_regularization,
+            min_film: model.contact.min_film,
+            drivetrain: model.drivetrain,
+        };
+        let mut s = Self {
+            d,
+            settings: *settings,
+            p: vec![p_amb; n],
+            h0: model.roughness.sigma * 3.0,
+            time: 0.0,
+            velocity: 0.0,
+            hist: [Level::new(n), Level::new(n)],
+            hist_save: [Level::new(n), Level::new(n)],
+            last_load: None,
+            hist_len: 0,
+            w: Work::new(n),
+            p_old: vec![p_amb; n],
+            p_old2: vec![p_amb; n],
+            p_hist: 0,
+            h0_n3: 0.0,
+            contraction: CONTRACTION_MAX,
+            anchor: (0.0, 0.0, 0.0),
+            last: None,
+        };
+        s.w.p_anchor.copy_from_slice(&s.p);
+        Ok(s)
+    }
+
+    pub fn settings(&self) -> &SolverSettings {
+        &self.settings
+    }
+
+    /// Switch the algorithm (and its tolerance) while keeping the state, e.g.
+    /// to time the reference solver from exactly the same state.
+    pub fn set_method(&mut self, method: Method, tolerance: f64) {
+        self.settings.method = method;
+        self.settings.tolerance = tolerance;
+        self.settings.reference.fluid_tolerance = tolerance;
+        self.settings.reference.motion_tolerance = tolerance;
+    }
+
+    pub fn cells(&self) -> usize {
+        self.d.grid.n
+    }
+
+    pub fn dx(&self) -> f64 {
+        self.d.grid.dx
+    }
+
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    pub fn h0(&self) -> f64 {
+        self.h0
+    }
+
+    /// Absolute pressure at the cell centres, Pa.
+    pub fn pressure(&self) -> &[f64] {
+        &self.p
+    }
+
+    /// Film thickness at cell i (cell average), m.
+    pub fn film_thickness(&self, i: usize) -> f64 {
+        self.h0 + self.d.grid.g_cell[i]
+    }
+
+    /// The last estimate returned, if any.
+    pub fn last_estimate(&self) -> Option<&Estimate> {
+        self.last.as_ref()
+    }
+
+    /// The liquid's dynamic viscosity μl now, Pa·s.
+    pub fn liquid_viscosity(&self) -> f64 {
+        self.d.eos.mu_l
+    }
+
+    /// Change the liquid's viscosity between two steps (it follows the
+    /// temperature). No allocation; the stored time levels are kept. A value
+    /// that is not finite and positive is ignored (returns false).
+    pub fn set_liquid_viscosity(&mut self, mu_l: f64) -> bool {
+        if !(mu_l.is_finite() && mu_l > 0.0) {
+            return false;
+        }
+        self.d.eos.mu_l = mu_l;
+        let b = self.d.eos.eval(self.d.p_amb);
+        self.d.rho_b = b.rho;
+        self.d.gr_b = b.rho / b.mu;
+        true
+    }
+
+    /// Vapour fraction α(p) of the mixture EOS.
+    pub fn vapour_fraction(&self, p: f64) -> f64 {
+        self.d.eos.alpha(p)
+    }
+
+    /// Fields along x at the current state (allocation-free iterator).
+    pub fn field(&self) -> impl Iterator<Item = FieldPoint> + '_ {
+        let n = self.d.grid.n;
+        (0..n).map(move |i| {
+            let h = self.film_thickness(i);
+            let s = self.d.eos.eval(self.p[i]);
+            let (pl, pr) = self.face_pressures(i);
+            FieldPoint {
+                x: self.d.grid.x_cell(i),
+                h,
+                p: self.p[i],
+                vapour_fraction: s.alpha,
+                asperity_pressure: self.d.gw.pressure(h).0,
+                shear: -0.5 * h * (pr - pl) / self.d.grid.dx + s.mu * self.velocity / h,
+            }
+        })
+    }
+
+    /// Set an external lubricant mass source per cell (kg/(m·s) per unit
+    /// width, integrated over the cell), applied at the new time level. Used by
+    /// the method of manufactured solutions. `None` clears it.
+    pub fn set_mass_source(&mut self, source: Option<&[f64]>) {
+        match source {
+            Some(s) => {
+                let n = self.w.source.len().min(s.len());
+                self.w.source[..n].copy_from_slice(&s[..n]);
+                self.w.has_source = true;
+            }
+            None => {
+                self.w.source.fill(0.0);
+                self.w.has_source = false;
+            }
+        }
+    }
+
+    fn face_pressures(&self, i: usize) -> (f64, f64) {
+        let n = self.d.grid.n;
+        let pl = if i == 0 {
+            self.d.p_amb
+        } else {
+            0.5 * (self.p[i - 1] + self.p[i])
+        };
+        let pr = if i + 1 == n {
+            self.d.p_amb
+        } else {
+            0.5 * (self.p[i] + self.p[i + 1])
+        };
+        (pl, pr)
+    }
+}

@@ -1,0 +1,216 @@
+//! One time step: input checks, the quadratic predictor, Newton and its
+//! fallbacks (retry from the last state, then backward-Euler sub-steps), the
+//! optional film floor.
+
+use super::newton::MAX_SUBSTEPS;
+use super::{Ctx, H0Mode, Solver};
+use crate::physics::estimate::{Diagnostics, Estimate, Regime, Status};
+use crate::physics::params::{Method, MAX_ABS_VELOCITY, MAX_LOAD, MAX_STEP_OVER};
+use crate::physics::scheme::StepCoefficients;
+
+impl Solver {
+    // ------------------------------------------------------------------
+    // Public solves
+    // ------------------------------------------------------------------
+
+    /// Advance one step of `dt` with velocity `v` (m/s) and load `load` (N).
+    ///
+    /// Inputs outside the physical envelope (non-finite, |v| above
+    /// [`MAX_ABS_VELOCITY`], a load not in (0, [`MAX_LOAD`]]) are rejected:
+    /// nothing is computed, the state is kept (the film is held for the step),
+    /// time still advances, and the estimate is the last good one (or a
+    /// defined zero before any) with the status saying why.
+    pub fn step(&mut self, v: f64, load: f64) -> Estimate {
+        self.step_with_gap(v, load, H0Mode::Balance)
+    }
+
+    /// One backward-Euler step of arbitrary length `dt` (s, in (0,
+    /// [`MAX_STEP_OVER`]]), for a loop that lost more time than it can catch
+    /// up in fixed steps. The history restarts around it: the step and the
+    /// one after it are backward Euler (first order), then BDF2 resumes.
+    pub fn step_over(&mut self, v: f64, load: f64, dt: f64) -> Estimate {
+        if !(dt.is_finite() && dt > 0.0 && dt <= MAX_STEP_OVER) {
+            return self.rejected_input(v, load, Status::InputOutOfRange, true);
+        }
+        self.restart_history();
+        let fixed = self.settings.dt;
+        self.settings.dt = dt;
+        let e = self.step(v, load);
+        self.settings.dt = fixed;
+        self.restart_history();
+        e
+    }
+
+    /// Advance one step with a prescribed gap h0 (no load balance). `load`
+    /// is only used to normalise the COF.
+    pub fn step_prescribed_gap(&mut self, v: f64, h0: f64, load: f64) -> Estimate {
+        self.step_with_gap(v, load, H0Mode::Prescribed(h0))
+    }
+    /// The status of inputs outside the envelope, None when inside.
+    pub(super) fn input_status(v: f64, load: f64) -> Option<Status> {
+        if !(v.is_finite() && load.is_finite()) {
+            Some(Status::NonFiniteInput)
+        } else if v.abs() > MAX_ABS_VELOCITY || load <= 0.0 || load > MAX_LOAD {
+            Some(Status::InputOutOfRange)
+        } else {
+            None
+        }
+    }
+
+    /// The last good estimate (or a defined zero) under `status`; the
+    /// rejected inputs themselves are never reported. A rejected time step
+    /// still advances time (`advance`).
+    pub(super) fn rejected_input(
+        &mut self,
+        _v: f64,
+        _load: f64,
+        status: Status,
+        advance: bool,
+    ) -> Estimate {
+        if advance {
+            self.time += self.settings.dt;
+        }
+        let mut e = self.last.unwrap_or_else(|| self.blank_estimate());
+        e.time = self.time;
+        e.status = status;
+        e.diagnostics = Diagnostics::default();
+        e.inertia_force = 0.0;
+        e
+    }
+
+    pub(super) fn blank_estimate(&self) -> Estimate {
+        Estimate {
+            time: self.time,
+            velocity: self.velocity,
+            load: 0.0,
+            h0: self.h0,
+            h_min: self.h0 + self.d.grid.g_min,
+            hydrodynamic_force: 0.0,
+            asperity_force: 0.0,
+            viscous_force: 0.0,
+            friction_force: 0.0,
+            contact_friction_force: 0.0,
+            cof: 0.0,
+            asperity_load_share: 0.0,
+            inertia_force: 0.0,
+            contact_area_ratio: 0.0,
+            max_pressure: self.d.p_amb,
+            cavitated_fraction: 0.0,
+            regime: Regime::Boundary,
+            status: Status::NonFiniteInput,
+            diagnostics: Diagnostics::default(),
+        }
+    }
+
+    fn step_with_gap(&mut self, v: f64, load: f64, gap: H0Mode) -> Estimate {
+        let gap_ok = match gap {
+            H0Mode::Balance => true,
+            H0Mode::Prescribed(h) => h.is_finite() && h > 0.0,
+        };
+        let rejected = Self::input_status(v, load).or((!gap_ok).then_some(Status::InputOutOfRange));
+        if let Some(status) = rejected {
+            return self.rejected_input(v, load, status, true);
+        }
+        if self.hist_len == 0 {
+            // Never initialised: start from the steady state at this input.
+            self.initialize_steady(v, load);
+        }
+        let coeffs = if self.hist_len >= 2 {
+            StepCoefficients::for_scheme(self.settings.scheme)
+        } else {
+            StepCoefficients::BDF1
+        };
+        let ctx = Ctx {
+            v,
+            load,
+            time: Some((coeffs, self.settings.dt)),
+            gap,
+        };
+        self.w.p_backup.copy_from_slice(&self.p);
+        let h_backup = self.h0;
+        // Warm start: pressure and h0 extrapolated in time, quadratically
+        // once three levels exist (error O(Δt³): within the tolerance for
+        // smooth motion, so such steps take one Newton iteration).
+        let quadratic = self.p_hist == 2 && self.hist_len >= 2;
+        if quadratic {
+            for ((p, o), o2) in self.p.iter_mut().zip(&self.p_old).zip(&self.p_old2) {
+                *p = 3.0 * (*p - o) + o2;
+            }
+        } else if self.p_hist >= 1 && self.hist_len >= 2 {
+            for (p, o) in self.p.iter_mut().zip(&self.p_old) {
+                *p = 2.0 * *p - o;
+            }
+        }
+        match gap {
+            H0Mode::Prescribed(h) => self.h0 = h,
+            H0Mode::Balance => {
+                if self.hist_len >= 2 {
+                    let (h1, h2) = (self.hist[0].h0, self.hist[1].h0);
+                    let ext = if quadratic {
+                        3.0 * (h1 - h2) + self.h0_n3
+                    } else {
+                        2.0 * h1 - h2
+                    };
+                    if ext > 0.5 * self.h0 && ext.is_finite() {
+                        self.h0 = ext;
+                    }
+                }
+            }
+        }
+        let mut out = match self.settings.method {
+            Method::Newton => self.solve(&ctx),
+            Method::Reference => self.reference_solve(&ctx),
+        };
+        let mut substeps = 0;
+        if out.status != Status::Converged && self.settings.method == Method::Newton {
+            // Fallbacks for the rare hard step (a fast vapour-pocket collapse):
+            // Newton from the last state instead of the extrapolated one, then
+            // the step split into backward-Euler sub-steps.
+            let spent = out.iterations;
+            self.p.copy_from_slice(&self.w.p_backup);
+            self.h0 = match gap {
+                H0Mode::Prescribed(h) => h,
+                H0Mode::Balance => h_backup,
+            };
+            out = self.solve(&ctx);
+            out.iterations += spent;
+            let mut m = 2;
+            while out.status != Status::Converged && m <= MAX_SUBSTEPS {
+                let spent = out.iterations;
+                out = self.solve_substepped(&ctx, m, h_backup);
+                out.iterations += spent;
+                substeps = m;
+                m *= 2;
+            }
+        }
+        let mut floor = false;
+        if out.status != Status::NonFinite && gap == H0Mode::Balance && self.h0 < self.d.min_film {
+            // The floor binds: hold h0 there and give up the load balance.
+            floor = true;
+            let inner = out.iterations;
+            let c2 = Ctx {
+                gap: H0Mode::Prescribed(self.d.min_film),
+                ..ctx
+            };
+            self.h0 = self.d.min_film;
+            out = self.solve(&c2);
+            out.iterations += inner;
+        }
+        if out.status == Status::NonFinite {
+            self.p.copy_from_slice(&self.w.p_backup);
+            self.h0 = h_backup;
+        }
+        std::mem::swap(&mut self.p_old2, &mut self.p_old);
+        std::mem::swap(&mut self.p_old, &mut self.w.p_backup);
+        self.p_hist = (self.p_hist + 1).min(2);
+        // Level n−2 now becomes n−3 for the next step.
+        self.h0_n3 = self.hist[1].h0;
+        self.velocity = v;
+        self.last_load = Some(load);
+        let mut e = self.finish(&ctx, out, true);
+        e.diagnostics.film_floor_active = floor;
+        e.diagnostics.substeps = substeps as u32;
+        self.last = Some(e);
+        e
+    }
+}

@@ -1,0 +1,272 @@
+//! One MCAP file in the ROS 2 profile for the node's topics: schemas and
+//! channels (every file carries all of them, so each is readable alone),
+//! the `friction_node` metadata record, messages, per-topic counts.
+
+use super::entry::{Encoder, Entry, TopicId};
+use super::RecorderError;
+use crate::config::{CommandType, Compression, Config, QosConfig, Reliability};
+use crate::msgs::{self, MsgType, RecordItem};
+use crate::transport::names::TopicNames;
+use std::collections::BTreeMap;
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+
+/// rosbag2's `offered_qos_profiles` metadata for one publisher.
+pub fn offered_qos_yaml(q: &QosConfig) -> String {
+    // rosbag2 enums: history 1 keep_last; reliability 1 reliable, 2 best
+    // effort; durability 1 transient local, 2 volatile; liveliness 1
+    // automatic.
+    let reliability = match q.reliability {
+        Reliability::Reliable => 1,
+        Reliability::BestEffort => 2,
+    };
+    let durability = match q.durability {
+        crate::config::Durability::TransientLocal => 1,
+        crate::config::Durability::Volatile => 2,
+    };
+    let inf = "    sec: 2147483647\n    nsec: 4294967295\n";
+    format!(
+        "- history: 1\n  depth: {}\n  reliability: {reliability}\n  durability: {durability}\n  deadline:\n{inf}  lifespan:\n{inf}  liveliness: 1\n  liveliness_lease_duration:\n{inf}  avoid_ros_namespace_conventions: false\n",
+        q.depth
+    )
+}
+
+/// What each recorded topic is: its name, type and offered QoS.
+#[derive(Debug, Clone)]
+pub struct TopicTable {
+    pub topics: Vec<(TopicId, String, &'static MsgType, String)>,
+}
+
+impl TopicTable {
+    pub fn new(config: &Config, names: &TopicNames) -> Self {
+        let velocity_type = match config.ros.command_type {
+            CommandType::Float64 => &msgs::FLOAT64,
+            CommandType::TwistStamped => &msgs::TWIST_STAMPED,
+        };
+        let cq = offered_qos_yaml(&config.ros.qos.commands);
+        let eq = offered_qos_yaml(&config.ros.qos.estimates);
+        Self {
+            topics: vec![
+                (
+                    TopicId::Velocity,
+                    names.cmd_velocity.clone(),
+                    velocity_type,
+                    cq.clone(),
+                ),
+                (
+                    TopicId::Load,
+                    names.normal_load.clone(),
+                    &msgs::FLOAT64,
+                    cq.clone(),
+                ),
+                (
+                    TopicId::Friction,
+                    names.friction.clone(),
+                    &msgs::FRICTION_ESTIMATE,
+                    eq.clone(),
+                ),
+                (
+                    TopicId::FrictionForce,
+                    names.friction_force.clone(),
+                    &msgs::FLOAT64,
+                    eq.clone(),
+                ),
+                (
+                    TopicId::FilmProfile,
+                    names.film_profile.clone(),
+                    &msgs::FILM_PROFILE,
+                    eq.clone(),
+                ),
+                (
+                    TopicId::Statistics,
+                    names.loop_statistics.clone(),
+                    &msgs::LOOP_STATISTICS,
+                    eq,
+                ),
+                (
+                    TopicId::Temperature,
+                    names.temperature.clone(),
+                    &msgs::TEMPERATURE,
+                    cq,
+                ),
+            ],
+        }
+    }
+}
+
+type McapWriter = mcap::Writer<BufWriter<std::fs::File>>;
+
+/// One MCAP file being written.
+pub struct BagWriter {
+    w: McapWriter,
+    /// Channel id of each [`TopicId`].
+    channels: [u16; 7],
+    encoder: Encoder,
+    sequence: u32,
+    messages: u64,
+    /// Messages per topic.
+    pub counts: [u64; 7],
+    /// Log time of the first and last message, ns.
+    pub first_log_ns: Option<u64>,
+    pub last_log_ns: u64,
+    /// Bytes handed to the writer (serialized messages; the file is smaller
+    /// when compressed).
+    pub payload_bytes: u64,
+    path: PathBuf,
+    scratch: Vec<Entry>,
+}
+
+impl BagWriter {
+    /// Create `path` with the schemas, channels and the `friction_node`
+    /// metadata record (resolved config, plus `extra` keys).
+    pub fn create(
+        path: &Path,
+        config: &Config,
+        names: &TopicNames,
+        extra: BTreeMap<String, String>,
+        started_ns: u64,
+    ) -> Result<Self, RecorderError> {
+        let create = |source| RecorderError::Create {
+            path: path.to_path_buf(),
+            source,
+        };
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir).map_err(create)?;
+        }
+        let file = std::fs::File::create(path).map_err(create)?;
+        let mcap_err = |e: mcap::McapError| RecorderError::Mcap {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        };
+        let compression = match config.recording.compression {
+            Compression::None => None,
+            Compression::Zstd => Some(mcap::Compression::Zstd),
+            Compression::Lz4 => Some(mcap::Compression::Lz4),
+        };
+        let mut w = mcap::WriteOptions::new()
+            .profile("ros2")
+            .library(concat!("friction-node ", env!("CARGO_PKG_VERSION")))
+            .compression(compression)
+            .chunk_size(Some(config.recording.chunk_size_bytes))
+            .create(BufWriter::new(file))
+            .map_err(mcap_err)?;
+        let mut channels = [0u16; 7];
+        let mut schemas: BTreeMap<String, u16> = BTreeMap::new();
+        for (id, topic, ty, qos) in TopicTable::new(config, names).topics {
+            let name = ty.full_name();
+            let schema = match schemas.get(&name) {
+                Some(s) => *s,
+                None => {
+                    let s = w
+                        .add_schema(&name, "ros2msg", ty.ros2msg_schema().as_bytes())
+                        .map_err(mcap_err)?;
+                    schemas.insert(name, s);
+                    s
+                }
+            };
+            let mut meta = BTreeMap::new();
+            meta.insert("offered_qos_profiles".to_string(), qos);
+            channels[id.index()] = w
+                .add_channel(schema, &topic, "cdr", &meta)
+                .map_err(mcap_err)?;
+        }
+        let mut meta = extra;
+        meta.insert("config_yaml".to_string(), config.to_yaml());
+        meta.insert("version".to_string(), env!("CARGO_PKG_VERSION").to_string());
+        meta.insert(
+            "step_mode".to_string(),
+            format!("{:?}", config.node.step_mode).to_lowercase(),
+        );
+        meta.insert("started_ns".to_string(), started_ns.to_string());
+        w.write_metadata(&mcap::records::Metadata {
+            name: "friction_node".into(),
+            metadata: meta,
+        })
+        .map_err(mcap_err)?;
+        Ok(Self {
+            w,
+            channels,
+            encoder: Encoder {
+                frame_id: config.node.frame_id.clone(),
+                command_type: config.ros.command_type,
+            },
+            sequence: 0,
+            messages: 0,
+            counts: [0; 7],
+            first_log_ns: None,
+            last_log_ns: 0,
+            payload_bytes: 0,
+            path: path.to_path_buf(),
+            scratch: Vec::new(),
+        })
+    }
+
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Messages written so far.
+    pub fn messages(&self) -> u64 {
+        self.messages
+    }
+
+    /// Write a metadata record.
+    pub fn write_metadata(
+        &mut self,
+        name: &str,
+        metadata: BTreeMap<String, String>,
+    ) -> Result<(), String> {
+        self.w
+            .write_metadata(&mcap::records::Metadata {
+                name: name.into(),
+                metadata,
+            })
+            .map_err(|e| e.to_string())
+    }
+
+    /// Write one serialized message.
+    pub fn write_entry(&mut self, e: &Entry) -> Result<(), String> {
+        self.sequence = self.sequence.wrapping_add(1);
+        self.w
+            .write_to_known_channel(
+                &mcap::records::MessageHeader {
+                    channel_id: self.channels[e.topic.index()],
+                    sequence: self.sequence,
+                    log_time: e.log_ns,
+                    publish_time: e.publish_ns,
+                },
+                &e.data,
+            )
+            .map_err(|x| x.to_string())?;
+        self.messages += 1;
+        self.counts[e.topic.index()] += 1;
+        self.first_log_ns.get_or_insert(e.log_ns);
+        self.last_log_ns = self.last_log_ns.max(e.log_ns);
+        self.payload_bytes += e.data.len() as u64 + 31;
+        Ok(())
+    }
+
+    /// Write one item the loop or a transport produced.
+    pub fn write_item(&mut self, item: &RecordItem) -> Result<(), String> {
+        let mut out = std::mem::take(&mut self.scratch);
+        out.clear();
+        let r = self
+            .encoder
+            .encode(item, &mut out)
+            .and_then(|_| out.iter().try_for_each(|e| self.write_entry(e)));
+        self.scratch = out;
+        r
+    }
+
+    /// Close the open chunk (what is on disk is then readable after a crash).
+    pub fn flush(&mut self) -> Result<(), String> {
+        self.w.flush().map_err(|e| e.to_string())
+    }
+
+    /// Write the summary and footer; returns the file's size.
+    pub fn finish(mut self) -> Result<u64, String> {
+        self.w.finish().map_err(|e| e.to_string())?;
+        drop(self.w);
+        Ok(std::fs::metadata(&self.path).map_or(0, |m| m.len()))
+    }
+}

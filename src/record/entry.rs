@@ -1,0 +1,175 @@
+//! What the recorder writes: every item as a serialized message on one of
+//! the node's topics, ready for any file (a single recording, a split file,
+//! a snapshot).
+
+use crate::config::CommandType;
+use crate::msgs::{self, Command, CommandKind, Float64, Header, RecordItem, Time, TwistStamped};
+use crate::transport::ProfileData;
+
+/// The node's recorded topics.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum TopicId {
+    Velocity,
+    Load,
+    Friction,
+    FrictionForce,
+    FilmProfile,
+    Statistics,
+    Temperature,
+}
+
+impl TopicId {
+    pub const ALL: [TopicId; 7] = [
+        TopicId::Velocity,
+        TopicId::Load,
+        TopicId::Friction,
+        TopicId::FrictionForce,
+        TopicId::FilmProfile,
+        TopicId::Statistics,
+        TopicId::Temperature,
+    ];
+
+    pub fn index(self) -> usize {
+        self as usize
+    }
+}
+
+/// One serialized message.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Entry {
+    pub topic: TopicId,
+    /// When it was received or recorded (wall clock), ns.
+    pub log_ns: u64,
+    /// The publisher's stamp, ns.
+    pub publish_ns: u64,
+    /// CDR with its encapsulation header.
+    pub data: Vec<u8>,
+}
+
+impl Entry {
+    /// Bytes it holds in memory (for the snapshot ring's bound).
+    pub fn footprint(&self) -> usize {
+        self.data.capacity() + std::mem::size_of::<Entry>()
+    }
+}
+
+/// Turns items into entries.
+#[derive(Debug, Clone)]
+pub struct Encoder {
+    pub frame_id: String,
+    pub command_type: CommandType,
+}
+
+fn cdr<T: serde::Serialize>(m: &T) -> Result<Vec<u8>, String> {
+    msgs::to_cdr(m)
+}
+
+impl Encoder {
+    fn command(&self, c: &Command, received_ns: u64) -> Result<Entry, String> {
+        let (topic, data) = match (c.kind, self.command_type) {
+            (CommandKind::Load, _) => (TopicId::Load, cdr(&Float64 { data: c.value })?),
+            (CommandKind::Temperature, _) => (
+                TopicId::Temperature,
+                cdr(&msgs::Temperature {
+                    header: Header {
+                        stamp: Time::from_ns(c.stamp_ns),
+                        frame_id: self.frame_id.clone(),
+                    },
+                    temperature: c.value,
+                    variance: 0.0,
+                })?,
+            ),
+            (CommandKind::Velocity, CommandType::Float64) => {
+                (TopicId::Velocity, cdr(&Float64 { data: c.value })?)
+            }
+            (CommandKind::Velocity, CommandType::TwistStamped) => {
+                let mut m = TwistStamped {
+                    header: Header {
+                        stamp: Time::from_ns(c.stamp_ns),
+                        frame_id: self.frame_id.clone(),
+                    },
+                    ..Default::default()
+                };
+                m.twist.linear.x = c.value;
+                (TopicId::Velocity, cdr(&m)?)
+            }
+        };
+        Ok(Entry {
+            topic,
+            log_ns: received_ns,
+            publish_ns: c.stamp_ns,
+            data,
+        })
+    }
+
+    /// The entries of one item (an estimate is two: the full estimate and
+    /// the plain friction force), logged when the item says it was received
+    /// or published.
+    pub fn encode(&self, item: &RecordItem, out: &mut Vec<Entry>) -> Result<(), String> {
+        match item {
+            RecordItem::Command {
+                command,
+                received_ns,
+            } => out.push(self.command(command, *received_ns)?),
+            RecordItem::Raw(r) => out.push(Entry {
+                topic: match r.kind {
+                    CommandKind::Velocity => TopicId::Velocity,
+                    CommandKind::Load => TopicId::Load,
+                    CommandKind::Temperature => TopicId::Temperature,
+                },
+                log_ns: r.received_ns,
+                publish_ns: r.publish_ns,
+                data: r.cdr.clone(),
+            }),
+            &RecordItem::Estimate {
+                record: ref e,
+                logged_ns: log_ns,
+            } => {
+                out.push(Entry {
+                    topic: TopicId::Friction,
+                    log_ns,
+                    publish_ns: e.stamp_ns,
+                    data: cdr(&e.to_wire(&self.frame_id))?,
+                });
+                out.push(Entry {
+                    topic: TopicId::FrictionForce,
+                    log_ns,
+                    publish_ns: e.stamp_ns,
+                    data: cdr(&Float64 {
+                        data: e.friction_force_n,
+                    })?,
+                });
+            }
+            &RecordItem::Statistics {
+                record: ref s,
+                logged_ns: log_ns,
+            } => out.push(Entry {
+                topic: TopicId::Statistics,
+                log_ns,
+                publish_ns: s.stamp_ns,
+                data: cdr(&s.to_wire(&self.frame_id))?,
+            }),
+        }
+        Ok(())
+    }
+
+    /// A film profile's entry.
+    pub fn profile(&self, p: ProfileData, log_ns: u64) -> Result<Entry, String> {
+        let stamp = p.stamp_ns;
+        let m = msgs::FilmProfile {
+            header: Header {
+                stamp: Time::from_ns(stamp),
+                frame_id: self.frame_id.clone(),
+            },
+            dx_m: p.dx_m,
+            h_m: p.h_m,
+            p_pa: p.p_pa,
+        };
+        Ok(Entry {
+            topic: TopicId::FilmProfile,
+            log_ns,
+            publish_ns: stamp,
+            data: cdr(&m)?,
+        })
+    }
+}

@@ -1,0 +1,318 @@
+//! The replay's output: the `simulate` columns as CSV, or MCAP in the ROS 2
+//! profile, written by a background thread to a temporary sibling and moved
+//! into place only when complete.
+
+use super::{InputMode, Oracle, PreparedReplay, ReplayError};
+use crate::msgs::{self, Command, EstimateRecord};
+use crate::output::tmp_sibling;
+use crate::physics::Estimate;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// Output format of a replay.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OutputFormat {
+    /// The `simulate` columns, then `stamp_ns`; `t_s` is the stamp relative
+    /// to the first step.
+    Csv,
+    /// ROS 2 profile, the node's topics: the inputs and the estimates.
+    Mcap,
+}
+
+impl OutputFormat {
+    /// From the output path's extension (`.csv` or `.mcap`).
+    pub fn from_path(path: &Path) -> Option<Self> {
+        match path.extension()?.to_str()?.to_ascii_lowercase().as_str() {
+            "csv" => Some(Self::Csv),
+            "mcap" => Some(Self::Mcap),
+            _ => None,
+        }
+    }
+}
+
+type Step = (Estimate, EstimateRecord);
+
+/// One output file, written to a temporary sibling and renamed over the
+/// destination only when complete.
+trait Sink: Send {
+    fn write(&mut self, steps: &[Step]) -> Result<(), String>;
+    fn finish(self: Box<Self>, oracle: Option<&Oracle>) -> Result<PathBuf, ReplayError>;
+}
+
+struct CsvSink {
+    file: crate::output::AtomicFile,
+    t0: Option<u64>,
+}
+
+impl Sink for CsvSink {
+    fn write(&mut self, steps: &[Step]) -> Result<(), String> {
+        for (e, rec) in steps {
+            let t0 = *self.t0.get_or_insert(rec.stamp_ns);
+            let mut e = *e;
+            e.time = rec.stamp_ns.saturating_sub(t0) as f64 / 1e9;
+            let row = crate::offline::simulate_row_with_status(
+                &e,
+                msgs::status_name(rec.status),
+                rec.temperature_c,
+            );
+            self.file
+                .line(format_args!(
+                    "{row},{},{}",
+                    rec.stamp_ns,
+                    msgs::command_status_name(rec.command_status)
+                ))
+                .map_err(|e| e.to_string())?;
+        }
+        Ok(())
+    }
+
+    fn finish(self: Box<Self>, _: Option<&Oracle>) -> Result<PathBuf, ReplayError> {
+        let path = self.file.path().to_path_buf();
+        self.file.commit().map_err(|e| ReplayError::Output {
+            path,
+            message: e.to_string(),
+        })
+    }
+}
+
+struct McapSink {
+    /// None once finished.
+    w: Option<crate::record::BagWriter>,
+    path: PathBuf,
+    /// The temporary sibling written (None: a device written in place).
+    tmp: Option<PathBuf>,
+    /// The inputs, written in stamp order between the estimates.
+    commands: Vec<Command>,
+    next: usize,
+}
+
+impl McapSink {
+    fn writer(&mut self) -> Result<&mut crate::record::BagWriter, String> {
+        self.w
+            .as_mut()
+            .ok_or_else(|| "already finished".to_string())
+    }
+
+    fn commands_up_to(&mut self, stamp: u64) -> Result<(), String> {
+        while let Some(&c) = self.commands.get(self.next).filter(|c| c.stamp_ns <= stamp) {
+            let item = msgs::RecordItem::Command {
+                command: c,
+                received_ns: c.stamp_ns,
+            };
+            self.writer()?.write_item(&item)?;
+            self.next += 1;
+        }
+        Ok(())
+    }
+}
+
+impl Sink for McapSink {
+    fn write(&mut self, steps: &[Step]) -> Result<(), String> {
+        for (_, rec) in steps {
+            self.commands_up_to(rec.stamp_ns)?;
+            self.writer()?.write_item(&msgs::RecordItem::Estimate {
+                record: *rec,
+                logged_ns: rec.stamp_ns,
+            })?;
+        }
+        Ok(())
+    }
+
+    fn finish(mut self: Box<Self>, oracle: Option<&Oracle>) -> Result<PathBuf, ReplayError> {
+        let err = |path: &Path, message: String| ReplayError::Output {
+            path: path.to_path_buf(),
+            message,
+        };
+        let result = (|| {
+            self.commands_up_to(u64::MAX)?;
+            if let Some(o) = oracle {
+                let mut m = BTreeMap::new();
+                m.insert("bit_identical".to_string(), o.identical.to_string());
+                m.insert("compared_steps".to_string(), o.compared.to_string());
+                self.writer()?
+                    .write_metadata("friction_node_replay_oracle", m)?;
+            }
+            Ok::<(), String>(())
+        })();
+        let (path, tmp) = (self.path.clone(), self.tmp.clone());
+        let Some(tmp) = tmp else {
+            // A device: written in place, nothing to move.
+            let w = self.w.take();
+            result
+                .and_then(|_| w.ok_or_else(|| "already finished".to_string())?.finish())
+                .map_err(|e| err(&path, e))?;
+            return Ok(path);
+        };
+        let w = self.w.take();
+        let finished =
+            result.and_then(|_| w.ok_or_else(|| "already finished".to_string())?.finish());
+        if let Err(e) = finished {
+            let _ = std::fs::remove_file(&tmp);
+            return Err(err(&path, e));
+        }
+        std::fs::rename(&tmp, &path).map_err(|e| err(&path, e.to_string()))?;
+        Ok(path)
+    }
+}
+
+impl Drop for McapSink {
+    fn drop(&mut self) {
+        // An unfinished output is abandoned (a finished one was renamed).
+        if self.w.take().is_some() {
+            if let Some(tmp) = &self.tmp {
+                let _ = std::fs::remove_file(tmp);
+            }
+        }
+    }
+}
+
+/// The replay's output, written by a background thread while the model
+/// runs (the formatting and compression then cost no replay time on a
+/// machine with a second core). Nothing replaces the destination until
+/// [`OutputStream::finish`]; dropped unfinished, the temporary file is
+/// removed.
+pub struct OutputStream {
+    tx: Option<std::sync::mpsc::SyncSender<Vec<Step>>>,
+    batch: Vec<Step>,
+    thread: Option<std::thread::JoinHandle<SinkOutcome>>,
+    path: PathBuf,
+}
+
+const BATCH: usize = 1024;
+
+/// The writer thread hands its sink back with the first write error.
+type SinkOutcome = (Box<dyn Sink>, Result<(), String>);
+
+impl OutputStream {
+    /// Create the temporary output next to `path` and start the writer.
+    pub fn start(
+        path: &Path,
+        format: OutputFormat,
+        p: &PreparedReplay,
+        source: &Path,
+    ) -> Result<Self, ReplayError> {
+        let out_err = |message: String| ReplayError::Output {
+            path: path.to_path_buf(),
+            message,
+        };
+        let sink: Box<dyn Sink> = match format {
+            OutputFormat::Csv => {
+                let mut file =
+                    crate::output::AtomicFile::create(path).map_err(|e| out_err(e.to_string()))?;
+                file.line(format_args!(
+                    "{},stamp_ns,command_status",
+                    crate::offline::SIMULATE_COLUMNS
+                ))
+                .map_err(|e| out_err(e.to_string()))?;
+                Box::new(CsvSink { file, t0: None })
+            }
+            OutputFormat::Mcap => {
+                // A device (e.g. /dev/null) is written in place, never renamed over.
+                let tmp = (!crate::output::is_special(path)).then(|| tmp_sibling(path));
+                let target = tmp.clone().unwrap_or_else(|| path.to_path_buf());
+                let mut extra = BTreeMap::new();
+                extra.insert("replay_of".to_string(), source.display().to_string());
+                extra.insert(
+                    "replay_input".to_string(),
+                    match &p.mode {
+                        InputMode::Topics { velocity, .. } => format!("topic {velocity}"),
+                        InputMode::RecordedEstimates { topic } => {
+                            format!("recorded estimates {topic}")
+                        }
+                    },
+                );
+                let names = crate::transport::names::TopicNames::from_config(&p.config);
+                let w = crate::record::BagWriter::create(
+                    &target,
+                    &p.config,
+                    &names,
+                    extra,
+                    crate::clock::system_wall_ns(),
+                )
+                .map_err(|e| {
+                    if let Some(t) = &tmp {
+                        let _ = std::fs::remove_file(t);
+                    }
+                    out_err(e.to_string())
+                })?;
+                Box::new(McapSink {
+                    w: Some(w),
+                    path: path.to_path_buf(),
+                    tmp,
+                    commands: p.commands.clone(),
+                    next: 0,
+                })
+            }
+        };
+        let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<Step>>(8);
+        let thread = std::thread::Builder::new()
+            .name("replay-output".into())
+            .spawn(move || {
+                let mut sink = sink;
+                let mut result = Ok(());
+                for batch in rx {
+                    if result.is_ok() {
+                        result = sink.write(&batch);
+                    }
+                }
+                (sink, result)
+            })
+            .map_err(|e| out_err(format!("cannot start the writer thread: {e}")))?;
+        Ok(Self {
+            tx: Some(tx),
+            batch: Vec::with_capacity(BATCH),
+            thread: Some(thread),
+            path: path.to_path_buf(),
+        })
+    }
+
+    /// Queue one step.
+    pub fn push(&mut self, e: &Estimate, rec: &EstimateRecord) {
+        self.batch.push((*e, *rec));
+        if self.batch.len() >= BATCH {
+            self.send();
+        }
+    }
+
+    fn send(&mut self) {
+        let batch = std::mem::replace(&mut self.batch, Vec::with_capacity(BATCH));
+        if let Some(tx) = &self.tx {
+            // A failed writer has stopped receiving; finish reports why.
+            let _ = tx.send(batch);
+        }
+    }
+
+    /// Write what is queued, close the file and move it into place.
+    pub fn finish(mut self, oracle: Option<&Oracle>) -> Result<PathBuf, ReplayError> {
+        self.send();
+        self.tx = None;
+        let (sink, result) = self
+            .thread
+            .take()
+            .expect("finish once")
+            .join()
+            .map_err(|_| ReplayError::Output {
+                path: self.path.clone(),
+                message: "the writer thread panicked".into(),
+            })?;
+        if let Err(message) = result {
+            // Dropping the sink removes the temporary file.
+            drop(sink);
+            return Err(ReplayError::Output {
+                path: self.path.clone(),
+                message,
+            });
+        }
+        sink.finish(oracle)
+    }
+}
+
+impl Drop for OutputStream {
+    fn drop(&mut self) {
+        self.tx = None;
+        if let Some(t) = self.thread.take() {
+            // The sink is dropped with the thread's result: temp removed.
+            let _ = t.join();
+        }
+    }
+}

@@ -1,0 +1,277 @@
+//! The ROS 2 node's I/O thread: commands in (raw samples, decoded here and
+//! recorded unchanged), estimates, profiles and statistics out.
+
+use super::raw::{RawAdapter, RawCdr};
+use super::{advertise, context, err, qos, ros_node, topic, Out, Ros2Spec};
+use crate::clock::system_wall_ns;
+use crate::config::CommandType;
+use crate::msgs::{
+    self, Command, CommandKind, FilmProfile, Float64, FrictionEstimate, Header, LoopStatistics,
+    RawSample, RecordItem, Time, TwistStamped, FILM_PROFILE, FLOAT64, FRICTION_ESTIMATE,
+    LOOP_STATISTICS, TWIST_STAMPED,
+};
+use crate::transport::{record_input, ProfileSlot, RecordQueue, SharedCounters, TransportError};
+use crossbeam_queue::ArrayQueue;
+use ros2_client::dds::rustdds::mio1::{Events, Interest, Poll, Token, Waker};
+use ros2_client::dds::rustdds::no_key::SimpleDataReader;
+use ros2_client::dds::rustdds::QosPolicies;
+use ros2_client::Publisher;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::Duration;
+
+/// What the I/O thread shares with the node's port.
+pub(super) struct Shared {
+    pub spec: Ros2Spec,
+    pub commands: Arc<ArrayQueue<Command>>,
+    pub outputs: Arc<ArrayQueue<Out>>,
+    pub stop: Arc<AtomicBool>,
+    pub counters: Arc<SharedCounters>,
+    pub profile: Option<Arc<ProfileSlot>>,
+    pub record: RecordQueue,
+    pub snapshot: Option<Arc<AtomicBool>>,
+}
+
+type RawReader = SimpleDataReader<RawCdr, RawAdapter>;
+
+const VELOCITY: Token = Token(1);
+const LOAD: Token = Token(2);
+const WAKE: Token = Token(3);
+const TEMPERATURE: Token = Token(4);
+
+/// The DDS entities of the node.
+struct Entities {
+    _ctx: ros2_client::Context,
+    _node: ros2_client::Node,
+    velocity: RawReader,
+    load: RawReader,
+    temperature: RawReader,
+    friction: Publisher<FrictionEstimate>,
+    force: Publisher<Float64>,
+    film: Publisher<FilmProfile>,
+    stats: Publisher<LoopStatistics>,
+    snapshot: Option<ros2_client::Subscription<msgs::Empty>>,
+    poll: Poll,
+    waker: Arc<Waker>,
+}
+
+fn setup(spec: &Ros2Spec, snapshots: bool) -> Result<Entities, TransportError> {
+    let ctx = context(spec)?;
+    let mut node = ros_node(&ctx, &spec.namespace, &spec.node_name)?;
+    let cq = qos(&spec.command_qos);
+    let eq = qos(&spec.estimate_qos);
+    let n = &mut node;
+    let velocity_type = match spec.command_type {
+        CommandType::Float64 => &FLOAT64,
+        CommandType::TwistStamped => &TWIST_STAMPED,
+    };
+    let subscriber = ctx
+        .domain_participant()
+        .create_subscriber(&QosPolicies::from(&cq))
+        .map_err(|e| err("create a DDS subscriber", e))?;
+    let raw_reader = |n: &mut ros2_client::Node, name: &str, ty: &msgs::MsgType, what: &str| {
+        let t = topic(n, name, ty.package, ty.name, &cq)?;
+        subscriber
+            .create_simple_datareader_no_key::<RawCdr, RawAdapter>(&t, Some(QosPolicies::from(&cq)))
+            .map_err(|e| err(format!("subscribe to {what}"), e))
+    };
+    let mut velocity = raw_reader(n, &spec.cmd_velocity, velocity_type, "the velocity")?;
+    let mut load = raw_reader(n, &spec.normal_load, &FLOAT64, "the load")?;
+    let mut temperature = raw_reader(n, &spec.temperature, &msgs::TEMPERATURE, "the temperature")?;
+    let friction = advertise(n, &spec.friction, &FRICTION_ESTIMATE, &eq, "the estimate")?;
+    let force = advertise(n, &spec.friction_force, &FLOAT64, &eq, "the friction force")?;
+    let film = advertise(
+        n,
+        &spec.film_profile,
+        &FILM_PROFILE,
+        &eq,
+        "the film profile",
+    )?;
+    let stats = advertise(
+        n,
+        &spec.loop_statistics,
+        &LOOP_STATISTICS,
+        &eq,
+        "the statistics",
+    )?;
+    let snapshot = if snapshots {
+        Some(super::subscribe(
+            n,
+            &spec.snapshot,
+            &msgs::EMPTY,
+            &cq,
+            "the snapshot request",
+        )?)
+    } else {
+        None
+    };
+    let poll = Poll::new().map_err(|e| err("create a poll", e))?;
+    poll.registry()
+        .register(&mut velocity, VELOCITY, Interest::READABLE)
+        .map_err(|e| err("register the velocity reader", e))?;
+    poll.registry()
+        .register(&mut load, LOAD, Interest::READABLE)
+        .map_err(|e| err("register the load reader", e))?;
+    poll.registry()
+        .register(&mut temperature, TEMPERATURE, Interest::READABLE)
+        .map_err(|e| err("register the temperature reader", e))?;
+    let waker = Arc::new(Waker::new(poll.registry(), WAKE).map_err(|e| err("create a waker", e))?);
+    Ok(Entities {
+        _ctx: ctx,
+        _node: node,
+        velocity,
+        load,
+        temperature,
+        friction,
+        force,
+        film,
+        stats,
+        snapshot,
+        poll,
+        waker,
+    })
+}
+
+/// Decode a raw command sample: (value, sender's stamp). An undecodable
+/// sample becomes a NaN command, which the loop rejects and counts.
+fn decode(kind: CommandKind, ty: CommandType, raw: &[u8], source_ns: Option<u64>) -> (f64, u64) {
+    let now = || source_ns.unwrap_or_else(system_wall_ns);
+    match (kind, ty) {
+        (CommandKind::Temperature, _) => match msgs::from_cdr::<msgs::Temperature>(raw) {
+            Ok(m) => {
+                let stamp = m.header.stamp.to_ns();
+                (m.temperature, if stamp != 0 { stamp } else { now() })
+            }
+            Err(_) => (f64::NAN, now()),
+        },
+        (CommandKind::Velocity, CommandType::TwistStamped) => {
+            match msgs::from_cdr::<TwistStamped>(raw) {
+                Ok(m) => {
+                    let stamp = m.header.stamp.to_ns();
+                    (m.twist.linear.x, if stamp != 0 { stamp } else { now() })
+                }
+                Err(_) => (f64::NAN, now()),
+            }
+        }
+        _ => match msgs::from_cdr::<Float64>(raw) {
+            Ok(m) => (m.data, now()),
+            Err(_) => (f64::NAN, now()),
+        },
+    }
+}
+
+/// An RTPS timestamp (seconds, 2^-32 s fraction) in ns since the epoch.
+fn ticks_to_ns(ticks: u64) -> u64 {
+    let seconds = ticks >> 32;
+    let fraction = ticks & 0xFFFF_FFFF;
+    seconds * 1_000_000_000 + ((fraction * 1_000_000_000) >> 32)
+}
+
+/// Take every pending sample of one reader.
+fn take_all(sh: &Shared, reader: &RawReader, kind: CommandKind) {
+    reader.drain_read_notifications();
+    loop {
+        let sample = match reader.try_take_one() {
+            Ok(Some(s)) => s,
+            Ok(None) => break,
+            Err(e) => {
+                tracing::debug!("ros2: taking a command failed: {e:?}");
+                break;
+            }
+        };
+        let received_ns = system_wall_ns();
+        let source_ns = sample.source_timestamp().map(|t| ticks_to_ns(t.to_ticks()));
+        let RawCdr(cdr) = sample.into_value();
+        let (value, stamp_ns) = decode(kind, sh.spec.command_type, &cdr, source_ns);
+        SharedCounters::bump(&sh.counters.received);
+        if sh
+            .commands
+            .force_push(Command {
+                kind,
+                value,
+                stamp_ns,
+            })
+            .is_some()
+        {
+            SharedCounters::bump(&sh.counters.overwritten);
+        }
+        if sh.record.is_some() {
+            let item = RecordItem::Raw(RawSample {
+                kind,
+                cdr,
+                publish_ns: source_ns.unwrap_or(stamp_ns),
+                received_ns,
+            });
+            record_input(&sh.record, item, &sh.counters);
+        }
+    }
+}
+
+pub(super) fn run(sh: Shared, ready: std::sync::mpsc::Sender<Result<Arc<Waker>, TransportError>>) {
+    let mut e = match setup(&sh.spec, sh.snapshot.is_some()) {
+        Ok(e) => e,
+        Err(x) => {
+            let _ = ready.send(Err(x));
+            return;
+        }
+    };
+    let _ = ready.send(Ok(e.waker.clone()));
+    let mut events = Events::with_capacity(16);
+    let mut seen_profile = 0u64;
+    let frame = sh.spec.frame_id.clone();
+    let counters = &sh.counters;
+    let count = |ok: bool, which: &std::sync::atomic::AtomicU64| {
+        if !ok {
+            SharedCounters::bump(which);
+        }
+    };
+    while !sh.stop.load(Ordering::Acquire) {
+        // Wake on commands, on outputs (the waker), or every 20 ms for profiles.
+        let _ = e.poll.poll(&mut events, Some(Duration::from_millis(20)));
+        take_all(&sh, &e.velocity, CommandKind::Velocity);
+        take_all(&sh, &e.load, CommandKind::Load);
+        take_all(&sh, &e.temperature, CommandKind::Temperature);
+        if let (Some(sub), Some(flag)) = (&e.snapshot, &sh.snapshot) {
+            while let Ok(Some(_)) = sub.take() {
+                flag.store(true, Ordering::Release);
+            }
+        }
+        while let Some(o) = sh.outputs.pop() {
+            match o {
+                Out::Estimate(r) => {
+                    count(
+                        e.friction.publish(r.to_wire(&frame)).is_ok(),
+                        &counters.publish_failures,
+                    );
+                    count(
+                        e.force
+                            .publish(Float64 {
+                                data: r.friction_force_n,
+                            })
+                            .is_ok(),
+                        &counters.publish_failures,
+                    );
+                }
+                Out::Statistics(s) => count(
+                    e.stats.publish(s.to_wire(&frame)).is_ok(),
+                    &counters.statistics_failures,
+                ),
+            }
+        }
+        if let Some(slot) = &sh.profile {
+            if let Some(p) = slot.read_if_newer(&mut seen_profile) {
+                let m = FilmProfile {
+                    header: Header {
+                        stamp: Time::from_ns(p.stamp_ns),
+                        frame_id: frame.clone(),
+                    },
+                    dx_m: p.dx_m,
+                    h_m: p.h_m,
+                    p_pa: p.p_pa,
+                };
+                count(e.film.publish(m).is_ok(), &counters.publish_failures);
+            }
+        }
+    }
+    drop(e);
+}

@@ -1,0 +1,184 @@
+//! A peer's side of the ROS 2 transport: its own participant and node on
+//! the same domain (drivers, tests, benchmarks).
+
+use super::{advertise, context, err, qos, ros_node, subscribe, Ros2Spec, NAME};
+use crate::config::CommandType;
+use crate::msgs::{
+    self, Command, CommandKind, EstimateRecord, Float64, FrictionEstimate, Header, LoopStatistics,
+    StatisticsRecord, Time, TwistStamped, FLOAT64, FRICTION_ESTIMATE, LOOP_STATISTICS,
+    TWIST_STAMPED,
+};
+use crate::transport::{PeerPort, TransportError};
+use ros2_client::{Context, Node, Publisher, Subscription};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// A peer's side (its own participant and node on the same domain).
+pub struct Ros2Peer {
+    node: Node,
+    _ctx: Context,
+    velocity_f64: Option<Publisher<Float64>>,
+    velocity_twist: Option<Publisher<TwistStamped>>,
+    load: Publisher<Float64>,
+    temperature: Publisher<msgs::Temperature>,
+    estimate: Subscription<FrictionEstimate>,
+    statistics: Subscription<LoopStatistics>,
+    frame_id: String,
+}
+
+static PEER_COUNTER: AtomicU64 = AtomicU64::new(0);
+
+impl Ros2Peer {
+    pub fn open(spec: &Ros2Spec) -> Result<Self, TransportError> {
+        let ctx = context(spec)?;
+        let name = format!(
+            "{}_peer_{}_{}",
+            spec.node_name,
+            std::process::id(),
+            PEER_COUNTER.fetch_add(1, Ordering::Relaxed)
+        );
+        let mut node = ros_node(&ctx, &spec.namespace, &name)?;
+        let cq = qos(&spec.command_qos);
+        let eq = qos(&spec.estimate_qos);
+        let n = &mut node;
+        let (mut vf, mut vt) = (None, None);
+        match spec.command_type {
+            CommandType::Float64 => {
+                vf = Some(advertise(
+                    n,
+                    &spec.cmd_velocity,
+                    &FLOAT64,
+                    &cq,
+                    "the velocity",
+                )?);
+            }
+            CommandType::TwistStamped => {
+                vt = Some(advertise(
+                    n,
+                    &spec.cmd_velocity,
+                    &TWIST_STAMPED,
+                    &cq,
+                    "the velocity",
+                )?);
+            }
+        }
+        let load = advertise(n, &spec.normal_load, &FLOAT64, &cq, "the load")?;
+        let temperature = advertise(
+            n,
+            &spec.temperature,
+            &msgs::TEMPERATURE,
+            &cq,
+            "the temperature",
+        )?;
+        let estimate = subscribe(n, &spec.friction, &FRICTION_ESTIMATE, &eq, "the estimate")?;
+        let statistics = subscribe(
+            n,
+            &spec.loop_statistics,
+            &LOOP_STATISTICS,
+            &eq,
+            "the statistics",
+        )?;
+        Ok(Self {
+            node,
+            _ctx: ctx,
+            velocity_f64: vf,
+            velocity_twist: vt,
+            load,
+            temperature,
+            estimate,
+            statistics,
+            frame_id: spec.frame_id.clone(),
+        })
+    }
+}
+
+impl Ros2Peer {
+    /// Publish a whole TwistStamped as given (its frame, angular velocity,
+    /// …), on a node configured for `twist_stamped` commands.
+    pub fn send_twist(&mut self, m: &TwistStamped) -> Result<(), TransportError> {
+        let p = self
+            .velocity_twist
+            .as_ref()
+            .ok_or_else(|| err("publish a TwistStamped", "the node takes Float64 commands"))?;
+        p.publish(m.clone())
+            .map_err(|e| err("publish a TwistStamped", e))
+    }
+}
+
+impl PeerPort for Ros2Peer {
+    fn name(&self) -> &'static str {
+        NAME
+    }
+
+    fn send(&mut self, c: &Command) -> Result<(), TransportError> {
+        let r = match (c.kind, &self.velocity_f64, &self.velocity_twist) {
+            (CommandKind::Temperature, _, _) => self
+                .temperature
+                .publish(msgs::Temperature {
+                    header: Header {
+                        stamp: Time::from_ns(c.stamp_ns),
+                        frame_id: self.frame_id.clone(),
+                    },
+                    temperature: c.value,
+                    variance: 0.0,
+                })
+                .map_err(|e| format!("{e:?}")),
+            (CommandKind::Load, _, _) => self
+                .load
+                .publish(Float64 { data: c.value })
+                .map_err(|e| format!("{e:?}")),
+            (CommandKind::Velocity, Some(p), _) => p
+                .publish(Float64 { data: c.value })
+                .map_err(|e| format!("{e:?}")),
+            (CommandKind::Velocity, None, Some(p)) => {
+                let mut m = TwistStamped {
+                    header: Header {
+                        stamp: Time::from_ns(c.stamp_ns),
+                        frame_id: self.frame_id.clone(),
+                    },
+                    ..Default::default()
+                };
+                m.twist.linear.x = c.value;
+                p.publish(m).map_err(|e| format!("{e:?}"))
+            }
+            (CommandKind::Velocity, None, None) => Err("no velocity publisher".into()),
+        };
+        r.map_err(|e| err("publish a command", e))
+    }
+
+    fn try_recv(&mut self) -> Result<Option<EstimateRecord>, TransportError> {
+        match self.estimate.take() {
+            Ok(m) => Ok(m.map(|(m, _)| EstimateRecord::from_wire(&m))),
+            Err(e) => Err(err("take an estimate", e)),
+        }
+    }
+
+    fn try_recv_statistics(&mut self) -> Result<Option<StatisticsRecord>, TransportError> {
+        match self.statistics.take() {
+            Ok(m) => Ok(m.map(|(m, _)| StatisticsRecord::from_wire(&m))),
+            Err(e) => Err(err("take loop statistics", e)),
+        }
+    }
+
+    fn is_matched(&mut self) -> bool {
+        // The wait futures resolve at once when a match exists; polled once
+        // they answer without the error ros2-client logs for a writer or
+        // reader it has not matched yet (get_*_count does).
+        use futures::FutureExt;
+        let node = &self.node;
+        let vel = match (&self.velocity_f64, &self.velocity_twist) {
+            (Some(p), _) => p.wait_for_subscription(node).now_or_never().is_some(),
+            (_, Some(p)) => p.wait_for_subscription(node).now_or_never().is_some(),
+            _ => false,
+        };
+        vel && self
+            .load
+            .wait_for_subscription(node)
+            .now_or_never()
+            .is_some()
+            && self
+                .estimate
+                .wait_for_publisher(node)
+                .now_or_never()
+                .is_some()
+    }
+}
