@@ -338,7 +338,7 @@ fn things_that_are_not_bags_are_named() {
     let cases: Vec<(&str, Vec<u8>, &str)> = vec![
         ("empty.mcap", vec![], "MCAP magic"),
         ("text.mcap", b"hello, this is text\n".to_vec(), "MCAP magic"),
-        ("db.mcap", b"SQLite format 3\0rest".to_vec(), ".db3"),
+        ("db.mcap", b"SQLite format 3\0rest".to_vec(), "SQLite"),
         (
             "magic_only.mcap",
             b"\x89MCAP0\r\n".to_vec(),

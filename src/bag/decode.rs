@@ -62,6 +62,29 @@ impl SampleKind {
     }
 }
 
+/// The load topic used when none is named: the first valid
+/// `std_msgs/msg/Float64` topic whose name ends in `normal_load`.
+pub fn default_load_topic(scan: &super::BagScan) -> Option<String> {
+    scan.channels
+        .iter()
+        .find(|c| {
+            c.topic.ends_with("normal_load") && TopicDecoder::new(c, SampleKind::Float64).is_ok()
+        })
+        .map(|c| c.topic.clone())
+}
+
+/// The temperature topic used when none is named: the first valid
+/// `sensor_msgs/msg/Temperature` topic whose name ends in `temperature`.
+pub fn default_temperature_topic(scan: &super::BagScan) -> Option<String> {
+    scan.channels
+        .iter()
+        .find(|c| {
+            c.topic.ends_with("temperature")
+                && TopicDecoder::new(c, SampleKind::Temperature).is_ok()
+        })
+        .map(|c| c.topic.clone())
+}
+
 /// Types a velocity can be read from.
 pub const VELOCITY_TYPES: &str =
     "std_msgs/msg/Float64, geometry_msgs/msg/TwistStamped or sensor_msgs/msg/JointState";
@@ -84,6 +107,11 @@ pub fn check_schema(c: &ChannelInfo, expected: &MsgType) -> Result<(), BagError>
             "message encoding `{}`, expected `cdr`",
             c.message_encoding
         )));
+    }
+    // A Humble SQLite bag carries no message definitions: the declared type
+    // name (already matched) is all there is to check.
+    if c.schema_encoding.is_empty() && c.schema_text.is_empty() {
+        return Ok(());
     }
     if c.schema_encoding != "ros2msg" {
         return Err(mismatch(format!(

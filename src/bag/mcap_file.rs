@@ -85,7 +85,7 @@ impl McapFile {
     fn from_data(path: &Path, map: Data) -> Result<Self, BagError> {
         if map.len() < 8 || &map[..8] != b"\x89MCAP0\r\n" {
             let hint = if map.starts_with(b"SQLite format 3\0") {
-                " (an SQLite file: a ROS 2 `.db3` bag; give its directory)"
+                " (an SQLite file: open it as a `.db3` bag)"
             } else {
                 ""
             };

@@ -1,5 +1,6 @@
-//! Reading ROS 2 bags: MCAP files and rosbag2 directories (a
-//! `metadata.yaml` with its split `*.mcap` files, read in order as one run).
+//! Reading ROS 2 bags: MCAP files, rosbag2 SQLite files (`.db3`) and
+//! rosbag2 directories (a `metadata.yaml` with its split `*.mcap` or `*.db3`
+//! files, read in order as one run).
 //!
 //! This module knows nothing of replay or calibration: it opens a bag, lists
 //! its channels ([`Bag::scan`]), streams its messages in file order
@@ -12,16 +13,19 @@
 //! |---|---|
 //! | `mod.rs` | [`Bag`], [`BagScan`], [`ChannelInfo`], [`Damage`], [`BagError`] |
 //! | `mcap_file.rs` | one memory-mapped MCAP file: summary, metadata, message stream |
+//! | `db3_file.rs` | one rosbag2 SQLite file: topics, definitions, message stream |
 //! | `rosbag2.rs` | rosbag2 directories: `metadata.yaml` and its files |
 //! | `decode.rs` | schema checks and the known message types as samples |
 //! | `resample.rs` | sampled inputs onto the model's step grid, silences |
 
+mod db3_file;
 pub mod decode;
 mod mcap_file;
 pub mod resample;
 pub mod rosbag2;
 pub mod structure;
 
+pub use db3_file::Db3File;
 pub use decode::{check_schema, decode_cdr, read_topics, SampleKind, TopicDecoder, TopicSamples};
 pub use mcap_file::McapFile;
 pub use resample::{resample, Hold, Silence};
@@ -187,16 +191,57 @@ pub struct BagMessage<'a> {
     pub data: &'a [u8],
 }
 
-/// An opened bag: one MCAP file or a rosbag2 directory of them.
+/// One storage file of a bag.
+pub enum BagFile {
+    Mcap(McapFile),
+    Sqlite(Db3File),
+}
+
+impl BagFile {
+    /// Open an MCAP or SQLite storage file, told apart by its first bytes.
+    pub fn open(path: &Path) -> Result<Self, BagError> {
+        let mut head = [0u8; 16];
+        let n = {
+            use std::io::Read;
+            let mut f = std::fs::File::open(path).map_err(|source| BagError::Io {
+                path: path.to_path_buf(),
+                source,
+            })?;
+            f.read(&mut head).unwrap_or(0)
+        };
+        if db3_file::is_sqlite(&head[..n]) {
+            Ok(Self::Sqlite(Db3File::open(path)?))
+        } else {
+            Ok(Self::Mcap(McapFile::open(path)?))
+        }
+    }
+
+    pub fn path(&self) -> &Path {
+        match self {
+            Self::Mcap(f) => f.path(),
+            Self::Sqlite(f) => f.path(),
+        }
+    }
+
+    fn scan(&self) -> Result<BagScan, BagError> {
+        match self {
+            Self::Mcap(f) => f.scan(),
+            Self::Sqlite(f) => Ok(f.scan()),
+        }
+    }
+}
+
+/// An opened bag: one storage file or a rosbag2 directory of them.
 pub struct Bag {
     path: PathBuf,
-    files: Vec<McapFile>,
+    files: Vec<BagFile>,
     /// The directory's `metadata.yaml` (when the bag is a directory).
     pub directory: Option<rosbag2::Metadata>,
 }
 
 impl Bag {
-    /// Open an MCAP file or a rosbag2 directory; nothing is decoded yet.
+    /// Open an MCAP file, an SQLite (`.db3`) file or a rosbag2 directory;
+    /// nothing is decoded yet.
     pub fn open(path: &Path) -> Result<Self, BagError> {
         let io = |source| BagError::Io {
             path: path.to_path_buf(),
@@ -207,7 +252,7 @@ impl Bag {
             let (metadata, files) = rosbag2::open_directory(path)?;
             let files = files
                 .iter()
-                .map(|f| McapFile::open(f))
+                .map(|f| BagFile::open(f))
                 .collect::<Result<Vec<_>, _>>()?;
             return Ok(Self {
                 path: path.to_path_buf(),
@@ -217,7 +262,7 @@ impl Bag {
         }
         Ok(Self {
             path: path.to_path_buf(),
-            files: vec![McapFile::open(path)?],
+            files: vec![BagFile::open(path)?],
             directory: None,
         })
     }
@@ -226,7 +271,7 @@ impl Bag {
     pub fn from_bytes(path: &Path, bytes: Vec<u8>) -> Result<Self, BagError> {
         Ok(Self {
             path: path.to_path_buf(),
-            files: vec![McapFile::from_bytes(path, bytes)?],
+            files: vec![BagFile::Mcap(McapFile::from_bytes(path, bytes)?)],
             directory: None,
         })
     }
@@ -235,8 +280,8 @@ impl Bag {
         &self.path
     }
 
-    /// The MCAP files, in order.
-    pub fn files(&self) -> &[McapFile] {
+    /// The storage files, in order.
+    pub fn files(&self) -> &[BagFile] {
         &self.files
     }
 
@@ -277,30 +322,46 @@ impl Bag {
     }
 }
 
+/// The stream of one storage file.
+enum FileStream<'a> {
+    Mcap(Box<mcap::MessageStream<'a>>),
+    Sqlite(db3_file::Db3Stream),
+}
+
 /// Iterator over a bag's messages (see [`Bag::messages`]).
 pub struct Messages<'a> {
-    files: &'a [McapFile],
-    current: Option<(usize, mcap::MessageStream<'a>)>,
+    files: &'a [BagFile],
+    current: Option<(usize, FileStream<'a>)>,
     next_file: usize,
     count: u64,
     last_log: Option<u64>,
     done: bool,
 }
 
-/// A message with its channel kept alive (the stream hands out `Arc`s).
-pub struct OwnedChannelMessage<'a> {
-    pub message: mcap::Message<'a>,
+/// A message with its channel kept alive: borrowed from an MCAP file (the
+/// stream hands out `Arc`s) or owned, read from an SQLite file.
+pub enum OwnedChannelMessage<'a> {
+    Mcap(mcap::Message<'a>),
+    Sqlite(db3_file::Db3Message),
 }
 
-impl<'a> OwnedChannelMessage<'a> {
+impl OwnedChannelMessage<'_> {
     pub fn view(&self) -> BagMessage<'_> {
-        let m = &self.message;
-        BagMessage {
-            topic: &m.channel.topic,
-            schema_name: m.channel.schema.as_ref().map_or("", |s| s.name.as_str()),
-            log_time: m.log_time,
-            publish_time: m.publish_time,
-            data: &m.data,
+        match self {
+            Self::Mcap(m) => BagMessage {
+                topic: &m.channel.topic,
+                schema_name: m.channel.schema.as_ref().map_or("", |s| s.name.as_str()),
+                log_time: m.log_time,
+                publish_time: m.publish_time,
+                data: &m.data,
+            },
+            Self::Sqlite(m) => BagMessage {
+                topic: &m.topic,
+                schema_name: &m.type_name,
+                log_time: m.timestamp,
+                publish_time: m.timestamp,
+                data: &m.data,
+            },
         }
     }
 }
@@ -317,36 +378,48 @@ impl<'a> Iterator for Messages<'a> {
                 let k = self.next_file;
                 let f = self.files.get(k)?;
                 self.next_file += 1;
-                match f.stream() {
-                    Ok(s) => self.current = Some((k, s)),
-                    Err(e) => {
-                        self.done = true;
-                        return Some(Err(self.damage(k, e.to_string())));
-                    }
+                match f {
+                    BagFile::Mcap(f) => match f.stream() {
+                        Ok(s) => self.current = Some((k, FileStream::Mcap(Box::new(s)))),
+                        Err(e) => {
+                            self.done = true;
+                            return Some(Err(self.damage(k, e.to_string())));
+                        }
+                    },
+                    BagFile::Sqlite(f) => self.current = Some((k, FileStream::Sqlite(f.stream()))),
                 }
             }
             let (k, stream) = self.current.as_mut().expect("set above");
             let k = *k;
-            match mcap_file::guarded(|| stream.next()) {
-                Ok(None) => {
+            let next = match stream {
+                FileStream::Mcap(stream) => match mcap_file::guarded(|| stream.next()) {
+                    Ok(None) => None,
+                    Ok(Some(Ok(m))) => Some(Ok(OwnedChannelMessage::Mcap(m))),
+                    Ok(Some(Err(e))) => Some(Err(e.to_string())),
+                    Err(e) => Some(Err(e)),
+                },
+                FileStream::Sqlite(stream) => {
+                    stream.next().map(|m| m.map(OwnedChannelMessage::Sqlite))
+                }
+            };
+            match next {
+                None => {
                     self.current = None;
                     // A structurally damaged file ends where the damage is.
-                    if let Some(why) = self.files[k].structural_damage() {
-                        self.done = true;
-                        let why = why.to_string();
-                        return Some(Err(self.damage(k, why)));
+                    if let BagFile::Mcap(f) = &self.files[k] {
+                        if let Some(why) = f.structural_damage() {
+                            self.done = true;
+                            let why = why.to_string();
+                            return Some(Err(self.damage(k, why)));
+                        }
                     }
                 }
-                Ok(Some(Ok(m))) => {
+                Some(Ok(m)) => {
                     self.count += 1;
-                    self.last_log = Some(m.log_time);
-                    return Some(Ok(OwnedChannelMessage { message: m }));
+                    self.last_log = Some(m.view().log_time);
+                    return Some(Ok(m));
                 }
-                Ok(Some(Err(e))) => {
-                    self.done = true;
-                    return Some(Err(self.damage(k, e.to_string())));
-                }
-                Err(e) => {
+                Some(Err(e)) => {
                     self.done = true;
                     return Some(Err(self.damage(k, e)));
                 }

@@ -1,5 +1,6 @@
 //! rosbag2 directories: `metadata.yaml` (what `ros2 bag record` writes, and
-//! the node's split recordings) and the storage files it lists.
+//! the node's split recordings) and the storage files it lists (`mcap` or
+//! `sqlite3` storage).
 //!
 //! Reading accepts every field rosbag2 writes (unknown ones are ignored);
 //! writing produces version 5 of the format with storage identifier `mcap`.
@@ -42,7 +43,23 @@ pub struct TopicMetadata {
     #[serde(rename = "type")]
     pub type_name: String,
     pub serialization_format: String,
+    /// rosbag2 writes a YAML string; version 9 writers (e.g. `rosbags`) may
+    /// write a YAML list: either is read, kept as YAML text.
+    #[serde(deserialize_with = "yaml_text")]
     pub offered_qos_profiles: String,
+}
+
+/// A string, or any other YAML value as its YAML text (`null` → empty).
+fn yaml_text<'de, D: serde::Deserializer<'de>>(d: D) -> Result<String, D::Error> {
+    let v = serde_norway::Value::deserialize(d)?;
+    Ok(match v {
+        serde_norway::Value::String(s) => s,
+        serde_norway::Value::Null => String::new(),
+        other => serde_norway::to_string(&other)
+            .map_err(serde::de::Error::custom)?
+            .trim_end()
+            .to_string(),
+    })
 }
 
 /// One storage file of the bag.
@@ -117,9 +134,9 @@ pub fn open_directory(dir: &Path) -> Result<(Metadata, Vec<PathBuf>), BagError> 
     let file: MetadataFile = serde_norway::from_str(&text)
         .map_err(|e| not_bag(format!("metadata.yaml is not rosbag2 metadata: {e}")))?;
     let m = file.rosbag2_bagfile_information;
-    if m.storage_identifier != "mcap" {
+    if !matches!(m.storage_identifier.as_str(), "mcap" | "sqlite3") {
         return Err(not_bag(format!(
-            "storage `{}` is not supported here (only mcap)",
+            "storage `{}` is not supported here (mcap or sqlite3)",
             m.storage_identifier
         )));
     }

@@ -235,7 +235,20 @@ impl FitArgs {
                     load: self.load_topic.clone(),
                     temperature: self.temperature_topic.clone(),
                 };
-                let (table, note) = friction_node::fit::bag_input::read(path, &topics)?;
+                let (table, note, used) = friction_node::fit::bag_input::read(path, &topics)?;
+                eprintln!(
+                    "fit: {}: velocity `{}`, friction `{}`, load {}, temperature {}",
+                    path.display(),
+                    used.velocity,
+                    used.friction,
+                    used.load.as_deref().map_or(
+                        "from the configuration (contact.load_n)".into(),
+                        |t| format!("`{t}`")
+                    ),
+                    used.temperature
+                        .as_deref()
+                        .map_or("none".into(), |t| format!("`{t}`")),
+                );
                 if let Some(n) = note {
                     eprintln!("warning: {n}");
                 }

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 pub fn run(args: ReplayArgs, config: Option<PathBuf>, overrides: Vec<String>) -> Result<()> {
     use friction_node::bag::Bag;
-    use friction_node::replay::{self, InputMode, OutputFormat, OutputStream, ReplayOptions};
+    use friction_node::replay::{self, OutputFormat, OutputStream, ReplayOptions};
     use indicatif::{ProgressBar, ProgressStyle};
     let ReplayArgs {
         bag: bag_path,
@@ -52,10 +52,7 @@ pub fn run(args: ReplayArgs, config: Option<PathBuf>, overrides: Vec<String>) ->
     eprintln!(
         "replay {}: {} ({} velocity messages → {} steps of {} s), configuration {}",
         bag_path.display(),
-        match &prepared.mode {
-            InputMode::Topics { velocity, .. } => format!("topic {velocity}"),
-            InputMode::RecordedEstimates { topic } => format!("recorded estimates {topic}"),
-        },
+        prepared.mode.describe(),
         prepared.velocity_messages,
         steps,
         prepared.config.solver.dt_s,

@@ -20,9 +20,11 @@ pub struct BagTopics {
     pub friction: String,
     /// The joint of JointState topics (optional when there is one).
     pub joint: Option<String>,
-    /// `std_msgs/msg/Float64`, N.
+    /// `std_msgs/msg/Float64`, N (default: as replay, a Float64 topic
+    /// ending in `normal_load`, if the bag has one).
     pub load: Option<String>,
-    /// `sensor_msgs/msg/Temperature`, °C.
+    /// `sensor_msgs/msg/Temperature`, °C (default: as replay, a Temperature
+    /// topic ending in `temperature`, if the bag has one).
     pub temperature: Option<String>,
 }
 
@@ -44,10 +46,22 @@ fn held(samples: &[(u64, f64)], stamp: u64, j: &mut usize) -> f64 {
 }
 
 /// Read the topics of `path` into a table; the second value notes damage
-/// (reading stopped there; the table holds what came before).
-pub fn read(path: &Path, topics: &BagTopics) -> Result<(Table, Option<String>), FitError> {
+/// (reading stopped there; the table holds what came before). The load and
+/// temperature topics default as in replay; the topics used are returned.
+pub fn read(
+    path: &Path,
+    topics: &BagTopics,
+) -> Result<(Table, Option<String>, BagTopics), FitError> {
     let bag = Bag::open(path)?;
     let scan = bag.scan()?;
+    let mut topics = topics.clone();
+    if topics.load.is_none() {
+        topics.load = crate::bag::decode::default_load_topic(&scan);
+    }
+    if topics.temperature.is_none() {
+        topics.temperature = crate::bag::decode::default_temperature_topic(&scan);
+    }
+    let topics = &topics;
     let joint = topics.joint.as_deref();
     let vc = scan.require(&topics.velocity)?;
     let vkind = SampleKind::velocity_for(&vc.schema_name, joint).ok_or_else(|| {
@@ -166,5 +180,6 @@ pub fn read(path: &Path, topics: &BagTopics) -> Result<(Table, Option<String>), 
             columns,
         },
         note,
+        topics.clone(),
     ))
 }

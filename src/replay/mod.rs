@@ -230,8 +230,8 @@ fn velocity_channel(scan: &BagScan, opts: &ReplayOptions) -> Result<ChannelInfo,
     }
 }
 
-/// The load channel: `--load-topic`, else a valid Float64 one ending in
-/// `normal_load`.
+/// The load channel: `--load-topic`, else the bag's default (see
+/// [`crate::bag::decode::default_load_topic`]).
 fn load_channel(scan: &BagScan, opts: &ReplayOptions) -> Result<Option<String>, ReplayError> {
     match &opts.load_topic {
         Some(t) => {
@@ -239,19 +239,12 @@ fn load_channel(scan: &BagScan, opts: &ReplayOptions) -> Result<Option<String>, 
             TopicDecoder::new(c, SampleKind::Float64)?;
             Ok(Some(t.clone()))
         }
-        None => Ok(scan
-            .channels
-            .iter()
-            .find(|c| {
-                c.topic.ends_with("normal_load")
-                    && TopicDecoder::new(c, SampleKind::Float64).is_ok()
-            })
-            .map(|c| c.topic.clone())),
+        None => Ok(crate::bag::decode::default_load_topic(scan)),
     }
 }
 
-/// The temperature channel: `--temperature-topic`, else a valid
-/// `sensor_msgs/msg/Temperature` one ending in `temperature`.
+/// The temperature channel: `--temperature-topic`, else the bag's default
+/// (see [`crate::bag::decode::default_temperature_topic`]).
 fn temperature_channel(
     scan: &BagScan,
     opts: &ReplayOptions,
@@ -261,14 +254,7 @@ fn temperature_channel(
             TopicDecoder::new(scan.require(t)?, SampleKind::Temperature)?;
             Ok(Some(t.clone()))
         }
-        None => Ok(scan
-            .channels
-            .iter()
-            .find(|c| {
-                c.topic.ends_with("temperature")
-                    && TopicDecoder::new(c, SampleKind::Temperature).is_ok()
-            })
-            .map(|c| c.topic.clone())),
+        None => Ok(crate::bag::decode::default_temperature_topic(scan)),
     }
 }
 
