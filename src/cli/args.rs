@@ -117,6 +117,10 @@ fn hours(s: &str) -> Result<u64, String> {
     count(s, 1, 10_000, "a number of hours")
 }
 
+fn seeds(s: &str) -> Result<u64, String> {
+    count(s, 1, 1000, "a number of seeds")
+}
+
 fn cells(s: &str) -> Result<usize, String> {
     count(s, 8, 65_536, "a number of cells").map(|v| v as usize)
 }
@@ -290,6 +294,23 @@ pub enum Command {
         #[arg(long, value_name = "DIR")]
         out: PathBuf,
     },
+    /// The calibration targets on synthetic data: recovery of three parameters, transfer to another load and frequency against the classic models (release build!).
+    BenchFit {
+        #[command(flatten)]
+        common: Common,
+        /// Grid cells of the model (data and fit), in [8, 65536].
+        #[arg(long, default_value = "128", value_parser = cells)]
+        cells: usize,
+        /// Seconds of data per set, at the configured solver.dt_s, in (0, 1e7].
+        #[arg(long, default_value = "10", value_parser = sim_seconds)]
+        duration: f64,
+        /// Noise seeds of the recovery test (one fit each), in [1, 1000].
+        #[arg(long, default_value = "5", value_parser = seeds)]
+        seeds: u64,
+        /// Also write the synthetic data sets (CSV) into this directory.
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+    },
     /// Benchmark one step of the paper's reciprocating case (release build!).
     Bench {
         #[command(flatten)]
@@ -321,6 +342,7 @@ impl Command {
             | Command::Profile { common, .. }
             | Command::Bench { common, .. }
             | Command::BenchRecorder { common, .. }
+            | Command::BenchFit { common, .. }
             | Command::Soak { common, .. }
             | Command::Fit { common, .. } => common,
         }

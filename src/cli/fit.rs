@@ -7,8 +7,8 @@ use friction_node::fit::params::{map_parameter, DataScale};
 use friction_node::fit::problem::{fit, FitOutcome, Options};
 use friction_node::fit::report::{self, ModelRow};
 use friction_node::fit::{
-    Baseline, BaselineKind, Data, Delimiter, Mapping, ParamSpec, Parameter, PhysicsModel, Source,
-    Table,
+    Baseline, BaselineKind, Data, Delimiter, LoadForm, Mapping, ParamSpec, Parameter, PhysicsModel,
+    Source, Table,
 };
 use std::path::{Path, PathBuf};
 
@@ -315,7 +315,11 @@ impl FitArgs {
 }
 
 /// Scales of the training data at the maps' start values.
-fn data_scale(sources: &[Source], map: &[f64], load_n: f64) -> Result<(DataScale, f64, bool)> {
+pub(crate) fn data_scale(
+    sources: &[Source],
+    map: &[f64],
+    load_n: f64,
+) -> Result<(DataScale, f64, bool)> {
     let (mut f, mut v, mut lmin, mut lmax) = (0.0f64, 0.0f64, f64::INFINITY, 0.0f64);
     let (mut sum_abs, mut n) = (0.0, 0usize);
     for s in sources {
@@ -349,6 +353,8 @@ pub struct Prepared {
     pub scale: DataScale,
     pub mean_abs_n: f64,
     pub loads_vary: bool,
+    /// The validation data hold loads outside the training data's range.
+    pub other_loads: bool,
     pub names: Vec<String>,
 }
 
@@ -367,6 +373,25 @@ pub fn prepare(config: &Config, args: &FitArgs) -> Result<Prepared> {
     let map_names: Vec<String> = mapping.coefficients.iter().map(|c| c.0.clone()).collect();
     let map_values: Vec<f64> = mapping.coefficients.iter().map(|c| c.1).collect();
     let (scale, mean_abs_n, loads_vary) = data_scale(&train, &map_values, config.contact.load_n)?;
+    let other_loads = if validate.is_empty() {
+        false
+    } else {
+        let range = |sources: &[Source]| -> Result<(f64, f64)> {
+            let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+            for s in sources {
+                let se = s.series(&map_values)?;
+                for k in 0..se.len() {
+                    let l = se.load_at(k, config.contact.load_n);
+                    lo = lo.min(l);
+                    hi = hi.max(l);
+                }
+            }
+            Ok((lo, hi))
+        };
+        let (tl, th) = range(&train)?;
+        let (vl, vh) = range(&validate)?;
+        vl < 0.99 * tl || vh > 1.01 * th
+    };
     let specs = args.specs()?;
     let mut key_specs = Vec::new();
     let mut map_fit = Vec::new();
@@ -397,6 +422,7 @@ pub fn prepare(config: &Config, args: &FitArgs) -> Result<Prepared> {
         scale,
         mean_abs_n,
         loads_vary,
+        other_loads,
     })
 }
 
@@ -457,7 +483,12 @@ pub fn fit_baselines(p: &Prepared, args: &FitArgs) -> Result<Vec<FitOutcome>> {
             eprintln!("fit: LuGre skipped: on steady curves it is Stribeck");
             continue;
         }
-        let model = Baseline::new(kind, p.loads_vary, &p.scale, p.mean_abs_n);
+        let model = Baseline::new(
+            kind,
+            LoadForm::for_data(p.loads_vary, p.other_loads),
+            &p.scale,
+            p.mean_abs_n,
+        );
         // A classic model costs microseconds per evaluation: give it ten
         // times the budget, so that a non-converged baseline is never the
         // budget's fault.

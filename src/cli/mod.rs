@@ -96,6 +96,13 @@ pub fn dispatch(cli: Cli, allocations: &dyn Fn() -> u64) -> Result<()> {
         } => study::run(&config, name, &out, cycles, jobs),
         Command::Fit { args, .. } => fit::run(&config, &args),
         Command::BenchRecorder { hours, out, .. } => bench::recorder(&config, hours, out),
+        Command::BenchFit {
+            cells,
+            duration,
+            seeds,
+            out,
+            ..
+        } => bench::fit_targets(&config, cells, duration, seeds, out),
         Command::Bench {
             cells,
             cycles,

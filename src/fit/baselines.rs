@@ -15,9 +15,11 @@
 //! - Stribeck: F = g(v) sgn v + b v, g(v) = F_c + (F_s − F_c) e^{−(v/v_s)²}
 //! - LuGre: ż = v − σ₀ |v| z / g(v), F = σ₀ z + σ₁ ż + σ₂ v
 //!
-//! With varying loads each level is linear in the load N (F_c = F_c0 + μ_c N,
-//! F_s = F_s0 + μ_s N): the classic models' usual extension, and what keeps
-//! the comparison fair when the data span several loads. LuGre's bristle
+//! How the levels follow the normal load N ([`LoadForm`]): constant; linear
+//! (F_c = F_c0 + μ_c N, F_s = F_s0 + μ_s N), the classic models' usual
+//! extension and what keeps the comparison fair when the data span several
+//! loads; or proportional (F_c = μ_c N, F_s = μ_s N), the one form that can
+//! carry a fit at a single load to another load. LuGre's bristle
 //! state is integrated exactly over each sample interval for the velocity
 //! at its end (ż = v − a z is linear in z), so it is stable for any σ₀;
 //! it starts in its steady state. On a steady curve LuGre is Stribeck.
@@ -49,11 +51,37 @@ impl BaselineKind {
     }
 }
 
+/// How a classic model's friction levels follow the normal load.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LoadForm {
+    /// No load dependence.
+    Constant,
+    /// F = F0 + μ N: needs data at two loads or more.
+    Linear,
+    /// F = μ N: Amontons; identifiable from one load.
+    Proportional,
+}
+
+impl LoadForm {
+    /// The form a fit should give the classic models: linear when the
+    /// training data span loads; proportional when they hold one load but
+    /// the model must predict at others (validation data at another load);
+    /// constant otherwise.
+    pub fn for_data(training_loads_vary: bool, predicts_other_loads: bool) -> Self {
+        if training_loads_vary {
+            LoadForm::Linear
+        } else if predicts_other_loads {
+            LoadForm::Proportional
+        } else {
+            LoadForm::Constant
+        }
+    }
+}
+
 /// A classic model with its fitted parameters.
 pub struct Baseline {
     pub kind: BaselineKind,
-    /// Levels linear in the load.
-    pub load_linear: bool,
+    pub load_form: LoadForm,
     params: Vec<Parameter>,
 }
 
@@ -69,28 +97,45 @@ struct Levels {
 
 impl Baseline {
     /// Bounds and starts from the data's scales (`mean_abs_n`: mean |F|).
-    pub fn new(kind: BaselineKind, load_linear: bool, scale: &DataScale, mean_abs_n: f64) -> Self {
+    pub fn new(
+        kind: BaselineKind,
+        load_form: LoadForm,
+        scale: &DataScale,
+        mean_abs_n: f64,
+    ) -> Self {
         let f = scale.friction_n.max(1e-12);
         let v = scale.velocity_m_s.max(1e-9);
         let fc0 = mean_abs_n.clamp(1e-3 * f, f);
         let mut params = Vec::new();
         let level = |params: &mut Vec<Parameter>, name: &str, start: f64, top: f64| {
-            if load_linear {
-                let mu_hi = 2.0 * top / scale.load_min_n.max(1e-9);
-                params.push(Parameter::new(
-                    &format!("{name}0_n"),
-                    0.0,
-                    -2.0 * top,
-                    2.0 * top,
-                ));
-                params.push(Parameter::new(
-                    &format!("mu_{}", &name[1..]),
-                    (0.5 * start / scale.load_min_n.max(1e-9)).min(0.5 * mu_hi),
-                    0.0,
-                    mu_hi,
-                ));
-            } else {
-                params.push(Parameter::new(&format!("{name}_n"), start, 0.0, top));
+            let mu_hi = 2.0 * top / scale.load_min_n.max(1e-9);
+            let mu = |share: f64| (share * start / scale.load_min_n.max(1e-9)).min(0.5 * mu_hi);
+            match load_form {
+                LoadForm::Linear => {
+                    params.push(Parameter::new(
+                        &format!("{name}0_n"),
+                        0.0,
+                        -2.0 * top,
+                        2.0 * top,
+                    ));
+                    params.push(Parameter::new(
+                        &format!("mu_{}", &name[1..]),
+                        mu(0.5),
+                        0.0,
+                        mu_hi,
+                    ));
+                }
+                LoadForm::Proportional => {
+                    params.push(Parameter::new(
+                        &format!("mu_{}", &name[1..]),
+                        mu(1.0),
+                        0.0,
+                        mu_hi,
+                    ));
+                }
+                LoadForm::Constant => {
+                    params.push(Parameter::new(&format!("{name}_n"), start, 0.0, top));
+                }
             }
         };
         level(&mut params, "fc", fc0, 2.0 * f);
@@ -105,7 +150,7 @@ impl Baseline {
         }
         Self {
             kind,
-            load_linear,
+            load_form,
             params,
         }
     }
@@ -116,13 +161,13 @@ impl Baseline {
             i += 1;
             x[i - 1]
         };
-        let level = |next: &mut dyn FnMut() -> f64| {
-            if self.load_linear {
+        let level = |next: &mut dyn FnMut() -> f64| match self.load_form {
+            LoadForm::Linear => {
                 let a = next();
                 a + next() * load
-            } else {
-                next()
             }
+            LoadForm::Proportional => next() * load,
+            LoadForm::Constant => next(),
         };
         let fc = level(&mut next);
         let (fs, vs) = if self.kind == BaselineKind::CoulombViscous {
@@ -164,10 +209,10 @@ fn sgn(v: f64) -> f64 {
 
 impl Model for Baseline {
     fn label(&self) -> String {
-        if self.load_linear {
-            format!("{} (load-linear)", self.kind.label())
-        } else {
-            self.kind.label().into()
+        match self.load_form {
+            LoadForm::Linear => format!("{} (load-linear)", self.kind.label()),
+            LoadForm::Proportional => format!("{} (∝ load)", self.kind.label()),
+            LoadForm::Constant => self.kind.label().into(),
         }
     }
 
@@ -245,7 +290,7 @@ mod tests {
 
     #[test]
     fn stribeck_friction_falls_from_the_static_level_to_coulomb_plus_viscous() {
-        let m = Baseline::new(BaselineKind::Stribeck, false, &scale(), 5.0);
+        let m = Baseline::new(BaselineKind::Stribeck, LoadForm::Constant, &scale(), 5.0);
         let x = [4.0, 6.0, 0.01, 20.0];
         let mut s = series(true);
         s.velocity = vec![1e-6, 0.01, 0.1, -0.1];
@@ -263,8 +308,8 @@ mod tests {
 
     #[test]
     fn lugre_in_steady_sliding_is_stribeck_and_lags_after_a_reversal() {
-        let lugre = Baseline::new(BaselineKind::LuGre, false, &scale(), 5.0);
-        let stribeck = Baseline::new(BaselineKind::Stribeck, false, &scale(), 5.0);
+        let lugre = Baseline::new(BaselineKind::LuGre, LoadForm::Constant, &scale(), 5.0);
+        let stribeck = Baseline::new(BaselineKind::Stribeck, LoadForm::Constant, &scale(), 5.0);
         let x = [4.0, 6.0, 0.01, 20.0, 1e5, 0.0];
         let s = series(false);
         let fl = lugre.predict(&x, &s).unwrap();
@@ -283,10 +328,16 @@ mod tests {
         );
         assert_eq!(lugre.parameters().len(), 6);
         assert_eq!(
-            Baseline::new(BaselineKind::LuGre, true, &scale(), 5.0)
+            Baseline::new(BaselineKind::LuGre, LoadForm::Linear, &scale(), 5.0)
                 .parameters()
                 .len(),
             8
+        );
+        assert_eq!(
+            Baseline::new(BaselineKind::LuGre, LoadForm::Proportional, &scale(), 5.0)
+                .parameters()
+                .len(),
+            6
         );
     }
 }

@@ -30,6 +30,7 @@
 //! | `search.rs` | the global phase and the distinct optima |
 //! | `stats.rs` | standard errors, correlations, flags |
 //! | `report.rs` | the summary, the tables, plots, the fitted YAML |
+//! | `synthetic.rs` | synthetic data: the model along a motion, with noise |
 
 #[cfg(feature = "mcap")]
 pub mod bag_input;
@@ -41,9 +42,10 @@ pub mod report;
 pub mod search;
 pub mod series;
 pub mod stats;
+pub mod synthetic;
 pub mod table;
 
-pub use baselines::{Baseline, BaselineKind};
+pub use baselines::{Baseline, BaselineKind, LoadForm};
 pub use params::{ParamSpec, Parameter};
 pub use physics_model::PhysicsModel;
 pub use problem::{Data, FitOutcome, Model, Options};

@@ -402,6 +402,10 @@ pub struct FitOutcome {
     pub holdout_rms: Option<f64>,
     /// RMS on the validation sources, N.
     pub validate_rms: Option<f64>,
+    /// Why the fitted model gives no prediction on the validation sources
+    /// (e.g. LuGre's g(v) ≤ 0 beyond the training velocities): an outcome
+    /// to report, not an error.
+    pub validate_failure: Option<String>,
     pub simulations: usize,
     pub simulation_mean_s: f64,
     pub wall_s: f64,
@@ -450,7 +454,10 @@ pub fn fit(
             .collect()
     };
     let train = collect(problem.predict_sources(&best.x, true))?;
-    let validate = collect(problem.predict_sources(&best.x, false))?;
+    let (validate, validate_failure) = match collect(problem.predict_sources(&best.x, false)) {
+        Ok(v) => (v, None),
+        Err(e) => (Vec::new(), Some(e.to_string())),
+    };
     let (train_rms, train_max) = pooled(&train, |f, i| f.series.fit[i]).unwrap_or((f64::NAN, 0.0));
     let holdout_rms = pooled(&train, |f, i| !f.series.fit[i]).map(|p| p.0);
     let validate_rms = pooled(&validate, |_, _| true).map(|p| p.0);
@@ -469,6 +476,7 @@ pub fn fit(
         train_max,
         holdout_rms,
         validate_rms,
+        validate_failure,
         simulations,
         simulation_mean_s: ns as f64 / 1e9 / simulations.max(1) as f64,
         wall_s: wall.elapsed().as_secs_f64(),

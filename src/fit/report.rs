@@ -117,6 +117,9 @@ pub fn residual_lines(o: &FitOutcome) -> String {
     if let Some(v) = o.validate_rms {
         let _ = writeln!(s, "validation RMS {v:.4} N (--validate data)");
     }
+    if let Some(why) = &o.validate_failure {
+        let _ = writeln!(s, "no prediction on the --validate data: {why}");
+    }
     let _ = writeln!(
         s,
         "{} simulations, {:.1} ms each on average, {:.1} s in all",
@@ -134,6 +137,8 @@ pub struct ModelRow {
     pub parameters: Vec<(String, f64)>,
     pub train_rms: f64,
     pub held_out_rms: Option<f64>,
+    /// Why there is no held-out prediction, when there is none.
+    pub held_out_failure: Option<String>,
     pub converged: bool,
 }
 
@@ -149,6 +154,7 @@ impl From<&FitOutcome> for ModelRow {
                 .collect(),
             train_rms: o.train_rms,
             held_out_rms: o.held_out_rms(),
+            held_out_failure: o.validate_failure.clone(),
             converged: o.converged,
         }
     }
@@ -174,7 +180,11 @@ pub fn models_table(rows: &[ModelRow], scale_n: f64) -> String {
             r.parameters.len(),
             params.join(", "),
             r.train_rms,
-            r.held_out_rms.map_or("–".into(), |h| format!("{h:.4}")),
+            match (&r.held_out_rms, &r.held_out_failure) {
+                (Some(h), _) => format!("{h:.4}"),
+                (None, Some(why)) => format!("none: {}", why.replace('|', "/")),
+                (None, None) => "–".into(),
+            },
             r.held_out_rms
                 .map_or("–".into(), |h| format!("{:.1} %", 100.0 * h / scale_n)),
         );
