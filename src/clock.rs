@@ -202,11 +202,31 @@ impl WallStamps {
         }
     }
 
+    /// The wall clock read between two monotonic reads at most this far
+    /// apart is a clean sample; a thread preempted between the reads would
+    /// otherwise see a "jump" of its own making.
+    pub const READ_WINDOW_NS: u64 = 20_000;
+
     /// Compare the wall clock with the mapping now; re-anchor on a step.
-    /// Returns true when a jump was detected.
+    /// Returns true when a jump was detected. The wall clock is read between
+    /// two monotonic reads and compared with their midpoint; a sample whose
+    /// reads lie further apart than [`Self::READ_WINDOW_NS`] (the thread was
+    /// preempted) is retried, and after three such samples no decision is
+    /// taken until the next check.
     pub fn check(&mut self, clock: &dyn Clock) -> bool {
-        let mono = clock.now_ns();
-        let wall = clock.wall_ns();
+        let mut sample = None;
+        for _ in 0..3 {
+            let m1 = clock.now_ns();
+            let wall = clock.wall_ns();
+            let m2 = clock.now_ns();
+            if m2.saturating_sub(m1) <= Self::READ_WINDOW_NS {
+                sample = Some((m1 + (m2.saturating_sub(m1)) / 2, wall));
+                break;
+            }
+        }
+        let Some((mono, wall)) = sample else {
+            return false;
+        };
         if wall.abs_diff(self.mapped(mono)) > Self::JUMP_NS {
             self.jumps += 1;
             self.mono_anchor = mono;
@@ -262,6 +282,52 @@ mod tests {
         c.jump_wall(5_000_000_000);
         assert!(w.check(&c));
         assert_eq!(w.jumps, 2);
+    }
+
+    /// A thread preempted between its clock reads: the wall clock is read
+    /// `stall_ns` after the monotonic read before it, the first `stalls`
+    /// times.
+    struct Preempted {
+        mono: AtomicU64,
+        wall0: u64,
+        stall_ns: u64,
+        stalls: AtomicU64,
+    }
+
+    impl Clock for Preempted {
+        fn now_ns(&self) -> u64 {
+            self.mono.load(Ordering::Relaxed)
+        }
+        fn sleep_until_ns(&self, deadline_ns: u64) {
+            self.mono.fetch_max(deadline_ns, Ordering::Relaxed);
+        }
+        fn wall_ns(&self) -> u64 {
+            if self.stalls.load(Ordering::Relaxed) > 0 {
+                self.stalls.fetch_sub(1, Ordering::Relaxed);
+                self.mono.fetch_add(self.stall_ns, Ordering::Relaxed);
+            }
+            self.wall0 + self.mono.load(Ordering::Relaxed)
+        }
+    }
+
+    #[test]
+    fn a_thread_preempted_between_its_clock_reads_sees_no_jump() {
+        let c = Preempted {
+            mono: AtomicU64::new(0),
+            wall0: 1_700_000_000_000_000_000,
+            stall_ns: 3_000_000,
+            stalls: AtomicU64::new(0),
+        };
+        let mut w = WallStamps::new(&c);
+        // Two samples spoiled by 3 ms stalls, the third clean.
+        c.stalls.store(2, Ordering::Relaxed);
+        assert!(!w.check(&c));
+        // Every sample spoiled: no decision, no jump.
+        c.stalls.store(3, Ordering::Relaxed);
+        assert!(!w.check(&c));
+        assert_eq!(w.jumps, 0);
+        let s = w.stamp(c.now_ns());
+        assert_eq!(s, c.wall0 + c.now_ns(), "the mapping was not moved");
     }
 
     #[test]
