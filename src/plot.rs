@@ -167,21 +167,25 @@ where
                     MAX_POINTS,
                 );
                 let style = ShapeStyle::from(&l.color).stroke_width(if l.dashed { 1 } else { 2 });
-                if l.dashed {
+                let s = if l.dashed {
                     chart
                         .draw_series(DashedLineSeries::new(pts, 6, 4, style))
-                        .map_err(|e| e.to_string())?;
+                        .map_err(|e| e.to_string())?
                 } else {
-                    let s = chart
+                    chart
                         .draw_series(LineSeries::new(pts, style))
-                        .map_err(|e| e.to_string())?;
-                    if let Some(label) = &l.label {
-                        let c = l.color;
-                        s.label(label.clone()).legend(move |(x, y)| {
-                            PathElement::new(vec![(x, y), (x + 18, y)], c.stroke_width(2))
-                        });
-                        labelled = true;
-                    }
+                        .map_err(|e| e.to_string())?
+                };
+                if let Some(label) = &l.label {
+                    let (c, dashed) = (l.color, l.dashed);
+                    s.label(label.clone()).legend(move |(x, y)| {
+                        // A dashed line's key is dashed too.
+                        let (a, b) = if dashed { (7, 11) } else { (18, 18) };
+                        EmptyElement::at((x, y))
+                            + PathElement::new(vec![(0, 0), (a, 0)], c.stroke_width(2))
+                            + PathElement::new(vec![(b, 0), (18, 0)], c.stroke_width(2))
+                    });
+                    labelled = true;
                 }
             }
             if labelled && legend {

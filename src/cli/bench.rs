@@ -261,6 +261,65 @@ pub fn fit_targets(
         "\n✗: the 95 % interval misses the truth (expected in about 1 seed in 20 per parameter)\n"
     );
 
+    // ---- drivetrain terms beside the contact; the global phase's seeds ----
+    let dt_keys = [
+        "roughness.sigma_m",
+        "contact.boundary_friction",
+        "drivetrain.coulomb_n",
+        "drivetrain.viscous_n_s_m",
+    ];
+    let dt_truth = [3.5e-6, 0.22, 300.0, 800.0];
+    let mut with_dt = base.clone();
+    with_dt.roughness.sigma_m = dt_truth[0];
+    with_dt.contact.boundary_friction = dt_truth[1];
+    with_dt.drivetrain.coulomb_n = dt_truth[2];
+    with_dt.drivetrain.viscous_n_s_m = dt_truth[3];
+    let dt_specs: Vec<ParamSpec> = dt_keys
+        .iter()
+        .map(|k| ParamSpec {
+            name: (*k).into(),
+            ..Default::default()
+        })
+        .collect();
+    let d = data(
+        source(
+            "drivetrain.csv",
+            &noisy_csv(&m, &model_friction(&with_dt, &m)?, 0.02, 11),
+        )?,
+        vec![],
+    );
+    let (scale, _, _) = super::fit::data_scale(&d.train, &[], base.contact.load_n)?;
+    let model = PhysicsModel::new(&base, &dt_specs, &scale)?;
+    println!("## Drivetrain terms beside the contact (from the defaults; global phase with three seeds)\n");
+    println!(
+        "truth: σ = {:.2} µm, μ_bl = {}, drivetrain Coulomb {} N, viscous {} N·s/m; same motion, 2 % noise\n",
+        dt_truth[0] * 1e6,
+        dt_truth[1],
+        dt_truth[2],
+        dt_truth[3]
+    );
+    let mut head = String::from("| global-phase seed |");
+    for k in dt_keys {
+        head += &format!(" `{k}` (error) |");
+    }
+    println!("{head} cost ½Σr² (N²) | wall s |\n|---|---|---|---|---|---|---|");
+    for seed in 1..=3u64 {
+        let mut opts = progress("drivetrain");
+        opts.seed = seed;
+        let o = fit(&model, &d, vec![], &opts)?;
+        let mut row = format!("| {seed} |");
+        for (x, t) in o.best.iter().zip(dt_truth) {
+            row += &format!(" {x:.4e} ({:+.2} %) |", 100.0 * (x - t) / t);
+        }
+        println!(
+            "{row} {:.6e} | {:.1}{} |",
+            o.optima[0].cost,
+            o.wall_s,
+            if o.converged { "" } else { " (not converged)" }
+        );
+    }
+    println!();
+
     // ---- transfer ----
     let seg = |a, f, l| Segment {
         amplitude_m_s: a,

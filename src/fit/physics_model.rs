@@ -119,6 +119,11 @@ fn transient(config: &Config, s: &Series) -> Result<Vec<f64>, String> {
     out[0] = first.friction_force;
     let (mut t_prev, mut f_prev) = (t0, first.friction_force);
     let mut k = 1;
+    // Parameters that make the inputs unreachable (a load the contact cannot
+    // carry) leave the solver at its iteration bound step after step, each
+    // at the cost of its fallbacks: such a run is no prediction.
+    const STUCK_STEPS: u32 = 50;
+    let mut stuck = 0u32;
     for step in 1..=steps {
         let t = t0 + step as f64 * dt;
         if follows {
@@ -133,6 +138,16 @@ fn transient(config: &Config, s: &Series) -> Result<Vec<f64>, String> {
                 "the step at t = {t:.4} s ended {} ({} iterations)",
                 e.status.as_str(),
                 e.diagnostics.iterations
+            ));
+        }
+        stuck = if e.status == Status::MaxIterations {
+            stuck + 1
+        } else {
+            0
+        };
+        if stuck >= STUCK_STEPS {
+            return Err(format!(
+                "{STUCK_STEPS} steps in a row up to t = {t:.4} s hit the iteration bound: these parameters cannot follow the inputs (e.g. a load the contact cannot carry)"
             ));
         }
         while k < n && s.t[k] <= t + 1e-12 * dt {

@@ -9,6 +9,7 @@ use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt, TerminationRe
 use nalgebra::{storage::Owned, DMatrix, DVector, Dyn};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 /// A friction model with fitted parameters.
@@ -98,6 +99,13 @@ impl SeriesFit {
 /// A residual of a failed prediction, times the data's friction scale.
 const PENALTY: f64 = 1e3;
 
+/// Series computed for one set of map coefficients: (training?, the
+/// coefficients' bits, one series or error per source).
+type SeriesEntry = (bool, Vec<u64>, Arc<Vec<Result<Series, String>>>);
+
+/// Map-coefficient values whose series are kept.
+const RECENT_SERIES: usize = 8;
+
 /// A model on data, with the map coefficients that are fitted.
 pub struct Problem<'a> {
     pub model: &'a dyn Model,
@@ -111,6 +119,10 @@ pub struct Problem<'a> {
     /// The series of every training and validation source when no map
     /// coefficient is fitted (they do not change).
     fixed: Option<(Vec<Series>, Vec<Series>)>,
+    /// The series of the last few map-coefficient values (training or
+    /// validation): a Jacobian column that moves only a model parameter
+    /// reuses them instead of evaluating the column expressions again.
+    recent: Mutex<Vec<SeriesEntry>>,
     pub simulations: AtomicUsize,
     pub simulation_ns: AtomicU64,
 }
@@ -170,6 +182,7 @@ impl<'a> Problem<'a> {
             fitted_samples,
             friction_scale: scale,
             fixed,
+            recent: Mutex::new(Vec::new()),
             simulations: AtomicUsize::new(0),
             simulation_ns: AtomicU64::new(0),
         })
@@ -198,16 +211,18 @@ impl<'a> Problem<'a> {
             (&self.data.validate, 0.0)
         };
         let map = self.map_values(x);
+        let computed = if self.fixed.is_none() {
+            Some(self.series_for(&map, train, sources, holdout))
+        } else {
+            None
+        };
         (0..sources.len())
             .into_par_iter()
             .map(|i| {
-                let series = match &self.fixed {
-                    Some((t, v)) => (if train { t } else { v })[i].clone(),
-                    None => {
-                        let mut se = sources[i].series(&map).map_err(|e| e.to_string())?;
-                        se.hold_out(holdout);
-                        se
-                    }
+                let series = match (&self.fixed, &computed) {
+                    (Some((t, v)), _) => (if train { t } else { v })[i].clone(),
+                    (None, Some(c)) => c[i].clone()?,
+                    (None, None) => unreachable!("computed when not fixed"),
                 };
                 let start = Instant::now();
                 let predicted = self.model.predict(&x[..n], &series);
@@ -222,6 +237,38 @@ impl<'a> Problem<'a> {
                 })
             })
             .collect()
+    }
+
+    /// The series of `sources` for map values `map`, from the recent ones
+    /// when they were computed already.
+    fn series_for(
+        &self,
+        map: &[f64],
+        train: bool,
+        sources: &[Source],
+        holdout: f64,
+    ) -> Arc<Vec<Result<Series, String>>> {
+        let key: Vec<u64> = map.iter().map(|v| v.to_bits()).collect();
+        let lock = || self.recent.lock().unwrap_or_else(|p| p.into_inner());
+        if let Some((_, _, s)) = lock().iter().find(|(t, k, _)| *t == train && *k == key) {
+            return s.clone();
+        }
+        let computed: Arc<Vec<Result<Series, String>>> = Arc::new(
+            sources
+                .par_iter()
+                .map(|s| {
+                    let mut se = s.series(map).map_err(|e| e.to_string())?;
+                    se.hold_out(holdout);
+                    Ok(se)
+                })
+                .collect(),
+        );
+        let mut recent = lock();
+        if recent.len() >= RECENT_SERIES {
+            recent.remove(0);
+        }
+        recent.push((train, key, computed.clone()));
+        computed
     }
 
     /// Residuals on the fitted samples; a failed prediction gives large

@@ -14,8 +14,7 @@
 use super::table::Table;
 use super::FitError;
 use evalexpr::{
-    build_operator_tree, ContextWithMutableVariables, DefaultNumericTypes, HashMapContext, Node,
-    Value,
+    build_operator_tree, Context, DefaultNumericTypes, EvalexprError, EvalexprResult, Node, Value,
 };
 use std::path::PathBuf;
 
@@ -102,10 +101,101 @@ impl Series {
     }
 }
 
+/// Where a variable of an expression comes from.
+#[derive(Debug, Clone, Copy)]
+enum Var {
+    Column(usize),
+    Derived(usize),
+    Coefficient(usize),
+}
+
 /// One compiled expression and the identifiers it reads.
 struct Expr {
     text: String,
     node: Node<DefaultNumericTypes>,
+    /// The identifiers it reads, resolved once the derived columns exist.
+    vars: Vec<(String, Var)>,
+    /// Its values when it reads no map coefficient (computed once).
+    fixed: Option<Vec<f64>>,
+    /// When it is affine in the coefficients it reads (checked at
+    /// construction): its values at the start coefficients c₀ and its slope
+    /// per coefficient, so that e(c) = e(c₀) + Σ (cᵢ − c₀ᵢ) gᵢ row by row
+    /// without evaluating the expression again.
+    affine: Option<Affine>,
+}
+
+/// An expression's values as an affine function of the coefficients.
+struct Affine {
+    c0: Vec<f64>,
+    base: Vec<f64>,
+    /// (coefficient index, slope column).
+    slopes: Vec<(usize, Vec<f64>)>,
+}
+
+impl Affine {
+    fn at(&self, coeffs: &[f64]) -> Vec<f64> {
+        let mut out = self.base.clone();
+        for (i, g) in &self.slopes {
+            let d = coeffs.get(*i).copied().unwrap_or(f64::NAN) - self.c0[*i];
+            if d != 0.0 {
+                for (o, gk) in out.iter_mut().zip(g) {
+                    *o += d * gk;
+                }
+            }
+        }
+        out
+    }
+}
+
+impl Expr {
+    fn reads_coefficients(&self) -> bool {
+        self.vars
+            .iter()
+            .any(|(_, v)| matches!(v, Var::Coefficient(_)))
+    }
+}
+
+/// The variables of one expression at one row: a few names, looked up
+/// linearly, their values overwritten row by row (no allocation per row).
+struct RowContext {
+    names: Vec<String>,
+    values: Vec<Value<DefaultNumericTypes>>,
+}
+
+impl Context for RowContext {
+    type NumericTypes = DefaultNumericTypes;
+
+    fn get_value(&self, identifier: &str) -> Option<&Value<DefaultNumericTypes>> {
+        self.names
+            .iter()
+            .position(|n| n == identifier)
+            .map(|i| &self.values[i])
+    }
+
+    fn call_function(
+        &self,
+        identifier: &str,
+        _argument: &Value<DefaultNumericTypes>,
+    ) -> evalexpr::error::EvalexprResultValue<DefaultNumericTypes> {
+        Err(EvalexprError::FunctionIdentifierNotFound(
+            identifier.to_string(),
+        ))
+    }
+
+    fn are_builtin_functions_disabled(&self) -> bool {
+        false
+    }
+
+    fn set_builtin_functions_disabled(
+        &mut self,
+        disabled: bool,
+    ) -> EvalexprResult<(), DefaultNumericTypes> {
+        if disabled {
+            Err(EvalexprError::BuiltinFunctionsCannotBeDisabled)
+        } else {
+            Ok(())
+        }
+    }
 }
 
 /// A table with its mapping, ready to give series for any coefficients.
@@ -121,6 +211,8 @@ pub struct Source {
     /// Derived columns `ddt__NAME`.
     derived: Vec<(String, Vec<f64>)>,
     coefficients: Vec<String>,
+    /// The times (they cannot depend on coefficients).
+    times: Vec<f64>,
 }
 
 fn compile(
@@ -182,6 +274,9 @@ fn compile(
     Ok(Expr {
         text: text.to_string(),
         node,
+        vars: Vec::new(),
+        fixed: None,
+        affine: None,
     })
 }
 
@@ -273,8 +368,9 @@ impl Source {
             temperature,
             derived: Vec::new(),
             coefficients: coeffs.iter().map(|(c, _)| c.clone()).collect(),
+            times: Vec::new(),
         };
-        let t = s.times()?;
+        let t = s.compute_times()?;
         if !derived_cols.is_empty() {
             if s.steady {
                 return Err(FitError::Expression {
@@ -299,7 +395,143 @@ impl Source {
                 s.derived.push((id, derivative(&t, &y, mapping.smooth_s)));
             }
         }
+        s.times = t;
+        // Resolve every expression's variables; those that read no map
+        // coefficient are evaluated once, here.
+        let resolve = |e: &Expr| -> Vec<(String, Var)> {
+            e.node
+                .iter_variable_identifiers()
+                .map(|id| {
+                    let var = if let Some(i) = s.table.names.iter().position(|n| n == id) {
+                        Var::Column(i)
+                    } else if let Some(i) = s.derived.iter().position(|(n, _)| n == id) {
+                        Var::Derived(i)
+                    } else {
+                        Var::Coefficient(
+                            s.coefficients
+                                .iter()
+                                .position(|c| c == id)
+                                .expect("checked when compiled"),
+                        )
+                    };
+                    (id.to_string(), var)
+                })
+                .collect()
+        };
+        let vars: Vec<Vec<(String, Var)>> = [
+            Some(&s.velocity),
+            Some(&s.friction),
+            s.load.as_ref(),
+            s.temperature.as_ref(),
+        ]
+        .into_iter()
+        .map(|e| e.map(resolve).unwrap_or_default())
+        .collect();
+        let mut vars = vars.into_iter();
+        s.velocity.vars = vars.next().unwrap_or_default();
+        s.friction.vars = vars.next().unwrap_or_default();
+        if let Some(e) = s.load.as_mut() {
+            e.vars = vars.next().unwrap_or_default();
+        }
+        if let Some(e) = s.temperature.as_mut() {
+            e.vars = vars.next().unwrap_or_default();
+        }
+        let fixed = |s: &Source, e: &Expr, what: &str| -> Result<Option<Vec<f64>>, FitError> {
+            if e.reads_coefficients() {
+                Ok(None)
+            } else {
+                s.eval_column(e, what, &[]).map(Some)
+            }
+        };
+        s.velocity.fixed = fixed(&s, &s.velocity, "--velocity")?;
+        s.friction.fixed = fixed(&s, &s.friction, "--friction")?;
+        if let Some(e) = &s.load {
+            let f = fixed(&s, e, "--load")?;
+            s.load.as_mut().expect("some").fixed = f;
+        }
+        if let Some(e) = &s.temperature {
+            let f = fixed(&s, e, "--temperature")?;
+            s.temperature.as_mut().expect("some").fixed = f;
+        }
+        let c0: Vec<f64> = coeffs.iter().map(|(_, v)| *v).collect();
+        s.velocity.affine = s.affine(&s.velocity, &c0);
+        s.friction.affine = s.affine(&s.friction, &c0);
+        if let Some(e) = &s.load {
+            let a = s.affine(e, &c0);
+            s.load.as_mut().expect("some").affine = a;
+        }
+        if let Some(e) = &s.temperature {
+            let a = s.affine(e, &c0);
+            s.temperature.as_mut().expect("some").affine = a;
+        }
         Ok(s)
+    }
+
+    /// `e` as an affine function of its coefficients about `c0`, if it is
+    /// one: slopes from unit steps, then checked at two other points (to
+    /// 1e-9 of the values' scale). None for a non-affine expression, one
+    /// that reads no coefficient, or one that fails to evaluate (the error
+    /// then shows when the series is asked for).
+    fn affine(&self, e: &Expr, c0: &[f64]) -> Option<Affine> {
+        if e.fixed.is_some() || !e.reads_coefficients() {
+            return None;
+        }
+        let eval = |c: &[f64]| self.eval_column(e, "", c).ok();
+        let base = eval(c0)?;
+        let mut slopes = Vec::new();
+        let used: Vec<usize> = e
+            .vars
+            .iter()
+            .filter_map(|(_, v)| match v {
+                Var::Coefficient(i) => Some(*i),
+                _ => None,
+            })
+            .collect();
+        for &i in &used {
+            let h = if c0[i] != 0.0 { c0[i].abs() } else { 1.0 };
+            let mut c = c0.to_vec();
+            c[i] += h;
+            let g: Vec<f64> = eval(&c)?
+                .iter()
+                .zip(&base)
+                .map(|(a, b)| (a - b) / h)
+                .collect();
+            slopes.push((i, g));
+        }
+        let a = Affine {
+            c0: c0.to_vec(),
+            base,
+            slopes,
+        };
+        let scale = a
+            .base
+            .iter()
+            .fold(0.0f64, |m, v| m.max(v.abs()))
+            .max(1e-300);
+        for factor in [0.37, 2.9] {
+            let c: Vec<f64> = c0
+                .iter()
+                .enumerate()
+                .map(|(i, v)| {
+                    if used.contains(&i) {
+                        v * factor + 0.13 * (1.0 + v.abs())
+                    } else {
+                        *v
+                    }
+                })
+                .collect();
+            let direct = eval(&c)?;
+            let predicted = a.at(&c);
+            let worst = direct
+                .iter()
+                .zip(&predicted)
+                .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+            let sc = scale.max(direct.iter().fold(0.0f64, |m, v| m.max(v.abs())));
+            if worst.is_nan() || worst > 1e-9 * sc {
+                return None;
+            }
+        }
+        Some(a)
     }
 
     pub fn name(&self) -> &str {
@@ -337,23 +569,50 @@ impl Source {
             .collect()
     }
 
-    fn context_row(&self, ctx: &mut HashMapContext<DefaultNumericTypes>, k: usize) {
-        for (name, col) in self.table.names.iter().zip(&self.table.columns) {
-            let _ = ctx.set_value(name.clone(), Value::Float(col[k]));
-        }
-        for (name, col) in &self.derived {
-            let _ = ctx.set_value(name.clone(), Value::Float(col[k]));
-        }
-    }
-
+    /// `e` at every row, for map coefficients `coeffs`.
     fn eval_column(&self, e: &Expr, what: &str, coeffs: &[f64]) -> Result<Vec<f64>, FitError> {
-        let mut ctx = HashMapContext::<DefaultNumericTypes>::new();
-        for (name, v) in self.coefficients.iter().zip(coeffs) {
-            let _ = ctx.set_value(name.clone(), Value::Float(*v));
+        if let Some(v) = &e.fixed {
+            return Ok(v.clone());
         }
+        if let Some(a) = &e.affine {
+            let v = a.at(coeffs);
+            if let Some(k) = v.iter().position(|x| !x.is_finite()) {
+                return Err(FitError::Data {
+                    what: self.name.clone(),
+                    message: format!("{what} `{}` is not finite at row {}", e.text, k + 1),
+                });
+            }
+            return Ok(v);
+        }
+        // The time expression is compiled but not resolved (it reads
+        // columns only): resolve it here.
+        let vars: Vec<(String, Var)> = if e.vars.is_empty() {
+            e.node
+                .iter_variable_identifiers()
+                .filter_map(|id| {
+                    self.table
+                        .names
+                        .iter()
+                        .position(|n| n == id)
+                        .map(|i| (id.to_string(), Var::Column(i)))
+                })
+                .collect()
+        } else {
+            e.vars.clone()
+        };
+        let mut ctx = RowContext {
+            names: vars.iter().map(|(n, _)| n.clone()).collect(),
+            values: vec![Value::Float(0.0); vars.len()],
+        };
         (0..self.table.rows())
             .map(|k| {
-                self.context_row(&mut ctx, k);
+                for (slot, (_, var)) in ctx.values.iter_mut().zip(&vars) {
+                    *slot = Value::Float(match *var {
+                        Var::Column(i) => self.table.columns[i][k],
+                        Var::Derived(i) => self.derived[i].1[k],
+                        Var::Coefficient(i) => coeffs.get(i).copied().unwrap_or(f64::NAN),
+                    });
+                }
                 let v =
                     e.node
                         .eval_number_with_context(&ctx)
@@ -374,7 +633,7 @@ impl Source {
             .collect()
     }
 
-    fn times(&self) -> Result<Vec<f64>, FitError> {
+    fn compute_times(&self) -> Result<Vec<f64>, FitError> {
         let t = match &self.time {
             Some(e) => self.eval_column(e, "--time", &[])?,
             None => (0..self.table.rows()).map(|k| k as f64).collect(),
@@ -401,7 +660,7 @@ impl Source {
 
     /// The series for map coefficients `coeffs` (in the mapping's order).
     pub fn series(&self, coeffs: &[f64]) -> Result<Series, FitError> {
-        let t = self.times()?;
+        let t = self.times.clone();
         let velocity = self.eval_column(&self.velocity, "--velocity", coeffs)?;
         let friction = self.eval_column(&self.friction, "--friction", coeffs)?;
         let load = self
@@ -485,6 +744,46 @@ mod tests {
         assert_eq!(se.load.as_ref().unwrap()[0], 100.0);
         let se = s.series(&[-1.0, 1.0]);
         assert!(se.unwrap_err().to_string().contains("must be positive"));
+    }
+
+    #[test]
+    fn affine_maps_take_the_fast_path_and_give_the_directly_evaluated_values() {
+        let mut text = String::from("t_s,p_bar,force\n");
+        for k in 0..50 {
+            text += &format!(
+                "{},{},{}\n",
+                k as f64 * 0.01,
+                1.0 + 0.1 * k as f64,
+                20.0 + k as f64
+            );
+        }
+        let m = Mapping {
+            velocity: "0.01 + 0 * p_bar".into(),
+            friction: "force - p_bar * 1e5 * a - off".into(),
+            load: Some("k * k * p_bar + f0".into()),
+            coefficients: vec![
+                ("a".into(), 5e-4),
+                ("off".into(), 0.0),
+                ("k".into(), 3.0),
+                ("f0".into(), 10.0),
+            ],
+            ..Default::default()
+        };
+        let s = Source::new(table(&text), &m).unwrap();
+        assert!(s.friction.affine.is_some(), "force - p A - off is affine");
+        assert!(s.load.as_ref().unwrap().affine.is_none(), "k² p is not");
+        let c = [5.2e-4, 1.5, 2.0, 30.0];
+        let se = s.series(&c).unwrap();
+        for k in 0..50 {
+            let p = 1.0 + 0.1 * k as f64;
+            let f = 20.0 + k as f64 - p * 1e5 * c[0] - c[1];
+            approx::assert_relative_eq!(se.friction[k], f, max_relative = 1e-12, epsilon = 1e-9);
+            approx::assert_relative_eq!(
+                se.load.as_ref().unwrap()[k],
+                4.0 * p + 30.0,
+                max_relative = 1e-12
+            );
+        }
     }
 
     #[test]
