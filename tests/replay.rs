@@ -715,3 +715,64 @@ fn a_truncated_sqlite3_bag_is_refused_or_replayed_up_to_the_damage_never_a_panic
         }
     }
 }
+
+#[test]
+fn velocity_and_load_maps_transform_the_topics_and_bad_maps_are_named() {
+    let d = dir("maps");
+    let plain = d.join("plain.csv");
+    let mapped = d.join("mapped.csv");
+    let base = |out: &Path| -> Vec<String> {
+        [
+            "replay",
+            ROSBAGS_MCAP,
+            "--topic",
+            "/joint_states",
+            "--joint",
+            "slider",
+            "--out",
+            out.to_str().unwrap(),
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .chain(ROSBAGS_SETS.iter().map(|s| s.to_string()))
+        .collect()
+    };
+    let a = base(&plain);
+    let (code, _, stderr) = run(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    assert_eq!(code, 0, "{stderr}");
+    let mut b = base(&mapped);
+    b.extend(["--velocity-map", "0.5 * x", "--load-map", "2 * x + 100"].map(String::from));
+    let (code, _, stderr) = run(&b.iter().map(String::as_str).collect::<Vec<_>>());
+    assert_eq!(code, 0, "{stderr}");
+    let col = |text: &str, name: &str| -> Vec<f64> {
+        let mut lines = text.lines();
+        let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let c = head.iter().position(|h| *h == name).unwrap();
+        lines
+            .map(|l| l.split(',').nth(c).unwrap().parse().unwrap())
+            .collect()
+    };
+    let (p, m) = (
+        std::fs::read_to_string(&plain).unwrap(),
+        std::fs::read_to_string(&mapped).unwrap(),
+    );
+    for (vp, vm) in col(&p, "velocity_m_s").iter().zip(col(&m, "velocity_m_s")) {
+        approx::assert_relative_eq!(vm, 0.5 * vp, max_relative = 1e-12, epsilon = 1e-15);
+    }
+    for (lp, lm) in col(&p, "load_n").iter().zip(col(&m, "load_n")) {
+        approx::assert_relative_eq!(lm, 2.0 * lp + 100.0, max_relative = 1e-12);
+    }
+    for (map, needle) in [
+        ("0.5 * y", "`y` is unknown"),
+        ("(x", "--velocity-map `(x`"),
+        ("x / 0", "gives"),
+    ] {
+        let out = d.join("bad.csv");
+        let mut c = base(&out);
+        c.extend(["--velocity-map", map].map(String::from));
+        let (code, _, stderr) = run(&c.iter().map(String::as_str).collect::<Vec<_>>());
+        assert_eq!(code, 2, "{map}: {stderr}");
+        assert!(stderr.contains(needle), "{map}: {stderr}");
+        assert!(!out.exists(), "{map}: nothing written");
+    }
+}

@@ -369,6 +369,14 @@ pub struct ReplayArgs {
     /// Temperature topic (sensor_msgs/Temperature); default: one ending in temperature.
     #[arg(long, value_name = "NAME")]
     pub temperature_topic: Option<String>,
+    /// The velocity, m/s, as an expression of the velocity topic's value x
+    /// (e.g. `0.005 * x`: a joint's rad/s through a 5 mm lever).
+    #[arg(long, value_name = "EXPR", allow_hyphen_values = true)]
+    pub velocity_map: Option<String>,
+    /// The load, N, as an expression of the load topic's value x (e.g.
+    /// `5.2e-4 * x + 20`: a pressure through an area, plus a preload).
+    #[arg(long, value_name = "EXPR", allow_hyphen_values = true)]
+    pub load_map: Option<String>,
     /// Output: OUT.mcap (ROS 2 profile) or OUT.csv (the simulate columns).
     #[arg(long, value_name = "OUT.mcap|OUT.csv")]
     pub out: PathBuf,

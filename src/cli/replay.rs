@@ -14,6 +14,8 @@ pub fn run(args: ReplayArgs, config: Option<PathBuf>, overrides: Vec<String>) ->
         joint,
         load_topic,
         temperature_topic,
+        velocity_map,
+        load_map,
         out,
         format,
         report,
@@ -39,6 +41,8 @@ pub fn run(args: ReplayArgs, config: Option<PathBuf>, overrides: Vec<String>) ->
         temperature_topic,
         config,
         overrides,
+        velocity_map,
+        load_map,
     };
     let prepared = replay::prepare(&bag, &opts).with_context(in_bag)?;
     if let Some(r) = &report {

@@ -73,6 +73,12 @@ pub enum ReplayError {
         span_s: f64,
         dt_s: f64,
     },
+    #[error("{flag} `{expr}`: {message}")]
+    Map {
+        flag: &'static str,
+        expr: String,
+        message: String,
+    },
     #[error("the recorded configuration in the bag: {0}")]
     RecordedConfig(ConfigError),
     #[error(transparent)]
@@ -153,6 +159,47 @@ pub struct ReplayOptions {
     pub config: Option<PathBuf>,
     /// Overrides applied to whichever configuration is used.
     pub overrides: Vec<String>,
+    /// The velocity, m/s, as an expression of the velocity topic's value
+    /// `x` (e.g. `0.005 * x`: a joint's rad/s through a 5 mm lever).
+    pub velocity_map: Option<String>,
+    /// The load, N, as an expression of the load topic's value `x` (e.g.
+    /// `5.2e-4 * x + 20`: a pressure in Pa through an area plus a preload).
+    pub load_map: Option<String>,
+}
+
+/// `expr` of `x` applied to every sample's value; a parse error, an
+/// unknown name or a non-finite result names the flag and the sample.
+fn map_samples(
+    flag: &'static str,
+    expr: &str,
+    samples: &mut [(u64, f64)],
+) -> Result<(), ReplayError> {
+    use evalexpr::{ContextWithMutableVariables, DefaultNumericTypes, HashMapContext, Value};
+    let err = |message: String| ReplayError::Map {
+        flag,
+        expr: expr.to_string(),
+        message,
+    };
+    let node = evalexpr::build_operator_tree::<DefaultNumericTypes>(expr)
+        .map_err(|e| err(e.to_string()))?;
+    if let Some(id) = node.iter_variable_identifiers().find(|id| *id != "x") {
+        return Err(err(format!(
+            "`{id}` is unknown: the expression reads the topic's value as `x`"
+        )));
+    }
+    let mut ctx = HashMapContext::<DefaultNumericTypes>::new();
+    for (k, s) in samples.iter_mut().enumerate() {
+        ctx.set_value("x".into(), Value::Float(s.1))
+            .map_err(|e| err(e.to_string()))?;
+        let v = node
+            .eval_number_with_context(&ctx)
+            .map_err(|e| err(format!("message {}: {e}", k + 1)))?;
+        if !v.is_finite() {
+            return Err(err(format!("message {}: x = {} gives {v}", k + 1, s.1)));
+        }
+        s.1 = v;
+    }
+    Ok(())
 }
 
 /// The validated input of a replay.
@@ -300,7 +347,24 @@ pub fn prepare(bag: &Bag, opts: &ReplayOptions) -> Result<PreparedReplay, Replay
             }
         }
     };
-    let inputs = decode_inputs(bag, &scan, &config, mode)?;
+    if matches!(mode, InputMode::RecordedEstimates { .. })
+        && (opts.velocity_map.is_some() || opts.load_map.is_some())
+    {
+        return Err(ReplayError::Map {
+            flag: if opts.velocity_map.is_some() {
+                "--velocity-map"
+            } else {
+                "--load-map"
+            },
+            expr: opts
+                .velocity_map
+                .clone()
+                .or_else(|| opts.load_map.clone())
+                .unwrap_or_default(),
+            message: "maps apply to a velocity or load topic; this replay follows the recorded estimates (give --topic)".into(),
+        });
+    }
+    let inputs = decode_inputs(bag, &scan, &config, mode, opts)?;
     if inputs.damage.is_some() {
         scan.damage = inputs.damage;
     }
@@ -366,6 +430,7 @@ fn decode_inputs(
     scan: &BagScan,
     config: &Config,
     mode: InputMode,
+    opts: &ReplayOptions,
 ) -> Result<Inputs, ReplayError> {
     let mut recorded = Vec::new();
     let mut velocity: Vec<(u64, f64)> = Vec::new();
@@ -476,6 +541,12 @@ fn decode_inputs(
         },
         (m, _) => m,
     };
+    if let Some(e) = &opts.velocity_map {
+        map_samples("--velocity-map", e, &mut velocity)?;
+    }
+    if let Some(e) = &opts.load_map {
+        map_samples("--load-map", e, &mut load)?;
+    }
     let velocity_messages = velocity.len() + recorded.len();
     if let InputMode::Topics {
         velocity: topic, ..
