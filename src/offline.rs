@@ -484,11 +484,11 @@ pub fn stribeck(
 }
 
 /// Columns of `stribeck`.
-pub const STRIBECK_COLUMNS: &str = "velocity_m_s,h0_m,h_min_m,f_hyd_n,f_asp_n,friction_n,cof,viscous_n,asperity_load_share,regime,status,iterations";
+pub const STRIBECK_COLUMNS: &str = "velocity_m_s,h0_m,h_min_m,f_hyd_n,f_asp_n,friction_n,cof,viscous_n,asperity_load_share,regime,status,iterations,contact_friction_n";
 
 pub fn stribeck_row(e: &Estimate) -> String {
     format!(
-        "{},{},{},{},{},{},{},{},{},{},{},{}",
+        "{},{},{},{},{},{},{},{},{},{},{},{},{}",
         Num(e.velocity),
         Num(e.h0),
         Num(e.h_min),
@@ -500,7 +500,8 @@ pub fn stribeck_row(e: &Estimate) -> String {
         Num(e.asperity_load_share),
         e.regime.as_str(),
         e.status.as_str(),
-        e.diagnostics.iterations
+        e.diagnostics.iterations,
+        Num(e.contact_friction_force)
     )
 }
 
