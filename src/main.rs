@@ -44,18 +44,22 @@ unsafe impl std::alloc::GlobalAlloc for CountingAlloc {
 static GLOBAL: CountingAlloc = CountingAlloc;
 
 fn main() {
-    tracing_subscriber::fmt()
-        .with_env_filter(
-            tracing_subscriber::EnvFilter::try_from_default_env()
-                // RustDDS logs harmless chatter at participant teardown;
-                // RUST_LOG=rustdds=warn shows it.
-                .unwrap_or_else(|_| {
-                    tracing_subscriber::EnvFilter::new("warn,rustdds=off,ros2_client=error")
-                }),
-        )
-        .with_writer(std::io::stderr)
-        .init();
-    let cli = match cli::args::Cli::try_parse() {
+    // `--ros-args ... [--]` sections are rcl's, not clap's: split them off.
+    let argv: Vec<String> = std::env::args().collect();
+    let (rest, ros_tokens) = friction_node::config::ros_args::split(&argv[1..]);
+    let ros = match ros_tokens
+        .as_deref()
+        .map(|t| friction_node::config::RosArgs::parse(t, friction_node::config::DEFAULT_NODE_NAME))
+        .transpose()
+    {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("error: {e}");
+            std::process::exit(2);
+        }
+    };
+    cli::logging::init(ros.as_ref());
+    let cli = match cli::args::Cli::try_parse_from(std::iter::once(argv[0].clone()).chain(rest)) {
         Ok(c) => c,
         Err(e) => match e.kind() {
             clap::error::ErrorKind::DisplayHelp
@@ -68,7 +72,7 @@ fn main() {
         },
     };
     let allocations = || ALLOCATIONS.with(Cell::get);
-    if let Err(e) = cli::dispatch(cli, &allocations) {
+    if let Err(e) = cli::dispatch(cli, ros, &allocations) {
         eprintln!("error: {e:#}");
         std::process::exit(2);
     }

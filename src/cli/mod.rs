@@ -4,6 +4,7 @@
 pub mod args;
 pub mod bench;
 pub mod fit;
+pub mod logging;
 pub mod node;
 pub mod offline;
 #[cfg(feature = "mcap")]
@@ -14,8 +15,13 @@ use anyhow::Result;
 use args::{Cli, Command};
 use friction_node::config::Config;
 
-/// Run one parsed command line.
-pub fn dispatch(cli: Cli, allocations: &dyn Fn() -> u64) -> Result<()> {
+/// Run one parsed command line (`ros`: its `--ros-args`, for `run` and
+/// `soak`, the commands that are ROS 2 nodes).
+pub fn dispatch(
+    cli: Cli,
+    ros: Option<friction_node::config::RosArgs>,
+    allocations: &dyn Fn() -> u64,
+) -> Result<()> {
     let sub = cli.command.common().clone();
     if cli.common.config.is_some() && sub.config.is_some() {
         anyhow::bail!("--config given twice (before and after the subcommand)");
@@ -31,7 +37,15 @@ pub fn dispatch(cli: Cli, allocations: &dyn Fn() -> u64) -> Result<()> {
             anyhow::bail!("replay needs the `mcap` feature");
         }
     }
-    let config = Config::load(path.as_deref(), &sets)?;
+    let config = match (&cli.command, &ros) {
+        (Command::Run { .. } | Command::Soak { .. }, Some(r)) => {
+            Config::load_with_ros_args(path.as_deref(), &sets, r)?
+        }
+        (_, Some(_)) => anyhow::bail!(
+            "--ros-args: only `run` and `soak` start a ROS 2 node; give the configuration with --config/--set"
+        ),
+        (_, None) => Config::load(path.as_deref(), &sets)?,
+    };
     match cli.command {
         Command::Replay { .. } => unreachable!("handled above"),
         Command::Simulate {

@@ -27,6 +27,8 @@ pub enum ConfigError {
     },
     #[error("override `{arg}`: {message}")]
     BadOverride { arg: String, message: String },
+    #[error("--ros-args {arg}: {message}")]
+    RosArgs { arg: String, message: String },
 }
 
 /// Where a configuration came from (for messages).

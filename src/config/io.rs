@@ -247,6 +247,9 @@ pub struct RosConfig {
     pub command_type: CommandType,
     pub topics: TopicsConfig,
     pub qos: QosProfiles,
+    /// Topic remappings `FROM:=TO` (what `--ros-args -r` gives), applied
+    /// to every topic the node has, `~/` ones included.
+    pub remappings: Vec<String>,
 }
 
 impl Default for RosConfig {
@@ -259,6 +262,7 @@ impl Default for RosConfig {
             command_type: CommandType::Float64,
             topics: TopicsConfig::default(),
             qos: QosProfiles::default(),
+            remappings: Vec::new(),
         }
     }
 }

@@ -23,6 +23,92 @@ impl Config {
         Self::from_yaml(&text, &origin, overrides)
     }
 
+    /// As [`Config::load`], with `--ros-args` applied as rcl applies them:
+    /// the file (or built-in defaults) < `--params-file` entries matching
+    /// the node, in order < `-p`, in order; then `--set` overrides, the
+    /// node's name and namespace (`-r __node:=`, `-r __ns:=`) and the topic
+    /// remappings (appended to `ros.remappings`).
+    pub fn load_with_ros_args(
+        path: Option<&Path>,
+        overrides: &[String],
+        ros: &super::RosArgs,
+    ) -> Result<Config, ConfigError> {
+        let (text, origin) = match path {
+            Some(p) => (
+                std::fs::read_to_string(p).map_err(|source| ConfigError::Io {
+                    path: p.to_path_buf(),
+                    source,
+                })?,
+                Origin::File(p.to_path_buf()),
+            ),
+            None => (DEFAULT_YAML.to_string(), Origin::Embedded),
+        };
+        let doc: Value = serde_norway::from_str(&text).map_err(|e| ConfigError::Syntax {
+            origin: origin.to_string(),
+            message: e.to_string(),
+        })?;
+        let mut params = ros_parameters(doc, &origin)?;
+        let text_of = |v: &Value, key: &str, default: &str| -> String {
+            v.get("ros")
+                .and_then(|r| r.get(key))
+                .and_then(Value::as_str)
+                .unwrap_or(default)
+                .to_string()
+        };
+        let fqn = ros.fully_qualified(
+            &text_of(&params, "node_name", DEFAULT_NODE_NAME),
+            &text_of(&params, "namespace", "/"),
+        );
+        for file in &ros.params_files {
+            for entry in super::ros_args::matching_parameters(file, &fqn)? {
+                super::ros_args::merge(&mut params, entry);
+            }
+        }
+        for (key, value) in &ros.params {
+            apply_override(&mut params, &format!("{key}={value}")).map_err(|e| match e {
+                ConfigError::BadOverride { message, .. } => ConfigError::RosArgs {
+                    arg: format!("-p {key}:={value}"),
+                    message,
+                },
+                other => other,
+            })?;
+        }
+        for o in overrides {
+            apply_override(&mut params, o)?;
+        }
+        fn set(params: &mut Value, key: &str, v: Value) {
+            if let Value::Mapping(top) = params {
+                let ros = top
+                    .entry(Value::String("ros".into()))
+                    .or_insert_with(|| Value::Mapping(Default::default()));
+                if let Value::Mapping(r) = ros {
+                    r.insert(Value::String(key.into()), v);
+                }
+            }
+        }
+        if let Some(n) = &ros.node_name {
+            set(&mut params, "node_name", Value::String(n.clone()));
+        }
+        if let Some(n) = &ros.namespace {
+            set(&mut params, "namespace", Value::String(n.clone()));
+        }
+        if !ros.remaps.is_empty() {
+            let mut rules: Vec<Value> = params
+                .get("ros")
+                .and_then(|r| r.get("remappings"))
+                .and_then(Value::as_sequence)
+                .cloned()
+                .unwrap_or_default();
+            rules.extend(
+                ros.remaps
+                    .iter()
+                    .map(|(f, t)| Value::String(format!("{f}:={t}"))),
+            );
+            set(&mut params, "remappings", Value::Sequence(rules));
+        }
+        Self::from_params(params)
+    }
+
     /// Parse parameter-file text (see [`Config::load`]).
     pub fn from_yaml(
         text: &str,
@@ -37,6 +123,11 @@ impl Config {
         for o in overrides {
             apply_override(&mut params, o)?;
         }
+        Self::from_params(params)
+    }
+
+    /// Deserialize and validate a `ros__parameters` tree.
+    fn from_params(params: Value) -> Result<Config, ConfigError> {
         let cfg: Config = serde_path_to_error::deserialize(params).map_err(|e| {
             let key = e.path().to_string();
             let message = e.inner().to_string();

@@ -31,13 +31,17 @@ mod error;
 mod io;
 mod load;
 mod model;
+pub mod ros_args;
 mod validate;
 
 pub use error::{ConfigError, Origin};
 pub use io::*;
 pub use load::apply_override;
 pub use model::*;
-pub use validate::{check_namespace, check_node_name, check_topic, snapshot_bytes};
+pub use ros_args::RosArgs;
+pub use validate::{
+    check_namespace, check_node_name, check_topic, key_ranges, snapshot_bytes, KeyRange,
+};
 
 use crate::physics::{
     Contact, Geometry, Lubricant, Method, ModelParams, Pocket, Profile, ReferenceSettings,
@@ -56,6 +60,9 @@ pub const DEFAULT_NODE_NAME: &str = "friction_node";
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Config {
+    /// Follow `/clock` (`rosgraph_msgs/msg/Clock`) instead of the wall clock
+    /// in timer mode, as ROS 2 nodes do for simulation and bag playback.
+    pub use_sim_time: bool,
     pub contact: ContactConfig,
     pub texture: TextureConfig,
     pub lubricant: LubricantConfig,

@@ -14,7 +14,65 @@ enum End {
     Open(f64),
 }
 
+/// The documented range of one numeric key (see [`key_ranges`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct KeyRange {
+    pub key: String,
+    pub lo: f64,
+    pub lo_open: bool,
+    pub hi: f64,
+    pub hi_open: bool,
+}
+
+impl std::fmt::Display for KeyRange {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{}{}, {}{}",
+            if self.lo_open { '(' } else { '[' },
+            Num(self.lo),
+            Num(self.hi),
+            if self.hi_open { ')' } else { ']' }
+        )
+    }
+}
+
+thread_local! {
+    static COLLECT: std::cell::RefCell<Option<Vec<KeyRange>>> = const { std::cell::RefCell::new(None) };
+}
+
+/// The range of every numeric key that [`Config::validate`] checks, as it
+/// checks them on the default configuration (ranges that depend on another
+/// key are given at its default value).
+pub fn key_ranges() -> Vec<KeyRange> {
+    COLLECT.with(|c| *c.borrow_mut() = Some(Vec::new()));
+    let _ = Config::default().validate();
+    let mut v = COLLECT.with(|c| c.borrow_mut().take()).unwrap_or_default();
+    let mut seen = std::collections::HashSet::new();
+    v.retain(|r| seen.insert(r.key.clone()));
+    v
+}
+
 fn check(key: &str, value: f64, lo: End, hi: End) -> Result<(), ConfigError> {
+    COLLECT.with(|c| {
+        if let Some(v) = c.borrow_mut().as_mut() {
+            let (lo, lo_open) = match lo {
+                End::Closed(l) => (l, false),
+                End::Open(l) => (l, true),
+            };
+            let (hi, hi_open) = match hi {
+                End::Closed(h) => (h, false),
+                End::Open(h) => (h, true),
+            };
+            v.push(KeyRange {
+                key: key.to_string(),
+                lo,
+                lo_open,
+                hi,
+                hi_open,
+            });
+        }
+    });
     let above = match lo {
         End::Closed(l) => value >= l,
         End::Open(l) => value > l,
@@ -328,6 +386,17 @@ impl Config {
         };
         name("ros.node_name", &r.node_name, check_node_name(&r.node_name))?;
         name("ros.namespace", &r.namespace, check_namespace(&r.namespace))?;
+        for (i, rule) in r.remappings.iter().enumerate() {
+            let key = format!("ros.remappings[{i}]");
+            let Some((from, to)) = rule.split_once(":=") else {
+                return Err(ConfigError::InvalidValue {
+                    key,
+                    message: format!("`{rule}` is not FROM:=TO"),
+                });
+            };
+            name(&key, from, check_topic(from))?;
+            name(&key, to, check_topic(to))?;
+        }
         let t = &r.topics;
         for (key, value) in [
             ("ros.topics.cmd_velocity", &t.cmd_velocity),

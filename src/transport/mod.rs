@@ -11,6 +11,7 @@
 
 pub mod memory;
 pub mod names;
+pub mod rosout;
 
 #[cfg(feature = "iceoryx2")]
 pub mod iceoryx;

@@ -3,16 +3,40 @@
 
 use crate::config::Config;
 
-/// Expand a topic name: `~/x` → `/<namespace>/<node>/x`; other names as given
-/// (relative names are resolved by DDS against the node's namespace).
+/// Expand a topic name: `~/x` → `/<namespace>/<node>/x`, a relative `x` →
+/// `/<namespace>/x`, an absolute one as given.
 pub fn resolve_topic(topic: &str, namespace: &str, node: &str) -> String {
+    let ns = namespace.trim_end_matches('/');
     match topic.strip_prefix("~/") {
-        Some(rest) => {
-            let ns = namespace.trim_end_matches('/');
-            format!("{ns}/{node}/{rest}")
-        }
-        None => topic.to_string(),
+        Some(rest) => format!("{ns}/{node}/{rest}"),
+        None if topic.starts_with('/') => topic.to_string(),
+        None => format!("{ns}/{topic}"),
     }
+}
+
+/// A resolved name after the remapping rules `FROM:=TO` (each side
+/// resolved as a topic of this node): the first rule whose `FROM` is `name`
+/// gives its `TO`, as rcl applies them.
+pub fn remap(name: &str, rules: &[String], namespace: &str, node: &str) -> String {
+    for r in rules {
+        if let Some((from, to)) = r.split_once(":=") {
+            if resolve_topic(from, namespace, node) == name {
+                return resolve_topic(to, namespace, node);
+            }
+        }
+    }
+    name.to_string()
+}
+
+/// A name of this node, resolved and remapped.
+pub fn node_topic(cfg: &Config, topic: &str) -> String {
+    let r = &cfg.ros;
+    remap(
+        &resolve_topic(topic, &r.namespace, &r.node_name),
+        &r.remappings,
+        &r.namespace,
+        &r.node_name,
+    )
 }
 
 /// The node's topics, resolved.
@@ -32,7 +56,7 @@ pub struct TopicNames {
 impl TopicNames {
     pub fn from_config(cfg: &Config) -> Self {
         let r = &cfg.ros;
-        let t = |topic: &str| resolve_topic(topic, &r.namespace, &r.node_name);
+        let t = |topic: &str| node_topic(cfg, topic);
         Self {
             cmd_velocity: t(&r.topics.cmd_velocity),
             normal_load: t(&r.topics.normal_load),
@@ -61,8 +85,32 @@ mod tests {
             "/robot/fn/cmd_velocity"
         );
         assert_eq!(resolve_topic("/abs/x", "/robot", "fn"), "/abs/x");
-        assert_eq!(resolve_topic("rel/x", "/robot", "fn"), "rel/x");
+        assert_eq!(resolve_topic("rel/x", "/robot", "fn"), "/robot/rel/x");
+        assert_eq!(resolve_topic("rel/x", "/", "fn"), "/rel/x");
         let n = TopicNames::from_config(&Config::default());
         assert_eq!(n.friction, "/friction_node/friction");
+    }
+
+    #[test]
+    fn remappings_apply_to_every_topic_private_ones_included() {
+        let mut c = Config::default();
+        c.ros.namespace = "/robot".into();
+        c.ros.remappings = vec![
+            "~/friction:=/ff/friction".into(),
+            "/robot/friction_node/cmd_velocity:=cmd".into(),
+            "~/snapshot:=/snapshots/now".into(),
+            "~/friction:=/never/this".into(),
+        ];
+        let n = TopicNames::from_config(&c);
+        assert_eq!(n.friction, "/ff/friction", "first rule wins");
+        assert_eq!(
+            n.cmd_velocity, "/robot/cmd",
+            "relative TO in the node's namespace"
+        );
+        assert_eq!(n.snapshot, "/snapshots/now");
+        assert_eq!(
+            n.normal_load, "/robot/friction_node/normal_load",
+            "untouched"
+        );
     }
 }

@@ -1,0 +1,39 @@
+//! Logging for the binary: `tracing` events to the terminal (stderr), at
+//! the level `RUST_LOG` or `--ros-args --log-level` gives (default: warn;
+//! RustDDS's teardown chatter is silenced). The ROS 2 transport also sends
+//! them to `/rosout` (see `friction_node::transport::rosout`).
+
+use friction_node::config::RosArgs;
+use tracing_subscriber::layer::SubscriberExt;
+use tracing_subscriber::util::SubscriberInitExt;
+use tracing_subscriber::EnvFilter;
+
+/// rcl's level names to `tracing` filter directives.
+fn directive(level: &str) -> &'static str {
+    match level {
+        "debug" => "debug",
+        "info" => "info",
+        "warn" | "warning" => "warn",
+        "error" | "fatal" => "error",
+        _ => "warn",
+    }
+}
+
+pub fn init(ros: Option<&RosArgs>) {
+    let quiet = ",rustdds=off,ros2_client=error";
+    let filter = match ros.and_then(|r| r.log_level.as_deref()) {
+        Some(level) => EnvFilter::new(format!("{}{quiet}", directive(level))),
+        None => EnvFilter::try_from_default_env()
+            // RustDDS logs harmless chatter at participant teardown;
+            // RUST_LOG=rustdds=warn shows it.
+            .unwrap_or_else(|_| EnvFilter::new(format!("warn{quiet}"))),
+    };
+    let stdout = !ros.is_some_and(|r| r.stdout_disabled);
+    let terminal = stdout.then(|| tracing_subscriber::fmt::layer().with_writer(std::io::stderr));
+    let rosout_enabled = !ros.is_some_and(|r| r.rosout_disabled);
+    tracing_subscriber::registry()
+        .with(filter)
+        .with(terminal)
+        .with(friction_node::transport::rosout::layer(rosout_enabled))
+        .init();
+}
