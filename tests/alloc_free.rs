@@ -162,3 +162,51 @@ fn the_loop_allocates_nothing_while_a_transport_refuses_every_output_for_ten_min
     assert_eq!(steps, 601_000, "the loop kept its pace");
     assert_eq!(n, 0, "{n} allocations in ten simulated minutes");
 }
+
+#[test]
+fn a_prepared_model_swaps_in_between_two_steps_without_allocating() {
+    let model = ModelParams::default();
+    let settings = SolverSettings {
+        cells: 64,
+        ..Default::default()
+    };
+    let mut s = Solver::new(&model, &settings).unwrap();
+    s.initialize_steady(0.05, 20_762.0);
+    let before = s.step(0.05, 20_762.0);
+    // Boundary friction halved, rougher surfaces, a thicker oil: built here,
+    // off the "loop".
+    let mut changed = model.clone();
+    changed.contact.boundary_friction = 0.15;
+    changed.roughness.sigma = 6e-6;
+    changed.lubricant.viscosity = 0.08;
+    let mut prepared = Solver::prepare_model(&changed, &settings).unwrap();
+    let n = allocations(|| s.swap_model(&mut prepared).unwrap());
+    assert_eq!(n, 0, "the swap allocates nothing");
+    let mut after = s.step(0.05, 20_762.0);
+    for _ in 0..200 {
+        after = s.step(0.05, 20_762.0);
+    }
+    assert!(after.status.is_converged());
+    // Mostly boundary friction at 5 cm/s: halving mu_bl about halves it.
+    let ratio = after.friction_force / before.friction_force;
+    assert!((0.4..0.65).contains(&ratio), "ratio {ratio}");
+    // Swapping back restores the original numbers at the steady state.
+    s.swap_model(&mut prepared).unwrap();
+    let mut back = s.step(0.05, 20_762.0);
+    for _ in 0..3000 {
+        back = s.step(0.05, 20_762.0);
+    }
+    let steady = Solver::new(&model, &settings)
+        .unwrap()
+        .initialize_steady(0.05, 20_762.0);
+    approx::assert_relative_eq!(
+        back.friction_force,
+        steady.friction_force,
+        max_relative = 1e-5
+    );
+    // Another geometry cannot be swapped in.
+    let mut other = model.clone();
+    other.geometry.length *= 2.0;
+    let mut wrong = Solver::prepare_model(&other, &settings).unwrap();
+    assert!(s.swap_model(&mut wrong).is_err());
+}

@@ -40,7 +40,7 @@
 //!
 //! | file | content |
 //! |---|---|
-//! | `mod.rs` | [`Solver`]: state, discretisation data, accessors |
+//! | `mod.rs` | [`Solver`]: state, discretisation data, accessors; [`PreparedModel`] |
 //! | `history.rs` | time levels: starting states and the history of past levels |
 //! | `step.rs` | one time step: input checks, predictor, Newton and its fallbacks |
 //! | `steady.rs` | steady states (Stribeck points) and continuation |
@@ -174,6 +174,8 @@ pub struct FieldPoint {
 #[derive(Debug, Clone)]
 pub struct Solver {
     pub(crate) d: Disc,
+    /// The geometry the grid was built from (a swapped model must match it).
+    geometry: super::params::Geometry,
     pub(crate) settings: SolverSettings,
     pub(crate) p: Vec<f64>,
     pub(crate) h0: f64,
@@ -201,11 +203,34 @@ pub struct Solver {
     last: Option<Estimate>,
 }
 
+/// Model parameters prepared for a running solver: every table built and
+/// buffer allocated here, off the loop thread, so that
+/// [`Solver::swap_model`] changes the model between two steps in O(1)
+/// without allocating. The geometry and the grid must be those of the
+/// solver it is swapped into (lubricant, roughness, contact and drivetrain
+/// may differ).
+#[derive(Debug, Clone)]
+pub struct PreparedModel {
+    d: Disc,
+    cells: usize,
+    geometry: super::params::Geometry,
+}
+
+/// Why a prepared model cannot replace a solver's.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModelMismatch;
+
+impl std::fmt::Display for ModelMismatch {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("the prepared model has another geometry or grid than the solver's (only lubricant, roughness, contact and drivetrain may change while running)")
+    }
+}
+
+impl std::error::Error for ModelMismatch {}
+
 impl Solver {
-    /// Build the solver: validates the parameters and allocates every buffer.
-    /// Start it with [`Solver::initialize_steady`] or [`Solver::initialize_gap`]
-    /// (a first [`Solver::step`] without either starts from the steady state).
-    pub fn new(model: &ModelParams, settings: &SolverSettings) -> Result<Self, SetupError> {
+    /// Build the discretisation data of `model` on `settings.cells` cells.
+    fn disc(model: &ModelParams, settings: &SolverSettings) -> Result<Disc, SetupError> {
         model.check()?;
         settings.check()?;
         let n = settings.cells;
@@ -223,7 +248,7 @@ impl Solver {
         let p_amb = model.lubricant.ambient_pressure;
         let sb = eos.eval(p_amb);
         let contact = gw.summed(&grid.g_cell);
-        let d = Disc {
+        Ok(Disc {
             grid,
             eos,
             gw,
@@ -238,9 +263,42 @@ impl Solver {
             v_reg: model.contact.sign_regularization,
             min_film: model.contact.min_film,
             drivetrain: model.drivetrain,
-        };
+        })
+    }
+
+    /// Prepare `model` for [`Solver::swap_model`] (validates it; allocates).
+    pub fn prepare_model(
+        model: &ModelParams,
+        settings: &SolverSettings,
+    ) -> Result<PreparedModel, SetupError> {
+        Ok(PreparedModel {
+            d: Self::disc(model, settings)?,
+            cells: settings.cells,
+            geometry: model.geometry.clone(),
+        })
+    }
+
+    /// Replace the model by a prepared one between two steps, keeping the
+    /// state (pressures, h0, history). No allocation: `m` receives the old
+    /// model, to be dropped off the loop thread.
+    pub fn swap_model(&mut self, m: &mut PreparedModel) -> Result<(), ModelMismatch> {
+        if m.cells != self.d.grid.n || m.geometry != self.geometry {
+            return Err(ModelMismatch);
+        }
+        std::mem::swap(&mut self.d, &mut m.d);
+        Ok(())
+    }
+
+    /// Build the solver: validates the parameters and allocates every buffer.
+    /// Start it with [`Solver::initialize_steady`] or [`Solver::initialize_gap`]
+    /// (a first [`Solver::step`] without either starts from the steady state).
+    pub fn new(model: &ModelParams, settings: &SolverSettings) -> Result<Self, SetupError> {
+        let d = Self::disc(model, settings)?;
+        let n = settings.cells;
+        let p_amb = d.p_amb;
         let mut s = Self {
             d,
+            geometry: model.geometry.clone(),
             settings: *settings,
             p: vec![p_amb; n],
             h0: model.roughness.sigma * 3.0,
