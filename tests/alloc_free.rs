@@ -210,3 +210,71 @@ fn a_prepared_model_swaps_in_between_two_steps_without_allocating() {
     let mut wrong = Solver::prepare_model(&other, &settings).unwrap();
     assert!(s.swap_model(&mut wrong).is_err());
 }
+
+#[test]
+fn a_parameter_change_is_applied_by_the_loop_between_two_steps_without_allocating() {
+    use friction_node::config::{Config, StepMode};
+    use friction_node::msgs::ros_interfaces::{parameter_type, ParameterValue};
+    use friction_node::msgs::{Command, CommandKind};
+    use friction_node::node::parameters::{apply_set, declare, ParameterChannel, ParameterUpdate};
+    use friction_node::node::{LiveStatus, Loop};
+    use friction_node::transport::memory::MemoryLink;
+    use friction_node::transport::PeerPort;
+    use std::sync::Arc;
+    let mut cfg = Config::default();
+    cfg.solver.cells = 32;
+    cfg.node.step_mode = StepMode::Lockstep;
+    let link = MemoryLink::new(1000);
+    let mut peer = link.peer();
+    let ch = Arc::new(ParameterChannel::default());
+    let mut l = Loop::new(
+        &cfg,
+        vec![Box::new(link.node())],
+        None,
+        None,
+        Arc::new(LiveStatus::default()),
+    )
+    .unwrap()
+    .with_parameters(ch.clone());
+    let v = |k: u64| Command {
+        kind: CommandKind::Velocity,
+        value: 0.1,
+        stamp_ns: k * 1_000_000,
+    };
+    for k in 1..=10 {
+        l.feed(v(k));
+    }
+    let double = |x: f64| ParameterValue {
+        r#type: parameter_type::DOUBLE,
+        double_value: x,
+        ..Default::default()
+    };
+    let changes = vec![
+        ("contact.load_n".to_string(), double(5762.0)),
+        ("contact.boundary_friction".to_string(), double(0.15)),
+    ];
+    let new = apply_set(&cfg, &declare(&cfg), &changes).unwrap();
+    // Prepared here, off the loop.
+    ch.submit(ParameterUpdate::prepare(&cfg, new, changes).unwrap())
+        .unwrap();
+    let n = allocations(|| l.feed(v(11)));
+    assert_eq!(n, 0, "the step that applies the change allocates nothing");
+    for k in 12..=20 {
+        l.feed(v(k));
+    }
+    let est: Vec<_> = std::iter::from_fn(|| peer.try_recv().unwrap()).collect();
+    assert_eq!(est.len(), 20);
+    assert!(est[..10].iter().all(|e| e.load_n == 20_762.0));
+    assert!(
+        est[10..].iter().all(|e| e.load_n == 5762.0),
+        "from the next step on"
+    );
+    let applied = ch.take_applied().expect("handed back");
+    assert_eq!(
+        applied.applied_stamp_ns, 11_000_000,
+        "stamped with its first step"
+    );
+    assert_eq!(l.summary().parameter_updates, 1);
+    // Lower load and half the boundary friction: much less friction.
+    assert!(est[19].friction_force_n < 0.5 * est[9].friction_force_n);
+}

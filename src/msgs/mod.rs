@@ -13,9 +13,11 @@
 //! | `types.rs` | [`MsgType`]: package, name, definition, `ros2msg` schema |
 //! | `records.rs` | heap-free records of the loop and their conversions |
 //! | `cdr.rs` | CDR with its encapsulation header |
+//! | `ros_interfaces.rs` | standard interfaces: parameters, `/rosout`, diagnostics, `/clock`, Trigger |
 
 mod cdr;
 mod records;
+pub mod ros_interfaces;
 mod types;
 mod wire;
 

@@ -415,4 +415,11 @@ pub enum RecordItem {
         record: StatisticsRecord,
         logged_ns: u64,
     },
+    /// An `rcl_interfaces/msg/ParameterEvent` (CDR with its encapsulation
+    /// header) stamped with the first step that used the new values.
+    ParameterEvent {
+        cdr: Vec<u8>,
+        stamp_ns: u64,
+        logged_ns: u64,
+    },
 }

@@ -33,6 +33,7 @@
 //! | `lockstep.rs` | lockstep mode and [`Loop::feed`] (replay) |
 //! | `commands.rs` | command validation, timeouts, command status |
 //! | `outputs.rs` | one step and its outputs: estimates, profiles, statistics |
+//! | `parameters.rs` | declared parameters, sets validated and prepared off the loop, applied between steps |
 //! | `runner.rs` | the `run` command around the loop |
 //! | `rt.rs` | real-time settings |
 
@@ -40,6 +41,7 @@ mod commands;
 pub mod driver;
 mod lockstep;
 mod outputs;
+pub mod parameters;
 pub mod rt;
 pub mod runner;
 mod timer;
@@ -110,6 +112,8 @@ pub struct RunSummary {
     pub status_counts: [u64; 8],
     /// Steps per command status code (index = code).
     pub command_status_counts: [u64; 4],
+    /// Parameter changes applied while running.
+    pub parameter_updates: u64,
 }
 
 /// Settings the loop reads every step (from the configuration).
@@ -218,6 +222,8 @@ pub struct Loop {
     /// Timer mode: steps counted as already taken when the run starts.
     first_step: u64,
     recorder: Option<Arc<crate::stats::RecorderCounters>>,
+    /// Parameter changes while running (see [`parameters`]).
+    parameters: Option<Arc<parameters::ParameterChannel>>,
 }
 
 impl Loop {
@@ -268,6 +274,7 @@ impl Loop {
             started_ns: 0,
             first_step: 0,
             recorder: None,
+            parameters: None,
             s,
         })
     }

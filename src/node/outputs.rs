@@ -11,6 +11,7 @@ impl Loop {
     /// One fixed step with velocity `v`, stamped `stamp_ns`, `late_ns`
     /// after its deadline.
     pub(super) fn step(&mut self, v: f64, stamp_ns: u64, late_ns: u64) {
+        self.apply_parameters(stamp_ns);
         let start = self.clock.now_ns();
         let e = self.solver.step(v, self.load);
         let compute = self.clock.now_ns().saturating_sub(start);
@@ -19,6 +20,7 @@ impl Loop {
 
     /// `steps` lost periods advanced in one long step.
     pub(super) fn step_over(&mut self, steps: u64, stamp_ns: u64, late_ns: u64) {
+        self.apply_parameters(stamp_ns);
         let start = self.clock.now_ns();
         let dt = self.s.dt * steps as f64;
         let e = self.solver.step_over(self.applied, self.load, dt);

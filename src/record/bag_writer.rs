@@ -89,6 +89,16 @@ impl TopicTable {
                     &msgs::TEMPERATURE,
                     cq,
                 ),
+                (
+                    TopicId::ParameterEvents,
+                    names.parameter_events.clone(),
+                    &msgs::ros_interfaces::PARAMETER_EVENT,
+                    offered_qos_yaml(&crate::config::QosConfig {
+                        reliability: Reliability::Reliable,
+                        depth: 1000,
+                        durability: crate::config::Durability::Volatile,
+                    }),
+                ),
             ],
         }
     }
@@ -100,12 +110,12 @@ type McapWriter = mcap::Writer<BufWriter<std::fs::File>>;
 pub struct BagWriter {
     w: McapWriter,
     /// Channel id of each [`TopicId`].
-    channels: [u16; 7],
+    channels: [u16; super::entry::TOPICS],
     encoder: Encoder,
     sequence: u32,
     messages: u64,
     /// Messages per topic.
-    pub counts: [u64; 7],
+    pub counts: [u64; super::entry::TOPICS],
     /// Log time of the first and last message, ns.
     pub first_log_ns: Option<u64>,
     pub last_log_ns: u64,
@@ -150,7 +160,7 @@ impl BagWriter {
             .chunk_size(Some(config.recording.chunk_size_bytes))
             .create(BufWriter::new(file))
             .map_err(mcap_err)?;
-        let mut channels = [0u16; 7];
+        let mut channels = [0u16; super::entry::TOPICS];
         let mut schemas: BTreeMap<String, u16> = BTreeMap::new();
         for (id, topic, ty, qos) in TopicTable::new(config, names).topics {
             let name = ty.full_name();
@@ -192,7 +202,7 @@ impl BagWriter {
             },
             sequence: 0,
             messages: 0,
-            counts: [0; 7],
+            counts: [0; super::entry::TOPICS],
             first_log_ns: None,
             last_log_ns: 0,
             payload_bytes: 0,

@@ -16,10 +16,16 @@ pub enum TopicId {
     FilmProfile,
     Statistics,
     Temperature,
+    /// `/parameter_events`: parameters changed while running, stamped with
+    /// the first step that used them (replay re-applies them there).
+    ParameterEvents,
 }
 
+/// How many topics the recorder writes.
+pub const TOPICS: usize = 8;
+
 impl TopicId {
-    pub const ALL: [TopicId; 7] = [
+    pub const ALL: [TopicId; TOPICS] = [
         TopicId::Velocity,
         TopicId::Load,
         TopicId::Friction,
@@ -27,6 +33,7 @@ impl TopicId {
         TopicId::FilmProfile,
         TopicId::Statistics,
         TopicId::Temperature,
+        TopicId::ParameterEvents,
     ];
 
     pub fn index(self) -> usize {
@@ -148,6 +155,16 @@ impl Encoder {
                 log_ns,
                 publish_ns: s.stamp_ns,
                 data: cdr(&s.to_wire(&self.frame_id))?,
+            }),
+            RecordItem::ParameterEvent {
+                cdr,
+                stamp_ns,
+                logged_ns,
+            } => out.push(Entry {
+                topic: TopicId::ParameterEvents,
+                log_ns: *logged_ns,
+                publish_ns: *stamp_ns,
+                data: cdr.clone(),
             }),
         }
         Ok(())

@@ -29,7 +29,7 @@ struct Done {
     name: String,
     path: PathBuf,
     info: FileInfo,
-    counts: [u64; 7],
+    counts: [u64; super::entry::TOPICS],
 }
 
 /// The split directory being written.
@@ -226,7 +226,7 @@ impl SplitDir {
     /// `metadata.yaml` for the files present (written atomically).
     fn write_metadata(&self) -> Result<(), String> {
         let table = TopicTable::new(&self.config, &self.names);
-        let mut counts = [0u64; 7];
+        let mut counts = [0u64; super::entry::TOPICS];
         let mut files = Vec::new();
         for d in &self.done {
             for (c, n) in counts.iter_mut().zip(d.counts) {

@@ -51,6 +51,8 @@ pub struct TopicNames {
     pub loop_statistics: String,
     /// `~/snapshot` (std_msgs/Empty): asks for a snapshot of the last minutes.
     pub snapshot: String,
+    /// `/parameter_events` (rcl_interfaces/ParameterEvent).
+    pub parameter_events: String,
 }
 
 impl TopicNames {
@@ -66,6 +68,7 @@ impl TopicNames {
             film_profile: t(&r.topics.film_profile),
             loop_statistics: t(&r.topics.loop_statistics),
             snapshot: t("~/snapshot"),
+            parameter_events: t("/parameter_events"),
         }
     }
 }

@@ -1,0 +1,458 @@
+//! Parameters while the node runs: every configuration key is a declared
+//! ROS 2 parameter (dotted name, type, description, range, read-only or
+//! not); a set is validated off the loop, prepared there (tables built,
+//! buffers allocated) and handed to the loop through a lock-free channel,
+//! which applies it between two steps without blocking or allocating and
+//! hands it back stamped with the first step that used it (for
+//! `/parameter_events`, the recording and replay).
+//!
+//! Keys that can change while running ([`is_runtime`]): the load, the
+//! contact's mass, boundary friction and sign regularisation, every
+//! lubricant, roughness and drivetrain key, and the node's command limits,
+//! timeout rule and publication rates. Everything else (geometry, grid,
+//! solver, transports, names, recording) is read-only: changing it needs a
+//! restart.
+
+use super::LoopSettings;
+use crate::config::{key_ranges, Config, ConfigError, KeyRange};
+use crate::msgs::ros_interfaces::{parameter_type as ty, ParameterValue};
+use crate::physics::{PreparedModel, SetupError, Solver, ViscosityModel};
+use crossbeam_queue::ArrayQueue;
+use serde_norway::Value;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// Whether `key` may change while the node runs.
+pub fn is_runtime(key: &str) -> bool {
+    const EXACT: [&str; 13] = [
+        "contact.load_n",
+        "contact.mass_kg",
+        "contact.boundary_friction",
+        "contact.sign_regularization_m_s",
+        "contact.min_film_m",
+        "node.command_timeout_s",
+        "node.timeout_behaviour",
+        "node.timeout_deceleration_m_s2",
+        "node.max_abs_velocity_m_s",
+        "node.min_load_n",
+        "node.max_load_n",
+        "node.profile_rate_hz",
+        "node.statistics_rate_hz",
+    ];
+    EXACT.contains(&key)
+        || key == "node.max_catch_up_s"
+        || ["lubricant.", "roughness.", "drivetrain."]
+            .iter()
+            .any(|p| key.starts_with(p))
+}
+
+/// One declared parameter.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Declared {
+    pub name: String,
+    /// `rcl_interfaces/msg/ParameterType`.
+    pub r#type: u8,
+    pub value: ParameterValue,
+    /// The key's documentation in `launch-config/default.yaml`.
+    pub description: String,
+    pub range: Option<KeyRange>,
+    pub read_only: bool,
+}
+
+/// The comment of every key in the shipped `default.yaml` (dotted name →
+/// text after `#`, its range column included).
+fn documented() -> Vec<(String, String)> {
+    let mut out = Vec::new();
+    let mut path: Vec<(usize, String)> = Vec::new();
+    for line in crate::config::DEFAULT_YAML.lines() {
+        let body = line.split('#').next().unwrap_or("");
+        let Some((key, _)) = body.split_once(':') else {
+            continue;
+        };
+        let indent = key.len() - key.trim_start().len();
+        let key = key.trim();
+        if key.is_empty() || key.starts_with('-') {
+            continue;
+        }
+        while path.last().is_some_and(|(i, _)| *i >= indent) {
+            path.pop();
+        }
+        path.push((indent, key.to_string()));
+        // Under `friction_node: ros__parameters:`.
+        if path.len() > 2 {
+            let name: Vec<&str> = path[2..].iter().map(|(_, k)| k.as_str()).collect();
+            let comment = line.split_once('#').map_or("", |(_, c)| c.trim());
+            out.push((name.join("."), comment.to_string()));
+        }
+    }
+    out
+}
+
+/// Every leaf of the configuration as (dotted name, YAML value).
+pub fn flatten(config: &Config) -> Vec<(String, Value)> {
+    fn walk(prefix: &str, v: &Value, out: &mut Vec<(String, Value)>) {
+        match v {
+            Value::Mapping(m) => {
+                for (k, v) in m {
+                    let k = k.as_str().unwrap_or_default();
+                    let name = if prefix.is_empty() {
+                        k.to_string()
+                    } else {
+                        format!("{prefix}.{k}")
+                    };
+                    walk(&name, v, out);
+                }
+            }
+            other => out.push((prefix.to_string(), other.clone())),
+        }
+    }
+    let mut out = Vec::new();
+    walk(
+        "",
+        &serde_norway::to_value(config).expect("config serializes"),
+        &mut out,
+    );
+    out
+}
+
+/// The parameter type of a key (empty arrays take the key's element type).
+fn type_of(name: &str, v: &Value) -> u8 {
+    match v {
+        Value::Sequence(s) if s.is_empty() => {
+            if name.starts_with("texture.") {
+                ty::DOUBLE_ARRAY
+            } else {
+                ty::STRING_ARRAY
+            }
+        }
+        Value::Sequence(_) => {
+            let p = ParameterValue::from_yaml(v).r#type;
+            // Pocket arrays are doubles even when written as integers.
+            if name.starts_with("texture.") {
+                ty::DOUBLE_ARRAY
+            } else {
+                p
+            }
+        }
+        other => ParameterValue::from_yaml(other).r#type,
+    }
+}
+
+/// Every parameter of `config`, declared.
+pub fn declare(config: &Config) -> Vec<Declared> {
+    let docs = documented();
+    let ranges = key_ranges();
+    flatten(config)
+        .into_iter()
+        .map(|(name, v)| {
+            let r#type = type_of(&name, &v);
+            let mut value = ParameterValue::from_yaml(&v);
+            if r#type == ty::DOUBLE && value.r#type == ty::INTEGER {
+                value.double_value = value.integer_value as f64;
+            }
+            value.r#type = r#type;
+            let description = docs
+                .iter()
+                .find(|(k, _)| *k == name)
+                .map_or(String::new(), |(_, c)| c.clone());
+            Declared {
+                range: ranges.iter().find(|r| r.key == name).cloned(),
+                read_only: !is_runtime(&name),
+                description,
+                value,
+                r#type,
+                name,
+            }
+        })
+        .collect()
+}
+
+/// Why a set was refused (the text goes to `SetParametersResult.reason`).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SetRefusal {
+    #[error("parameter `{0}` is not declared (ros2 param list shows the names)")]
+    Undeclared(String),
+    #[error("parameter `{0}` is read-only while the node runs (restart with the new value)")]
+    ReadOnly(String),
+    #[error("parameter `{name}` is of type {want}; got {got} ({value})")]
+    WrongType {
+        name: String,
+        want: &'static str,
+        got: &'static str,
+        value: String,
+    },
+    #[error("{0}")]
+    Invalid(String),
+    #[error("the node is still applying earlier changes; try again")]
+    Busy,
+}
+
+/// A parameter type's name.
+pub fn type_name(t: u8) -> &'static str {
+    match t {
+        ty::BOOL => "bool",
+        ty::INTEGER => "integer",
+        ty::DOUBLE => "double",
+        ty::STRING => "string",
+        ty::BYTE_ARRAY => "byte array",
+        ty::BOOL_ARRAY => "bool array",
+        ty::INTEGER_ARRAY => "integer array",
+        ty::DOUBLE_ARRAY => "double array",
+        ty::STRING_ARRAY => "string array",
+        _ => "not set",
+    }
+}
+
+/// `config` with `changes` (name, value) applied and validated; refuses
+/// undeclared or read-only names, wrong types (an integer for a double is
+/// accepted, as a number) and values outside their range, naming the key
+/// and the value.
+pub fn apply_set(
+    config: &Config,
+    declared: &[Declared],
+    changes: &[(String, ParameterValue)],
+) -> Result<Config, SetRefusal> {
+    let mut tree = serde_norway::to_value(config).expect("config serializes");
+    for (name, value) in changes {
+        let d = declared
+            .iter()
+            .find(|d| d.name == *name)
+            .ok_or_else(|| SetRefusal::Undeclared(name.clone()))?;
+        if d.read_only {
+            return Err(SetRefusal::ReadOnly(name.clone()));
+        }
+        let compatible = value.r#type == d.r#type
+            || (d.r#type == ty::DOUBLE && value.r#type == ty::INTEGER)
+            || (d.r#type == ty::DOUBLE_ARRAY && value.r#type == ty::INTEGER_ARRAY);
+        let text = value
+            .to_yaml()
+            .map_err(|m| SetRefusal::Invalid(format!("parameter `{name}`: {m}")))?;
+        if !compatible {
+            return Err(SetRefusal::WrongType {
+                name: name.clone(),
+                want: type_name(d.r#type),
+                got: type_name(value.r#type),
+                value: text,
+            });
+        }
+        crate::config::apply_override(&mut tree, &format!("{name}={text}"))
+            .map_err(|e| SetRefusal::Invalid(e.to_string()))?;
+    }
+    let new: Config = serde_path_to_error::deserialize(tree)
+        .map_err(|e| SetRefusal::Invalid(format!("parameter `{}`: {}", e.path(), e.inner())))?;
+    new.validate()
+        .map_err(|e: ConfigError| SetRefusal::Invalid(e.to_string()))?;
+    Ok(new)
+}
+
+/// A validated change, prepared for the loop.
+pub struct ParameterUpdate {
+    /// The whole configuration after the change.
+    pub config: Config,
+    /// What changed: (name, new value).
+    pub changed: Vec<(String, ParameterValue)>,
+    settings: LoopSettings,
+    model: PreparedModel,
+    viscosity_model: ViscosityModel,
+    mu_ref: f64,
+    t_ref_c: f64,
+    /// The new held load, when `contact.load_n` changed.
+    load: Option<f64>,
+    /// Set by the loop: the stamp of the first step that used the change.
+    pub applied_stamp_ns: u64,
+}
+
+impl ParameterUpdate {
+    /// Prepare `new` (the result of [`apply_set`] on `old`) for the loop:
+    /// the model's tables are built here.
+    pub fn prepare(
+        old: &Config,
+        new: Config,
+        changed: Vec<(String, ParameterValue)>,
+    ) -> Result<Box<Self>, SetupError> {
+        let model = Solver::prepare_model(&new.model(), &new.solver_settings())?;
+        let load = (new.contact.load_n != old.contact.load_n).then_some(new.contact.load_n);
+        Ok(Box::new(Self {
+            settings: LoopSettings::from_config(&new),
+            model,
+            viscosity_model: new.viscosity_model(),
+            mu_ref: new.lubricant.viscosity_pa_s,
+            t_ref_c: new.lubricant.reference_temperature_c,
+            load,
+            changed,
+            config: new,
+            applied_stamp_ns: 0,
+        }))
+    }
+}
+
+/// Capacity of the channel: changes in flight (submitted, not yet taken
+/// back after the loop applied them).
+pub const IN_FLIGHT: usize = 8;
+
+/// Between the parameter service and the loop.
+pub struct ParameterChannel {
+    pending: ArrayQueue<Box<ParameterUpdate>>,
+    applied: ArrayQueue<Box<ParameterUpdate>>,
+    in_flight: AtomicUsize,
+}
+
+impl Default for ParameterChannel {
+    fn default() -> Self {
+        Self {
+            pending: ArrayQueue::new(IN_FLIGHT),
+            applied: ArrayQueue::new(IN_FLIGHT),
+            in_flight: AtomicUsize::new(0),
+        }
+    }
+}
+
+impl ParameterChannel {
+    /// Hand a prepared change to the loop; refused when [`IN_FLIGHT`]
+    /// changes wait (the loop is not stepping, or nobody takes them back).
+    pub fn submit(&self, u: Box<ParameterUpdate>) -> Result<(), SetRefusal> {
+        if self.in_flight.fetch_add(1, Ordering::AcqRel) >= IN_FLIGHT {
+            self.in_flight.fetch_sub(1, Ordering::AcqRel);
+            return Err(SetRefusal::Busy);
+        }
+        self.pending.push(u).map_err(|_| {
+            self.in_flight.fetch_sub(1, Ordering::AcqRel);
+            SetRefusal::Busy
+        })
+    }
+
+    /// A change the loop has applied (stamped), if any.
+    pub fn take_applied(&self) -> Option<Box<ParameterUpdate>> {
+        let u = self.applied.pop()?;
+        self.in_flight.fetch_sub(1, Ordering::AcqRel);
+        Some(u)
+    }
+}
+
+impl super::Loop {
+    /// Use `channel` for parameter changes while running.
+    pub fn with_parameters(mut self, channel: std::sync::Arc<ParameterChannel>) -> Self {
+        self.parameters = Some(channel);
+        self
+    }
+
+    /// Apply every pending change before the step stamped `stamp_ns`.
+    pub(super) fn apply_parameters(&mut self, stamp_ns: u64) {
+        let Some(ch) = self.parameters.clone() else {
+            return;
+        };
+        while let Some(mut u) = ch.pending.pop() {
+            self.apply_update(&mut u);
+            u.applied_stamp_ns = stamp_ns;
+            // In flight ≤ IN_FLIGHT = the capacity: this never fails.
+            let _ = ch.applied.push(u);
+        }
+    }
+
+    /// One change: the model swapped in, the settings replaced, the
+    /// viscosity re-derived at the current temperature, the load held.
+    pub fn apply_update(&mut self, u: &mut ParameterUpdate) {
+        if self.solver.swap_model(&mut u.model).is_err() {
+            // Geometry and grid are read-only: a mismatch cannot be built
+            // by apply_set. Nothing changes.
+            return;
+        }
+        self.s = u.settings.clone();
+        self.viscosity_model = u.viscosity_model;
+        self.mu_ref = u.mu_ref;
+        self.t_ref_c = u.t_ref_c;
+        if self.viscosity_model != ViscosityModel::Constant {
+            let mu = self
+                .viscosity_model
+                .viscosity(self.mu_ref, self.t_ref_c, self.temperature_c);
+            self.solver.set_liquid_viscosity(mu);
+        }
+        if let Some(l) = u.load {
+            self.load = l;
+        }
+        self.summary.parameter_updates += 1;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn value(text: &str) -> ParameterValue {
+        ParameterValue::from_yaml(&serde_norway::from_str(text).unwrap())
+    }
+
+    #[test]
+    fn every_key_is_declared_with_its_type_description_range_and_writability() {
+        let c = Config::default();
+        let d = declare(&c);
+        let get = |n: &str| {
+            d.iter()
+                .find(|p| p.name == n)
+                .unwrap_or_else(|| panic!("{n}"))
+        };
+        let load = get("contact.load_n");
+        assert_eq!(load.r#type, ty::DOUBLE);
+        assert!(!load.read_only);
+        assert!(
+            load.description.contains("normal load"),
+            "{}",
+            load.description
+        );
+        assert_eq!(load.range.as_ref().unwrap().to_string(), "(0, 1e9]");
+        assert_eq!(get("solver.cells").r#type, ty::INTEGER);
+        assert!(get("solver.cells").read_only);
+        assert_eq!(get("use_sim_time").r#type, ty::BOOL);
+        assert_eq!(get("node.timeout_behaviour").r#type, ty::STRING);
+        assert!(!get("node.timeout_behaviour").read_only);
+        assert_eq!(get("texture.pocket_start_m").r#type, ty::DOUBLE_ARRAY);
+        assert_eq!(get("ros.remappings").r#type, ty::STRING_ARRAY);
+        assert!(get("contact.profile").read_only);
+        assert_eq!(d.len(), flatten(&c).len());
+    }
+
+    #[test]
+    fn a_set_is_validated_and_refusals_name_the_key_and_the_value() {
+        let c = Config::default();
+        let d = declare(&c);
+        let ok = apply_set(&c, &d, &[("contact.load_n".into(), value("5762"))]).unwrap();
+        assert_eq!(
+            ok.contact.load_n, 5762.0,
+            "an integer for a double is a number"
+        );
+        for (name, v, needle) in [
+            ("contact.load_n", "-3.0", "contact.load_n"),
+            ("contact.load_n", "heavy", "string"),
+            ("solver.cells", "64", "read-only"),
+            ("contact.nosuch", "1.0", "not declared"),
+            (
+                "node.timeout_behaviour",
+                "explode",
+                "node.timeout_behaviour",
+            ),
+        ] {
+            let e = apply_set(&c, &d, &[(name.into(), value(v))])
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains(needle), "{name}={v}: {e}");
+        }
+        let e = apply_set(&c, &d, &[("contact.load_n".into(), value("-3.0"))])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("-3"), "the value is named: {e}");
+    }
+
+    #[test]
+    fn the_channel_bounds_changes_in_flight_and_hands_them_back() {
+        let c = Config::default();
+        let ch = ParameterChannel::default();
+        let mut small = c.clone();
+        small.solver.cells = 16;
+        for _ in 0..IN_FLIGHT {
+            let u = ParameterUpdate::prepare(&small, small.clone(), vec![]).unwrap();
+            ch.submit(u).unwrap();
+        }
+        let u = ParameterUpdate::prepare(&small, small.clone(), vec![]).unwrap();
+        assert_eq!(ch.submit(u).unwrap_err(), SetRefusal::Busy);
+        assert!(ch.take_applied().is_none(), "nothing applied yet");
+    }
+}
