@@ -446,3 +446,23 @@ mod tests {
         assert_eq!(crate::msgs::from_cdr::<ParameterEvent>(&bytes).unwrap(), e);
     }
 }
+
+#[cfg(feature = "ros2")]
+mod ros2_messages {
+    use super::*;
+    impl ros2_client::Message for ParameterEvent {}
+    impl ros2_client::Message for Log {}
+    impl ros2_client::Message for DiagnosticArray {}
+    impl ros2_client::Message for Clock {}
+    impl ros2_client::Message for ListParametersRequest {}
+    impl ros2_client::Message for ListParametersResponse {}
+    impl ros2_client::Message for NamesRequest {}
+    impl ros2_client::Message for GetParametersResponse {}
+    impl ros2_client::Message for GetParameterTypesResponse {}
+    impl ros2_client::Message for DescribeParametersResponse {}
+    impl ros2_client::Message for SetParametersRequest {}
+    impl ros2_client::Message for SetParametersResponse {}
+    impl ros2_client::Message for SetParametersAtomicallyResponse {}
+    impl ros2_client::Message for TriggerRequest {}
+    impl ros2_client::Message for TriggerResponse {}
+}

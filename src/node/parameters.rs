@@ -285,6 +285,14 @@ impl ParameterUpdate {
     }
 }
 
+/// What a transport that serves parameters needs from the node.
+#[derive(Clone)]
+pub struct ParameterIo {
+    /// The configuration the node runs with.
+    pub config: Config,
+    pub channel: std::sync::Arc<ParameterChannel>,
+}
+
 /// Capacity of the channel: changes in flight (submitted, not yet taken
 /// back after the loop applied them).
 pub const IN_FLIGHT: usize = 8;

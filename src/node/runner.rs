@@ -233,15 +233,28 @@ pub fn run_node(
     #[cfg(not(feature = "mcap"))]
     let snapshot_flag = None;
     let mut ports: Vec<Box<dyn NodePort>> = Vec::new();
+    let channel = Arc::new(super::parameters::ParameterChannel::default());
+    let mut served = false;
     for s in &specs {
+        let parameters = (!served && s.serves_parameters()).then(|| {
+            served = true;
+            super::parameters::ParameterIo {
+                config: config.clone(),
+                channel: channel.clone(),
+            }
+        });
         ports.push(s.open_node(transport::PortIo {
             profile: profile.clone(),
             record: queue.clone(),
             snapshot: snapshot_flag.clone(),
+            parameters,
         })?);
     }
     let live = Arc::new(LiveStatus::default());
     let mut l = Loop::new(config, ports, queue, profile, live.clone())?;
+    if served {
+        l = l.with_parameters(channel);
+    }
     #[cfg(feature = "mcap")]
     if let Some(r) = &recorder {
         l = l.with_recorder(r.counters());

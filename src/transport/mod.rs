@@ -124,6 +124,8 @@ pub struct PortIo {
     pub record: RecordQueue,
     /// Set when a peer asks for a snapshot (ROS 2 `~/snapshot`).
     pub snapshot: Option<Arc<std::sync::atomic::AtomicBool>>,
+    /// Parameters while running (ROS 2 serves them; others ignore it).
+    pub parameters: Option<crate::node::parameters::ParameterIo>,
 }
 
 /// Hand a received sample to the recorder, counting a full queue.
@@ -268,6 +270,15 @@ pub enum BackendSpec {
 }
 
 impl BackendSpec {
+    /// Whether this backend serves the node's parameters (ROS 2 does).
+    pub fn serves_parameters(&self) -> bool {
+        match self {
+            #[cfg(feature = "ros2")]
+            BackendSpec::Ros2(_) => true,
+            _ => false,
+        }
+    }
+
     pub fn name(&self) -> &'static str {
         match self {
             BackendSpec::Memory(_) => "memory",

@@ -41,7 +41,7 @@ const TEMPERATURE: Token = Token(4);
 
 /// The DDS entities of the node.
 struct Entities {
-    _ctx: ros2_client::Context,
+    ctx: ros2_client::Context,
     _node: ros2_client::Node,
     velocity: RawReader,
     load: RawReader,
@@ -117,7 +117,7 @@ fn setup(spec: &Ros2Spec, snapshots: bool) -> Result<Entities, TransportError> {
         .map_err(|e| err("register the temperature reader", e))?;
     let waker = Arc::new(Waker::new(poll.registry(), WAKE).map_err(|e| err("create a waker", e))?);
     Ok(Entities {
-        _ctx: ctx,
+        ctx,
         _node: node,
         velocity,
         load,
@@ -207,7 +207,10 @@ fn take_all(sh: &Shared, reader: &RawReader, kind: CommandKind) {
     }
 }
 
-pub(super) fn run(sh: Shared, ready: std::sync::mpsc::Sender<Result<Arc<Waker>, TransportError>>) {
+pub(super) fn run(
+    sh: Shared,
+    ready: std::sync::mpsc::Sender<Result<(Arc<Waker>, ros2_client::Context), TransportError>>,
+) {
     let mut e = match setup(&sh.spec, sh.snapshot.is_some()) {
         Ok(e) => e,
         Err(x) => {
@@ -215,7 +218,7 @@ pub(super) fn run(sh: Shared, ready: std::sync::mpsc::Sender<Result<Arc<Waker>, 
             return;
         }
     };
-    let _ = ready.send(Ok(e.waker.clone()));
+    let _ = ready.send(Ok((e.waker.clone(), e.ctx.clone())));
     let mut events = Events::with_capacity(16);
     let mut seen_profile = 0u64;
     let frame = sh.spec.frame_id.clone();

@@ -17,8 +17,10 @@
 //! same-host unicast announcements.
 
 mod io;
+pub mod params;
 mod peer;
-mod raw;
+pub mod raw;
+pub mod service;
 
 pub use peer::Ros2Peer;
 
@@ -105,6 +107,12 @@ pub fn localhost_only(cfg: &Config) -> bool {
 }
 
 impl Ros2Spec {
+    /// `/<namespace>/<node_name>`.
+    pub fn fully_qualified_name(&self) -> String {
+        let ns = self.namespace.trim_end_matches('/');
+        format!("{ns}/{}", self.node_name)
+    }
+
     pub fn from_config(cfg: &Config) -> Result<Self, TransportError> {
         let r = &cfg.ros;
         let names = super::names::TopicNames::from_config(cfg);
@@ -164,7 +172,13 @@ pub(super) fn ros_node(ctx: &Context, namespace: &str, name: &str) -> Result<Nod
     let nn = NodeName::new(namespace, name)
         .map_err(|e| err(format!("use node name `{namespace}` `{name}`"), e))?;
     let mut node = ctx
-        .new_node(nn, NodeOptions::new().enable_rosout(false))
+        .new_node(
+            nn,
+            NodeOptions::new()
+                .enable_rosout(false)
+                // Parameters are served by `params.rs`, in both DDS layouts.
+                .start_parameter_services(false),
+        )
         .map_err(|e| err("create the ROS 2 node", e))?;
     // The spinner maintains the matched-endpoint counts (and answers
     // parameter services); it runs until the node is dropped.
@@ -235,6 +249,8 @@ pub struct Ros2Node {
     stop: Arc<AtomicBool>,
     counters: Arc<SharedCounters>,
     thread: Option<std::thread::JoinHandle<()>>,
+    /// The services thread (parameters, ~/snapshot).
+    services: Option<std::thread::JoinHandle<()>>,
 }
 
 impl Ros2Node {
@@ -243,7 +259,7 @@ impl Ros2Node {
         let outputs = Arc::new(ArrayQueue::new(spec.queue_capacity));
         let stop = Arc::new(AtomicBool::new(false));
         let counters = Arc::new(SharedCounters::default());
-        let (tx, rx) = std::sync::mpsc::channel::<Result<Arc<Waker>, TransportError>>();
+        let (tx, rx) = std::sync::mpsc::channel::<Result<(Arc<Waker>, Context), TransportError>>();
         let shared = io::Shared {
             spec: spec.clone(),
             commands: commands.clone(),
@@ -251,22 +267,36 @@ impl Ros2Node {
             stop: stop.clone(),
             counters: counters.clone(),
             profile: io.profile,
-            record: io.record,
-            snapshot: io.snapshot,
+            record: io.record.clone(),
+            snapshot: io.snapshot.clone(),
         };
         let thread = std::thread::Builder::new()
             .name("ros2-io".into())
             .spawn(move || io::run(shared, tx))
             .map_err(|e| err("start the I/O thread", e))?;
-        let waker = rx.recv().map_err(|e| err("start the I/O thread", e))??;
-        Ok(Self {
+        let (waker, ctx) = rx.recv().map_err(|e| err("start the I/O thread", e))??;
+        let mut node = Self {
             commands,
             outputs,
             waker,
             stop,
             counters,
             thread: Some(thread),
-        })
+            services: None,
+        };
+        if let Some(p) = io.parameters {
+            let (tx, rx) = std::sync::mpsc::channel();
+            let fqn = spec.fully_qualified_name();
+            let (record, snapshot, stop) = (io.record, io.snapshot, node.stop.clone());
+            let t = std::thread::Builder::new()
+                .name("ros2-services".into())
+                .spawn(move || params::run(ctx, fqn, p, record, snapshot, stop, tx))
+                .map_err(|e| err("start the services thread", e))?;
+            node.services = Some(t);
+            rx.recv()
+                .map_err(|e| err("start the services thread", e))??;
+        }
+        Ok(node)
     }
 
     fn push(&mut self, o: Out) -> bool {
@@ -281,6 +311,9 @@ impl Drop for Ros2Node {
         self.stop.store(true, Ordering::Release);
         let _ = self.waker.wake();
         if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+        if let Some(t) = self.services.take() {
             let _ = t.join();
         }
     }
