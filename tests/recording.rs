@@ -112,8 +112,8 @@ fn read_file(path: &Path) -> Vec<(String, u64, u64, Vec<u8>)> {
     let summary = mcap::Summary::read(&bytes).unwrap().expect("finalised");
     assert_eq!(
         summary.channels.len(),
-        7,
-        "{}: every channel",
+        8,
+        "{}: every channel (/parameter_events included)",
         path.display()
     );
     mcap::MessageStream::new(&bytes)

@@ -382,3 +382,127 @@ fn reply_counter(domain: u32, fqn: &str, service: &str) -> impl Fn() -> usize {
         n
     }
 }
+
+/// `diagnostic_msgs` as ROS 2 Humble defines them (written here from the
+/// `.msg` files, independently of the node's own structs).
+mod diagnostic_msgs {
+    use serde::Deserialize;
+    #[derive(Debug, Clone, Deserialize)]
+    pub struct Time {
+        pub sec: i32,
+        pub nanosec: u32,
+    }
+    #[derive(Debug, Clone, Deserialize)]
+    pub struct Header {
+        pub stamp: Time,
+        pub frame_id: String,
+    }
+    #[derive(Debug, Clone, Deserialize)]
+    pub struct KeyValue {
+        pub key: String,
+        pub value: String,
+    }
+    #[derive(Debug, Clone, Deserialize)]
+    pub struct DiagnosticStatus {
+        pub level: u8,
+        pub name: String,
+        pub message: String,
+        pub hardware_id: String,
+        pub values: Vec<KeyValue>,
+    }
+    #[derive(Debug, Clone, Deserialize)]
+    pub struct DiagnosticArray {
+        pub header: Header,
+        pub status: Vec<DiagnosticStatus>,
+    }
+}
+
+#[test]
+fn log_lines_reach_rosout_and_health_reaches_diagnostics_in_the_standard_layouts() {
+    let pid = std::process::id();
+    let domain = 150 + (pid + 41) % 80;
+    let name = format!("fnd_{pid}");
+    let _node = start(
+        domain,
+        &["-r", &format!("__node:={name}"), "--log-level", "info"],
+    );
+    let (_ctx, mut node) = client_node(domain, &format!("fnd_client_{pid}"));
+    // /rosout, read with ros2-client's own Log type.
+    let rosout_topic = node
+        .create_topic(
+            &Name::parse("/rosout").unwrap(),
+            MessageTypeName::new("rcl_interfaces", "Log"),
+            &QosProfile::subscription_default(),
+        )
+        .unwrap();
+    let rosout_qos = QosProfile::publisher_default()
+        .durability(ros2_client::qos::Durability::TransientLocal)
+        .history(ros2_client::qos::History::KeepLast { depth: 1000 });
+    let rosout = node
+        .create_subscription::<ros2_client::log::Log>(&rosout_topic, Some(rosout_qos))
+        .unwrap();
+    let line = within("a line on /rosout", async {
+        loop {
+            if let Ok(Some((l, _))) = rosout.take() {
+                if l.name == name && l.msg.starts_with("loop running") {
+                    return l;
+                }
+            }
+            futures_timer(Duration::from_millis(5)).await;
+        }
+    });
+    assert_eq!(line.level, 20, "INFO");
+    assert!(line.msg.contains("Timer mode"), "{}", line.msg);
+    // /diagnostics at 1 Hz: five statuses with their values.
+    let diag_topic = node
+        .create_topic(
+            &Name::parse("/diagnostics").unwrap(),
+            MessageTypeName::new("diagnostic_msgs", "DiagnosticArray"),
+            &QosProfile::subscription_default(),
+        )
+        .unwrap();
+    let diag = node
+        .create_subscription::<diagnostic_msgs::DiagnosticArray>(&diag_topic, None)
+        .unwrap();
+    let a = within("an array on /diagnostics", async {
+        loop {
+            if let Ok(Some((a, _))) = diag.take() {
+                if a.status
+                    .first()
+                    .is_some_and(|s| s.hardware_id.ends_with(&name))
+                {
+                    return a;
+                }
+            }
+            futures_timer(Duration::from_millis(5)).await;
+        }
+    });
+    let names: Vec<String> = a
+        .status
+        .iter()
+        .map(|s| s.name.rsplit(": ").next().unwrap().to_string())
+        .collect();
+    assert_eq!(
+        names,
+        ["loop timing", "solver", "commands", "outputs", "recorder"]
+    );
+    assert!(a.status.iter().all(|s| s.level <= 2));
+    let steps: u64 = a.status[0]
+        .values
+        .iter()
+        .find(|v| v.key == "steps")
+        .unwrap()
+        .value
+        .parse()
+        .unwrap();
+    assert!(steps > 0);
+    assert_eq!(a.header.frame_id, "slider");
+    // No peer commands anything: the command concern says so.
+    assert_eq!(a.status[2].level, 1, "{:?}", a.status[2]);
+    assert!(
+        a.status[2].message.contains("timed-out"),
+        "{}",
+        a.status[2].message
+    );
+    assert!(a.header.stamp.sec > 0 && a.header.stamp.nanosec < 1_000_000_000);
+}

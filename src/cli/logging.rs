@@ -1,6 +1,7 @@
 //! Logging for the binary: `tracing` events to the terminal (stderr), at
-//! the level `RUST_LOG` or `--ros-args --log-level` gives (default: warn;
-//! RustDDS's teardown chatter is silenced). The ROS 2 transport also sends
+//! the level `RUST_LOG` or `--ros-args --log-level` gives (default: the
+//! node's own lines from info up, other crates' from warn; RustDDS's
+//! teardown chatter is silenced). The ROS 2 transport also sends
 //! them to `/rosout` (see `friction_node::transport::rosout`).
 
 use friction_node::config::RosArgs;
@@ -24,9 +25,10 @@ pub fn init(ros: Option<&RosArgs>) {
     let filter = match ros.and_then(|r| r.log_level.as_deref()) {
         Some(level) => EnvFilter::new(format!("{}{quiet}", directive(level))),
         None => EnvFilter::try_from_default_env()
-            // RustDDS logs harmless chatter at participant teardown;
-            // RUST_LOG=rustdds=warn shows it.
-            .unwrap_or_else(|_| EnvFilter::new(format!("warn{quiet}"))),
+            // The node's own lines from info up (a few: start, splits,
+            // parameter changes); RustDDS logs harmless chatter at
+            // participant teardown (RUST_LOG=rustdds=warn shows it).
+            .unwrap_or_else(|_| EnvFilter::new(format!("warn,friction_node=info{quiet}"))),
     };
     let stdout = !ros.is_some_and(|r| r.stdout_disabled);
     let terminal = stdout.then(|| tracing_subscriber::fmt::layer().with_writer(std::io::stderr));

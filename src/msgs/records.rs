@@ -284,6 +284,10 @@ pub struct StatisticsRecord {
     pub recording: RecordingStatus,
     pub compute_time_ns: [u64; 3],
     pub period_jitter_ns: [u64; 3],
+    /// Steps whose solver status was not converged.
+    pub steps_not_converged: u64,
+    /// Parameter changes applied while running.
+    pub parameter_updates: u64,
 }
 
 impl StatisticsRecord {
@@ -319,6 +323,8 @@ impl StatisticsRecord {
             period_jitter_p50_ns: self.period_jitter_ns[0],
             period_jitter_p99_ns: self.period_jitter_ns[1],
             period_jitter_max_ns: self.period_jitter_ns[2],
+            steps_not_converged: self.steps_not_converged,
+            parameter_updates: self.parameter_updates,
         }
     }
 
@@ -357,6 +363,8 @@ impl StatisticsRecord {
                 m.period_jitter_p99_ns,
                 m.period_jitter_max_ns,
             ],
+            steps_not_converged: m.steps_not_converged,
+            parameter_updates: m.parameter_updates,
         }
     }
 }

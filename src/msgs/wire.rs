@@ -201,6 +201,8 @@ pub struct LoopStatistics {
     pub period_jitter_p50_ns: u64,
     pub period_jitter_p99_ns: u64,
     pub period_jitter_max_ns: u64,
+    pub steps_not_converged: u64,
+    pub parameter_updates: u64,
 }
 
 #[cfg(feature = "ros2")]

@@ -131,6 +131,10 @@ impl Loop {
             } else {
                 [0; 3]
             },
+            steps_not_converged: total.steps.saturating_sub(
+                total.status_counts[usize::from(crate::msgs::estimate_constants::STATUS_CONVERGED)],
+            ),
+            parameter_updates: total.parameter_updates,
         };
         self.window_compute.clear();
         self.window_jitter.clear();

@@ -298,6 +298,13 @@ pub fn run_node(
         "friction-node: loop running ({:?} mode)",
         config.node.step_mode
     );
+    tracing::info!(
+        "loop running: {:?} mode, dt = {} s, N = {}, transports {}",
+        config.node.step_mode,
+        config.solver.dt_s,
+        config.solver.cells,
+        report.transports.join(", ")
+    );
     report.summary = l.run(&stop, duration);
     report.interrupted = stop.load(Ordering::Relaxed);
     status_stop.store(true, Ordering::Relaxed);

@@ -70,7 +70,7 @@ pub struct EstimatePayload {
 /// Loop statistics (the fields of `friction_msgs/LoopStatistics`).
 #[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
 #[repr(C)]
-#[type_name("friction_node::LoopStatistics_v3")]
+#[type_name("friction_node::LoopStatistics_v4")]
 pub struct StatisticsPayload {
     pub stamp_ns: u64,
     pub steps: u64,
@@ -97,6 +97,8 @@ pub struct StatisticsPayload {
     pub last_snapshot_len: u8,
     pub compute_time_ns: [u64; 3],
     pub period_jitter_ns: [u64; 3],
+    pub steps_not_converged: u64,
+    pub parameter_updates: u64,
 }
 
 impl From<&StatisticsRecord> for StatisticsPayload {
@@ -131,6 +133,8 @@ impl From<&StatisticsRecord> for StatisticsPayload {
             last_snapshot_len: s.recording.last_snapshot.as_str().len() as u8,
             compute_time_ns: s.compute_time_ns,
             period_jitter_ns: s.period_jitter_ns,
+            steps_not_converged: s.steps_not_converged,
+            parameter_updates: s.parameter_updates,
         }
     }
 }
@@ -166,6 +170,8 @@ impl From<&StatisticsPayload> for StatisticsRecord {
             },
             compute_time_ns: s.compute_time_ns,
             period_jitter_ns: s.period_jitter_ns,
+            steps_not_converged: s.steps_not_converged,
+            parameter_updates: s.parameter_updates,
         }
     }
 }

@@ -9,6 +9,7 @@
 //! Backends are opened from a [`BackendSpec`] on the thread that uses them
 //! (iceoryx2 ports are not `Send`).
 
+pub mod diagnostics;
 pub mod memory;
 pub mod names;
 pub mod rosout;

@@ -34,7 +34,8 @@ def main() -> int:
             reader = make_reader(fh, decoder_factories=[DecoderFactory()])
             summary = reader.get_summary()
             assert summary is not None, f"{f}: not finalised"
-            assert len(summary.channels) == 7, f"{f}: {len(summary.channels)} channels"
+            # The node's seven topics and /parameter_events.
+            assert len(summary.channels) == 8, f"{f}: {len(summary.channels)} channels"
             n = 0
             for schema, channel, message, decoded in reader.iter_decoded_messages():
                 n += 1

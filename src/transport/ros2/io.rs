@@ -50,6 +50,8 @@ struct Entities {
     force: Publisher<Float64>,
     film: Publisher<FilmProfile>,
     stats: Publisher<LoopStatistics>,
+    rosout: Publisher<msgs::ros_interfaces::Log>,
+    diagnostics: Publisher<msgs::ros_interfaces::DiagnosticArray>,
     snapshot: Option<ros2_client::Subscription<msgs::Empty>>,
     poll: Poll,
     waker: Arc<Waker>,
@@ -94,6 +96,25 @@ fn setup(spec: &Ros2Spec, snapshots: bool) -> Result<Entities, TransportError> {
         &eq,
         "the statistics",
     )?;
+    // /rosout as rcl offers it: reliable, transient local, keep last 1000.
+    let rosout_qos = ros2_client::QosProfile::publisher_default()
+        .durability(ros2_client::qos::Durability::TransientLocal)
+        .history(ros2_client::qos::History::KeepLast { depth: 1000 });
+    let rosout = advertise(
+        n,
+        "/rosout",
+        &msgs::ros_interfaces::LOG,
+        &rosout_qos,
+        "/rosout",
+    )?;
+    let diagnostics = advertise(
+        n,
+        "/diagnostics",
+        &msgs::ros_interfaces::DIAGNOSTIC_ARRAY,
+        &ros2_client::QosProfile::publisher_default()
+            .history(ros2_client::qos::History::KeepLast { depth: 10 }),
+        "/diagnostics",
+    )?;
     let snapshot = if snapshots {
         Some(super::subscribe(
             n,
@@ -126,6 +147,8 @@ fn setup(spec: &Ros2Spec, snapshots: bool) -> Result<Entities, TransportError> {
         force,
         film,
         stats,
+        rosout,
+        diagnostics,
         snapshot,
         poll,
         waker,
@@ -222,6 +245,11 @@ pub(super) fn run(
     let mut events = Events::with_capacity(16);
     let mut seen_profile = 0u64;
     let frame = sh.spec.frame_id.clone();
+    let fqn = sh.spec.fully_qualified_name();
+    // rcl's logger name: the node's name with `.` between namespace tokens.
+    let logger = fqn.trim_start_matches('/').replace('/', ".");
+    let mut diagnostics = crate::transport::diagnostics::Diagnostics::default();
+    let mut last_diagnostics: Option<std::time::Instant> = None;
     let counters = &sh.counters;
     let count = |ok: bool, which: &std::sync::atomic::AtomicU64| {
         if !ok {
@@ -255,12 +283,32 @@ pub(super) fn run(
                         &counters.publish_failures,
                     );
                 }
-                Out::Statistics(s) => count(
-                    e.stats.publish(s.to_wire(&frame)).is_ok(),
-                    &counters.statistics_failures,
-                ),
+                Out::Statistics(s) => {
+                    count(
+                        e.stats.publish(s.to_wire(&frame)).is_ok(),
+                        &counters.statistics_failures,
+                    );
+                    // /diagnostics at most once a second.
+                    let a = diagnostics.update(&s, &fqn, &frame);
+                    if last_diagnostics.is_none_or(|t| t.elapsed() >= Duration::from_millis(990)) {
+                        last_diagnostics = Some(std::time::Instant::now());
+                        count(e.diagnostics.publish(a).is_ok(), &counters.publish_failures);
+                    }
+                }
             }
         }
+        crate::transport::rosout::drain(|l| {
+            let m = msgs::ros_interfaces::Log {
+                stamp: Time::from_ns(l.stamp_ns),
+                level: l.level,
+                name: logger.clone(),
+                msg: l.message,
+                file: l.file,
+                function: l.target,
+                line: l.line,
+            };
+            let _ = e.rosout.publish(m);
+        });
         if let Some(slot) = &sh.profile {
             if let Some(p) = slot.read_if_newer(&mut seen_profile) {
                 let m = FilmProfile {

@@ -1,0 +1,248 @@
+//! `/diagnostics`: the loop's health as `diagnostic_msgs/msg/DiagnosticArray`
+//! (what `diagnostic_aggregator` and `rqt_robot_monitor` read), built from
+//! two consecutive `LoopStatistics`, one `DiagnosticStatus` per concern.
+//!
+//! | status | OK | WARN | ERROR |
+//! |---|---|---|---|
+//! | `<node>: loop timing` | deadline misses < 0.1 % of the period's steps | < 5 %, or lost time advanced in one step | ≥ 5 % |
+//! | `<node>: solver` | every step converged | < 1 % of the steps not converged | ≥ 1 % |
+//! | `<node>: commands` | nothing rejected, overwritten or timed out | any of them | (never) |
+//! | `<node>: outputs` | nothing dropped or failed | any output dropped or not sent | (never) |
+//! | `<node>: recorder` | recording everything (or not recording) | messages dropped by a full queue | messages lost (a write failed) |
+//!
+//! "The period" is the time since the previous statistics (1 s by
+//! default). Values carry the cumulative counters and the period's.
+
+use crate::msgs::ros_interfaces::{
+    diagnostic_level as level, DiagnosticArray, DiagnosticStatus, KeyValue,
+};
+use crate::msgs::{Header, StatisticsRecord, Time};
+
+/// Misses above this fraction of a period's steps: WARN.
+pub const MISS_WARN: f64 = 0.001;
+/// Misses at or above this fraction: ERROR.
+pub const MISS_ERROR: f64 = 0.05;
+/// Non-converged steps at or above this fraction: ERROR.
+pub const SOLVER_ERROR: f64 = 0.01;
+
+/// Builds the diagnostics from consecutive statistics.
+#[derive(Debug, Default)]
+pub struct Diagnostics {
+    previous: Option<StatisticsRecord>,
+}
+
+fn kv(key: &str, value: impl std::fmt::Display) -> KeyValue {
+    KeyValue {
+        key: key.into(),
+        value: value.to_string(),
+    }
+}
+
+impl Diagnostics {
+    /// The array for `s` (compared with the previous statistics).
+    pub fn update(&mut self, s: &StatisticsRecord, node: &str, frame_id: &str) -> DiagnosticArray {
+        let p = self.previous.unwrap_or_default();
+        self.previous = Some(*s);
+        let d = |now: u64, before: u64| now.saturating_sub(before);
+        let steps = d(s.steps, p.steps).max(1);
+        let frac = |n: u64| n as f64 / steps as f64;
+        let status =
+            |name: &str, lvl: u8, message: String, values: Vec<KeyValue>| DiagnosticStatus {
+                level: lvl,
+                name: format!("{node}: {name}"),
+                message,
+                hardware_id: node.to_string(),
+                values,
+            };
+        let us = |ns: u64| format!("{:.1}", ns as f64 / 1e3);
+
+        let misses = d(s.deadline_misses, p.deadline_misses);
+        let jumps = d(s.time_jumps, p.time_jumps);
+        let (lvl, msg) = if frac(misses) >= MISS_ERROR {
+            (
+                level::ERROR,
+                format!("{misses} deadline misses in {steps} steps"),
+            )
+        } else if frac(misses) >= MISS_WARN || jumps > 0 {
+            (
+                level::WARN,
+                format!(
+                    "{misses} deadline misses, {jumps} long steps over lost time in {steps} steps"
+                ),
+            )
+        } else {
+            (level::OK, "on time".into())
+        };
+        let timing = status(
+            "loop timing",
+            lvl,
+            msg,
+            vec![
+                kv("steps", s.steps),
+                kv("deadline misses", s.deadline_misses),
+                kv("deadline misses in the period", misses),
+                kv("catch-up steps", s.catch_up_steps),
+                kv("long steps over lost time", s.time_jumps),
+                kv("wall clock jumps", s.clock_jumps),
+                kv("compute p50 (us)", us(s.compute_time_ns[0])),
+                kv("compute p99 (us)", us(s.compute_time_ns[1])),
+                kv("compute max (us)", us(s.compute_time_ns[2])),
+                kv("jitter p50 (us)", us(s.period_jitter_ns[0])),
+                kv("jitter p99 (us)", us(s.period_jitter_ns[1])),
+                kv("jitter max (us)", us(s.period_jitter_ns[2])),
+            ],
+        );
+
+        let bad = d(s.steps_not_converged, p.steps_not_converged);
+        let (lvl, msg) = if frac(bad) >= SOLVER_ERROR {
+            (
+                level::ERROR,
+                format!("{bad} of {steps} steps not converged"),
+            )
+        } else if bad > 0 {
+            (level::WARN, format!("{bad} of {steps} steps not converged"))
+        } else {
+            (level::OK, "every step converged".into())
+        };
+        let solver = status(
+            "solver",
+            lvl,
+            msg,
+            vec![
+                kv("steps not converged", s.steps_not_converged),
+                kv("steps not converged in the period", bad),
+                kv("parameter updates", s.parameter_updates),
+            ],
+        );
+
+        let rejected = d(s.commands_rejected, p.commands_rejected);
+        let overwritten = d(s.commands_overwritten, p.commands_overwritten);
+        let timeouts = d(s.command_timeouts, p.command_timeouts);
+        let (lvl, msg) = if rejected + overwritten + timeouts > 0 {
+            (
+                level::WARN,
+                format!(
+                    "{rejected} rejected, {overwritten} overwritten, {timeouts} steps on a timed-out command"
+                ),
+            )
+        } else {
+            (level::OK, "every command applied".into())
+        };
+        let commands = status(
+            "commands",
+            lvl,
+            msg,
+            vec![
+                kv("received", s.commands_received),
+                kv("applied", s.commands_applied),
+                kv("overwritten", s.commands_overwritten),
+                kv("rejected", s.commands_rejected),
+                kv("steps on a timed-out command", s.command_timeouts),
+            ],
+        );
+
+        let lost_out = d(s.publish_drops, p.publish_drops)
+            + d(s.publish_failures, p.publish_failures)
+            + d(s.statistics_not_sent, p.statistics_not_sent);
+        let outputs = status(
+            "outputs",
+            if lost_out > 0 { level::WARN } else { level::OK },
+            if lost_out > 0 {
+                format!("{lost_out} outputs dropped or not sent")
+            } else {
+                "every output sent".into()
+            },
+            vec![
+                kv("publish drops", s.publish_drops),
+                kv("publish failures", s.publish_failures),
+                kv("statistics not sent", s.statistics_not_sent),
+            ],
+        );
+
+        let drops = d(s.recorder_drops, p.recorder_drops);
+        let lost = d(s.recording.lost, p.recording.lost);
+        let (lvl, msg) = if lost > 0 {
+            (
+                level::ERROR,
+                format!("{lost} messages lost: writing failed"),
+            )
+        } else if drops > 0 {
+            (
+                level::WARN,
+                format!("{drops} messages dropped by a full recorder queue"),
+            )
+        } else if s.recording.files == 0 {
+            (level::OK, "not recording".into())
+        } else {
+            (level::OK, "recording".into())
+        };
+        let recorder = status(
+            "recorder",
+            lvl,
+            msg,
+            vec![
+                kv("files", s.recording.files),
+                kv("files deleted for the budget", s.recording.files_deleted),
+                kv("messages lost", s.recording.lost),
+                kv("queue drops", s.recorder_drops),
+                kv("snapshots", s.recording.snapshots),
+                kv("last snapshot", s.recording.last_snapshot.as_str()),
+            ],
+        );
+        DiagnosticArray {
+            header: Header {
+                stamp: Time::from_ns(s.stamp_ns),
+                frame_id: frame_id.to_string(),
+            },
+            status: vec![timing, solver, commands, outputs, recorder],
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn levels_follow_the_documented_thresholds_per_period() {
+        let mut d = Diagnostics::default();
+        let mut s = StatisticsRecord {
+            steps: 1000,
+            ..Default::default()
+        };
+        let a = d.update(&s, "/friction_node", "slider");
+        assert!(a.status.iter().all(|x| x.level == level::OK), "{a:?}");
+        assert_eq!(a.status[0].name, "/friction_node: loop timing");
+        // 2 misses in 1000 steps: WARN; then 60 in 1000: ERROR.
+        s.steps = 2000;
+        s.deadline_misses = 2;
+        s.steps_not_converged = 3;
+        s.commands_rejected = 1;
+        let b = d.update(&s, "/friction_node", "slider");
+        assert_eq!(b.status[0].level, level::WARN);
+        assert_eq!(b.status[1].level, level::WARN);
+        assert_eq!(b.status[2].level, level::WARN);
+        s.steps = 3000;
+        s.deadline_misses = 62;
+        s.steps_not_converged = 13;
+        let c = d.update(&s, "/friction_node", "slider");
+        assert_eq!(c.status[0].level, level::ERROR);
+        assert_eq!(c.status[1].level, level::ERROR);
+        assert_eq!(c.status[2].level, level::OK, "nothing new rejected");
+        s.steps = 4000;
+        s.recording.lost = 5;
+        let e = d.update(&s, "/friction_node", "slider");
+        assert_eq!(e.status[0].level, level::OK, "no new misses");
+        assert_eq!(e.status[4].level, level::ERROR);
+        let kv = |a: &DiagnosticArray, i: usize, k: &str| {
+            a.status[i]
+                .values
+                .iter()
+                .find(|v| v.key == k)
+                .unwrap()
+                .value
+                .clone()
+        };
+        assert_eq!(kv(&c, 0, "deadline misses in the period"), "60");
+    }
+}
