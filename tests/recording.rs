@@ -305,3 +305,97 @@ fn a_split_recording_refuses_a_directory_that_is_not_empty() {
     .to_string();
     assert!(e.contains("not empty") && e.contains("nonempty"), "{e}");
 }
+
+#[test]
+fn a_run_whose_parameters_changed_midway_replays_bit_identically() {
+    use friction_node::msgs::ros_interfaces::{parameter_type, ParameterValue};
+    use friction_node::node::parameters::{
+        apply_set, declare, record_applied, ParameterChannel, ParameterUpdate,
+    };
+    let d = dir("params");
+    let bag = d.join("params.mcap");
+    let mut cfg = config();
+    cfg.lubricant.viscosity_model = friction_node::config::ViscosityModelKind::Vogel;
+    let clock = Arc::new(SimClock::new(WALL0));
+    let rec = Recorder::start(
+        RecordPlan {
+            path: Some(bag.clone()),
+            snapshot_dir: d.clone(),
+        },
+        &cfg,
+        &TopicNames::from_config(&cfg),
+        None,
+        clock.clone(),
+    )
+    .unwrap();
+    let link = MemoryLink::new(16);
+    let mut peer = link.peer();
+    peer.send(&Command {
+        kind: CommandKind::Velocity,
+        value: 0.3,
+        stamp_ns: 1,
+    })
+    .unwrap();
+    let ch = Arc::new(ParameterChannel::default());
+    let mut l = Loop::new(
+        &cfg,
+        vec![Box::new(
+            link.node_recording(Some(rec.queue()))
+                .with_clock(clock.clone()),
+        )],
+        Some(rec.queue()),
+        None,
+        Arc::new(LiveStatus::default()),
+    )
+    .unwrap()
+    .with_clock(clock)
+    .with_parameters(ch.clone());
+    let stop = AtomicBool::new(false);
+    let double = |x: f64| ParameterValue {
+        r#type: parameter_type::DOUBLE,
+        double_value: x,
+        ..Default::default()
+    };
+    let mut current = cfg.clone();
+    let declared = declare(&cfg);
+    // Three changes, each between two stretches of the run: what
+    // `ros2 param set` does to a running node.
+    l.run(&stop, Some(Duration::from_millis(300)));
+    for changes in [
+        vec![("contact.load_n", double(9000.0))],
+        vec![
+            ("contact.boundary_friction", double(0.2)),
+            ("lubricant.viscosity_pa_s", double(0.1)),
+        ],
+        vec![("roughness.sigma_m", double(4e-6))],
+    ] {
+        let changes: Vec<(String, ParameterValue)> = changes
+            .into_iter()
+            .map(|(k, v)| (k.to_string(), v))
+            .collect();
+        let next = apply_set(&current, &declared, &changes).unwrap();
+        ch.submit(ParameterUpdate::prepare(&current, next.clone(), changes).unwrap())
+            .unwrap();
+        current = next;
+        l.run(&stop, Some(Duration::from_millis(300)));
+        let u = ch.take_applied().expect("applied");
+        record_applied(&rec.queue(), "/friction_node", &u, WALL0).unwrap();
+    }
+    assert_eq!(l.summary().parameter_updates, 3);
+    drop(l);
+    let report = rec.finish();
+    assert!(report.error.is_none(), "{report:?}");
+    // The replay re-applies each change at the step that used it.
+    let b = Bag::open(&bag).unwrap();
+    let prepared = replay::prepare(&b, &ReplayOptions::default()).unwrap();
+    assert_eq!(prepared.parameter_changes.len(), 3);
+    let r = replay::run(&prepared, &mut |_, _| {}, &mut |_, _| {}).unwrap();
+    let oracle = r.oracle.expect("a friction-node bag");
+    assert!(oracle.identical, "{:?}", oracle.deviations);
+    assert_eq!(oracle.compared, 1200);
+    // Without the changes the replay differs: they are what made it match.
+    let mut without = prepared.clone();
+    without.parameter_changes.clear();
+    let r = replay::run(&without, &mut |_, _| {}, &mut |_, _| {}).unwrap();
+    assert!(!r.oracle.unwrap().identical);
+}

@@ -119,6 +119,12 @@ pub fn run(args: ReplayArgs, config: Option<PathBuf>, overrides: Vec<String>) ->
         );
     }
     println!("commands         {} rejected", result.commands_rejected);
+    if !prepared.parameter_changes.is_empty() {
+        println!(
+            "parameters       {} changes re-applied at the steps that used them (recorded /parameter_events)",
+            prepared.parameter_changes.len()
+        );
+    }
     if let Some(d) = &prepared.scan.damage {
         println!("damaged bag      stopped {d}");
     }

@@ -285,6 +285,43 @@ impl ParameterUpdate {
     }
 }
 
+/// The `rcl_interfaces/msg/ParameterEvent` of an applied update, stamped
+/// with the first step that used it.
+pub fn event(node_fqn: &str, u: &ParameterUpdate) -> crate::msgs::ros_interfaces::ParameterEvent {
+    use crate::msgs::ros_interfaces::{Parameter, ParameterEvent};
+    ParameterEvent {
+        stamp: crate::msgs::Time::from_ns(u.applied_stamp_ns),
+        node: node_fqn.to_string(),
+        changed_parameters: u
+            .changed
+            .iter()
+            .map(|(name, value)| Parameter {
+                name: name.clone(),
+                value: value.clone(),
+            })
+            .collect(),
+        ..Default::default()
+    }
+}
+
+/// Hand an applied update's event to the recorder (replay re-applies it at
+/// the same step); `logged_ns` is the wall time now.
+pub fn record_applied(
+    queue: &crossbeam_queue::ArrayQueue<crate::msgs::RecordItem>,
+    node_fqn: &str,
+    u: &ParameterUpdate,
+    logged_ns: u64,
+) -> Result<(), String> {
+    let cdr = crate::msgs::to_cdr(&event(node_fqn, u))?;
+    queue
+        .push(crate::msgs::RecordItem::ParameterEvent {
+            cdr,
+            stamp_ns: u.applied_stamp_ns,
+            logged_ns,
+        })
+        .map_err(|_| "the recorder queue is full".to_string())
+}
+
 /// What a transport that serves parameters needs from the node.
 #[derive(Clone)]
 pub struct ParameterIo {

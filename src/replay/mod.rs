@@ -81,6 +81,10 @@ pub enum ReplayError {
     },
     #[error("the recorded configuration in the bag: {0}")]
     RecordedConfig(ConfigError),
+    #[error("the parameter change recorded at {stamp_ns} ns cannot be applied: {message}")]
+    Parameters { stamp_ns: u64, message: String },
+    #[error(transparent)]
+    Setup(#[from] crate::physics::SetupError),
     #[error(transparent)]
     Config(#[from] ConfigError),
     #[error(transparent)]
@@ -217,6 +221,17 @@ pub struct PreparedReplay {
     pub gaps: Vec<Silence>,
     /// Velocity messages read.
     pub velocity_messages: usize,
+    /// Parameters the node changed while it ran (its `/parameter_events`),
+    /// each stamped with the first step that used it, in time order.
+    pub parameter_changes: Vec<ParameterChange>,
+}
+
+/// One recorded parameter change.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ParameterChange {
+    /// The stamp of the first step that used it.
+    pub stamp_ns: u64,
+    pub changed: Vec<(String, crate::msgs::ros_interfaces::ParameterValue)>,
 }
 
 /// Choose the configuration: `--config`, else the bag's recorded one, else
@@ -377,6 +392,7 @@ pub fn prepare(bag: &Bag, opts: &ReplayOptions) -> Result<PreparedReplay, Replay
         scan,
         gaps: inputs.gaps,
         velocity_messages: inputs.velocity_messages,
+        parameter_changes: inputs.parameter_changes,
     })
 }
 
@@ -389,6 +405,7 @@ struct Inputs {
     velocity_messages: usize,
     /// Where reading stopped early (everything before it is kept).
     damage: Option<Damage>,
+    parameter_changes: Vec<ParameterChange>,
 }
 
 /// The recorded estimates as the commands each step applied: the load and
@@ -459,6 +476,17 @@ fn decode_inputs(
     };
     let legacy = est_channel.is_some_and(|c| msgs::is_legacy_estimate_schema(&c.schema_text));
     let mut est_index = 0u64;
+    // The node's parameter changes (recorded estimates only).
+    let node_fqn = {
+        let ns = config.ros.namespace.trim_end_matches('/');
+        format!("{ns}/{}", config.ros.node_name)
+    };
+    let events_channel = est_channel.and_then(|_| {
+        scan.channels
+            .iter()
+            .find(|c| c.schema_name == "rcl_interfaces/msg/ParameterEvent")
+    });
+    let mut parameter_changes = Vec::new();
     // A message that does not decode is damage: replay what came before.
     let mut damage: Option<Damage> = None;
     let mut decode_error: Option<BagError> = None;
@@ -472,7 +500,27 @@ fn decode_inputs(
             }
         };
         let view = m.view();
-        let result = if let Some(c) = est_channel.filter(|c| c.topic == view.topic) {
+        let result = if let Some(c) = events_channel.filter(|c| c.topic == view.topic) {
+            msgs::from_cdr::<msgs::ros_interfaces::ParameterEvent>(view.data)
+                .map_err(|message| BagError::Decode {
+                    topic: c.topic.clone(),
+                    type_name: c.schema_name.clone(),
+                    index: parameter_changes.len() as u64 + 1,
+                    message,
+                })
+                .map(|ev| {
+                    if ev.node == node_fqn && !ev.changed_parameters.is_empty() {
+                        parameter_changes.push(ParameterChange {
+                            stamp_ns: ev.stamp.to_ns(),
+                            changed: ev
+                                .changed_parameters
+                                .into_iter()
+                                .map(|p| (p.name, p.value))
+                                .collect(),
+                        });
+                    }
+                })
+        } else if let Some(c) = est_channel.filter(|c| c.topic == view.topic) {
             est_index += 1;
             msgs::decode_estimate(view.data, legacy)
                 .map_err(|message| BagError::Decode {
@@ -586,6 +634,7 @@ fn decode_inputs(
             Vec::new(),
         ),
     };
+    parameter_changes.sort_by_key(|c| c.stamp_ns);
     Ok(Inputs {
         commands,
         recorded,
@@ -593,6 +642,7 @@ fn decode_inputs(
         gaps,
         velocity_messages,
         damage,
+        parameter_changes,
     })
 }
 
@@ -625,7 +675,27 @@ pub fn run(
     )?;
     let mut out = Vec::with_capacity(p.commands.len());
     let total = p.commands.len();
+    // Recorded parameter changes, re-applied before the step that used them.
+    let mut current = p.config.clone();
+    let declared = crate::node::parameters::declare(&current);
+    let mut changes = p.parameter_changes.iter().peekable();
     for (k, c) in p.commands.iter().enumerate() {
+        if c.kind == CommandKind::Velocity {
+            while let Some(ch) = changes.next_if(|ch| ch.stamp_ns <= c.stamp_ns) {
+                let next = crate::node::parameters::apply_set(&current, &declared, &ch.changed)
+                    .map_err(|e| ReplayError::Parameters {
+                        stamp_ns: ch.stamp_ns,
+                        message: e.to_string(),
+                    })?;
+                let mut u = crate::node::parameters::ParameterUpdate::prepare(
+                    &current,
+                    next.clone(),
+                    ch.changed.clone(),
+                )?;
+                l.apply_update(&mut u);
+                current = next;
+            }
+        }
         l.feed(*c);
         if let Ok(Some(rec)) = peer.try_recv() {
             let e = *l.solver().last_estimate().expect("a step happened");

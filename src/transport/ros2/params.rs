@@ -16,13 +16,13 @@ use crate::config::Config;
 use crate::msgs::ros_interfaces::{
     parameter_type as ty, DescribeParametersResponse, FloatingPointRange,
     GetParameterTypesResponse, GetParametersResponse, IntegerRange, ListParametersRequest,
-    ListParametersResponse, ListParametersResult, NamesRequest, Parameter, ParameterDescriptor,
+    ListParametersResponse, ListParametersResult, NamesRequest, ParameterDescriptor,
     ParameterEvent, ParameterValue, SetParametersAtomicallyResponse, SetParametersRequest,
     SetParametersResponse, SetParametersResult, TriggerRequest, TriggerResponse,
 };
-use crate::msgs::{RecordItem, Time};
 use crate::node::parameters::{
-    apply_set, declare, Declared, ParameterChannel, ParameterIo, ParameterUpdate, SetRefusal,
+    apply_set, declare, event, record_applied, Declared, ParameterChannel, ParameterIo,
+    ParameterUpdate, SetRefusal,
 };
 use crate::transport::RecordQueue;
 use ros2_client::dds::rustdds::mio1::{Events, Interest, Poll, Token};
@@ -182,23 +182,6 @@ fn result(r: Result<(), SetRefusal>) -> SetParametersResult {
     }
 }
 
-/// The `ParameterEvent` of an applied update.
-pub fn event(node_fqn: &str, u: &ParameterUpdate) -> ParameterEvent {
-    ParameterEvent {
-        stamp: Time::from_ns(u.applied_stamp_ns),
-        node: node_fqn.to_string(),
-        changed_parameters: u
-            .changed
-            .iter()
-            .map(|(name, value)| Parameter {
-                name: name.clone(),
-                value: value.clone(),
-            })
-            .collect(),
-        ..Default::default()
-    }
-}
-
 /// Everything the thread serves and publishes.
 struct Entities {
     servers: Vec<DualServer>,
@@ -234,20 +217,12 @@ pub(super) fn run(
         let _ = e.poll.poll(&mut events, Some(Duration::from_millis(5)));
         serve(&mut e, &mut state, snapshot.as_deref());
         while let Some(u) = state.channel.take_applied() {
-            let ev = event(&node_fqn, &u);
-            if let Err(x) = e.events.write(ev.clone(), None) {
+            if let Err(x) = e.events.write(event(&node_fqn, &u), None) {
                 tracing::warn!("/parameter_events: {x:?}");
             }
             if let Some(q) = &record {
-                match crate::msgs::to_cdr(&ev) {
-                    Ok(cdr) => {
-                        let _ = q.push(RecordItem::ParameterEvent {
-                            cdr,
-                            stamp_ns: u.applied_stamp_ns,
-                            logged_ns: crate::clock::system_wall_ns(),
-                        });
-                    }
-                    Err(x) => tracing::warn!("recording a parameter event: {x}"),
+                if let Err(x) = record_applied(q, &node_fqn, &u, crate::clock::system_wall_ns()) {
+                    tracing::warn!("recording a parameter event: {x}");
                 }
             }
             tracing::info!(
