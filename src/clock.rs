@@ -78,6 +78,82 @@ impl Clock for SystemClock {
     }
 }
 
+/// Time that an outside source drives: ROS 2 `/clock` (`use_sim_time`),
+/// as simulators and bag playback publish it. Monotonic time is the time
+/// since the first value received (it holds when the source goes back, as
+/// a restarted playback does); wall time is the latest value; sleeping
+/// waits until the source has passed the deadline, or the node is told to
+/// stop. Before the first value, time stands at 0.
+#[derive(Debug)]
+pub struct ExternalClock {
+    /// Latest value, ns since the epoch (0: none yet).
+    latest: AtomicU64,
+    /// First value received (0: none yet).
+    origin: AtomicU64,
+    /// Monotonic time handed out so far (never decreases).
+    mono: AtomicU64,
+    lock: std::sync::Mutex<()>,
+    moved: std::sync::Condvar,
+    stop: std::sync::Arc<std::sync::atomic::AtomicBool>,
+}
+
+impl ExternalClock {
+    /// A clock that stops waiting when `stop` is set.
+    pub fn new(stop: std::sync::Arc<std::sync::atomic::AtomicBool>) -> Self {
+        Self {
+            latest: AtomicU64::new(0),
+            origin: AtomicU64::new(0),
+            mono: AtomicU64::new(0),
+            lock: std::sync::Mutex::new(()),
+            moved: std::sync::Condvar::new(),
+            stop,
+        }
+    }
+
+    /// The source says it is `ns` (since the epoch) now.
+    pub fn set(&self, ns: u64) {
+        if ns == 0 {
+            return;
+        }
+        let _ = self
+            .origin
+            .compare_exchange(0, ns, Ordering::SeqCst, Ordering::SeqCst);
+        self.latest.store(ns, Ordering::SeqCst);
+        let origin = self.origin.load(Ordering::SeqCst);
+        self.mono
+            .fetch_max(ns.saturating_sub(origin), Ordering::SeqCst);
+        let _g = self.lock.lock().unwrap_or_else(|p| p.into_inner());
+        self.moved.notify_all();
+    }
+
+    /// Whether a value has been received.
+    pub fn started(&self) -> bool {
+        self.origin.load(Ordering::SeqCst) != 0
+    }
+}
+
+impl Clock for ExternalClock {
+    fn now_ns(&self) -> u64 {
+        self.mono.load(Ordering::SeqCst)
+    }
+
+    fn sleep_until_ns(&self, deadline_ns: u64) {
+        let mut g = self.lock.lock().unwrap_or_else(|p| p.into_inner());
+        while self.now_ns() < deadline_ns && !self.stop.load(Ordering::Relaxed) {
+            // Woken by every new value; the timeout only re-checks `stop`.
+            g = self
+                .moved
+                .wait_timeout(g, Duration::from_millis(50))
+                .map(|(g, _)| g)
+                .unwrap_or_else(|p| p.into_inner().0);
+        }
+    }
+
+    fn wall_ns(&self) -> u64 {
+        self.latest.load(Ordering::SeqCst)
+    }
+}
+
 /// `20261123T131500Z` for a wall time in ns (UTC, to the second).
 pub fn utc_stamp(wall_ns: u64) -> String {
     let secs = wall_ns / 1_000_000_000;
@@ -328,6 +404,35 @@ mod tests {
         assert_eq!(w.jumps, 0);
         let s = w.stamp(c.now_ns());
         assert_eq!(s, c.wall0 + c.now_ns(), "the mapping was not moved");
+    }
+
+    #[test]
+    fn an_external_clock_follows_its_source_and_never_goes_back() {
+        let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+        let c = std::sync::Arc::new(ExternalClock::new(stop.clone()));
+        assert_eq!((c.now_ns(), c.started()), (0, false));
+        c.set(1_000_000_000_000);
+        assert_eq!(c.now_ns(), 0, "time starts at the first value");
+        assert_eq!(c.wall_ns(), 1_000_000_000_000);
+        c.set(1_000_005_000_000);
+        assert_eq!(c.now_ns(), 5_000_000);
+        c.set(1_000_001_000_000); // playback restarted
+        assert_eq!(c.now_ns(), 5_000_000, "monotonic time holds");
+        assert_eq!(c.wall_ns(), 1_000_001_000_000, "stamps follow the source");
+        // A sleeper wakes when the source passes its deadline.
+        let c2 = c.clone();
+        let t = std::thread::spawn(move || {
+            c2.sleep_until_ns(7_000_000);
+            c2.now_ns()
+        });
+        c.set(1_000_006_000_000);
+        c.set(1_000_008_000_000);
+        assert!(t.join().unwrap() >= 7_000_000, "not before the deadline");
+        // And returns when told to stop, however far the deadline.
+        let c3 = c.clone();
+        let t = std::thread::spawn(move || c3.sleep_until_ns(u64::MAX));
+        stop.store(true, Ordering::Relaxed);
+        t.join().unwrap();
     }
 
     #[test]

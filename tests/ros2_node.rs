@@ -92,14 +92,22 @@ fn client_node(domain: u32, name: &str) -> (Context, Node) {
 
 /// Run a future here, waiting at most [`WAIT`].
 fn within<T>(what: &str, f: impl std::future::Future<Output = T>) -> T {
+    within_for(WAIT, f).unwrap_or_else(|| panic!("{what}: no answer within {WAIT:?}"))
+}
+
+/// Run a future here for at most `limit`.
+fn within_for<T>(limit: Duration, f: impl std::future::Future<Output = T>) -> Option<T> {
     match futures::executor::block_on(futures::future::select(
         Box::pin(f),
-        Box::pin(futures_timer(WAIT)),
+        Box::pin(futures_timer(limit)),
     )) {
-        futures::future::Either::Left((v, _)) => v,
-        futures::future::Either::Right(_) => panic!("{what}: no answer within {WAIT:?}"),
+        futures::future::Either::Left((v, _)) => Some(v),
+        futures::future::Either::Right(_) => None,
     }
 }
+
+/// Requests sent by [`call`] (a retried call sends more than one).
+static SENT: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 
 fn double(x: f64) -> ParameterValue {
     ParameterValue {
@@ -138,14 +146,22 @@ where
             service_qos(),
         )
         .unwrap();
-    // Discovery first (the request and reply endpoints matched), then one
-    // request: a request sent before the match could be lost or answered
-    // late.
-    within("discovery", client.wait_for_service(node));
-    match within(service, client.async_call_service(req)) {
-        Ok(r) => r,
-        Err(e) => panic!("{service}: {e}"),
+    // Discovery first (the request and reply endpoints matched); then a
+    // request, sent again if no reply comes (ros2-client's match tracking
+    // can miss an event; a request sent before the match can be lost).
+    let _ = within_for(Duration::from_secs(10), client.wait_for_service(node));
+    for _ in 0..6 {
+        SENT.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+        match within_for(
+            Duration::from_secs(10),
+            client.async_call_service(req.clone()),
+        ) {
+            Some(Ok(r)) => return r,
+            Some(Err(e)) => panic!("{service}: {e}"),
+            None => eprintln!("{service}: no reply within 10 s; sending again"),
+        }
     }
+    panic!("{service}: no reply to 6 requests")
 }
 
 /// A future that completes after `d` (a thread sleeps; no runtime needed).
@@ -318,8 +334,9 @@ fn parameters_are_listed_described_got_and_set_in_both_dds_layouts_and_a_remappe
             );
         }
         // Exactly one reply per request: a second reader of the reply
-        // topic counts what the server wrote for this one call.
+        // topic counts what the server wrote for this call.
         assert_eq!(replies(), 0, "{mapping:?}: nothing before the call");
+        let sent_before = SENT.load(std::sync::atomic::Ordering::SeqCst);
         let got: GetParametersResponse = call(
             node,
             mapping,
@@ -341,7 +358,13 @@ fn parameters_are_listed_described_got_and_set_in_both_dds_layouts_and_a_remappe
         // A duplicate would follow within milliseconds on loopback.
         std::thread::sleep(Duration::from_millis(500));
         seen += replies();
-        assert_eq!(seen, 1, "{mapping:?}: one reply to one request");
+        let sent = SENT.load(std::sync::atomic::Ordering::SeqCst) - sent_before;
+        // No duplicate: at most one reply per request sent (and when no
+        // retry was needed, which is the rule, exactly one).
+        assert!(
+            seen >= 1 && seen <= sent,
+            "{mapping:?}: {seen} replies to {sent} requests"
+        );
     }
 }
 
@@ -505,4 +528,91 @@ fn log_lines_reach_rosout_and_health_reaches_diagnostics_in_the_standard_layouts
         a.status[2].message
     );
     assert!(a.header.stamp.sec > 0 && a.header.stamp.nanosec < 1_000_000_000);
+}
+
+#[test]
+fn with_use_sim_time_the_loop_steps_on_clock_and_stamps_with_it() {
+    use friction_node::msgs::ros_interfaces::Clock;
+    use friction_node::msgs::Time;
+    let pid = std::process::id();
+    let domain = 150 + (pid + 17) % 80;
+    let name = format!("fns_{pid}");
+    let _node = start(
+        domain,
+        &["-r", &format!("__node:={name}"), "-p", "use_sim_time:=true"],
+    );
+    let (_ctx, mut node) = client_node(domain, &format!("fns_client_{pid}"));
+    let clock_topic = node
+        .create_topic(
+            &Name::parse("/clock").unwrap(),
+            MessageTypeName::new("rosgraph_msgs", "Clock"),
+            &QosProfile::publisher_default(),
+        )
+        .unwrap();
+    let clock = node.create_publisher::<Clock>(&clock_topic, None).unwrap();
+    let est_topic = node
+        .create_topic(
+            &Name::parse(&format!("/{name}/friction")).unwrap(),
+            MessageTypeName::new("friction_msgs", "FrictionEstimate"),
+            &QosProfile::subscription_default(),
+        )
+        .unwrap();
+    let est_qos = QosProfile::publisher_default()
+        .history(ros2_client::qos::History::KeepLast { depth: 1000 });
+    let sub = node
+        .create_subscription::<FrictionEstimate>(&est_topic, Some(est_qos))
+        .unwrap();
+    // Simulated time from an arbitrary epoch, 1 ms per message, published
+    // every 2 ms of wall time (half speed); the node must follow it.
+    let t0: u64 = 1_000_000_000_000_000_000;
+    let publish = |k: u64| {
+        let _ = clock.publish(Clock {
+            clock: Time::from_ns(t0 + k * 1_000_000),
+        });
+    };
+    // Until the node has matched us and stepped at least once.
+    let mut k = 0;
+    let mut stamps = Vec::new();
+    let until = std::time::Instant::now() + WAIT;
+    while stamps.is_empty() && std::time::Instant::now() < until {
+        publish(k);
+        k += 1;
+        std::thread::sleep(Duration::from_millis(2));
+        while let Ok(Some((e, _))) = sub.take() {
+            stamps.push(e.header.stamp);
+        }
+    }
+    assert!(!stamps.is_empty(), "the node steps once /clock moves");
+    for _ in 0..200 {
+        publish(k);
+        k += 1;
+        std::thread::sleep(Duration::from_millis(2));
+        while let Ok(Some((e, _))) = sub.take() {
+            stamps.push(e.header.stamp);
+        }
+    }
+    let last_clock = t0 + (k - 1) * 1_000_000;
+    // Let the last messages arrive; time then stands still.
+    std::thread::sleep(Duration::from_millis(300));
+    while let Ok(Some((e, _))) = sub.take() {
+        stamps.push(e.header.stamp);
+    }
+    let ns: Vec<u64> = stamps.iter().map(|t| t.to_ns()).collect();
+    assert!(
+        ns.windows(2).all(|w| w[1] - w[0] == 1_000_000),
+        "one step per simulated millisecond, stamped with /clock"
+    );
+    assert!(ns
+        .iter()
+        .all(|s| (s - t0).is_multiple_of(1_000_000) && *s <= last_clock));
+    assert!(ns.len() >= 150, "{} steps for {} simulated ms", ns.len(), k);
+    assert!(
+        *ns.last().unwrap() >= last_clock - 5_000_000,
+        "the loop keeps up with /clock"
+    );
+    // Paused /clock: no more steps.
+    std::thread::sleep(Duration::from_millis(300));
+    assert!(sub.take().unwrap().is_none(), "time stands still");
+    // Sim time is not a wall-clock jump.
+    drop(_node);
 }

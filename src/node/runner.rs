@@ -235,6 +235,17 @@ pub fn run_node(
     let mut ports: Vec<Box<dyn NodePort>> = Vec::new();
     let channel = Arc::new(super::parameters::ParameterChannel::default());
     let mut served = false;
+    // use_sim_time: timer mode follows ROS 2 /clock.
+    let sim_time = if config.use_sim_time {
+        if !specs.iter().any(|s| s.serves_parameters()) {
+            return Err(RunError::Option(
+                "use_sim_time: true needs the ros2 transport (it follows /clock)".into(),
+            ));
+        }
+        Some(Arc::new(crate::clock::ExternalClock::new(stop.clone())))
+    } else {
+        None
+    };
     for s in &specs {
         let parameters = (!served && s.serves_parameters()).then(|| {
             served = true;
@@ -248,12 +259,17 @@ pub fn run_node(
             record: queue.clone(),
             snapshot: snapshot_flag.clone(),
             parameters,
+            sim_time: sim_time.clone().filter(|_| s.serves_parameters()),
         })?);
     }
     let live = Arc::new(LiveStatus::default());
     let mut l = Loop::new(config, ports, queue, profile, live.clone())?;
     if served {
         l = l.with_parameters(channel);
+    }
+    if let Some(c) = &sim_time {
+        l = l.with_clock(c.clone());
+        tracing::info!("use_sim_time: the loop follows /clock");
     }
     #[cfg(feature = "mcap")]
     if let Some(r) = &recorder {

@@ -22,6 +22,11 @@ impl Loop {
             self.clock.sleep_until_ns(due);
             let woke = self.clock.now_ns();
             let late = woke.saturating_sub(due);
+            if k == self.first_step {
+                // Anchor the stamps at the first wake-up: an external clock
+                // (/clock) has no time at all before its first message.
+                self.stamps = crate::clock::WallStamps::new(self.clock.as_ref());
+            }
             if self.stamps.check(self.clock.as_ref()) {
                 tracing::warn!("the wall clock jumped; stamps stay monotonic");
             }

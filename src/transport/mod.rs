@@ -127,6 +127,8 @@ pub struct PortIo {
     pub snapshot: Option<Arc<std::sync::atomic::AtomicBool>>,
     /// Parameters while running (ROS 2 serves them; others ignore it).
     pub parameters: Option<crate::node::parameters::ParameterIo>,
+    /// `use_sim_time`: the clock that ROS 2 `/clock` drives.
+    pub sim_time: Option<Arc<crate::clock::ExternalClock>>,
 }
 
 /// Hand a received sample to the recorder, counting a full queue.

@@ -30,6 +30,8 @@ pub(super) struct Shared {
     pub profile: Option<Arc<ProfileSlot>>,
     pub record: RecordQueue,
     pub snapshot: Option<Arc<AtomicBool>>,
+    /// `use_sim_time`: the clock `/clock` drives.
+    pub sim_time: Option<Arc<crate::clock::ExternalClock>>,
 }
 
 type RawReader = SimpleDataReader<RawCdr, RawAdapter>;
@@ -38,6 +40,7 @@ const VELOCITY: Token = Token(1);
 const LOAD: Token = Token(2);
 const WAKE: Token = Token(3);
 const TEMPERATURE: Token = Token(4);
+const CLOCK: Token = Token(5);
 
 /// The DDS entities of the node.
 struct Entities {
@@ -53,11 +56,12 @@ struct Entities {
     rosout: Publisher<msgs::ros_interfaces::Log>,
     diagnostics: Publisher<msgs::ros_interfaces::DiagnosticArray>,
     snapshot: Option<ros2_client::Subscription<msgs::Empty>>,
+    clock: Option<ros2_client::Subscription<msgs::ros_interfaces::Clock>>,
     poll: Poll,
     waker: Arc<Waker>,
 }
 
-fn setup(spec: &Ros2Spec, snapshots: bool) -> Result<Entities, TransportError> {
+fn setup(spec: &Ros2Spec, snapshots: bool, sim_time: bool) -> Result<Entities, TransportError> {
     let ctx = context(spec)?;
     let mut node = ros_node(&ctx, &spec.namespace, &spec.node_name)?;
     let cq = qos(&spec.command_qos);
@@ -136,6 +140,25 @@ fn setup(spec: &Ros2Spec, snapshots: bool) -> Result<Entities, TransportError> {
     poll.registry()
         .register(&mut temperature, TEMPERATURE, Interest::READABLE)
         .map_err(|e| err("register the temperature reader", e))?;
+    // /clock for use_sim_time: keep last 1, best effort (matches every
+    // publisher), polled with the commands so that time moves at once.
+    let mut clock = if sim_time {
+        let q = ros2_client::QosProfile::subscription_default();
+        Some(super::subscribe(
+            n,
+            "/clock",
+            &msgs::ros_interfaces::CLOCK,
+            &q,
+            "/clock",
+        )?)
+    } else {
+        None
+    };
+    if let Some(c) = clock.as_mut() {
+        poll.registry()
+            .register(c, CLOCK, Interest::READABLE)
+            .map_err(|e| err("register /clock", e))?;
+    }
     let waker = Arc::new(Waker::new(poll.registry(), WAKE).map_err(|e| err("create a waker", e))?);
     Ok(Entities {
         ctx,
@@ -150,6 +173,7 @@ fn setup(spec: &Ros2Spec, snapshots: bool) -> Result<Entities, TransportError> {
         rosout,
         diagnostics,
         snapshot,
+        clock,
         poll,
         waker,
     })
@@ -234,7 +258,7 @@ pub(super) fn run(
     sh: Shared,
     ready: std::sync::mpsc::Sender<Result<(Arc<Waker>, ros2_client::Context), TransportError>>,
 ) {
-    let mut e = match setup(&sh.spec, sh.snapshot.is_some()) {
+    let mut e = match setup(&sh.spec, sh.snapshot.is_some(), sh.sim_time.is_some()) {
         Ok(e) => e,
         Err(x) => {
             let _ = ready.send(Err(x));
@@ -259,6 +283,11 @@ pub(super) fn run(
     while !sh.stop.load(Ordering::Acquire) {
         // Wake on commands, on outputs (the waker), or every 20 ms for profiles.
         let _ = e.poll.poll(&mut events, Some(Duration::from_millis(20)));
+        if let (Some(sub), Some(clock)) = (&e.clock, &sh.sim_time) {
+            while let Ok(Some((m, _))) = sub.take() {
+                clock.set(m.clock.to_ns());
+            }
+        }
         take_all(&sh, &e.velocity, CommandKind::Velocity);
         take_all(&sh, &e.load, CommandKind::Load);
         take_all(&sh, &e.temperature, CommandKind::Temperature);

@@ -269,6 +269,7 @@ impl Ros2Node {
             profile: io.profile,
             record: io.record.clone(),
             snapshot: io.snapshot.clone(),
+            sim_time: io.sim_time.clone(),
         };
         let thread = std::thread::Builder::new()
             .name("ros2-io".into())
