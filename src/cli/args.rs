@@ -218,6 +218,11 @@ pub enum Command {
         /// No live status line.
         #[arg(long)]
         quiet: bool,
+        /// Resolve the configuration (file, --set, --ros-args), validate it,
+        /// print the node's name, topics and the parameters that differ from
+        /// the defaults, and exit without starting the node.
+        #[arg(long, conflicts_with_all = ["demo", "duration", "record"])]
+        check: bool,
     },
     /// The node for hours under a reproducible random motion (iceoryx2 by default), memory sampled.
     Soak {

@@ -91,8 +91,16 @@ pub fn dispatch(
             demo,
             duration,
             quiet,
+            check,
             ..
-        } => node::run(&config, transport, record, demo, duration, quiet),
+        } => {
+            if check {
+                node::check(&config, transport);
+                Ok(())
+            } else {
+                node::run(&config, transport, record, demo, duration, quiet)
+            }
+        }
         Command::Soak {
             transport,
             duration,

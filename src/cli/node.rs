@@ -29,6 +29,70 @@ pub fn run(
     Ok(())
 }
 
+/// `run --check`: what the node would be, without starting it: its fully
+/// qualified name, transport, resolved topics (namespace and remappings
+/// applied) and every parameter that differs from the built-in default.
+/// The configuration was already loaded and validated by the caller.
+pub fn check(config: &Config, transport: Option<TransportArg>) {
+    use friction_node::node::parameters::flatten;
+    use friction_node::transport::names::TopicNames;
+    let r = &config.ros;
+    let fqn = if r.namespace.trim_end_matches('/').is_empty() {
+        format!("/{}", r.node_name)
+    } else {
+        format!("{}/{}", r.namespace.trim_end_matches('/'), r.node_name)
+    };
+    let transport = transport
+        .map(TransportArg::kind)
+        .unwrap_or(config.node.transport);
+    println!("node: {fqn}");
+    let transport = serde_norway::to_string(&transport).unwrap_or_default();
+    println!("transport: {}", transport.trim_end());
+    let t = TopicNames::from_config(config);
+    println!("topics:");
+    for (what, name) in [
+        ("cmd_velocity", &t.cmd_velocity),
+        ("normal_load", &t.normal_load),
+        ("temperature", &t.temperature),
+        ("friction", &t.friction),
+        ("friction_force", &t.friction_force),
+        ("film_profile", &t.film_profile),
+        ("loop_statistics", &t.loop_statistics),
+        ("snapshot", &t.snapshot),
+        ("parameter_events", &t.parameter_events),
+    ] {
+        println!("  {what}: {name}");
+    }
+    let defaults: std::collections::HashMap<String, serde_norway::Value> =
+        flatten(&Config::default()).into_iter().collect();
+    let all = flatten(config);
+    let changed: Vec<_> = all
+        .iter()
+        .filter(|(k, v)| defaults.get(k) != Some(v))
+        .collect();
+    println!(
+        "parameters: {} declared, {} differ from the defaults",
+        all.len(),
+        changed.len()
+    );
+    for (k, v) in changed {
+        let one = |v: &serde_norway::Value| {
+            serde_norway::to_string(v)
+                .unwrap_or_default()
+                .trim_end()
+                .to_string()
+        };
+        let v = match v {
+            serde_norway::Value::Sequence(s) => {
+                format!("[{}]", s.iter().map(one).collect::<Vec<_>>().join(", "))
+            }
+            v => one(v),
+        };
+        println!("  {k}: {v}");
+    }
+    println!("configuration valid (--check: not starting)");
+}
+
 /// `soak`: the node driven by a random motion for `seconds`, its resident
 /// memory sampled every `every_s` seconds into `rss_csv`.
 pub fn soak(
