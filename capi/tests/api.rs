@@ -1,0 +1,232 @@
+//! The C API's contract, called from Rust as C would call it: errors are
+//! codes with a message naming the input, nothing panics across the
+//! boundary, bad handles are detected, parameters change the model, and a
+//! step does not allocate.
+
+use friction_node_c::*;
+use std::cell::Cell;
+use std::ffi::{c_char, CStr, CString};
+use std::ptr::{null, null_mut};
+
+struct CountingAlloc;
+thread_local! {
+    static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
+}
+unsafe impl std::alloc::GlobalAlloc for CountingAlloc {
+    unsafe fn alloc(&self, l: std::alloc::Layout) -> *mut u8 {
+        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+        unsafe { std::alloc::System.alloc(l) }
+    }
+    unsafe fn dealloc(&self, p: *mut u8, l: std::alloc::Layout) {
+        unsafe { std::alloc::System.dealloc(p, l) }
+    }
+    unsafe fn realloc(&self, p: *mut u8, l: std::alloc::Layout, n: usize) -> *mut u8 {
+        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+        unsafe { std::alloc::System.realloc(p, l, n) }
+    }
+}
+#[global_allocator]
+static GLOBAL: CountingAlloc = CountingAlloc;
+
+fn last_error() -> String {
+    let mut buf = [0 as c_char; 512];
+    let n = unsafe { fn_last_error(buf.as_mut_ptr(), buf.len()) };
+    let s = unsafe { CStr::from_ptr(buf.as_ptr()) }
+        .to_str()
+        .unwrap()
+        .to_string();
+    assert_eq!(n, s.len(), "short messages are copied whole");
+    s
+}
+
+fn new_model(yaml: &str) -> Result<*mut FnModel, (i32, String)> {
+    let y = CString::new(yaml).unwrap();
+    let mut m = null_mut();
+    match unsafe { fn_model_new_from_yaml(y.as_ptr(), &mut m) } {
+        FN_OK => Ok(m),
+        code => Err((code, last_error())),
+    }
+}
+
+fn set(m: *mut FnModel, key: &str, value: &str) -> Result<(), (i32, String)> {
+    let (k, v) = (CString::new(key).unwrap(), CString::new(value).unwrap());
+    match unsafe { fn_model_set_parameter(m, k.as_ptr(), v.as_ptr()) } {
+        FN_OK => Ok(()),
+        code => Err((code, last_error())),
+    }
+}
+
+fn step(m: *mut FnModel, v: f64, load: f64, dt: f64) -> FnEstimate {
+    let mut e = FnEstimate::default();
+    assert_eq!(unsafe { fn_model_step(m, v, load, dt, &mut e) }, FN_OK);
+    e
+}
+
+#[test]
+fn a_bad_configuration_is_an_error_code_with_the_key_and_value_named() {
+    let (code, msg) =
+        new_model("/**:\n  ros__parameters:\n    contact:\n      load_n: -3.0\n").unwrap_err();
+    assert_eq!(code, FN_ERROR_CONFIG);
+    assert!(
+        msg.contains("contact.load_n") && msg.contains("-3"),
+        "{msg}"
+    );
+    let (code, msg) =
+        new_model("/**:\n  ros__parameters:\n    contact:\n      lod_n: 1\n").unwrap_err();
+    assert_eq!(code, FN_ERROR_CONFIG);
+    assert!(msg.contains("lod_n"), "{msg}");
+    let (code, _) = new_model("{{{").unwrap_err();
+    assert_eq!(code, FN_ERROR_CONFIG);
+    let path = CString::new("/nonexistent/machine.yaml").unwrap();
+    let mut m = null_mut();
+    assert_eq!(
+        unsafe { fn_model_new_from_file(path.as_ptr(), &mut m) },
+        FN_ERROR_IO
+    );
+    assert!(last_error().contains("/nonexistent/machine.yaml"));
+    assert!(m.is_null());
+    assert_eq!(
+        unsafe { fn_model_new_from_yaml(null(), &mut m) },
+        FN_ERROR_NULL_ARGUMENT
+    );
+    let bad_utf8 = [0xffu8 as c_char, 0];
+    assert_eq!(
+        unsafe { fn_model_new_from_yaml(bad_utf8.as_ptr(), &mut m) },
+        FN_ERROR_UTF8
+    );
+    let y = CString::new("").unwrap();
+    assert_eq!(
+        unsafe { fn_model_new_from_yaml(y.as_ptr(), null_mut()) },
+        FN_ERROR_NULL_ARGUMENT
+    );
+}
+
+#[test]
+fn null_freed_and_foreign_handles_are_refused_not_followed() {
+    let mut e = FnEstimate::default();
+    assert_eq!(
+        unsafe { fn_model_step(null_mut(), 0.1, 1e4, 1e-3, &mut e) },
+        FN_ERROR_INVALID_HANDLE
+    );
+    // A pointer to something that is not a model (aligned, readable).
+    let mut junk = vec![0u64; 4096];
+    let foreign = junk.as_mut_ptr() as *mut FnModel;
+    assert_eq!(
+        unsafe { fn_model_step(foreign, 0.1, 1e4, 1e-3, &mut e) },
+        FN_ERROR_INVALID_HANDLE
+    );
+    assert!(last_error().contains("not a friction-node model"));
+    assert_eq!(unsafe { fn_model_dt(foreign) }, 0.0);
+    unsafe { fn_model_free(foreign) }; // ignored, not freed
+    unsafe { fn_model_free(null_mut()) };
+    let m = new_model("").unwrap();
+    assert_eq!(
+        unsafe { fn_model_step(m, 0.1, 1e4, 1e-3, null_mut()) },
+        FN_ERROR_NULL_ARGUMENT
+    );
+    unsafe { fn_model_free(m) };
+    drop(junk);
+}
+
+#[test]
+fn a_step_is_a_status_not_an_error_and_does_not_allocate() {
+    let m = new_model("").unwrap();
+    let dt = unsafe { fn_model_dt(m) };
+    assert_eq!(dt, 1e-3);
+    let mut e = FnEstimate::default();
+    let before = ALLOCATIONS.with(Cell::get);
+    for k in 1..=2000 {
+        let v = (2.0 * std::f64::consts::PI * k as f64 * dt).sin();
+        assert_eq!(unsafe { fn_model_step(m, v, 20762.0, dt, &mut e) }, FN_OK);
+        assert_eq!(e.status, FN_STATUS_CONVERGED, "step {k}");
+    }
+    assert_eq!(
+        ALLOCATIONS.with(Cell::get) - before,
+        0,
+        "allocations in 2000 steps"
+    );
+    // Out of the envelope: FN_OK, the status says so, the last good values held.
+    let good = e;
+    let bad = step(m, f64::NAN, 20762.0, dt);
+    assert_eq!(bad.status, FN_STATUS_NON_FINITE_INPUT);
+    assert_eq!(bad.friction_force_n, good.friction_force_n);
+    assert_eq!(step(m, 0.5, -1.0, dt).status, FN_STATUS_INPUT_OUT_OF_RANGE);
+    assert_eq!(
+        step(m, 0.5, 20762.0, 7200.0).status,
+        FN_STATUS_INPUT_OUT_OF_RANGE
+    );
+    let name = unsafe { CStr::from_ptr(fn_status_name(FN_STATUS_INPUT_OUT_OF_RANGE)) };
+    assert_eq!(name.to_str().unwrap(), "input_out_of_range");
+    // A late period: one backward-Euler step of 3 ms, then back to dt.
+    let late = step(m, 0.5, 20762.0, 3e-3);
+    assert_eq!(late.status, FN_STATUS_CONVERGED);
+    assert!(
+        (late.time_s - good.time_s - 3e-3 - 3.0 * dt).abs() < 1e-12,
+        "{}",
+        late.time_s
+    );
+    unsafe { fn_model_free(m) };
+}
+
+#[test]
+fn a_runtime_parameter_changes_the_model_and_a_refused_one_changes_nothing() {
+    // Two identical models; only `m` is offered the refused changes.
+    let m = new_model("").unwrap();
+    let twin = new_model("").unwrap();
+    let dt = unsafe { fn_model_dt(m) };
+    for _ in 0..200 {
+        step(m, 0.05, 20762.0, dt);
+        step(twin, 0.05, 20762.0, dt);
+    }
+    let (code, msg) = set(m, "contact.boundary_friction", "7").unwrap_err();
+    assert_eq!(code, FN_ERROR_PARAMETER);
+    assert!(
+        msg.contains("contact.boundary_friction") && msg.contains('7'),
+        "{msg}"
+    );
+    let (_, msg) = set(m, "solver.cells", "64").unwrap_err();
+    assert!(msg.contains("solver.cells"), "read-only: {msg}");
+    let (_, msg) = set(m, "contact.boundary_friction", "high").unwrap_err();
+    assert!(
+        msg.contains("contact.boundary_friction") && msg.contains("high"),
+        "{msg}"
+    );
+    let (_, msg) = set(m, "contact.nosuch", "1").unwrap_err();
+    assert!(msg.contains("contact.nosuch"), "{msg}");
+    let before = step(m, 0.05, 20762.0, dt);
+    assert_eq!(
+        before,
+        step(twin, 0.05, 20762.0, dt),
+        "refused sets changed nothing"
+    );
+    // Half the boundary friction: the asperity part of the friction halves.
+    set(m, "contact.boundary_friction", "0.15").unwrap();
+    let after = step(m, 0.05, 20762.0, dt);
+    assert!(after.asperity_force_n > 0.0);
+    let asperity_part = |e: &FnEstimate, mu: f64| mu * e.asperity_force_n;
+    assert!(
+        (after.friction_force_n
+            - before.friction_force_n
+            - (asperity_part(&after, 0.15) - asperity_part(&before, 0.3)))
+        .abs()
+            < 0.05 * before.friction_force_n.abs(),
+        "{} -> {}",
+        before.friction_force_n,
+        after.friction_force_n
+    );
+    assert!(after.friction_force_n < 0.75 * before.friction_force_n);
+    let t = CString::new("x").unwrap();
+    assert_eq!(
+        unsafe { fn_model_set_parameter(m, t.as_ptr(), null()) },
+        FN_ERROR_NULL_ARGUMENT
+    );
+    assert_eq!(
+        unsafe { fn_model_set_temperature(m, f64::NAN) },
+        FN_ERROR_ARGUMENT
+    );
+    assert_eq!(unsafe { fn_model_set_temperature(m, 40.0) }, FN_OK);
+    assert_eq!(unsafe { fn_model_reset(m, 0.0, -1.0) }, FN_ERROR_ARGUMENT);
+    assert_eq!(unsafe { fn_model_reset(m, 0.0, 20762.0) }, FN_OK);
+    unsafe { fn_model_free(m) };
+    unsafe { fn_model_free(twin) };
+}
