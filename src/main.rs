@@ -43,7 +43,22 @@ unsafe impl std::alloc::GlobalAlloc for CountingAlloc {
 #[global_allocator]
 static GLOBAL: CountingAlloc = CountingAlloc;
 
+/// Keep large allocations (MCAP chunk buffers, compression contexts) out of
+/// the heap: glibc raises its mmap threshold each time such a block is freed,
+/// after which they come from the heap, fragment it and keep resident memory
+/// creeping up over hours of recording (measured: +1.5 MB in 8 simulated
+/// hours without this, +0.2 MB with it; `bench-recorder`). A fixed
+/// threshold returns every block above 128 KiB to the system when freed.
+fn fix_malloc_mmap_threshold() {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    // SAFETY: mallopt only changes allocator tuning; called before any thread starts.
+    unsafe {
+        libc::mallopt(libc::M_MMAP_THRESHOLD, 128 * 1024);
+    }
+}
+
 fn main() {
+    fix_malloc_mmap_threshold();
     // `--ros-args ... [--]` sections are rcl's, not clap's: split them off.
     let argv: Vec<String> = std::env::args().collect();
     let (rest, ros_tokens) = friction_node::config::ros_args::split(&argv[1..]);
