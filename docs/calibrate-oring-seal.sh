@@ -3,7 +3,7 @@
 # 3 bar, predict 5 and 7 bar, and compare with the classic models fitted on
 # the same data with the same optimiser.
 #
-# Data: tests/data/oring-seal (CC0, copied unchanged; its README gives the columns and the
+# Data: ../shared/data/oring-seal (CC0; its README gives the columns and the
 # provenance). Whitespace-separated, no header, 100 Hz:
 #   t_ms laser_v p_raw_v f_raw_v x_mm p_bar force_n
 #
@@ -20,7 +20,7 @@
 # report with plots (summary.md, fit.csv, SVGs per model).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-DATA=${ORING_DATA:-tests/data/oring-seal}
+DATA=${ORING_DATA:-../shared/data/oring-seal}
 OUT=${1:-out/oring-seal}
 rm -rf "$OUT"
 mkdir -p "$OUT"
