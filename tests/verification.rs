@@ -341,3 +341,26 @@ fn a_failed_full_step_is_retried_from_the_last_state_and_then_sub_stepped() {
         assert_eq!(s.step(10.0, 20_762.0).status, Status::Converged);
     }
 }
+
+/// The accuracy guide's claim (`bench-accuracy`): on the paper's
+/// reciprocating case the friction loop area converges at first order in
+/// the grid (cavitation makes the scheme first order, MODEL.md), so halving
+/// Δx halves its error, while the mean COF is already within 0.5 % at
+/// N = 32.
+#[test]
+fn the_loop_area_converges_at_first_order_in_the_grid() {
+    use friction_node::bench::accuracy::run_setting;
+    let config = friction_node::config::Config::load(None, &[]).unwrap();
+    let reference = run_setting(&config, 512, 1e-3, 2).unwrap();
+    let coarse = run_setting(&config, 32, 1e-3, 2).unwrap();
+    let finer = run_setting(&config, 64, 1e-3, 2).unwrap();
+    let (e32, e64) = (coarse.errors(&reference), finer.errors(&reference));
+    let ratio = e32[0] / e64[0];
+    assert!(
+        (1.6..=2.6).contains(&ratio),
+        "loop-area error ratio {ratio} ({} / {})",
+        e32[0],
+        e64[0]
+    );
+    assert!(e32[1] < 5e-3, "mean COF error at N = 32: {}", e32[1]);
+}

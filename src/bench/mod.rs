@@ -171,6 +171,7 @@ pub fn csv(cases: &[BenchCase]) -> String {
     s
 }
 
+pub mod accuracy;
 mod latency;
 #[cfg(feature = "mcap")]
 pub mod recorder;

@@ -117,6 +117,14 @@ fn hours(s: &str) -> Result<u64, String> {
     count(s, 1, 10_000, "a number of hours")
 }
 
+fn accuracy_dt(s: &str) -> Result<f64, String> {
+    ranged(s, 1e-6, false, 0.1, "a step in s")
+}
+
+fn accuracy_cycles(s: &str) -> Result<u32, String> {
+    count(s, 2, 100, "a number of cycles").map(|v| v as u32)
+}
+
 fn seeds(s: &str) -> Result<u64, String> {
     count(s, 1, 1000, "a number of seeds")
 }
@@ -299,6 +307,26 @@ pub enum Command {
         #[arg(long, value_name = "DIR")]
         out: PathBuf,
     },
+    /// The accuracy guide: the paper's reciprocating case over grids and steps against a fine reference, with the cost per step (release build!).
+    BenchAccuracy {
+        #[command(flatten)]
+        common: Common,
+        /// Grid sizes at the configured step, comma-separated, each in [8, 65536].
+        #[arg(long, default_value = "32,64,128,256,512,1024", value_delimiter = ',', value_parser = cells)]
+        grids: Vec<usize>,
+        /// Steps (s) at the configured grid, comma-separated, each in [1e-6, 0.1].
+        #[arg(long, default_value = "0.004,0.002,0.001,0.0005,0.00025", value_delimiter = ',', value_parser = accuracy_dt)]
+        steps: Vec<f64>,
+        /// The reference grid, in [8, 65536].
+        #[arg(long, default_value = "2048", value_parser = cells)]
+        reference_cells: usize,
+        /// The reference step (s), in [1e-6, 0.1].
+        #[arg(long, default_value = "0.000125", value_parser = accuracy_dt)]
+        reference_dt: f64,
+        /// Cycles per run (the last one is measured), in [2, 100].
+        #[arg(long, default_value = "3", value_parser = accuracy_cycles)]
+        cycles: u32,
+    },
     /// The calibration targets on synthetic data: recovery of three parameters, transfer to another load and frequency against the classic models (release build!).
     BenchFit {
         #[command(flatten)]
@@ -348,6 +376,7 @@ impl Command {
             | Command::Bench { common, .. }
             | Command::BenchRecorder { common, .. }
             | Command::BenchFit { common, .. }
+            | Command::BenchAccuracy { common, .. }
             | Command::Soak { common, .. }
             | Command::Fit { common, .. } => common,
         }

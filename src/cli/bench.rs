@@ -73,6 +73,24 @@ pub fn latency(
     Ok(())
 }
 
+/// `bench-accuracy`: the accuracy guide's table (markdown, on stdout).
+pub fn accuracy(
+    config: &Config,
+    grids: &[usize],
+    steps: &[f64],
+    reference: (usize, f64),
+    cycles: u32,
+) -> Result<()> {
+    if cfg!(debug_assertions) {
+        eprintln!("warning: a debug build; the step costs are not representative (use --release)");
+    }
+    let r = friction_node::bench::accuracy::run(config, grids, steps, reference, cycles, &|m| {
+        eprintln!("  {m}")
+    })?;
+    print!("{r}");
+    Ok(())
+}
+
 /// `bench-recorder`: simulated hours through the recorder.
 pub fn recorder(config: &Config, hours: u64, out: PathBuf) -> Result<()> {
     #[cfg(feature = "mcap")]

@@ -118,6 +118,20 @@ pub fn dispatch(
         } => study::run(&config, name, &out, cycles, jobs),
         Command::Fit { args, .. } => fit::run(&config, &args),
         Command::BenchRecorder { hours, out, .. } => bench::recorder(&config, hours, out),
+        Command::BenchAccuracy {
+            grids,
+            steps,
+            reference_cells,
+            reference_dt,
+            cycles,
+            ..
+        } => bench::accuracy(
+            &config,
+            &grids,
+            &steps,
+            (reference_cells, reference_dt),
+            cycles,
+        ),
         Command::BenchFit {
             cells,
             duration,
