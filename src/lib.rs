@@ -10,6 +10,7 @@ pub mod bag;
 pub mod bench;
 pub mod clock;
 pub mod config;
+pub mod contacts;
 pub mod fit;
 pub mod msgs;
 pub mod node;

@@ -127,7 +127,8 @@ impl Config {
     }
 
     /// Deserialize and validate a `ros__parameters` tree.
-    fn from_params(params: Value) -> Result<Config, ConfigError> {
+    fn from_params(mut params: Value) -> Result<Config, ConfigError> {
+        super::contacts::inherit_top_level(&mut params);
         let cfg: Config = serde_path_to_error::deserialize(params).map_err(|e| {
             let key = e.path().to_string();
             let message = e.inner().to_string();

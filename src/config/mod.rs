@@ -25,8 +25,10 @@
 //! | `io.rs` | the node's sections (`node`, `ros`, `iceoryx2`, `recording`) |
 //! | `load.rs` | parameter files, their ROS 2 shapes, `--set` overrides |
 //! | `validate.rs` | physical ranges and ROS 2 names, one function per section |
+//! | `contacts.rs` | `contacts.*`: several contacts, each overriding the top-level sections |
 //! | `error.rs` | [`ConfigError`] and the [`Origin`] of a configuration |
 
+mod contacts;
 mod error;
 mod io;
 mod load;
@@ -34,6 +36,10 @@ mod model;
 pub mod ros_args;
 mod validate;
 
+pub use contacts::{
+    ContactEntry, ContactList, ContactSolverConfig, ResolvedContact, CONTACT_SECTIONS,
+    SINGLE_CONTACT_NAME,
+};
 pub use error::{ConfigError, Origin};
 pub use io::*;
 pub use load::apply_override;
@@ -73,6 +79,10 @@ pub struct Config {
     pub ros: RosConfig,
     pub iceoryx2: Iceoryx2Config,
     pub recording: RecordingConfig,
+    /// Several contacts, each overriding the top-level sections (last, so
+    /// that a top-level mistake is reported first).
+    #[serde(skip_serializing_if = "ContactList::is_empty")]
+    pub contacts: ContactList,
 }
 
 impl Config {

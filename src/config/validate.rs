@@ -131,10 +131,11 @@ impl Config {
         self.validate_node()?;
         self.validate_ros()?;
         self.validate_iceoryx2()?;
-        self.validate_recording()
+        self.validate_recording()?;
+        self.validate_contacts()
     }
 
-    fn validate_contact(&self) -> Result<(), ConfigError> {
+    pub(super) fn validate_contact(&self) -> Result<(), ConfigError> {
         let c = &self.contact;
         oc("contact.length_m", c.length_m, 1e-4, 10.0)?;
         oc("contact.width_m", c.width_m, 1e-4, 10.0)?;
@@ -151,7 +152,7 @@ impl Config {
         cc("contact.min_film_m", c.min_film_m, 0.0, 1e-3)
     }
 
-    fn validate_texture(&self) -> Result<(), ConfigError> {
+    pub(super) fn validate_texture(&self) -> Result<(), ConfigError> {
         let t = &self.texture;
         let n = t.pocket_start_m.len();
         for (key, len) in [
@@ -179,7 +180,7 @@ impl Config {
         Ok(())
     }
 
-    fn validate_lubricant(&self) -> Result<(), ConfigError> {
+    pub(super) fn validate_lubricant(&self) -> Result<(), ConfigError> {
         let l = &self.lubricant;
         oc("lubricant.viscosity_pa_s", l.viscosity_pa_s, 1e-5, 100.0)?;
         cc(
@@ -247,7 +248,7 @@ impl Config {
         cc("drivetrain.load_coefficient", d.load_coefficient, 0.0, 10.0)
     }
 
-    fn validate_roughness(&self) -> Result<(), ConfigError> {
+    pub(super) fn validate_roughness(&self) -> Result<(), ConfigError> {
         let r = &self.roughness;
         oc("roughness.sigma_m", r.sigma_m, 1e-10, 1e-4)?;
         cc(
@@ -279,7 +280,7 @@ impl Config {
         Ok(())
     }
 
-    fn validate_solver(&self) -> Result<(), ConfigError> {
+    pub(super) fn validate_solver(&self) -> Result<(), ConfigError> {
         let s = &self.solver;
         cc("solver.cells", s.cells as f64, 8.0, 65536.0)?;
         oc("solver.dt_s", s.dt_s, 1e-7, 1.0)?;

@@ -118,7 +118,7 @@ pub fn flatten(config: &Config) -> Vec<(String, Value)> {
 fn type_of(name: &str, v: &Value) -> u8 {
     match v {
         Value::Sequence(s) if s.is_empty() => {
-            if name.starts_with("texture.") {
+            if is_texture(name) {
                 ty::DOUBLE_ARRAY
             } else {
                 ty::STRING_ARRAY
@@ -127,7 +127,7 @@ fn type_of(name: &str, v: &Value) -> u8 {
         Value::Sequence(_) => {
             let p = ParameterValue::from_yaml(v).r#type;
             // Pocket arrays are doubles even when written as integers.
-            if name.starts_with("texture.") {
+            if is_texture(name) {
                 ty::DOUBLE_ARRAY
             } else {
                 p
@@ -135,6 +135,18 @@ fn type_of(name: &str, v: &Value) -> u8 {
         }
         other => ParameterValue::from_yaml(other).r#type,
     }
+}
+
+fn is_texture(name: &str) -> bool {
+    top_level_key(name).starts_with("texture.")
+}
+
+/// The top-level key a per-contact key `contacts.NAME.section.key` mirrors
+/// (for its documentation and range); other keys are their own.
+fn top_level_key(name: &str) -> &str {
+    name.strip_prefix("contacts.")
+        .and_then(|rest| rest.split_once('.'))
+        .map_or(name, |(_, key)| key)
 }
 
 /// Every parameter of `config`, declared.
@@ -150,12 +162,17 @@ pub fn declare(config: &Config) -> Vec<Declared> {
                 value.double_value = value.integer_value as f64;
             }
             value.r#type = r#type;
+            let doc_key = top_level_key(&name);
             let description = docs
                 .iter()
-                .find(|(k, _)| *k == name)
+                .find(|(k, _)| k == doc_key)
                 .map_or(String::new(), |(_, c)| c.clone());
+            let range = ranges.iter().find(|r| r.key == doc_key).map(|r| KeyRange {
+                key: name.clone(),
+                ..r.clone()
+            });
             Declared {
-                range: ranges.iter().find(|r| r.key == name).cloned(),
+                range,
                 read_only: !is_runtime(&name),
                 description,
                 value,
