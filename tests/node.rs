@@ -832,3 +832,24 @@ mod recording {
         assert!(!stderr.contains("loop running"), "{stderr}");
     }
 }
+
+#[test]
+fn a_configuration_with_several_contacts_is_refused_by_the_one_contact_loop() {
+    let cfg = Config::from_yaml(
+        "/**:\n  ros__parameters:\n    contacts:\n      left: {}\n      right: {}\n",
+        &friction_node::config::Origin::Embedded,
+        &[],
+    )
+    .unwrap();
+    let link = MemoryLink::new(16);
+    let e = Loop::new(
+        &cfg,
+        vec![Box::new(link.node())],
+        None,
+        None,
+        Arc::new(LiveStatus::default()),
+    )
+    .err()
+    .expect("refused");
+    assert!(e.to_string().contains("2 contacts"), "{e}");
+}

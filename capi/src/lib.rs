@@ -229,6 +229,16 @@ unsafe fn text<'a>(s: *const c_char, what: &str) -> Result<&'a str, i32> {
 }
 
 fn build(config: Config, out: *mut *mut FnModel) -> i32 {
+    if !config.contacts.is_empty() {
+        return fail(
+            FN_ERROR_CONFIG,
+            format!(
+                "the configuration lists {} contacts (`contacts`): a handle is one contact; \
+                 create one handle per contact from a configuration without `contacts`",
+                config.contacts.0.len()
+            ),
+        );
+    }
     let solver = match Solver::new(&config.model(), &config.solver_settings()) {
         Ok(s) => s,
         Err(e) => return fail(FN_ERROR_SETUP, e.to_string()),

@@ -75,6 +75,14 @@ fn a_bad_configuration_is_an_error_code_with_the_key_and_value_named() {
         new_model("/**:\n  ros__parameters:\n    contact:\n      lod_n: 1\n").unwrap_err();
     assert_eq!(code, FN_ERROR_CONFIG);
     assert!(msg.contains("lod_n"), "{msg}");
+    let (code, msg) =
+        new_model("/**:\n  ros__parameters:\n    contacts:\n      left: {}\n      right: {}\n")
+            .unwrap_err();
+    assert_eq!(code, FN_ERROR_CONFIG);
+    assert!(
+        msg.contains("2 contacts") && msg.contains("one handle per contact"),
+        "{msg}"
+    );
     let (code, _) = new_model("{{{").unwrap_err();
     assert_eq!(code, FN_ERROR_CONFIG);
     let path = CString::new("/nonexistent/machine.yaml").unwrap();

@@ -185,6 +185,11 @@ pub enum NodeError {
     Setup(#[from] SetupError),
     #[error("the node needs at least one transport")]
     NoTransport,
+    #[error(
+        "the configuration lists {0} contacts (`contacts`): the node serves one contact per process \
+         today (multi-contact I/O is not built yet); remove `contacts` and run one node per contact"
+    )]
+    SeveralContacts(usize),
 }
 
 /// The loop: solver, ports, outputs and bookkeeping.
@@ -238,6 +243,9 @@ impl Loop {
     ) -> Result<Self, NodeError> {
         if ports.is_empty() {
             return Err(NodeError::NoTransport);
+        }
+        if !config.contacts.is_empty() {
+            return Err(NodeError::SeveralContacts(config.contacts.0.len()));
         }
         let mut solver = Solver::new(&config.model(), &config.solver_settings())?;
         let v0 = config.node.initial_velocity_m_s;
