@@ -278,10 +278,16 @@ fn a_fresh_recording_replays_bit_identically_and_so_does_the_replay_output() {
         "--expect-identical",
     ]);
     assert_eq!(code, 0, "{stdout}{err}");
-    assert!(
-        stdout.contains("bit-identical to the recorded estimates (500 steps)"),
-        "{stdout}"
-    );
+    // Every recorded step is reproduced; how many the node took depends on
+    // how many of the demo's 500 commands it received before the demo
+    // ended, which a loaded machine changes (lockstep takes only what arrives).
+    let steps: u64 = stdout
+        .split("bit-identical to the recorded estimates (")
+        .nth(1)
+        .and_then(|r| r.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no oracle verdict: {stdout}"));
+    assert!((20..=500).contains(&steps), "{stdout}");
     // The output is a friction-node bag in its own right.
     let again = d.join("again.csv");
     let (code, stdout, err) = run(&[
