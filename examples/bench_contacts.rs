@@ -12,17 +12,20 @@
 //! misses.
 
 use friction_node::clock::{Clock, SystemClock};
-use friction_node::config::{Config, Origin};
+use friction_node::config::{Config, Origin, RealtimeConfig};
 use friction_node::contacts::ContactSet;
 use std::sync::Arc;
 
+/// Pin the calling thread with the node's own real-time helper.
 fn pin(cpu: Option<usize>) {
     if let Some(cpu) = cpu {
-        // SAFETY: a zeroed cpu_set_t is valid; CPU_SET writes inside it.
-        unsafe {
-            let mut set: libc::cpu_set_t = std::mem::zeroed();
-            libc::CPU_SET(cpu, &mut set);
-            libc::sched_setaffinity(0, std::mem::size_of::<libc::cpu_set_t>(), &set);
+        let rt = RealtimeConfig {
+            cpu: cpu as i32,
+            ..RealtimeConfig::default()
+        };
+        let (_, warnings) = friction_node::node::rt::apply(&rt);
+        for w in warnings {
+            eprintln!("warning: {w}");
         }
     }
 }
