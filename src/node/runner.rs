@@ -277,6 +277,9 @@ pub fn run_node(
     }
     // The demo driver publishes on the first transport's real topics.
     let mut driver = None;
+    // The driver stops with the loop (or on a signal): in lockstep it waits
+    // for each estimate, and a loop that has ended sends none.
+    let driver_stop = Arc::new(AtomicBool::new(false));
     if let Some(seconds) = opts.demo_s {
         if !(seconds > 0.0 && seconds.is_finite()) {
             return Err(RunError::Option(format!(
@@ -285,7 +288,11 @@ pub fn run_node(
         }
         let (tx, rx) = std::sync::mpsc::channel();
         let spec = specs[0].clone();
-        let (mode, dt, s2) = (config.node.step_mode, config.solver.dt_s, stop.clone());
+        let (mode, dt, s2) = (
+            config.node.step_mode,
+            config.solver.dt_s,
+            driver_stop.clone(),
+        );
         let profile = opts.profile;
         driver = Some(std::thread::spawn(move || {
             super::driver::drive(spec, mode, dt, seconds, profile, tx, s2)
@@ -323,6 +330,7 @@ pub fn run_node(
     );
     report.summary = l.run(&stop, duration);
     report.interrupted = stop.load(Ordering::Relaxed);
+    driver_stop.store(true, Ordering::Relaxed);
     status_stop.store(true, Ordering::Relaxed);
     if let Some(s) = status {
         let _ = s.join();
