@@ -67,8 +67,11 @@ impl NodePort for Scripted {
         }
         Ok(c)
     }
-    fn publish_estimate(&mut self, e: &EstimateRecord) -> bool {
-        self.inner.publish_estimate(e)
+    fn publish_estimate(&mut self, contact: usize, e: &EstimateRecord) -> bool {
+        self.inner.publish_estimate(contact, e)
+    }
+    fn publish_efforts(&mut self, stamp_ns: u64, efforts: &[f64]) -> bool {
+        self.inner.publish_efforts(stamp_ns, efforts)
     }
     fn publish_statistics(&mut self, s: &StatisticsRecord) -> bool {
         self.inner.publish_statistics(s)
@@ -831,25 +834,4 @@ mod recording {
         assert!(stderr.contains("/proc/nope/x.mcap"), "{stderr}");
         assert!(!stderr.contains("loop running"), "{stderr}");
     }
-}
-
-#[test]
-fn a_configuration_with_several_contacts_is_refused_by_the_one_contact_loop() {
-    let cfg = Config::from_yaml(
-        "/**:\n  ros__parameters:\n    contacts:\n      left: {}\n      right: {}\n",
-        &friction_node::config::Origin::Embedded,
-        &[],
-    )
-    .unwrap();
-    let link = MemoryLink::new(16);
-    let e = Loop::new(
-        &cfg,
-        vec![Box::new(link.node())],
-        None,
-        None,
-        Arc::new(LiveStatus::default()),
-    )
-    .err()
-    .expect("refused");
-    assert!(e.to_string().contains("2 contacts"), "{e}");
 }

@@ -8,8 +8,8 @@
 //!     gain: 1.0             # friction force (N) → joint effort: 1 (linear joint, N) or the lever arm in m (rotary, N·m)
 //!     contact: {load_n: 5000.0}
 //!     solver: {cells: 128}
-//!   carriage_right:
-//!     joint: axis_x
+//!   carriage_y:
+//!     joint: axis_y
 //! ```
 //!
 //! A ROS 2 parameter cannot hold a list of structs, so the contacts are a
@@ -29,6 +29,13 @@ use serde::de::{MapAccess, Visitor};
 use serde::ser::SerializeMap;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use serde_norway::{Mapping, Value};
+
+/// Most contacts one node serves (its joint messages are fixed-size on
+/// the loop).
+pub const MAX_CONTACTS: usize = 64;
+
+/// Longest joint name, bytes (iceoryx2 carries names in fixed fields).
+pub const MAX_JOINT_NAME_BYTES: usize = 64;
 
 /// The sections a contact overrides key by key.
 pub const CONTACT_SECTIONS: [&str; 4] = ["contact", "texture", "lubricant", "roughness"];
@@ -255,6 +262,13 @@ impl Config {
     /// `contacts.NAME.section.key`).
     pub(super) fn validate_contacts(&self) -> Result<(), ConfigError> {
         let mut joints: Vec<(&str, &str)> = Vec::new();
+        if self.contacts.0.len() > MAX_CONTACTS {
+            return Err(ConfigError::OutOfRange {
+                key: "contacts".into(),
+                value: format!("{} contacts", self.contacts.0.len()),
+                range: format!("at most {MAX_CONTACTS} contacts per node (run several nodes)"),
+            });
+        }
         for e in &self.contacts.0 {
             let key = |k: &str| format!("contacts.{}.{k}", e.name);
             if let Err(why) = check_contact_name(&e.name) {
@@ -267,6 +281,16 @@ impl Config {
                 return Err(ConfigError::InvalidValue {
                     key: key("joint"),
                     message: format!("joint name {:?} must be non-empty text", e.joint),
+                });
+            }
+            if e.joint.len() > MAX_JOINT_NAME_BYTES {
+                return Err(ConfigError::InvalidValue {
+                    key: key("joint"),
+                    message: format!(
+                        "joint name `{}` is {} bytes long: at most {MAX_JOINT_NAME_BYTES}",
+                        e.joint,
+                        e.joint.len()
+                    ),
                 });
             }
             if let Some((other, _)) = joints.iter().find(|(_, j)| *j == e.joint) {

@@ -48,6 +48,9 @@ pub struct RealtimeConfig {
     pub lock_memory: bool,
     /// Pin the loop thread to this CPU; -1 = no pinning.
     pub cpu: i32,
+    /// Pin contact worker k (1, 2, …) to `worker_cpus[k - 1]`; workers
+    /// beyond the list are not pinned (they share the other settings).
+    pub worker_cpus: Vec<i32>,
 }
 
 impl Default for RealtimeConfig {
@@ -57,6 +60,7 @@ impl Default for RealtimeConfig {
             priority: 80,
             lock_memory: false,
             cpu: -1,
+            worker_cpus: Vec::new(),
         }
     }
 }
@@ -95,6 +99,11 @@ pub struct NodeConfig {
     /// s; further behind, it advances the lost time in one backward-Euler
     /// step and restarts BDF2.
     pub max_catch_up_s: f64,
+    /// Worker threads that step contacts beside the loop's own thread
+    /// (0: the loop steps every contact; at most one fewer than the
+    /// contacts). They wait for each step spinning (up to 50 µs, or
+    /// `lockstep_spin_us` if longer), then parked.
+    pub contact_workers: usize,
     pub realtime: RealtimeConfig,
 }
 
@@ -116,6 +125,7 @@ impl Default for NodeConfig {
             frame_id: "slider".into(),
             lockstep_spin_us: 0,
             max_catch_up_s: 0.1,
+            contact_workers: 0,
             realtime: RealtimeConfig::default(),
         }
     }
@@ -278,6 +288,12 @@ pub struct Iceoryx2Config {
     pub loop_statistics_service: String,
     /// Event service that wakes a lockstep node when a command is sent.
     pub cmd_event_service: String,
+    /// Several contacts: JointState-like velocities by joint name.
+    pub joint_state_service: String,
+    /// Several contacts: every contact's effort in joint order.
+    pub efforts_service: String,
+    /// Several contacts: each contact's estimate (tagged with its index).
+    pub contact_friction_service: String,
 }
 
 impl Default for Iceoryx2Config {
@@ -289,6 +305,9 @@ impl Default for Iceoryx2Config {
             friction_service: "friction_node/friction".into(),
             loop_statistics_service: "friction_node/loop_statistics".into(),
             cmd_event_service: "friction_node/cmd_event".into(),
+            joint_state_service: "friction_node/joint_states".into(),
+            efforts_service: "friction_node/joint_efforts".into(),
+            contact_friction_service: "friction_node/contact_friction".into(),
         }
     }
 }

@@ -38,7 +38,7 @@ mod validate;
 
 pub use contacts::{
     ContactEntry, ContactList, ContactSolverConfig, ResolvedContact, CONTACT_SECTIONS,
-    SINGLE_CONTACT_NAME,
+    MAX_CONTACTS, MAX_JOINT_NAME_BYTES, SINGLE_CONTACT_NAME,
 };
 pub use error::{ConfigError, Origin};
 pub use io::*;

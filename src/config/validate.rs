@@ -361,6 +361,25 @@ impl Config {
             99.0,
         )?;
         cc("node.realtime.cpu", n.realtime.cpu as f64, -1.0, 4095.0)?;
+        for (i, cpu) in n.realtime.worker_cpus.iter().enumerate() {
+            cc(
+                &format!("node.realtime.worker_cpus[{i}]"),
+                f64::from(*cpu),
+                0.0,
+                4095.0,
+            )?;
+        }
+        let contacts = self.contacts.0.len().max(1);
+        if n.contact_workers >= contacts && n.contact_workers > 0 {
+            return Err(ConfigError::InvalidValue {
+                key: "node.contact_workers".into(),
+                message: format!(
+                    "{} workers for {contacts} contact(s): at most {} (one fewer than the contacts; the loop's thread steps a share too)",
+                    n.contact_workers,
+                    contacts - 1
+                ),
+            });
+        }
         if n.frame_id.chars().any(|c| c.is_control()) {
             return Err(ConfigError::InvalidValue {
                 key: "node.frame_id".into(),

@@ -288,6 +288,12 @@ pub struct StatisticsRecord {
     pub steps_not_converged: u64,
     /// Parameter changes applied while running.
     pub parameter_updates: u64,
+    /// Contacts the loop steps.
+    pub contacts: u32,
+    /// The contact whose step took longest since the previous statistics,
+    /// and that step's compute time, ns.
+    pub slowest_contact: u32,
+    pub slowest_contact_compute_ns: u64,
 }
 
 impl StatisticsRecord {
@@ -325,6 +331,9 @@ impl StatisticsRecord {
             period_jitter_max_ns: self.period_jitter_ns[2],
             steps_not_converged: self.steps_not_converged,
             parameter_updates: self.parameter_updates,
+            contacts: self.contacts,
+            slowest_contact: self.slowest_contact,
+            slowest_contact_compute_ns: self.slowest_contact_compute_ns,
         }
     }
 
@@ -365,6 +374,9 @@ impl StatisticsRecord {
             ],
             steps_not_converged: m.steps_not_converged,
             parameter_updates: m.parameter_updates,
+            contacts: m.contacts,
+            slowest_contact: m.slowest_contact,
+            slowest_contact_compute_ns: m.slowest_contact_compute_ns,
         }
     }
 }
@@ -378,6 +390,21 @@ pub enum CommandKind {
     Load,
     /// Lubricant temperature, °C.
     Temperature,
+    /// One joint's velocity out of a `sensor_msgs/JointState` (m/s of the
+    /// contact's slider), for the configured contact at index `contact`;
+    /// `last` marks the message's last configured joint (lockstep steps
+    /// every contact once per message, on it).
+    JointVelocity { contact: u16, last: bool },
+}
+
+impl CommandKind {
+    /// A velocity, of the one contact or of one joint's contact.
+    pub fn is_velocity(self) -> bool {
+        matches!(
+            self,
+            CommandKind::Velocity | CommandKind::JointVelocity { .. }
+        )
+    }
 }
 
 /// A command as received from a transport (Copy, no heap).

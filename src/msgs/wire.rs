@@ -203,6 +203,9 @@ pub struct LoopStatistics {
     pub period_jitter_max_ns: u64,
     pub steps_not_converged: u64,
     pub parameter_updates: u64,
+    pub contacts: u32,
+    pub slowest_contact: u32,
+    pub slowest_contact_compute_ns: u64,
 }
 
 #[cfg(feature = "ros2")]

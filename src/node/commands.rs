@@ -1,10 +1,79 @@
 //! Commands: validation against the configured limits, the timeout rule,
-//! and the command status each estimate carries.
+//! and the command status each contact's estimate carries.
+//!
+//! Each contact has its own command state ([`ContactCommand`]): a
+//! `JointState` that leaves a joint out leaves that contact's command as it
+//! was (held, then timed out), and a rejected joint flags only its contact.
+//! Load and temperature commands apply to every contact (one load topic,
+//! one oil sump); each contact's viscosity follows the temperature by its
+//! own lubricant's law.
 
 use super::Loop;
-use crate::config::TimeoutBehaviour;
+use crate::config::{Config, TimeoutBehaviour};
 use crate::msgs::{estimate_constants as codes, Command, CommandKind};
+use crate::physics::ViscosityModel;
 use std::sync::atomic::Ordering;
+
+/// One contact's command state.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct ContactCommand {
+    /// The latest valid velocity command, m/s.
+    pub velocity: f64,
+    /// The velocity the steps apply (the command, or held/ramped after a
+    /// timeout), m/s.
+    pub applied: f64,
+    /// Normal load, N.
+    pub load: f64,
+    /// When the latest velocity command was taken (monotonic), ns.
+    pub last_velocity_at_ns: u64,
+    /// A velocity command was applied since the previous step.
+    pub fresh: bool,
+    pub rejected_pending: bool,
+    pub timed_out: bool,
+}
+
+impl ContactCommand {
+    pub fn new(v0: f64, load: f64) -> Self {
+        Self {
+            velocity: v0,
+            applied: v0,
+            load,
+            last_velocity_at_ns: 0,
+            fresh: false,
+            rejected_pending: false,
+            timed_out: false,
+        }
+    }
+}
+
+/// How one contact's liquid viscosity follows the temperature.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct ViscosityLaw {
+    pub model: ViscosityModel,
+    /// μ at `t_ref_c`, Pa·s.
+    pub mu_ref: f64,
+    pub t_ref_c: f64,
+}
+
+impl ViscosityLaw {
+    pub fn of(c: &Config) -> Self {
+        Self {
+            model: c.viscosity_model(),
+            mu_ref: c.lubricant.viscosity_pa_s,
+            t_ref_c: c.lubricant.reference_temperature_c,
+        }
+    }
+
+    /// μ at `t_c`, if the temperature is valid for this law.
+    fn at(&self, t_c: f64) -> Option<f64> {
+        let mu = self.model.viscosity(self.mu_ref, self.t_ref_c, t_c);
+        let vogel_ok = match self.model {
+            ViscosityModel::Vogel(v) => t_c > v.c_c,
+            ViscosityModel::Constant => true,
+        };
+        (t_c.is_finite() && (-60.0..=300.0).contains(&t_c) && vogel_ok && mu > 0.0).then_some(mu)
+    }
+}
 
 impl Loop {
     pub(super) fn poll(&mut self, i: usize) -> Option<Command> {
@@ -20,10 +89,14 @@ impl Loop {
         }
     }
 
-    pub(super) fn reject(&mut self) {
+    /// A command rejected; `contact` (None: every contact) reports it.
+    pub(super) fn reject(&mut self, contact: Option<usize>) {
         self.summary.commands_rejected += 1;
         self.live.commands_rejected.fetch_add(1, Ordering::Relaxed);
-        self.rejected_pending = true;
+        match contact {
+            Some(k) => self.cmd[k].rejected_pending = true,
+            None => self.cmd.iter_mut().for_each(|c| c.rejected_pending = true),
+        }
     }
 
     pub(super) fn accept(&mut self) {
@@ -39,93 +112,127 @@ impl Loop {
         f.is_finite() && f >= self.s.min_load && f <= self.s.max_load
     }
 
-    /// A load command: applied when within limits, else rejected.
-    pub(super) fn load_command(&mut self, value: f64) {
-        if self.load_ok(value) {
-            self.load = value;
-            self.accept();
-        } else {
-            self.reject();
+    /// The contact a velocity command is for (None: not a velocity, or a
+    /// joint index beyond the contacts, which no port produces).
+    pub(super) fn velocity_contact(&self, kind: CommandKind) -> Option<usize> {
+        match kind {
+            CommandKind::Velocity => Some(0),
+            CommandKind::JointVelocity { contact, .. } => {
+                Some(usize::from(contact)).filter(|&k| k < self.cmd.len())
+            }
+            CommandKind::Load | CommandKind::Temperature => None,
         }
     }
 
-    /// A temperature command: the viscosity follows it (Vogel), else it is
-    /// only reported. Outside [-60, 300] °C (or at or below Vogel's C) it is
-    /// rejected.
-    pub(super) fn temperature_command(&mut self, t_c: f64) {
-        let mu = self
-            .viscosity_model
-            .viscosity(self.mu_ref, self.t_ref_c, t_c);
-        let vogel_ok = match self.viscosity_model {
-            crate::physics::ViscosityModel::Vogel(v) => t_c > v.c_c,
-            crate::physics::ViscosityModel::Constant => true,
-        };
-        if t_c.is_finite() && (-60.0..=300.0).contains(&t_c) && vogel_ok && mu > 0.0 {
-            self.temperature_c = t_c;
-            self.solver.set_liquid_viscosity(mu);
+    /// A velocity command for contact `k`, taken at `now_ns`: applied when
+    /// within limits, else rejected (that contact only).
+    pub(super) fn velocity_command(&mut self, k: usize, value: f64, now_ns: u64) {
+        if self.velocity_ok(value) {
+            let c = &mut self.cmd[k];
+            c.velocity = value;
+            c.last_velocity_at_ns = now_ns;
+            c.fresh = true;
             self.accept();
         } else {
-            self.reject();
+            self.reject(Some(k));
+        }
+    }
+
+    /// A load command: applied to every contact when within limits, else
+    /// rejected.
+    pub(super) fn load_command(&mut self, value: f64) {
+        if self.load_ok(value) {
+            self.cmd.iter_mut().for_each(|c| c.load = value);
+            self.accept();
+        } else {
+            self.reject(None);
+        }
+    }
+
+    /// A temperature command: each contact's viscosity follows it (Vogel),
+    /// else it is only reported. Outside [-60, 300] °C (or at or below a
+    /// contact's Vogel C) it is rejected.
+    pub(super) fn temperature_command(&mut self, t_c: f64) {
+        if self.viscosity.iter().any(|law| law.at(t_c).is_none()) {
+            self.reject(None);
+            return;
+        }
+        self.temperature_c = t_c;
+        for k in 0..self.viscosity.len() {
+            if let Some(mu) = self.viscosity[k].at(t_c) {
+                self.contacts.with_solver(k, |s| s.set_liquid_viscosity(mu));
+            }
+        }
+        self.accept();
+    }
+
+    /// A command that is not a velocity (load, temperature), or a velocity
+    /// for contact `k` taken at `now_ns`.
+    pub(super) fn apply_command(&mut self, c: Command, now_ns: u64) {
+        match (c.kind, self.velocity_contact(c.kind)) {
+            (CommandKind::Load, _) => self.load_command(c.value),
+            (CommandKind::Temperature, _) => self.temperature_command(c.value),
+            (_, Some(k)) => self.velocity_command(k, c.value, now_ns),
+            (_, None) => self.reject(None),
         }
     }
 
     /// Timer mode: take every pending command; the latest valid velocity
-    /// and load become the set points (received at `now_ns`).
+    /// of each contact and the load become the set points (received at
+    /// `now_ns`).
     pub(super) fn drain_commands(&mut self, now_ns: u64) {
         for i in 0..self.ports.len() {
             while let Some(c) = self.poll(i) {
-                match c.kind {
-                    CommandKind::Velocity if self.velocity_ok(c.value) => {
-                        self.velocity = c.value;
-                        self.last_velocity_at_ns = now_ns;
-                        self.fresh = true;
-                        self.accept();
-                    }
-                    CommandKind::Velocity => self.reject(),
-                    CommandKind::Load => self.load_command(c.value),
-                    CommandKind::Temperature => self.temperature_command(c.value),
+                self.apply_command(c, now_ns);
+            }
+        }
+    }
+
+    /// The velocity each contact's next `steps` steps (ending at `at_ns`)
+    /// apply: the command, or after the timeout the held or ramped value.
+    pub(super) fn apply_timeout(&mut self, at_ns: u64, steps: u64) {
+        let (timeout, behaviour) = (self.s.command_timeout_ns, self.s.timeout_behaviour);
+        let dv = self.s.deceleration * self.s.dt * steps as f64;
+        let mut any = false;
+        for c in &mut self.cmd {
+            let age = at_ns.saturating_sub(c.last_velocity_at_ns);
+            c.timed_out = age > timeout;
+            if !c.timed_out {
+                c.applied = c.velocity;
+                continue;
+            }
+            any = true;
+            match behaviour {
+                TimeoutBehaviour::Hold => c.applied = c.velocity,
+                TimeoutBehaviour::RampToZero => {
+                    c.applied = if c.applied.abs() <= dv {
+                        0.0
+                    } else {
+                        c.applied - dv * c.applied.signum()
+                    };
                 }
             }
         }
-    }
-
-    /// The velocity the next `steps` steps (ending at `at_ns`) apply: the
-    /// command, or after the timeout the held or ramped value.
-    pub(super) fn apply_timeout(&mut self, at_ns: u64, steps: u64) {
-        let age = at_ns.saturating_sub(self.last_velocity_at_ns);
-        self.timed_out = age > self.s.command_timeout_ns;
-        if !self.timed_out {
-            self.applied = self.velocity;
-            return;
-        }
-        self.summary.command_timeouts += 1;
-        match self.s.timeout_behaviour {
-            TimeoutBehaviour::Hold => self.applied = self.velocity,
-            TimeoutBehaviour::RampToZero => {
-                let dv = self.s.deceleration * self.s.dt * steps as f64;
-                self.applied = if self.applied.abs() <= dv {
-                    0.0
-                } else {
-                    self.applied - dv * self.applied.signum()
-                };
-            }
+        if any {
+            self.summary.command_timeouts += 1;
         }
     }
 
-    /// The command status of the step about to be published; a pending
-    /// rejection is reported once, whatever the solver did.
-    pub(super) fn take_command_status(&mut self) -> u8 {
-        let status = if self.rejected_pending {
+    /// The command status of contact `k`'s step about to be published; a
+    /// pending rejection is reported once, whatever the solver did.
+    pub(super) fn take_command_status(&mut self, k: usize) -> u8 {
+        let c = &mut self.cmd[k];
+        let status = if c.rejected_pending {
             codes::COMMAND_REJECTED
-        } else if self.timed_out {
+        } else if c.timed_out {
             codes::COMMAND_TIMED_OUT
-        } else if self.fresh {
+        } else if c.fresh {
             codes::COMMAND_FRESH
         } else {
             codes::COMMAND_HELD
         };
-        self.rejected_pending = false;
-        self.fresh = false;
+        c.rejected_pending = false;
+        c.fresh = false;
         status
     }
 }

@@ -48,27 +48,33 @@ impl Loop {
     }
 
     fn lockstep_command(&mut self, c: Command) {
-        match c.kind {
-            CommandKind::Load => self.load_command(c.value),
-            CommandKind::Temperature => self.temperature_command(c.value),
-            CommandKind::Velocity => {
-                if self.last_stamp.is_some_and(|last| c.stamp_ns <= last) {
-                    // Duplicate or out of order: counted, no step.
-                    self.summary.commands_rejected += 1;
-                    self.live.commands_rejected.fetch_add(1, Ordering::Relaxed);
-                    return;
-                }
-                self.last_stamp = Some(c.stamp_ns);
-                if self.velocity_ok(c.value) {
-                    self.velocity = c.value;
-                    self.fresh = true;
-                    self.accept();
-                } else {
-                    self.reject();
-                }
-                self.timed_out = false;
-                self.step(self.velocity, c.stamp_ns, 0);
+        let Some(k) = self.velocity_contact(c.kind) else {
+            // Load and temperature: set points for the next step.
+            let now = self.clock.now_ns();
+            self.apply_command(c, now);
+            return;
+        };
+        let last = match c.kind {
+            CommandKind::JointVelocity { last, .. } => last,
+            _ => true,
+        };
+        // A JointState steps every contact once, on its last joint; its
+        // stamp orders the messages.
+        if last && self.last_stamp.is_some_and(|s| c.stamp_ns <= s) {
+            // Duplicate or out of order: counted, no step.
+            self.summary.commands_rejected += 1;
+            self.live.commands_rejected.fetch_add(1, Ordering::Relaxed);
+            return;
+        }
+        let now = self.clock.now_ns();
+        self.velocity_command(k, c.value, now);
+        if last {
+            self.last_stamp = Some(c.stamp_ns);
+            for cmd in &mut self.cmd {
+                cmd.timed_out = false;
+                cmd.applied = cmd.velocity;
             }
+            self.step(c.stamp_ns, 0);
         }
     }
 }

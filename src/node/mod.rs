@@ -48,8 +48,9 @@ mod timer;
 
 use crate::clock::{Clock, SystemClock, WallStamps};
 use crate::config::{Config, StepMode, TimeoutBehaviour};
+use crate::contacts::ContactSet;
 use crate::msgs::RecordItem;
-use crate::physics::{SetupError, Solver};
+use crate::physics::SetupError;
 use crate::stats::{Histogram, Window};
 use crate::transport::{NodePort, PortCounters, ProfileSlot};
 use crossbeam_queue::ArrayQueue;
@@ -114,6 +115,14 @@ pub struct RunSummary {
     pub command_status_counts: [u64; 4],
     /// Parameter changes applied while running.
     pub parameter_updates: u64,
+    /// Contacts stepped per step.
+    pub contacts: u32,
+    /// The contact whose step took longest in the latest step, and its
+    /// compute time, ns.
+    pub slowest_contact: usize,
+    pub slowest_contact_ns: u64,
+    /// The longest contact step since the previous statistics: (contact, ns).
+    pub window_slowest: (usize, u64),
 }
 
 /// Settings the loop reads every step (from the configuration).
@@ -183,18 +192,21 @@ impl LoopSettings {
 pub enum NodeError {
     #[error(transparent)]
     Setup(#[from] SetupError),
+    #[error(transparent)]
+    Contacts(#[from] crate::contacts::ContactSetError),
     #[error("the node needs at least one transport")]
     NoTransport,
-    #[error(
-        "the configuration lists {0} contacts (`contacts`): the node serves one contact per process \
-         today (multi-contact I/O is not built yet); remove `contacts` and run one node per contact"
-    )]
-    SeveralContacts(usize),
 }
 
-/// The loop: solver, ports, outputs and bookkeeping.
+/// The loop: the contacts' solvers, ports, outputs and bookkeeping.
 pub struct Loop {
-    solver: Solver,
+    contacts: ContactSet,
+    /// Command state per contact (index = contact).
+    cmd: Vec<commands::ContactCommand>,
+    /// Per-step scratch (no allocation per step): inputs and efforts.
+    velocities: Vec<f64>,
+    loads: Vec<f64>,
+    efforts: Vec<f64>,
     s: LoopSettings,
     ports: Vec<Box<dyn NodePort>>,
     record: Option<Arc<ArrayQueue<RecordItem>>>,
@@ -202,21 +214,10 @@ pub struct Loop {
     live: Arc<LiveStatus>,
     clock: Arc<dyn Clock>,
     stamps: WallStamps,
-    // command state
-    velocity: f64,
-    applied: f64,
-    load: f64,
     temperature_c: f64,
-    /// How the viscosity follows the temperature: μ_ref at T_ref.
-    viscosity_model: crate::physics::ViscosityModel,
-    mu_ref: f64,
-    t_ref_c: f64,
-    last_velocity_at_ns: u64,
+    /// How each contact's viscosity follows the temperature: μ_ref at T_ref.
+    viscosity: Vec<commands::ViscosityLaw>,
     last_stamp: Option<u64>,
-    /// A velocity command was applied since the previous step.
-    fresh: bool,
-    rejected_pending: bool,
-    timed_out: bool,
     // statistics
     summary: RunSummary,
     window_compute: Window,
@@ -232,8 +233,10 @@ pub struct Loop {
 }
 
 impl Loop {
-    /// Build the solver at the steady state of `node.initial_velocity_m_s`
-    /// under `contact.load_n`, on the system clock.
+    /// Build every contact's solver at the steady state of
+    /// `node.initial_velocity_m_s` under its load, on the system clock,
+    /// with `node.contact_workers` worker threads (pinned to
+    /// `node.realtime.worker_cpus`) beside the loop's.
     pub fn new(
         config: &Config,
         ports: Vec<Box<dyn NodePort>>,
@@ -244,36 +247,52 @@ impl Loop {
         if ports.is_empty() {
             return Err(NodeError::NoTransport);
         }
-        if !config.contacts.is_empty() {
-            return Err(NodeError::SeveralContacts(config.contacts.0.len()));
-        }
-        let mut solver = Solver::new(&config.model(), &config.solver_settings())?;
-        let v0 = config.node.initial_velocity_m_s;
-        let load = config.contact.load_n;
-        solver.initialize_steady(v0, load);
         let s = LoopSettings::from_config(config);
+        let realtime = config.node.realtime.clone();
+        let cpus = config.node.realtime.worker_cpus.clone();
+        let setup = Arc::new(move |k: usize| {
+            let mut rt = realtime.clone();
+            rt.cpu = cpus.get(k - 1).copied().unwrap_or(-1);
+            let (_, warnings) = rt::apply(&rt);
+            for w in warnings {
+                tracing::warn!("contact worker {k}: {w}");
+            }
+        });
+        let contacts = ContactSet::new(
+            config,
+            config.node.contact_workers,
+            s.lockstep_spin_ns.max(50_000),
+            Arc::new(SystemClock::new()),
+            setup,
+        )?;
+        let v0 = config.node.initial_velocity_m_s;
+        let resolved = config.resolved_contacts();
+        let cmd = resolved
+            .iter()
+            .map(|c| commands::ContactCommand::new(v0, c.config.contact.load_n))
+            .collect();
+        let viscosity = resolved
+            .iter()
+            .map(|c| commands::ViscosityLaw::of(&c.config))
+            .collect();
+        let n = contacts.len();
         let window = (s.statistics_every as usize).clamp(16, 1 << 16);
         let clock: Arc<dyn Clock> = Arc::new(SystemClock::new());
         Ok(Self {
-            solver,
+            contacts,
+            cmd,
+            velocities: vec![v0; n],
+            loads: resolved.iter().map(|c| c.config.contact.load_n).collect(),
+            efforts: vec![0.0; n],
             ports,
             record,
             profile,
             live,
             stamps: WallStamps::new(clock.as_ref()),
             clock,
-            velocity: v0,
-            applied: v0,
-            load,
             temperature_c: config.lubricant.reference_temperature_c,
-            viscosity_model: config.viscosity_model(),
-            mu_ref: config.lubricant.viscosity_pa_s,
-            t_ref_c: config.lubricant.reference_temperature_c,
-            last_velocity_at_ns: 0,
+            viscosity,
             last_stamp: None,
-            fresh: false,
-            rejected_pending: false,
-            timed_out: false,
             summary: RunSummary::default(),
             window_compute: Window::new(window),
             window_jitter: Window::new(window),
@@ -309,8 +328,9 @@ impl Loop {
         self
     }
 
-    pub fn solver(&self) -> &Solver {
-        &self.solver
+    /// The contacts and their solvers.
+    pub fn contacts(&self) -> &ContactSet {
+        &self.contacts
     }
 
     /// Counters so far, the ports' included.
@@ -340,7 +360,10 @@ impl Loop {
     /// Run until `stop` is set or `duration` has passed (in the loop's mode).
     pub fn run(&mut self, stop: &AtomicBool, duration: Option<Duration>) -> RunSummary {
         self.started_ns = self.clock.now_ns();
-        self.last_velocity_at_ns = self.started_ns;
+        for c in &mut self.cmd {
+            c.last_velocity_at_ns = self.started_ns;
+        }
+        self.summary.contacts = u32::try_from(self.cmd.len()).unwrap_or(u32::MAX);
         self.stamps = WallStamps::new(self.clock.as_ref());
         let duration_ns = duration.map(|d| u64::try_from(d.as_nanos()).unwrap_or(u64::MAX));
         match self.s.mode {

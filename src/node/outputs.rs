@@ -8,36 +8,66 @@ use crate::physics::Estimate;
 use std::sync::atomic::Ordering;
 
 impl Loop {
-    /// One fixed step with velocity `v`, stamped `stamp_ns`, `late_ns`
-    /// after its deadline.
-    pub(super) fn step(&mut self, v: f64, stamp_ns: u64, late_ns: u64) {
-        self.apply_parameters(stamp_ns);
-        let start = self.clock.now_ns();
-        let e = self.solver.step(v, self.load);
-        let compute = self.clock.now_ns().saturating_sub(start);
-        self.publish(&e, stamp_ns, compute, late_ns);
+    /// One fixed step of every contact with its applied velocity, stamped
+    /// `stamp_ns`, `late_ns` after its deadline.
+    pub(super) fn step(&mut self, stamp_ns: u64, late_ns: u64) {
+        self.step_contacts(None, stamp_ns, late_ns);
     }
 
     /// `steps` lost periods advanced in one long step.
     pub(super) fn step_over(&mut self, steps: u64, stamp_ns: u64, late_ns: u64) {
-        self.apply_parameters(stamp_ns);
-        let start = self.clock.now_ns();
-        let dt = self.s.dt * steps as f64;
-        let e = self.solver.step_over(self.applied, self.load, dt);
-        let compute = self.clock.now_ns().saturating_sub(start);
-        self.publish(&e, stamp_ns, compute, late_ns);
+        self.step_contacts(Some(self.s.dt * steps as f64), stamp_ns, late_ns);
     }
 
-    fn publish(&mut self, e: &Estimate, stamp_ns: u64, compute: u64, late_ns: u64) {
+    fn step_contacts(&mut self, step_over_s: Option<f64>, stamp_ns: u64, late_ns: u64) {
+        self.apply_parameters(stamp_ns);
+        for (k, c) in self.cmd.iter().enumerate() {
+            self.velocities[k] = c.applied;
+            self.loads[k] = c.load;
+        }
+        let start = self.clock.now_ns();
+        let timing = self
+            .contacts
+            .step(&self.velocities, &self.loads, step_over_s);
+        let compute = self.clock.now_ns().saturating_sub(start);
+        self.summary.steps += 1;
+        let several = self.contacts.len() > 1;
+        for k in 0..self.contacts.len() {
+            let e = self.contacts.estimates()[k];
+            // One contact: the step's time is the contact's (the loop's
+            // clock: simulated in tests). Several: each its own.
+            let own = if several {
+                self.contacts.compute_ns()[k]
+            } else {
+                compute
+            };
+            self.publish(k, &e, stamp_ns, own, late_ns);
+            self.efforts[k] = self.contacts.effort(k);
+        }
+        if several {
+            for p in self.ports.iter_mut() {
+                if !p.publish_efforts(stamp_ns, &self.efforts) {
+                    self.summary.publish_drops += 1;
+                }
+            }
+        }
+        self.summary.slowest_contact = timing.slowest;
+        self.summary.slowest_contact_ns = timing.slowest_ns;
+        if timing.slowest_ns >= self.summary.window_slowest.1 {
+            self.summary.window_slowest = (timing.slowest, timing.slowest_ns);
+        }
+        self.after_step(stamp_ns, compute, late_ns);
+    }
+
+    fn publish(&mut self, k: usize, e: &Estimate, stamp_ns: u64, compute: u64, late_ns: u64) {
         let mut rec = EstimateRecord::from_estimate(e, stamp_ns, compute);
         rec.temperature_c = self.temperature_c;
-        rec.command_status = self.take_command_status();
+        rec.command_status = self.take_command_status(k);
         rec.late_ns = late_ns;
-        self.summary.steps += 1;
         self.summary.status_counts[usize::from(rec.status).min(7)] += 1;
         self.summary.command_status_counts[usize::from(rec.command_status).min(3)] += 1;
         for p in self.ports.iter_mut() {
-            if !p.publish_estimate(&rec) {
+            if !p.publish_estimate(k, &rec) {
                 self.summary.publish_drops += 1;
             }
         }
@@ -52,17 +82,33 @@ impl Loop {
                 self.summary.recorder_drops += 1;
             }
         }
+        if k == 0 {
+            let l = &self.live;
+            l.velocity_bits
+                .store(rec.velocity_m_s.to_bits(), Ordering::Relaxed);
+            l.friction_bits
+                .store(rec.friction_force_n.to_bits(), Ordering::Relaxed);
+            l.cof_bits.store(rec.cof.to_bits(), Ordering::Relaxed);
+            l.h0_bits.store(rec.h0_m.to_bits(), Ordering::Relaxed);
+            l.status.store(u64::from(rec.status), Ordering::Relaxed);
+        }
+    }
+
+    /// Profiles, statistics and live values after a step of every contact.
+    fn after_step(&mut self, stamp_ns: u64, compute: u64, late_ns: u64) {
         let n = self.summary.steps;
         if self.s.profile_every > 0 && n.is_multiple_of(self.s.profile_every) {
-            if let Some(slot) = &self.profile {
-                let solver = &self.solver;
-                slot.try_write(|d| {
-                    d.stamp_ns = stamp_ns;
-                    d.dx_m = solver.dx();
-                    for (i, f) in solver.field().enumerate() {
-                        d.h_m[i] = f.h;
-                        d.p_pa[i] = f.p;
-                    }
+            if let Some(slot) = self.profile.clone() {
+                // The first contact's film (the one-contact node's profile).
+                self.contacts.with_solver(0, |solver| {
+                    slot.try_write(|d| {
+                        d.stamp_ns = stamp_ns;
+                        d.dx_m = solver.dx();
+                        for (i, f) in solver.field().enumerate() {
+                            d.h_m[i] = f.h;
+                            d.p_pa[i] = f.p;
+                        }
+                    })
                 });
             }
         }
@@ -77,14 +123,7 @@ impl Loop {
         }
         let l = &self.live;
         l.steps.store(n, Ordering::Relaxed);
-        l.velocity_bits
-            .store(rec.velocity_m_s.to_bits(), Ordering::Relaxed);
-        l.friction_bits
-            .store(rec.friction_force_n.to_bits(), Ordering::Relaxed);
-        l.cof_bits.store(rec.cof.to_bits(), Ordering::Relaxed);
-        l.h0_bits.store(rec.h0_m.to_bits(), Ordering::Relaxed);
         l.compute_ns.store(compute, Ordering::Relaxed);
-        l.status.store(u64::from(rec.status), Ordering::Relaxed);
         l.drops.store(
             self.summary.publish_drops + self.summary.recorder_drops,
             Ordering::Relaxed,
@@ -131,11 +170,16 @@ impl Loop {
             } else {
                 [0; 3]
             },
-            steps_not_converged: total.steps.saturating_sub(
+            // Contact steps (one per contact per step) that did not converge.
+            steps_not_converged: total.status_counts.iter().sum::<u64>().saturating_sub(
                 total.status_counts[usize::from(crate::msgs::estimate_constants::STATUS_CONVERGED)],
             ),
             parameter_updates: total.parameter_updates,
+            contacts: u32::try_from(self.contacts.len()).unwrap_or(u32::MAX),
+            slowest_contact: u32::try_from(total.window_slowest.0).unwrap_or(u32::MAX),
+            slowest_contact_compute_ns: total.window_slowest.1,
         };
+        self.summary.window_slowest = (0, 0);
         self.window_compute.clear();
         self.window_jitter.clear();
         for p in self.ports.iter_mut() {

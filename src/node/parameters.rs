@@ -413,23 +413,30 @@ impl super::Loop {
     /// One change: the model swapped in, the settings replaced, the
     /// viscosity re-derived at the current temperature, the load held.
     pub fn apply_update(&mut self, u: &mut ParameterUpdate) {
-        if self.solver.swap_model(&mut u.model).is_err() {
+        // The one contact's solver (the runner serves parameters only to a
+        // configuration without `contacts`).
+        if self
+            .contacts
+            .with_solver(0, |s| s.swap_model(&mut u.model))
+            .is_err()
+        {
             // Geometry and grid are read-only: a mismatch cannot be built
             // by apply_set. Nothing changes.
             return;
         }
         self.s = u.settings.clone();
-        self.viscosity_model = u.viscosity_model;
-        self.mu_ref = u.mu_ref;
-        self.t_ref_c = u.t_ref_c;
-        if self.viscosity_model != ViscosityModel::Constant {
-            let mu = self
-                .viscosity_model
-                .viscosity(self.mu_ref, self.t_ref_c, self.temperature_c);
-            self.solver.set_liquid_viscosity(mu);
+        let law = &mut self.viscosity[0];
+        law.model = u.viscosity_model;
+        law.mu_ref = u.mu_ref;
+        law.t_ref_c = u.t_ref_c;
+        if law.model != ViscosityModel::Constant {
+            let mu = law
+                .model
+                .viscosity(law.mu_ref, law.t_ref_c, self.temperature_c);
+            self.contacts.with_solver(0, |s| s.set_liquid_viscosity(mu));
         }
         if let Some(l) = u.load {
-            self.load = l;
+            self.cmd[0].load = l;
         }
         self.summary.parameter_updates += 1;
     }

@@ -98,7 +98,15 @@ pub fn backend_specs(
     }
     if matches!(kind, TransportKind::Iceoryx2 | TransportKind::Both) {
         #[cfg(feature = "iceoryx2")]
-        out.push(BackendSpec::Iceoryx2((&config.iceoryx2).into()));
+        {
+            let spec = transport::iceoryx::IceoryxSpec::from(&config.iceoryx2);
+            let contacts = config.resolved_contacts();
+            out.push(BackendSpec::Iceoryx2(if contacts.len() > 1 {
+                spec.with_joints(contacts.into_iter().map(|c| c.joint).collect())
+            } else {
+                spec
+            }));
+        }
         #[cfg(not(feature = "iceoryx2"))]
         return Err(TransportError::NotBuiltIn("iceoryx2"));
     }
@@ -183,6 +191,13 @@ pub fn run_node(
             }
         })
     });
+    if config.contacts.0.len() > 1 && (record_path.is_some() || config.recording.snapshot_s > 0) {
+        return Err(RunError::Option(format!(
+            "recording.*: the configuration lists {} contacts, and recording several contacts \
+             is not built yet (run without --record, recording.enabled and recording.snapshot_s)",
+            config.contacts.0.len()
+        )));
+    }
     #[cfg(feature = "mcap")]
     let recorder = if record_path.is_some() || config.recording.snapshot_s > 0 {
         let snapshot_dir = record_path

@@ -48,7 +48,7 @@ impl Loop {
                     self.summary.catch_up_steps += 1;
                 }
                 let stamp = self.stamps.stamp(due);
-                self.step(self.applied, stamp, late);
+                self.step(stamp, late);
                 k += 1;
             }
             let done = self.clock.now_ns();

@@ -89,6 +89,11 @@ impl Encoder {
             (CommandKind::Velocity, CommandType::Float64) => {
                 (TopicId::Velocity, cdr(&Float64 { data: c.value })?)
             }
+            (CommandKind::JointVelocity { .. }, _) => {
+                return Err(
+                    "a joint velocity: recording several contacts is not built yet".to_string(),
+                )
+            }
             (CommandKind::Velocity, CommandType::TwistStamped) => {
                 let mut m = TwistStamped {
                     header: Header {
@@ -120,7 +125,8 @@ impl Encoder {
             } => out.push(self.command(command, *received_ns)?),
             RecordItem::Raw(r) => out.push(Entry {
                 topic: match r.kind {
-                    CommandKind::Velocity => TopicId::Velocity,
+                    // Raw samples are ROS 2's, which serves one contact.
+                    CommandKind::Velocity | CommandKind::JointVelocity { .. } => TopicId::Velocity,
                     CommandKind::Load => TopicId::Load,
                     CommandKind::Temperature => TopicId::Temperature,
                 },

@@ -89,6 +89,12 @@ pub enum ReplayError {
     Config(#[from] ConfigError),
     #[error(transparent)]
     Node(#[from] NodeError),
+    #[error(
+        "the configuration lists {0} contacts (`contacts`): replay re-simulates one contact \
+         today (replay of a multi-joint bag is not built yet); replay with a configuration \
+         without `contacts`, once per contact"
+    )]
+    SeveralContacts(usize),
 }
 
 fn damage_note(d: &Option<Damage>) -> String {
@@ -324,6 +330,9 @@ fn temperature_channel(
 pub fn prepare(bag: &Bag, opts: &ReplayOptions) -> Result<PreparedReplay, ReplayError> {
     let mut scan = bag.scan()?;
     let (config, config_source) = choose_config(&scan, opts)?;
+    if config.contacts.0.len() > 1 {
+        return Err(ReplayError::SeveralContacts(config.contacts.0.len()));
+    }
     // A friction-node bag without --topic: drive it by its estimates.
     let estimates = scan
         .channels
@@ -698,7 +707,7 @@ pub fn run(
         }
         l.feed(*c);
         if let Ok(Some(rec)) = peer.try_recv() {
-            let e = *l.solver().last_estimate().expect("a step happened");
+            let e = l.contacts().estimates()[0];
             on_step(&e, &rec);
             out.push((e, rec));
         }

@@ -1,9 +1,14 @@
 //! In-memory transport: bounded lock-free queues between threads of one
 //! process. The reference backend of the conformance suite, and the node's
 //! transport when it is embedded in another program.
+//!
+//! With several contacts ([`MemoryLink::with_joints`]) the peer's
+//! JointStates are resolved by joint name into per-contact commands, and
+//! the node's outputs are per-contact estimates and joint efforts.
 
 use super::{
-    record_input, NodePort, PeerPort, PortCounters, RecordQueue, SharedCounters, TransportError,
+    joint_commands, record_input, JointEfforts, JointStateCommand, NodePort, PeerPort,
+    PortCounters, RecordQueue, SharedCounters, TransportError,
 };
 use crate::clock::system_wall_ns;
 use crate::msgs::{Command, EstimateRecord, RecordItem, StatisticsRecord};
@@ -17,6 +22,10 @@ pub struct MemoryLink {
     commands: Arc<ArrayQueue<Command>>,
     estimates: Arc<ArrayQueue<EstimateRecord>>,
     statistics: Arc<ArrayQueue<StatisticsRecord>>,
+    /// Several contacts: the configured joints (empty: one contact).
+    joints: Arc<[String]>,
+    contact_estimates: Arc<ArrayQueue<(usize, EstimateRecord)>>,
+    efforts: Arc<ArrayQueue<JointEfforts>>,
 }
 
 impl MemoryLink {
@@ -25,7 +34,22 @@ impl MemoryLink {
             commands: Arc::new(ArrayQueue::new(capacity)),
             estimates: Arc::new(ArrayQueue::new(capacity)),
             statistics: Arc::new(ArrayQueue::new(capacity.min(64))),
+            joints: Arc::from(Vec::new()),
+            contact_estimates: Arc::new(ArrayQueue::new(1)),
+            efforts: Arc::new(ArrayQueue::new(1)),
         }
+    }
+
+    /// A link for several contacts with these joints (configured order):
+    /// per-contact estimates (`capacity` each contact) and efforts.
+    pub fn with_joints(mut self, joints: &[String]) -> Self {
+        let capacity = self.estimates.capacity();
+        self.joints = Arc::from(joints.to_vec());
+        self.contact_estimates = Arc::new(ArrayQueue::new(
+            capacity.saturating_mul(joints.len().max(1)),
+        ));
+        self.efforts = Arc::new(ArrayQueue::new(capacity));
+        self
     }
 
     pub fn node(&self) -> MemoryNode {
@@ -94,9 +118,20 @@ impl NodePort for MemoryNode {
         Ok(c)
     }
 
-    fn publish_estimate(&mut self, e: &EstimateRecord) -> bool {
+    fn publish_estimate(&mut self, contact: usize, e: &EstimateRecord) -> bool {
         // A full queue is a drop, which the loop counts.
-        self.link.estimates.push(*e).is_ok()
+        if self.link.joints.is_empty() {
+            self.link.estimates.push(*e).is_ok()
+        } else {
+            self.link.contact_estimates.push((contact, *e)).is_ok()
+        }
+    }
+
+    fn publish_efforts(&mut self, stamp_ns: u64, efforts: &[f64]) -> bool {
+        self.link
+            .efforts
+            .push(JointEfforts::new(stamp_ns, efforts))
+            .is_ok()
     }
 
     fn publish_statistics(&mut self, s: &StatisticsRecord) -> bool {
@@ -148,6 +183,36 @@ impl PeerPort for MemoryPeer {
 
     fn try_recv_statistics(&mut self) -> Result<Option<StatisticsRecord>, TransportError> {
         Ok(self.link.statistics.pop())
+    }
+
+    fn send_joint_state(&mut self, js: &JointStateCommand) -> Result<(), TransportError> {
+        let mut full = false;
+        let names = js.name.iter().map(String::as_str);
+        joint_commands(
+            &self.link.joints,
+            js.stamp_ns,
+            names,
+            &js.velocity,
+            |c, _| {
+                full |= self.link.commands.push(c).is_err();
+            },
+        );
+        if full {
+            return Err(TransportError::backend(
+                "memory",
+                "send a JointState",
+                "the command queue is full",
+            ));
+        }
+        Ok(())
+    }
+
+    fn try_recv_efforts(&mut self) -> Result<Option<JointEfforts>, TransportError> {
+        Ok(self.link.efforts.pop())
+    }
+
+    fn try_recv_contact(&mut self) -> Result<Option<(usize, EstimateRecord)>, TransportError> {
+        Ok(self.link.contact_estimates.pop())
     }
 
     fn is_matched(&mut self) -> bool {

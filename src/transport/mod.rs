@@ -140,13 +140,107 @@ pub fn record_input(queue: &RecordQueue, item: RecordItem, counters: &SharedCoun
     }
 }
 
+pub use crate::config::MAX_CONTACTS;
+
+/// Every contact's effort on its joint after one step, in the configured
+/// joint order (Copy: the loop hands it over without allocating).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct JointEfforts {
+    pub stamp_ns: u64,
+    pub len: usize,
+    /// N (linear joint) or N·m (rotary), `gain · F_f`; `len` used.
+    pub effort: [f64; MAX_CONTACTS],
+}
+
+impl JointEfforts {
+    pub fn new(stamp_ns: u64, efforts: &[f64]) -> Self {
+        let len = efforts.len().min(MAX_CONTACTS);
+        let mut effort = [0.0; MAX_CONTACTS];
+        effort[..len].copy_from_slice(&efforts[..len]);
+        Self {
+            stamp_ns,
+            len,
+            effort,
+        }
+    }
+
+    pub fn as_slice(&self) -> &[f64] {
+        &self.effort[..self.len.min(MAX_CONTACTS)]
+    }
+}
+
+/// A `sensor_msgs/JointState` as a peer sends it (velocities by joint
+/// name; the peer side may allocate).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct JointStateCommand {
+    pub stamp_ns: u64,
+    pub name: Vec<String>,
+    pub velocity: Vec<f64>,
+}
+
+/// The commands a JointState carries for the configured `joints`, in
+/// message order, handed to `f` with the joint's name: one per configured
+/// joint it names (other joints are not this node's and are skipped); a
+/// joint whose velocity is missing (arrays of different lengths) gets a
+/// NaN, which the loop rejects for that contact only. The last command
+/// is marked `last` (lockstep steps on it). Allocates nothing.
+pub fn joint_commands<'a>(
+    joints: &[String],
+    stamp_ns: u64,
+    names: impl Iterator<Item = &'a str>,
+    velocity: &[f64],
+    mut f: impl FnMut(Command, &'a str),
+) {
+    let mut pending: Option<(u16, f64, &'a str)> = None;
+    for (i, name) in names.enumerate() {
+        let Some(k) = joints.iter().position(|j| j == name) else {
+            continue;
+        };
+        let v = velocity.get(i).copied().unwrap_or(f64::NAN);
+        if let Some((contact, value, n)) = pending.take() {
+            let kind = crate::msgs::CommandKind::JointVelocity {
+                contact,
+                last: false,
+            };
+            f(
+                Command {
+                    kind,
+                    value,
+                    stamp_ns,
+                },
+                n,
+            );
+        }
+        pending = Some((u16::try_from(k).unwrap_or(u16::MAX), v, name));
+    }
+    if let Some((contact, value, n)) = pending {
+        let kind = crate::msgs::CommandKind::JointVelocity {
+            contact,
+            last: true,
+        };
+        f(
+            Command {
+                kind,
+                value,
+                stamp_ns,
+            },
+            n,
+        );
+    }
+}
+
 /// The loop's side of a transport.
 pub trait NodePort {
     fn name(&self) -> &'static str;
     /// Next pending command, if any (non-blocking).
     fn poll_command(&mut self) -> Result<Option<Command>, TransportError>;
-    /// Publish an estimate (non-blocking); false when it was dropped.
-    fn publish_estimate(&mut self, e: &EstimateRecord) -> bool;
+    /// Publish contact `contact`'s estimate (non-blocking); false when it
+    /// was dropped. With one contact (no `contacts`), contact 0 on the
+    /// node's estimate topic; with several, on the per-contact output.
+    fn publish_estimate(&mut self, contact: usize, e: &EstimateRecord) -> bool;
+    /// Publish every contact's effort in the configured joint order (only
+    /// with several contacts; non-blocking); false when dropped.
+    fn publish_efforts(&mut self, stamp_ns: u64, efforts: &[f64]) -> bool;
     /// Publish loop statistics (non-blocking); false when dropped.
     fn publish_statistics(&mut self, s: &StatisticsRecord) -> bool;
     /// Block until a command may be pending or `timeout` passes.
@@ -163,6 +257,12 @@ pub trait PeerPort {
     fn try_recv(&mut self) -> Result<Option<EstimateRecord>, TransportError>;
     /// Next loop statistics, if any (non-blocking).
     fn try_recv_statistics(&mut self) -> Result<Option<StatisticsRecord>, TransportError>;
+    /// Send a JointState (several contacts: velocities by joint name).
+    fn send_joint_state(&mut self, js: &JointStateCommand) -> Result<(), TransportError>;
+    /// Next joint efforts (several contacts), if any (non-blocking).
+    fn try_recv_efforts(&mut self) -> Result<Option<JointEfforts>, TransportError>;
+    /// Next per-contact estimate (several contacts): (contact index, estimate).
+    fn try_recv_contact(&mut self) -> Result<Option<(usize, EstimateRecord)>, TransportError>;
     /// Whether the node's endpoints are matched (discovery done).
     fn is_matched(&mut self) -> bool;
 }

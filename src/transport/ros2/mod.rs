@@ -114,6 +114,18 @@ impl Ros2Spec {
     }
 
     pub fn from_config(cfg: &Config) -> Result<Self, TransportError> {
+        if cfg.contacts.0.len() > 1 {
+            return Err(TransportError::backend(
+                NAME,
+                "serve several contacts",
+                format!(
+                    "the configuration lists {} contacts; JointState in and Float64MultiArray \
+                     out over ROS 2 are not built yet: use node.transport: iceoryx2 for several \
+                     contacts, or one node per contact over ROS 2",
+                    cfg.contacts.0.len()
+                ),
+            ));
+        }
         let r = &cfg.ros;
         let names = super::names::TopicNames::from_config(cfg);
         Ok(Self {
@@ -329,8 +341,14 @@ impl NodePort for Ros2Node {
         Ok(self.commands.pop())
     }
 
-    fn publish_estimate(&mut self, e: &EstimateRecord) -> bool {
+    fn publish_estimate(&mut self, _contact: usize, e: &EstimateRecord) -> bool {
+        // One contact only (from_config refuses several).
         self.push(Out::Estimate(*e))
+    }
+
+    fn publish_efforts(&mut self, _stamp_ns: u64, _efforts: &[f64]) -> bool {
+        // Never called: a ROS 2 port serves one contact (from_config).
+        false
     }
 
     fn publish_statistics(&mut self, s: &StatisticsRecord) -> bool {

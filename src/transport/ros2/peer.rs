@@ -8,7 +8,7 @@ use crate::msgs::{
     StatisticsRecord, Time, TwistStamped, FLOAT64, FRICTION_ESTIMATE, LOOP_STATISTICS,
     TWIST_STAMPED,
 };
-use crate::transport::{PeerPort, TransportError};
+use crate::transport::{JointEfforts, JointStateCommand, PeerPort, TransportError};
 use ros2_client::{Context, Node, Publisher, Subscription};
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -104,6 +104,15 @@ impl Ros2Peer {
     }
 }
 
+/// What a ROS 2 peer says of the joint I/O it does not have yet.
+fn several_contacts() -> TransportError {
+    TransportError::backend(
+        NAME,
+        "use JointState or joint efforts",
+        "multi-contact I/O over ROS 2 is not built yet (iceoryx2 and in-memory have it)",
+    )
+}
+
 impl PeerPort for Ros2Peer {
     fn name(&self) -> &'static str {
         NAME
@@ -111,6 +120,7 @@ impl PeerPort for Ros2Peer {
 
     fn send(&mut self, c: &Command) -> Result<(), TransportError> {
         let r = match (c.kind, &self.velocity_f64, &self.velocity_twist) {
+            (CommandKind::JointVelocity { .. }, _, _) => return Err(several_contacts()),
             (CommandKind::Temperature, _, _) => self
                 .temperature
                 .publish(msgs::Temperature {
@@ -150,6 +160,18 @@ impl PeerPort for Ros2Peer {
             Ok(m) => Ok(m.map(|(m, _)| EstimateRecord::from_wire(&m))),
             Err(e) => Err(err("take an estimate", e)),
         }
+    }
+
+    fn send_joint_state(&mut self, _js: &JointStateCommand) -> Result<(), TransportError> {
+        Err(several_contacts())
+    }
+
+    fn try_recv_efforts(&mut self) -> Result<Option<JointEfforts>, TransportError> {
+        Err(several_contacts())
+    }
+
+    fn try_recv_contact(&mut self) -> Result<Option<(usize, EstimateRecord)>, TransportError> {
+        Err(several_contacts())
     }
 
     fn try_recv_statistics(&mut self) -> Result<Option<StatisticsRecord>, TransportError> {

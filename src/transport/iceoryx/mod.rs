@@ -14,8 +14,12 @@
 //! buffer loses its oldest sample); the node polls and publishes inline on the
 //! loop thread (lock-free shared-memory operations, no system call).
 
+mod joints;
+pub mod payloads;
+
 use super::{
-    record_input, NodePort, PeerPort, PortCounters, RecordQueue, SharedCounters, TransportError,
+    record_input, JointEfforts, JointStateCommand, NodePort, PeerPort, PortCounters, RecordQueue,
+    SharedCounters, TransportError,
 };
 use crate::clock::system_wall_ns;
 use crate::config::Iceoryx2Config;
@@ -23,209 +27,12 @@ use crate::msgs::{Command, CommandKind, EstimateRecord, RecordItem, StatisticsRe
 use iceoryx2::identifiers::UniquePublisherId;
 use iceoryx2::prelude::*;
 use iceoryx2::service::port_factory::PortFactory;
+use joints::{JointNode, JointPeer};
+pub use payloads::*;
 use std::sync::atomic::Ordering;
 use std::time::Duration;
 
 const NAME: &str = "iceoryx2";
-
-/// A velocity or load command.
-#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
-#[repr(C)]
-#[type_name("friction_node::Command_v2")]
-pub struct CommandPayload {
-    /// Sender's stamp, ns.
-    pub stamp_ns: u64,
-    /// m/s (velocity service) or N (load service).
-    pub value: f64,
-    /// 1, 2, 3, … per publisher: a gap is a sample lost to a full buffer.
-    pub sequence: u64,
-}
-
-/// One estimate (the fields of `friction_msgs/FrictionEstimate`).
-#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
-#[repr(C)]
-#[type_name("friction_node::FrictionEstimate_v2")]
-pub struct EstimatePayload {
-    pub stamp_ns: u64,
-    pub velocity_m_s: f64,
-    pub load_n: f64,
-    pub temperature_c: f64,
-    pub friction_force_n: f64,
-    pub contact_friction_force_n: f64,
-    pub cof: f64,
-    pub h0_m: f64,
-    pub h_min_m: f64,
-    pub hydrodynamic_force_n: f64,
-    pub asperity_force_n: f64,
-    pub asperity_load_share: f64,
-    pub compute_time_ns: u64,
-    pub late_ns: u64,
-    pub iterations: u32,
-    pub regime: u8,
-    pub status: u8,
-    pub command_status: u8,
-    pub reserved: u8,
-}
-
-/// Loop statistics (the fields of `friction_msgs/LoopStatistics`).
-#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
-#[repr(C)]
-#[type_name("friction_node::LoopStatistics_v4")]
-pub struct StatisticsPayload {
-    pub stamp_ns: u64,
-    pub steps: u64,
-    pub deadline_misses: u64,
-    pub catch_up_steps: u64,
-    pub time_jumps: u64,
-    pub clock_jumps: u64,
-    pub commands_received: u64,
-    pub commands_applied: u64,
-    pub commands_overwritten: u64,
-    pub commands_rejected: u64,
-    pub command_timeouts: u64,
-    pub publish_drops: u64,
-    pub publish_failures: u64,
-    pub statistics_not_sent: u64,
-    pub recorder_drops: u64,
-    pub recording_files: u64,
-    pub recording_files_deleted: u64,
-    pub recording_lost: u64,
-    pub snapshots: u64,
-    pub last_snapshot_span_s: f64,
-    /// UTF-8, `last_snapshot_len` bytes used.
-    pub last_snapshot: [u8; 255],
-    pub last_snapshot_len: u8,
-    pub compute_time_ns: [u64; 3],
-    pub period_jitter_ns: [u64; 3],
-    pub steps_not_converged: u64,
-    pub parameter_updates: u64,
-}
-
-impl From<&StatisticsRecord> for StatisticsPayload {
-    fn from(s: &StatisticsRecord) -> Self {
-        Self {
-            stamp_ns: s.stamp_ns,
-            steps: s.steps,
-            deadline_misses: s.deadline_misses,
-            catch_up_steps: s.catch_up_steps,
-            time_jumps: s.time_jumps,
-            clock_jumps: s.clock_jumps,
-            commands_received: s.commands_received,
-            commands_applied: s.commands_applied,
-            commands_overwritten: s.commands_overwritten,
-            commands_rejected: s.commands_rejected,
-            command_timeouts: s.command_timeouts,
-            publish_drops: s.publish_drops,
-            publish_failures: s.publish_failures,
-            statistics_not_sent: s.statistics_not_sent,
-            recorder_drops: s.recorder_drops,
-            recording_files: s.recording.files,
-            recording_files_deleted: s.recording.files_deleted,
-            recording_lost: s.recording.lost,
-            snapshots: s.recording.snapshots,
-            last_snapshot_span_s: s.recording.last_snapshot_span_s,
-            last_snapshot: {
-                let mut b = [0u8; 255];
-                let t = s.recording.last_snapshot.as_str().as_bytes();
-                b[..t.len()].copy_from_slice(t);
-                b
-            },
-            last_snapshot_len: s.recording.last_snapshot.as_str().len() as u8,
-            compute_time_ns: s.compute_time_ns,
-            period_jitter_ns: s.period_jitter_ns,
-            steps_not_converged: s.steps_not_converged,
-            parameter_updates: s.parameter_updates,
-        }
-    }
-}
-
-impl From<&StatisticsPayload> for StatisticsRecord {
-    fn from(s: &StatisticsPayload) -> Self {
-        Self {
-            stamp_ns: s.stamp_ns,
-            steps: s.steps,
-            deadline_misses: s.deadline_misses,
-            catch_up_steps: s.catch_up_steps,
-            time_jumps: s.time_jumps,
-            clock_jumps: s.clock_jumps,
-            commands_received: s.commands_received,
-            commands_applied: s.commands_applied,
-            commands_overwritten: s.commands_overwritten,
-            commands_rejected: s.commands_rejected,
-            command_timeouts: s.command_timeouts,
-            publish_drops: s.publish_drops,
-            publish_failures: s.publish_failures,
-            statistics_not_sent: s.statistics_not_sent,
-            recorder_drops: s.recorder_drops,
-            recording: crate::msgs::RecordingStatus {
-                files: s.recording_files,
-                files_deleted: s.recording_files_deleted,
-                lost: s.recording_lost,
-                snapshots: s.snapshots,
-                last_snapshot: crate::msgs::Note::new(
-                    std::str::from_utf8(&s.last_snapshot[..usize::from(s.last_snapshot_len)])
-                        .unwrap_or(""),
-                ),
-                last_snapshot_span_s: s.last_snapshot_span_s,
-            },
-            compute_time_ns: s.compute_time_ns,
-            period_jitter_ns: s.period_jitter_ns,
-            steps_not_converged: s.steps_not_converged,
-            parameter_updates: s.parameter_updates,
-        }
-    }
-}
-
-impl From<&EstimateRecord> for EstimatePayload {
-    fn from(e: &EstimateRecord) -> Self {
-        Self {
-            stamp_ns: e.stamp_ns,
-            velocity_m_s: e.velocity_m_s,
-            load_n: e.load_n,
-            temperature_c: e.temperature_c,
-            friction_force_n: e.friction_force_n,
-            contact_friction_force_n: e.contact_friction_force_n,
-            cof: e.cof,
-            h0_m: e.h0_m,
-            h_min_m: e.h_min_m,
-            hydrodynamic_force_n: e.hydrodynamic_force_n,
-            asperity_force_n: e.asperity_force_n,
-            asperity_load_share: e.asperity_load_share,
-            compute_time_ns: e.compute_time_ns,
-            late_ns: e.late_ns,
-            iterations: e.iterations,
-            regime: e.regime,
-            status: e.status,
-            command_status: e.command_status,
-            reserved: 0,
-        }
-    }
-}
-
-impl From<&EstimatePayload> for EstimateRecord {
-    fn from(p: &EstimatePayload) -> Self {
-        Self {
-            stamp_ns: p.stamp_ns,
-            velocity_m_s: p.velocity_m_s,
-            load_n: p.load_n,
-            temperature_c: p.temperature_c,
-            friction_force_n: p.friction_force_n,
-            contact_friction_force_n: p.contact_friction_force_n,
-            cof: p.cof,
-            h0_m: p.h0_m,
-            h_min_m: p.h_min_m,
-            hydrodynamic_force_n: p.hydrodynamic_force_n,
-            asperity_force_n: p.asperity_force_n,
-            asperity_load_share: p.asperity_load_share,
-            regime: p.regime,
-            status: p.status,
-            command_status: p.command_status,
-            iterations: p.iterations,
-            compute_time_ns: p.compute_time_ns,
-            late_ns: p.late_ns,
-        }
-    }
-}
 
 /// Service names (Send; opened on the using thread).
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -236,6 +43,20 @@ pub struct IceoryxSpec {
     pub estimate: String,
     pub statistics: String,
     pub event: String,
+    /// Several contacts: the configured joints (empty: one contact) and
+    /// the joint services.
+    pub joints: Vec<String>,
+    pub joint_state: String,
+    pub efforts: String,
+    pub contact_estimate: String,
+}
+
+impl IceoryxSpec {
+    /// The spec of a node serving several contacts with these joints.
+    pub fn with_joints(mut self, joints: Vec<String>) -> Self {
+        self.joints = joints;
+        self
+    }
 }
 
 impl From<&Iceoryx2Config> for IceoryxSpec {
@@ -247,6 +68,10 @@ impl From<&Iceoryx2Config> for IceoryxSpec {
             estimate: c.friction_service.clone(),
             statistics: c.loop_statistics_service.clone(),
             event: c.cmd_event_service.clone(),
+            joints: Vec::new(),
+            joint_state: c.joint_state_service.clone(),
+            efforts: c.efforts_service.clone(),
+            contact_estimate: c.contact_friction_service.clone(),
         }
     }
 }
@@ -357,6 +182,8 @@ pub struct IceoryxNode {
     temperature_sequences: Sequences,
     record: RecordQueue,
     counters: SharedCounters,
+    /// Several contacts: the joint services.
+    joints: Option<JointNode>,
 }
 
 impl IceoryxNode {
@@ -399,6 +226,11 @@ impl IceoryxNode {
                 .map_err(|e| err("create the command event listener", e))?,
             velocity_sequences: Sequences::new(),
             load_sequences: Sequences::new(),
+            joints: if spec.joints.is_empty() {
+                None
+            } else {
+                Some(JointNode::open(&n, spec)?)
+            },
             record,
             counters: SharedCounters::default(),
             _node: n,
@@ -413,7 +245,7 @@ impl IceoryxNode {
                 &mut self.temperature_sequences,
                 "a temperature",
             ),
-            CommandKind::Velocity => (
+            CommandKind::Velocity | CommandKind::JointVelocity { .. } => (
                 &self.velocity,
                 &mut self.velocity_sequences,
                 "a velocity command",
@@ -461,11 +293,30 @@ impl NodePort for IceoryxNode {
         if let Some(c) = self.take(CommandKind::Temperature)? {
             return Ok(Some(c));
         }
+        if let Some(j) = &mut self.joints {
+            if let Some(c) = j.poll(&self.counters, &self.record)? {
+                return Ok(Some(c));
+            }
+        }
         self.take(CommandKind::Velocity)
     }
 
-    fn publish_estimate(&mut self, e: &EstimateRecord) -> bool {
-        let ok = self.estimate.send_copy(EstimatePayload::from(e)).is_ok();
+    fn publish_estimate(&mut self, contact: usize, e: &EstimateRecord) -> bool {
+        let ok = match &self.joints {
+            Some(j) => j.publish_estimate(contact, e),
+            None => self.estimate.send_copy(EstimatePayload::from(e)).is_ok(),
+        };
+        if !ok {
+            SharedCounters::bump(&self.counters.publish_failures);
+        }
+        ok
+    }
+
+    fn publish_efforts(&mut self, stamp_ns: u64, efforts: &[f64]) -> bool {
+        let ok = self
+            .joints
+            .as_ref()
+            .is_some_and(|j| j.publish_efforts(stamp_ns, efforts));
         if !ok {
             SharedCounters::bump(&self.counters.publish_failures);
         }
@@ -509,6 +360,8 @@ pub struct IceoryxPeer {
     velocity_sequence: u64,
     load_sequence: u64,
     temperature_sequence: u64,
+    /// Several contacts: the joint services.
+    joints: Option<JointPeer>,
 }
 
 impl IceoryxPeer {
@@ -549,9 +402,26 @@ impl IceoryxPeer {
                 .notifier_builder()
                 .create()
                 .map_err(|e| err("create the command notifier", e))?,
+            joints: if spec.joints.is_empty() {
+                None
+            } else {
+                Some(JointPeer::open(&n, spec)?)
+            },
             velocity_service: v,
             estimate_service: e,
             _node: n,
+        })
+    }
+}
+
+impl IceoryxPeer {
+    fn joint_peer(&mut self) -> Result<&mut JointPeer, TransportError> {
+        self.joints.as_mut().ok_or_else(|| {
+            TransportError::backend(
+                NAME,
+                "use the joint services",
+                "this peer was opened for one contact (IceoryxSpec::with_joints opens them)",
+            )
         })
     }
 }
@@ -563,7 +433,9 @@ impl PeerPort for IceoryxPeer {
 
     fn send(&mut self, c: &Command) -> Result<(), TransportError> {
         let (port, sequence) = match c.kind {
-            CommandKind::Velocity => (&self.velocity, &mut self.velocity_sequence),
+            CommandKind::Velocity | CommandKind::JointVelocity { .. } => {
+                (&self.velocity, &mut self.velocity_sequence)
+            }
             CommandKind::Load => (&self.load, &mut self.load_sequence),
             CommandKind::Temperature => (&self.temperature, &mut self.temperature_sequence),
         };
@@ -594,6 +466,22 @@ impl PeerPort for IceoryxPeer {
             .receive()
             .map_err(|e| err("receive loop statistics", e))?
             .map(|s| StatisticsRecord::from(&*s)))
+    }
+
+    fn send_joint_state(&mut self, js: &JointStateCommand) -> Result<(), TransportError> {
+        self.joint_peer()?.send(js)?;
+        self.notifier
+            .notify()
+            .map_err(|e| err("notify the node", e))?;
+        Ok(())
+    }
+
+    fn try_recv_efforts(&mut self) -> Result<Option<JointEfforts>, TransportError> {
+        self.joint_peer()?.try_recv_efforts()
+    }
+
+    fn try_recv_contact(&mut self) -> Result<Option<(usize, EstimateRecord)>, TransportError> {
+        self.joint_peer()?.try_recv_contact()
     }
 
     fn is_matched(&mut self) -> bool {

@@ -1,0 +1,270 @@
+//! The `#[repr(C)]` payloads of the iceoryx2 services and their
+//! conversions to the loop's records. Type names are versioned: a peer
+//! built with a different layout gets a clean error when its port opens.
+
+use crate::msgs::{EstimateRecord, StatisticsRecord};
+use iceoryx2::prelude::*;
+
+/// A velocity or load command.
+#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("friction_node::Command_v2")]
+pub struct CommandPayload {
+    /// Sender's stamp, ns.
+    pub stamp_ns: u64,
+    /// m/s (velocity service) or N (load service).
+    pub value: f64,
+    /// 1, 2, 3, … per publisher: a gap is a sample lost to a full buffer.
+    pub sequence: u64,
+}
+
+/// One estimate (the fields of `friction_msgs/FrictionEstimate`).
+#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("friction_node::FrictionEstimate_v2")]
+pub struct EstimatePayload {
+    pub stamp_ns: u64,
+    pub velocity_m_s: f64,
+    pub load_n: f64,
+    pub temperature_c: f64,
+    pub friction_force_n: f64,
+    pub contact_friction_force_n: f64,
+    pub cof: f64,
+    pub h0_m: f64,
+    pub h_min_m: f64,
+    pub hydrodynamic_force_n: f64,
+    pub asperity_force_n: f64,
+    pub asperity_load_share: f64,
+    pub compute_time_ns: u64,
+    pub late_ns: u64,
+    pub iterations: u32,
+    pub regime: u8,
+    pub status: u8,
+    pub command_status: u8,
+    pub reserved: u8,
+}
+
+/// Loop statistics (the fields of `friction_msgs/LoopStatistics`).
+#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("friction_node::LoopStatistics_v5")]
+pub struct StatisticsPayload {
+    pub stamp_ns: u64,
+    pub steps: u64,
+    pub deadline_misses: u64,
+    pub catch_up_steps: u64,
+    pub time_jumps: u64,
+    pub clock_jumps: u64,
+    pub commands_received: u64,
+    pub commands_applied: u64,
+    pub commands_overwritten: u64,
+    pub commands_rejected: u64,
+    pub command_timeouts: u64,
+    pub publish_drops: u64,
+    pub publish_failures: u64,
+    pub statistics_not_sent: u64,
+    pub recorder_drops: u64,
+    pub recording_files: u64,
+    pub recording_files_deleted: u64,
+    pub recording_lost: u64,
+    pub snapshots: u64,
+    pub last_snapshot_span_s: f64,
+    /// UTF-8, `last_snapshot_len` bytes used.
+    pub last_snapshot: [u8; 255],
+    pub last_snapshot_len: u8,
+    pub compute_time_ns: [u64; 3],
+    pub period_jitter_ns: [u64; 3],
+    pub steps_not_converged: u64,
+    pub parameter_updates: u64,
+    pub contacts: u32,
+    pub slowest_contact: u32,
+    pub slowest_contact_compute_ns: u64,
+}
+
+impl From<&StatisticsRecord> for StatisticsPayload {
+    fn from(s: &StatisticsRecord) -> Self {
+        Self {
+            stamp_ns: s.stamp_ns,
+            steps: s.steps,
+            deadline_misses: s.deadline_misses,
+            catch_up_steps: s.catch_up_steps,
+            time_jumps: s.time_jumps,
+            clock_jumps: s.clock_jumps,
+            commands_received: s.commands_received,
+            commands_applied: s.commands_applied,
+            commands_overwritten: s.commands_overwritten,
+            commands_rejected: s.commands_rejected,
+            command_timeouts: s.command_timeouts,
+            publish_drops: s.publish_drops,
+            publish_failures: s.publish_failures,
+            statistics_not_sent: s.statistics_not_sent,
+            recorder_drops: s.recorder_drops,
+            recording_files: s.recording.files,
+            recording_files_deleted: s.recording.files_deleted,
+            recording_lost: s.recording.lost,
+            snapshots: s.recording.snapshots,
+            last_snapshot_span_s: s.recording.last_snapshot_span_s,
+            last_snapshot: {
+                let mut b = [0u8; 255];
+                let t = s.recording.last_snapshot.as_str().as_bytes();
+                b[..t.len()].copy_from_slice(t);
+                b
+            },
+            last_snapshot_len: s.recording.last_snapshot.as_str().len() as u8,
+            compute_time_ns: s.compute_time_ns,
+            period_jitter_ns: s.period_jitter_ns,
+            steps_not_converged: s.steps_not_converged,
+            parameter_updates: s.parameter_updates,
+            contacts: s.contacts,
+            slowest_contact: s.slowest_contact,
+            slowest_contact_compute_ns: s.slowest_contact_compute_ns,
+        }
+    }
+}
+
+impl From<&StatisticsPayload> for StatisticsRecord {
+    fn from(s: &StatisticsPayload) -> Self {
+        Self {
+            stamp_ns: s.stamp_ns,
+            steps: s.steps,
+            deadline_misses: s.deadline_misses,
+            catch_up_steps: s.catch_up_steps,
+            time_jumps: s.time_jumps,
+            clock_jumps: s.clock_jumps,
+            commands_received: s.commands_received,
+            commands_applied: s.commands_applied,
+            commands_overwritten: s.commands_overwritten,
+            commands_rejected: s.commands_rejected,
+            command_timeouts: s.command_timeouts,
+            publish_drops: s.publish_drops,
+            publish_failures: s.publish_failures,
+            statistics_not_sent: s.statistics_not_sent,
+            recorder_drops: s.recorder_drops,
+            recording: crate::msgs::RecordingStatus {
+                files: s.recording_files,
+                files_deleted: s.recording_files_deleted,
+                lost: s.recording_lost,
+                snapshots: s.snapshots,
+                last_snapshot: crate::msgs::Note::new(
+                    std::str::from_utf8(&s.last_snapshot[..usize::from(s.last_snapshot_len)])
+                        .unwrap_or(""),
+                ),
+                last_snapshot_span_s: s.last_snapshot_span_s,
+            },
+            compute_time_ns: s.compute_time_ns,
+            period_jitter_ns: s.period_jitter_ns,
+            steps_not_converged: s.steps_not_converged,
+            parameter_updates: s.parameter_updates,
+            contacts: s.contacts,
+            slowest_contact: s.slowest_contact,
+            slowest_contact_compute_ns: s.slowest_contact_compute_ns,
+        }
+    }
+}
+
+impl From<&EstimateRecord> for EstimatePayload {
+    fn from(e: &EstimateRecord) -> Self {
+        Self {
+            stamp_ns: e.stamp_ns,
+            velocity_m_s: e.velocity_m_s,
+            load_n: e.load_n,
+            temperature_c: e.temperature_c,
+            friction_force_n: e.friction_force_n,
+            contact_friction_force_n: e.contact_friction_force_n,
+            cof: e.cof,
+            h0_m: e.h0_m,
+            h_min_m: e.h_min_m,
+            hydrodynamic_force_n: e.hydrodynamic_force_n,
+            asperity_force_n: e.asperity_force_n,
+            asperity_load_share: e.asperity_load_share,
+            compute_time_ns: e.compute_time_ns,
+            late_ns: e.late_ns,
+            iterations: e.iterations,
+            regime: e.regime,
+            status: e.status,
+            command_status: e.command_status,
+            reserved: 0,
+        }
+    }
+}
+
+impl From<&EstimatePayload> for EstimateRecord {
+    fn from(p: &EstimatePayload) -> Self {
+        Self {
+            stamp_ns: p.stamp_ns,
+            velocity_m_s: p.velocity_m_s,
+            load_n: p.load_n,
+            temperature_c: p.temperature_c,
+            friction_force_n: p.friction_force_n,
+            contact_friction_force_n: p.contact_friction_force_n,
+            cof: p.cof,
+            h0_m: p.h0_m,
+            h_min_m: p.h_min_m,
+            hydrodynamic_force_n: p.hydrodynamic_force_n,
+            asperity_force_n: p.asperity_force_n,
+            asperity_load_share: p.asperity_load_share,
+            regime: p.regime,
+            status: p.status,
+            command_status: p.command_status,
+            iterations: p.iterations,
+            compute_time_ns: p.compute_time_ns,
+            late_ns: p.late_ns,
+        }
+    }
+}
+
+/// Most bytes of one joint name in a [`JointStatePayload`].
+pub const JOINT_NAME_BYTES: usize = crate::config::MAX_JOINT_NAME_BYTES;
+
+/// A `sensor_msgs/JointState`'s names and velocities (fixed size:
+/// [`MAX_CONTACTS`](crate::transport::MAX_CONTACTS) joints of up to
+/// [`JOINT_NAME_BYTES`] bytes). `name_count` and `velocity_count` are sent
+/// as the sender had them: different counts reject the joints without a
+/// velocity, as over ROS 2.
+#[derive(Debug, Clone, Copy, ZeroCopySend)]
+#[repr(C)]
+#[type_name("friction_node::JointState_v1")]
+pub struct JointStatePayload {
+    pub stamp_ns: u64,
+    /// 1, 2, 3, … per publisher (gaps: samples lost to a full buffer).
+    pub sequence: u64,
+    pub name_count: u32,
+    pub velocity_count: u32,
+    /// UTF-8, `name_len[i]` bytes used.
+    pub name: [[u8; JOINT_NAME_BYTES]; crate::transport::MAX_CONTACTS],
+    pub name_len: [u8; crate::transport::MAX_CONTACTS],
+    pub velocity: [f64; crate::transport::MAX_CONTACTS],
+}
+
+impl JointStatePayload {
+    /// Joint `i`'s name ("" when not UTF-8: matches no joint).
+    pub fn name(&self, i: usize) -> &str {
+        let len = usize::from(self.name_len[i]).min(JOINT_NAME_BYTES);
+        std::str::from_utf8(&self.name[i][..len]).unwrap_or("")
+    }
+}
+
+/// Every contact's effort in the configured joint order (the data of the
+/// `std_msgs/Float64MultiArray` a ros2_control forward command controller
+/// takes).
+#[derive(Debug, Clone, Copy, ZeroCopySend)]
+#[repr(C)]
+#[type_name("friction_node::JointEfforts_v1")]
+pub struct EffortsPayload {
+    pub stamp_ns: u64,
+    pub len: u32,
+    pub reserved: u32,
+    /// N or N·m, `len` used.
+    pub effort: [f64; crate::transport::MAX_CONTACTS],
+}
+
+/// One contact's estimate (several contacts: one service for all).
+#[derive(Debug, Clone, Copy, ZeroCopySend)]
+#[repr(C)]
+#[type_name("friction_node::ContactEstimate_v1")]
+pub struct ContactEstimatePayload {
+    /// Index of the contact in the configured order.
+    pub contact: u32,
+    pub reserved: u32,
+    pub estimate: EstimatePayload,
+}
