@@ -278,3 +278,63 @@ fn a_parameter_change_is_applied_by_the_loop_between_two_steps_without_allocatin
     // Lower load and half the boundary friction: much less friction.
     assert!(est[19].friction_force_n < 0.5 * est[9].friction_force_n);
 }
+
+#[test]
+fn a_loop_of_several_contacts_allocates_nothing_per_joint_state() {
+    use friction_node::config::{Config, Origin};
+    use friction_node::node::{LiveStatus, Loop};
+    use friction_node::transport::memory::MemoryLink;
+    use friction_node::transport::{JointStateCommand, PeerPort};
+    use std::sync::Arc;
+    let cfg = Config::from_yaml(
+        "/**:
+  ros__parameters:
+    solver: {cells: 8}
+    node: {step_mode: lockstep, profile_rate_hz: 0.0}
+    contacts:
+      a: {joint: ja}
+      b: {joint: jb, gain: 0.1}
+      c: {joint: jc, solver: {cells: 16}}
+",
+        &Origin::Embedded,
+        &[],
+    )
+    .unwrap();
+    let joints = vec!["ja".to_string(), "jb".to_string(), "jc".to_string()];
+    // Nobody reads: the output queues fill up, and a full queue is a
+    // counted drop, never an allocation.
+    let link = MemoryLink::new(64).with_joints(&joints);
+    let mut peer = link.peer();
+    let mut l = Loop::new(
+        &cfg,
+        vec![Box::new(link.node())],
+        None,
+        None,
+        Arc::new(LiveStatus::default()),
+    )
+    .unwrap();
+    let mut steps = 0;
+    let mut worst = 0;
+    for batch in 0..20u64 {
+        // 20 JointStates (60 commands) sent outside the counted region.
+        for i in 0..20u64 {
+            let k = batch * 20 + i + 1;
+            let v = (k as f64 * 0.01).sin();
+            peer.send_joint_state(&JointStateCommand {
+                stamp_ns: k,
+                name: joints.clone(),
+                velocity: vec![v, -v, 0.5 * v],
+            })
+            .unwrap();
+        }
+        worst = worst.max(allocations(|| {
+            l.poll_once();
+        }));
+        steps = l.summary().steps;
+    }
+    assert_eq!(steps, 400, "one step per JointState");
+    assert_eq!(
+        worst, 0,
+        "{worst} allocations in a batch of 20 steps of 3 contacts"
+    );
+}

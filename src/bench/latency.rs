@@ -1,5 +1,8 @@
 //! `friction-node bench-latency`: command → estimate through a transport,
-//! model step included, against a lockstep node.
+//! model step included, against a lockstep node. With several contacts
+//! configured: JointState (every joint) → joint efforts (the
+//! Float64MultiArray a ros2_control controller takes), every contact's
+//! step included.
 
 use crate::config::Config;
 use std::time::Instant;
@@ -9,6 +12,8 @@ use std::time::Instant;
 #[derive(Debug, Clone)]
 pub struct LatencyReport {
     pub transport: &'static str,
+    /// Contacts stepped per round trip (several: JointState → efforts).
+    pub contacts: usize,
     pub samples: usize,
     /// p50, p99, p99.9, max of command → estimate, µs.
     pub latency_us: [f64; 4],
@@ -59,19 +64,45 @@ pub fn latency(
     let mut times = Vec::with_capacity(samples);
     let mut lost = 0;
     let stamp0 = crate::clock::system_wall_ns();
+    let joints: Vec<String> = cfg
+        .resolved_contacts()
+        .into_iter()
+        .map(|c| c.joint)
+        .collect();
+    let several = joints.len() > 1;
+    let mut js = crate::transport::JointStateCommand {
+        stamp_ns: 0,
+        velocity: vec![0.0; joints.len()],
+        name: joints,
+    };
     for k in 0..warmup + samples {
         let t = (k + 1) as f64 * dt;
+        let v = (2.0 * std::f64::consts::PI * t).sin();
+        let stamp_ns = stamp0 + k as u64 * 1_000_000;
         let c = Command {
             kind: CommandKind::Velocity,
-            value: (2.0 * std::f64::consts::PI * t).sin(),
-            stamp_ns: stamp0 + k as u64 * 1_000_000,
+            value: v,
+            stamp_ns,
         };
+        js.stamp_ns = stamp_ns;
+        for (i, x) in js.velocity.iter_mut().enumerate() {
+            *x = v * (1.0 - 0.05 * i as f64);
+        }
         let start = Instant::now();
-        peer.send(&c)?;
+        if several {
+            peer.send_joint_state(&js)?;
+        } else {
+            peer.send(&c)?;
+        }
         // Busy-poll: the peer is a tight control loop waiting for its answer.
         let got = loop {
-            if let Some(e) = peer.try_recv()? {
-                break Some(e);
+            let answer = if several {
+                peer.try_recv_efforts()?.map(|_| ())
+            } else {
+                peer.try_recv()?.map(|_| ())
+            };
+            if answer.is_some() {
+                break answer;
             }
             if start.elapsed() > Duration::from_secs(2) {
                 break None;
@@ -79,6 +110,7 @@ pub fn latency(
             std::hint::spin_loop();
         };
         let ns = start.elapsed().as_nanos() as u64;
+        while several && peer.try_recv_contact()?.is_some() {}
         match got {
             Some(_) if k >= warmup => times.push(ns),
             Some(_) => {}
@@ -98,6 +130,7 @@ pub fn latency(
             .map_or(f64::NAN, |v| *v as f64 / 1e3)
     };
     Ok(LatencyReport {
+        contacts: cfg.resolved_contacts().len(),
         transport: spec.name(),
         samples: times.len(),
         latency_us: [

@@ -66,8 +66,13 @@ pub fn latency(
         config.solver.cells
     );
     let r = friction_node::bench::latency(config, spec, samples, warmup)?;
+    let what = if r.contacts > 1 {
+        format!("{} contacts: JointState → efforts", r.contacts)
+    } else {
+        "command → estimate".to_string()
+    };
     println!(
-        "{}: command → estimate p50 {:.1} µs, p99 {:.1} µs, p99.9 {:.1} µs, max {:.1} µs over {} samples ({} lost); model step p50 {:.1} µs, p99 {:.1} µs",
+        "{}: {what} p50 {:.1} µs, p99 {:.1} µs, p99.9 {:.1} µs, max {:.1} µs over {} samples ({} lost); model step p50 {:.1} µs, p99 {:.1} µs",
         r.transport, r.latency_us[0], r.latency_us[1], r.latency_us[2], r.latency_us[3], r.samples, r.lost, r.step_us[0], r.step_us[1]
     );
     Ok(())

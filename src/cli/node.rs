@@ -228,6 +228,14 @@ fn summary(config: &Config, r: &RunReport) {
         s.recorder_drops,
         s.transport_errors
     );
+    if s.contacts > 1 {
+        println!(
+            "  contacts         {} per step (statuses below count contact steps); the last step's slowest: contact {} ({:.1} µs)",
+            s.contacts,
+            s.slowest_contact,
+            us(s.slowest_contact_ns)
+        );
+    }
     let statuses: Vec<String> = s
         .status_counts
         .iter()
