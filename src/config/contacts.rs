@@ -400,7 +400,11 @@ mod tests {
         assert_eq!(r.len(), 1);
         assert_eq!(r[0].name, SINGLE_CONTACT_NAME);
         assert_eq!(r[0].config, c);
-        assert!(!c.to_yaml().contains("contacts"));
+        let yaml = c.to_yaml();
+        assert!(
+            !yaml.lines().any(|l| l.trim_start().starts_with("contacts:")),
+            "{yaml}"
+        );
     }
 
     #[test]

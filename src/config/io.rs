@@ -229,6 +229,17 @@ pub struct TopicsConfig {
     pub friction_force: String,
     pub film_profile: String,
     pub loop_statistics: String,
+    /// Several contacts: `sensor_msgs/msg/JointState`, velocities by joint
+    /// name (m/s of each contact's slider).
+    pub joint_commands: String,
+    /// Several contacts: `std_msgs/msg/Float64MultiArray` of efforts in the
+    /// configured joint order (a forward_command_controller's input).
+    pub joint_efforts: String,
+    /// Several contacts: `sensor_msgs/msg/JointState` with the efforts.
+    pub joint_friction: String,
+    /// Several contacts: the prefix of each contact's FrictionEstimate
+    /// topic, `<contact_friction>/<contact name>/friction`.
+    pub contact_friction: String,
 }
 
 impl Default for TopicsConfig {
@@ -241,6 +252,10 @@ impl Default for TopicsConfig {
             friction_force: "~/friction_force".into(),
             film_profile: "~/film_profile".into(),
             loop_statistics: "~/loop_statistics".into(),
+            joint_commands: "~/joint_commands".into(),
+            joint_efforts: "~/joint_efforts".into(),
+            joint_friction: "~/joint_friction".into(),
+            contact_friction: "~/contacts".into(),
         }
     }
 }

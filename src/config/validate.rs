@@ -426,6 +426,10 @@ impl Config {
             ("ros.topics.friction_force", &t.friction_force),
             ("ros.topics.film_profile", &t.film_profile),
             ("ros.topics.loop_statistics", &t.loop_statistics),
+            ("ros.topics.joint_commands", &t.joint_commands),
+            ("ros.topics.joint_efforts", &t.joint_efforts),
+            ("ros.topics.joint_friction", &t.joint_friction),
+            ("ros.topics.contact_friction", &t.contact_friction),
         ] {
             name(key, value, check_topic(value))?;
         }
@@ -444,6 +448,12 @@ impl Config {
                 &i.loop_statistics_service,
             ),
             ("iceoryx2.cmd_event_service", &i.cmd_event_service),
+            ("iceoryx2.joint_state_service", &i.joint_state_service),
+            ("iceoryx2.efforts_service", &i.efforts_service),
+            (
+                "iceoryx2.contact_friction_service",
+                &i.contact_friction_service,
+            ),
         ] {
             if value.is_empty() || value.len() > 255 || value.chars().any(char::is_whitespace) {
                 return Err(ConfigError::InvalidValue {

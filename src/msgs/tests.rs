@@ -55,6 +55,9 @@ fn wire_structs_mirror_the_msg_files_field_by_field() {
     check::<Time>(&TIME);
     check::<TwistStamped>(&TWIST_STAMPED);
     check::<JointState>(&JOINT_STATE);
+    check::<Float64MultiArray>(&FLOAT64_MULTI_ARRAY);
+    check::<MultiArrayLayout>(&MULTI_ARRAY_LAYOUT);
+    check::<MultiArrayDimension>(&MULTI_ARRAY_DIMENSION);
     check::<Float64>(&FLOAT64);
     check::<Temperature>(&TEMPERATURE);
     check::<FrictionEstimateV1>(&FRICTION_ESTIMATE_V1);

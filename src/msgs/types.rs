@@ -89,6 +89,27 @@ pub static JOINT_STATE: MsgType = MsgType {
     dependencies: &[&HEADER],
 };
 
+pub static MULTI_ARRAY_DIMENSION: MsgType = MsgType {
+    package: "std_msgs",
+    name: "MultiArrayDimension",
+    definition: "string label\nuint32 size\nuint32 stride\n",
+    dependencies: &[],
+};
+
+pub static MULTI_ARRAY_LAYOUT: MsgType = MsgType {
+    package: "std_msgs",
+    name: "MultiArrayLayout",
+    definition: "MultiArrayDimension[] dim\nuint32 data_offset\n",
+    dependencies: &[&MULTI_ARRAY_DIMENSION],
+};
+
+pub static FLOAT64_MULTI_ARRAY: MsgType = MsgType {
+    package: "std_msgs",
+    name: "Float64MultiArray",
+    definition: "MultiArrayLayout layout\nfloat64[] data\n",
+    dependencies: &[&MULTI_ARRAY_LAYOUT],
+};
+
 pub static EMPTY: MsgType = MsgType {
     package: "std_msgs",
     name: "Empty",

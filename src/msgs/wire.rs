@@ -85,6 +85,29 @@ pub struct JointState {
     pub effort: Vec<f64>,
 }
 
+/// `std_msgs/MultiArrayDimension`.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct MultiArrayDimension {
+    pub label: String,
+    pub size: u32,
+    pub stride: u32,
+}
+
+/// `std_msgs/MultiArrayLayout`.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct MultiArrayLayout {
+    pub dim: Vec<MultiArrayDimension>,
+    pub data_offset: u32,
+}
+
+/// `std_msgs/Float64MultiArray`: the joint efforts, one per configured
+/// joint in order (one dimension labelled `joints`).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct Float64MultiArray {
+    pub layout: MultiArrayLayout,
+    pub data: Vec<f64>,
+}
+
 /// `std_msgs/Empty`. On the wire an empty structure carries one byte (as
 /// rosidl generates it).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -216,6 +239,7 @@ mod ros2_impls {
     impl ros2_client::Message for Float64 {}
     impl ros2_client::Message for TwistStamped {}
     impl ros2_client::Message for JointState {}
+    impl ros2_client::Message for Float64MultiArray {}
     impl ros2_client::Message for Temperature {}
     impl ros2_client::Message for Empty {}
     impl ros2_client::Message for FrictionEstimate {}

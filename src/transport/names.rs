@@ -53,6 +53,12 @@ pub struct TopicNames {
     pub snapshot: String,
     /// `/parameter_events` (rcl_interfaces/ParameterEvent).
     pub parameter_events: String,
+    pub joint_commands: String,
+    pub joint_efforts: String,
+    pub joint_friction: String,
+    /// One FrictionEstimate topic per contact (several contacts), in the
+    /// configured order: `<ros.topics.contact_friction>/<name>`.
+    pub contact_friction: Vec<String>,
 }
 
 impl TopicNames {
@@ -69,6 +75,19 @@ impl TopicNames {
             loop_statistics: t(&r.topics.loop_statistics),
             snapshot: t("~/snapshot"),
             parameter_events: t("/parameter_events"),
+            joint_commands: t(&r.topics.joint_commands),
+            joint_efforts: t(&r.topics.joint_efforts),
+            joint_friction: t(&r.topics.joint_friction),
+            contact_friction: if cfg.contacts.0.len() > 1 {
+                let prefix = r.topics.contact_friction.trim_end_matches('/');
+                cfg.contacts
+                    .0
+                    .iter()
+                    .map(|c| t(&format!("{prefix}/{}/friction", c.name)))
+                    .collect()
+            } else {
+                Vec::new()
+            },
         }
     }
 }

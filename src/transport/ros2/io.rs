@@ -41,6 +41,7 @@ const LOAD: Token = Token(2);
 const WAKE: Token = Token(3);
 const TEMPERATURE: Token = Token(4);
 const CLOCK: Token = Token(5);
+const JOINTS: Token = Token(6);
 
 /// The DDS entities of the node.
 struct Entities {
@@ -59,6 +60,8 @@ struct Entities {
     clock: Option<ros2_client::Subscription<msgs::ros_interfaces::Clock>>,
     poll: Poll,
     waker: Arc<Waker>,
+    /// Several contacts: the joint topics.
+    joints: Option<super::joints::JointTopics>,
 }
 
 fn setup(spec: &Ros2Spec, snapshots: bool, sim_time: bool) -> Result<Entities, TransportError> {
@@ -159,6 +162,16 @@ fn setup(spec: &Ros2Spec, snapshots: bool, sim_time: bool) -> Result<Entities, T
             .register(c, CLOCK, Interest::READABLE)
             .map_err(|e| err("register /clock", e))?;
     }
+    let mut joints = if spec.joints.is_empty() {
+        None
+    } else {
+        Some(super::joints::JointTopics::open(n, spec, &cq, &eq)?)
+    };
+    if let Some(j) = joints.as_mut() {
+        poll.registry()
+            .register(&mut j.commands, JOINTS, Interest::READABLE)
+            .map_err(|e| err("register the joint commands", e))?;
+    }
     let waker = Arc::new(Waker::new(poll.registry(), WAKE).map_err(|e| err("create a waker", e))?);
     Ok(Entities {
         ctx,
@@ -176,6 +189,7 @@ fn setup(spec: &Ros2Spec, snapshots: bool, sim_time: bool) -> Result<Entities, T
         clock,
         poll,
         waker,
+        joints,
     })
 }
 
@@ -291,6 +305,9 @@ pub(super) fn run(
         take_all(&sh, &e.velocity, CommandKind::Velocity);
         take_all(&sh, &e.load, CommandKind::Load);
         take_all(&sh, &e.temperature, CommandKind::Temperature);
+        if let Some(j) = e.joints.as_mut() {
+            j.take(&sh.commands, &sh.counters);
+        }
         if let (Some(sub), Some(flag)) = (&e.snapshot, &sh.snapshot) {
             while let Ok(Some(_)) = sub.take() {
                 flag.store(true, Ordering::Release);
@@ -312,6 +329,18 @@ pub(super) fn run(
                         &counters.publish_failures,
                     );
                 }
+                Out::ContactEstimate(k, r) => count(
+                    e.joints
+                        .as_ref()
+                        .is_some_and(|j| j.publish_estimate(k, &r, &frame)),
+                    &counters.publish_failures,
+                ),
+                Out::Efforts(x) => count(
+                    e.joints
+                        .as_ref()
+                        .is_some_and(|j| j.publish_efforts(&x, &frame)),
+                    &counters.publish_failures,
+                ),
                 Out::Statistics(s) => {
                     count(
                         e.stats.publish(s.to_wire(&frame)).is_ok(),

@@ -8,6 +8,9 @@
 //! publishes estimates (`FrictionEstimate` and the plain `std_msgs/Float64`
 //! friction force), `FilmProfile` (from the shared profile slot) and
 //! `LoopStatistics`, counting what fails. The loop never calls into DDS.
+//! With several contacts (`joints.rs`), JointState commands by joint name
+//! in, and the efforts (`Float64MultiArray`, `JointState`) and each
+//! contact's `FrictionEstimate` out.
 //!
 //! Discovery follows the ROS 2 conventions: `ROS_DOMAIN_ID`, and
 //! `ROS_AUTOMATIC_DISCOVERY_RANGE` / `ROS_LOCALHOST_ONLY` unless
@@ -17,6 +20,7 @@
 //! same-host unicast announcements.
 
 mod io;
+mod joints;
 pub mod params;
 mod peer;
 pub mod raw;
@@ -67,6 +71,13 @@ pub struct Ros2Spec {
     pub estimate_qos: QosConfig,
     pub frame_id: String,
     pub queue_capacity: usize,
+    /// Several contacts: the configured joints (empty: one contact), the
+    /// joint topics and each contact's estimate topic.
+    pub joints: Vec<String>,
+    pub joint_commands: String,
+    pub joint_efforts: String,
+    pub joint_friction: String,
+    pub contact_friction: Vec<String>,
 }
 
 /// The domain id: the config's, else `ROS_DOMAIN_ID`, else 0.
@@ -114,18 +125,6 @@ impl Ros2Spec {
     }
 
     pub fn from_config(cfg: &Config) -> Result<Self, TransportError> {
-        if cfg.contacts.0.len() > 1 {
-            return Err(TransportError::backend(
-                NAME,
-                "serve several contacts",
-                format!(
-                    "the configuration lists {} contacts; JointState in and Float64MultiArray \
-                     out over ROS 2 are not built yet: use node.transport: iceoryx2 for several \
-                     contacts, or one node per contact over ROS 2",
-                    cfg.contacts.0.len()
-                ),
-            ));
-        }
         let r = &cfg.ros;
         let names = super::names::TopicNames::from_config(cfg);
         Ok(Self {
@@ -146,6 +145,15 @@ impl Ros2Spec {
             estimate_qos: r.qos.estimates.clone(),
             frame_id: cfg.node.frame_id.clone(),
             queue_capacity: cfg.node.queue_capacity,
+            joints: if cfg.contacts.0.len() > 1 {
+                cfg.contacts.0.iter().map(|c| c.joint.clone()).collect()
+            } else {
+                Vec::new()
+            },
+            joint_commands: names.joint_commands.clone(),
+            joint_efforts: names.joint_efforts.clone(),
+            joint_friction: names.joint_friction.clone(),
+            contact_friction: names.contact_friction.clone(),
         })
     }
 }
@@ -250,6 +258,10 @@ pub(super) fn subscribe<M: 'static>(
 #[derive(Debug, Clone, Copy)]
 enum Out {
     Estimate(EstimateRecord),
+    /// Several contacts: contact k's estimate.
+    ContactEstimate(usize, EstimateRecord),
+    /// Several contacts: the efforts in joint order.
+    Efforts(crate::transport::JointEfforts),
     Statistics(StatisticsRecord),
 }
 
@@ -263,6 +275,8 @@ pub struct Ros2Node {
     thread: Option<std::thread::JoinHandle<()>>,
     /// The services thread (parameters, ~/snapshot).
     services: Option<std::thread::JoinHandle<()>>,
+    /// Several contacts: estimates go to the per-contact topics.
+    several: bool,
 }
 
 impl Ros2Node {
@@ -296,6 +310,7 @@ impl Ros2Node {
             counters,
             thread: Some(thread),
             services: None,
+            several: !spec.joints.is_empty(),
         };
         if let Some(p) = io.parameters {
             let (tx, rx) = std::sync::mpsc::channel();
@@ -341,14 +356,18 @@ impl NodePort for Ros2Node {
         Ok(self.commands.pop())
     }
 
-    fn publish_estimate(&mut self, _contact: usize, e: &EstimateRecord) -> bool {
-        // One contact only (from_config refuses several).
-        self.push(Out::Estimate(*e))
+    fn publish_estimate(&mut self, contact: usize, e: &EstimateRecord) -> bool {
+        if self.several {
+            self.push(Out::ContactEstimate(contact, *e))
+        } else {
+            self.push(Out::Estimate(*e))
+        }
     }
 
-    fn publish_efforts(&mut self, _stamp_ns: u64, _efforts: &[f64]) -> bool {
-        // Never called: a ROS 2 port serves one contact (from_config).
-        false
+    fn publish_efforts(&mut self, stamp_ns: u64, efforts: &[f64]) -> bool {
+        self.push(Out::Efforts(crate::transport::JointEfforts::new(
+            stamp_ns, efforts,
+        )))
     }
 
     fn publish_statistics(&mut self, s: &StatisticsRecord) -> bool {

@@ -23,6 +23,8 @@ pub struct Ros2Peer {
     estimate: Subscription<FrictionEstimate>,
     statistics: Subscription<LoopStatistics>,
     frame_id: String,
+    /// Several contacts: the joint topics.
+    joints: Option<super::joints::JointPeer>,
 }
 
 static PEER_COUNTER: AtomicU64 = AtomicU64::new(0);
@@ -77,7 +79,13 @@ impl Ros2Peer {
             &eq,
             "the statistics",
         )?;
+        let joints = if spec.joints.is_empty() {
+            None
+        } else {
+            Some(super::joints::JointPeer::open(n, spec, &cq, &eq)?)
+        };
         Ok(Self {
+            joints,
             node,
             _ctx: ctx,
             velocity_f64: vf,
@@ -104,12 +112,12 @@ impl Ros2Peer {
     }
 }
 
-/// What a ROS 2 peer says of the joint I/O it does not have yet.
+/// What a one-contact peer says when asked for the joint topics.
 fn several_contacts() -> TransportError {
     TransportError::backend(
         NAME,
-        "use JointState or joint efforts",
-        "multi-contact I/O over ROS 2 is not built yet (iceoryx2 and in-memory have it)",
+        "use the joint topics",
+        "this peer was opened for one contact (a configuration with `contacts` opens them)",
     )
 }
 
@@ -120,7 +128,12 @@ impl PeerPort for Ros2Peer {
 
     fn send(&mut self, c: &Command) -> Result<(), TransportError> {
         let r = match (c.kind, &self.velocity_f64, &self.velocity_twist) {
-            (CommandKind::JointVelocity { .. }, _, _) => return Err(several_contacts()),
+            (CommandKind::JointVelocity { .. }, _, _) => {
+                return Err(err(
+                    "send a joint velocity",
+                    "send a JointState (send_joint_state) instead",
+                ))
+            }
             (CommandKind::Temperature, _, _) => self
                 .temperature
                 .publish(msgs::Temperature {
@@ -162,16 +175,22 @@ impl PeerPort for Ros2Peer {
         }
     }
 
-    fn send_joint_state(&mut self, _js: &JointStateCommand) -> Result<(), TransportError> {
-        Err(several_contacts())
+    fn send_joint_state(&mut self, js: &JointStateCommand) -> Result<(), TransportError> {
+        self.joints.as_mut().ok_or_else(several_contacts)?.send(js)
     }
 
     fn try_recv_efforts(&mut self) -> Result<Option<JointEfforts>, TransportError> {
-        Err(several_contacts())
+        self.joints
+            .as_mut()
+            .ok_or_else(several_contacts)?
+            .try_recv_efforts()
     }
 
     fn try_recv_contact(&mut self) -> Result<Option<(usize, EstimateRecord)>, TransportError> {
-        Err(several_contacts())
+        self.joints
+            .as_mut()
+            .ok_or_else(several_contacts)?
+            .try_recv_contact()
     }
 
     fn try_recv_statistics(&mut self) -> Result<Option<StatisticsRecord>, TransportError> {
@@ -202,5 +221,6 @@ impl PeerPort for Ros2Peer {
                 .wait_for_publisher(node)
                 .now_or_never()
                 .is_some()
+            && self.joints.as_ref().is_none_or(|j| j.is_matched(node))
     }
 }
