@@ -402,7 +402,9 @@ mod tests {
         assert_eq!(r[0].config, c);
         let yaml = c.to_yaml();
         assert!(
-            !yaml.lines().any(|l| l.trim_start().starts_with("contacts:")),
+            !yaml
+                .lines()
+                .any(|l| l.trim_start().starts_with("contacts:")),
             "{yaml}"
         );
     }
