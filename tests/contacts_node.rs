@@ -377,3 +377,27 @@ fn bad_contact_settings_for_the_node_are_errors_naming_the_key() {
         "{e}"
     );
 }
+
+#[test]
+fn a_one_contact_parameter_update_changes_nothing_in_a_loop_of_several() {
+    use friction_node::node::parameters::ParameterUpdate;
+    let cfg = three();
+    let link = MemoryLink::new(100).with_joints(&joints(&cfg));
+    let mut l = Loop::new(
+        &cfg,
+        vec![Box::new(link.node())],
+        None,
+        None,
+        Arc::new(LiveStatus::default()),
+    )
+    .unwrap();
+    let mut next = cfg.clone();
+    next.contact.load_n = 9_000.0;
+    let mut u = ParameterUpdate::prepare(&cfg, next, vec![]).unwrap();
+    l.apply_update(&mut u);
+    assert_eq!(
+        l.summary().parameter_updates,
+        0,
+        "not applied to any contact"
+    );
+}

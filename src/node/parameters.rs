@@ -413,6 +413,11 @@ impl super::Loop {
     /// One change: the model swapped in, the settings replaced, the
     /// viscosity re-derived at the current temperature, the load held.
     pub fn apply_update(&mut self, u: &mut ParameterUpdate) {
+        if self.contacts.len() > 1 {
+            // A prepared update holds one contact's model (the runner
+            // serves parameters only without `contacts`).
+            return;
+        }
         // The one contact's solver (the runner serves parameters only to a
         // configuration without `contacts`).
         if self
