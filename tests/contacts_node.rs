@@ -52,6 +52,18 @@ fn outputs(peer: &mut dyn PeerPort) -> (Vec<Vec<EstimateRecord>>, Vec<JointEffor
     (per, efforts)
 }
 
+/// A loop over `cfg` on the node side of `link`.
+fn new_loop(cfg: &Config, link: &MemoryLink) -> Loop {
+    Loop::new(
+        cfg,
+        vec![Box::new(link.node())],
+        None,
+        None,
+        Arc::new(LiveStatus::default()),
+    )
+    .unwrap()
+}
+
 fn run_timer(cfg: &Config, link: &MemoryLink, ms: u64) -> RunSummary {
     let clock = Arc::new(SimClock::starting_at(0, WALL0));
     let mut l = Loop::new(
@@ -240,14 +252,7 @@ fn lockstep(cfg: &Config, steps: u64, v: impl Fn(usize, u64) -> f64) -> Vec<Vec<
     let names = joints(&cfg);
     let link = MemoryLink::new(100_000).with_joints(&names);
     let mut peer = link.peer();
-    let mut l = Loop::new(
-        &cfg,
-        vec![Box::new(link.node())],
-        None,
-        None,
-        Arc::new(LiveStatus::default()),
-    )
-    .unwrap();
+    let mut l = new_loop(&cfg, &link);
     let mut per: Vec<Vec<EstimateRecord>> = vec![Vec::new(); names.len()];
     for i in 0..steps {
         let velocity: Vec<f64> = (0..names.len()).map(|k| v(k, i)).collect();
@@ -276,14 +281,7 @@ fn each_contact_of_a_lockstep_loop_equals_a_one_contact_loop_bit_for_bit() {
         one.node.step_mode = friction_node::config::StepMode::Lockstep;
         let link = MemoryLink::new(100_000);
         let mut peer = link.peer();
-        let mut l = Loop::new(
-            &one,
-            vec![Box::new(link.node())],
-            None,
-            None,
-            Arc::new(LiveStatus::default()),
-        )
-        .unwrap();
+        let mut l = new_loop(&one, &link);
         for i in 0..300u64 {
             l.feed(Command {
                 kind: CommandKind::Velocity,
@@ -328,14 +326,7 @@ fn a_lockstep_joint_state_with_an_old_stamp_takes_no_step() {
     cfg.node.step_mode = friction_node::config::StepMode::Lockstep;
     let link = MemoryLink::new(1000).with_joints(&joints(&cfg));
     let mut peer = link.peer();
-    let mut l = Loop::new(
-        &cfg,
-        vec![Box::new(link.node())],
-        None,
-        None,
-        Arc::new(LiveStatus::default()),
-    )
-    .unwrap();
+    let mut l = new_loop(&cfg, &link);
     let all = ["j_left", "j_right", "j_wrist"];
     peer.send_joint_state(&js(5 * MS, &all, &[0.1, 0.2, 0.3]))
         .unwrap();
@@ -383,14 +374,7 @@ fn a_one_contact_parameter_update_changes_nothing_in_a_loop_of_several() {
     use friction_node::node::parameters::ParameterUpdate;
     let cfg = three();
     let link = MemoryLink::new(100).with_joints(&joints(&cfg));
-    let mut l = Loop::new(
-        &cfg,
-        vec![Box::new(link.node())],
-        None,
-        None,
-        Arc::new(LiveStatus::default()),
-    )
-    .unwrap();
+    let mut l = new_loop(&cfg, &link);
     let mut next = cfg.clone();
     next.contact.load_n = 9_000.0;
     let mut u = ParameterUpdate::prepare(&cfg, next, vec![]).unwrap();
