@@ -3,14 +3,14 @@
 
 use anyhow::{bail, Context, Result};
 use friction_node::config::Config;
-use friction_node::fit::params::{map_parameter, DataScale};
-use friction_node::fit::problem::{fit, FitOutcome, Options};
 use friction_node::fit::report::{self, ModelRow};
-use friction_node::fit::{
-    Baseline, BaselineKind, Data, Delimiter, LoadForm, Mapping, ParamSpec, Parameter, PhysicsModel,
-    Source, Table,
+use friction_node::fit::request::{
+    fit_baselines, fit_ours, held_out_scale, param_specs, prepare, FitRequest, OursFitted,
+    TopicChoice,
 };
-use std::path::{Path, PathBuf};
+use friction_node::fit::{Delimiter, Mapping, ParamSpec};
+use std::path::PathBuf;
+use std::sync::Arc;
 
 /// Column separator of CSV data.
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -189,10 +189,6 @@ fn number(text: &str, what: &str) -> Result<f64> {
     }
 }
 
-fn is_bag(p: &Path) -> bool {
-    p.is_dir() || matches!(p.extension().and_then(|e| e.to_str()), Some("mcap" | "db3"))
-}
-
 impl FitArgs {
     fn mapping(&self) -> Result<Mapping> {
         let coefficients = self
@@ -217,46 +213,31 @@ impl FitArgs {
         })
     }
 
-    fn table(&self, path: &Path) -> Result<Table> {
-        if is_bag(path) {
-            #[cfg(feature = "mcap")]
-            {
-                let (Some(velocity), Some(friction)) = (&self.velocity_topic, &self.friction_topic)
-                else {
-                    bail!(
-                        "{}: bag data needs --velocity-topic and --friction-topic",
-                        path.display()
-                    );
-                };
-                let topics = friction_node::fit::bag_input::BagTopics {
-                    velocity: velocity.clone(),
-                    friction: friction.clone(),
-                    joint: self.joint.clone(),
-                    load: self.load_topic.clone(),
-                    temperature: self.temperature_topic.clone(),
-                };
-                let (table, note, used) = friction_node::fit::bag_input::read(path, &topics)?;
-                eprintln!(
-                    "fit: {}: velocity `{}`, friction `{}`, load {}, temperature {}",
-                    path.display(),
-                    used.velocity,
-                    used.friction,
-                    used.load.as_deref().map_or(
-                        "from the configuration (contact.load_n)".into(),
-                        |t| format!("`{t}`")
-                    ),
-                    used.temperature
-                        .as_deref()
-                        .map_or("none".into(), |t| format!("`{t}`")),
-                );
-                if let Some(n) = note {
-                    eprintln!("warning: {n}");
-                }
-                return Ok(table);
-            }
-            #[cfg(not(feature = "mcap"))]
-            bail!("{}: reading bags needs the `mcap` feature", path.display());
+    /// `--fit`, `--bounds` and `--start` → the fitted parameters.
+    fn specs(&self) -> Result<Vec<ParamSpec>> {
+        let mut bounds = Vec::new();
+        for b in &self.bounds {
+            let (n, v) = name_value(b, "--bounds")?;
+            let Some((lo, hi)) = v.split_once(':') else {
+                bail!("--bounds {b}: expected KEY=LO:HI");
+            };
+            bounds.push((
+                n.clone(),
+                number(lo.trim(), &format!("--bounds {n}"))?,
+                number(hi.trim(), &format!("--bounds {n}"))?,
+            ));
         }
+        let mut starts = Vec::new();
+        for st in &self.start {
+            let (n, v) = name_value(st, "--start")?;
+            let v = number(&v, &format!("--start {n}"))?;
+            starts.push((n, v));
+        }
+        Ok(param_specs(&self.keys, &bounds, &starts)?)
+    }
+
+    /// The request the library runs.
+    pub fn request(&self) -> Result<FitRequest> {
         let delimiter = match self.delimiter {
             DelimiterArg::Auto => Delimiter::Auto,
             DelimiterArg::Comma => Delimiter::Comma,
@@ -264,240 +245,32 @@ impl FitArgs {
             DelimiterArg::Tab => Delimiter::Tab,
             DelimiterArg::Whitespace => Delimiter::Whitespace,
         };
-        Ok(Table::read(
-            path,
+        Ok(FitRequest {
+            data: self.data.clone(),
+            validate: self.validate.clone(),
+            params: self.specs()?,
+            mapping: self.mapping()?,
+            holdout: self.holdout,
+            columns: self.columns.clone(),
+            skip: self.skip,
             delimiter,
-            self.columns.as_deref(),
-            self.skip,
-        )?)
+            topics: TopicChoice {
+                velocity: self.velocity_topic.clone(),
+                friction: self.friction_topic.clone(),
+                joint: self.joint.clone(),
+                load: self.load_topic.clone(),
+                temperature: self.temperature_topic.clone(),
+            },
+            starts: self.starts,
+            global_points: self.global_points,
+            seed: self.seed,
+            max_evaluations: self.max_evaluations,
+            baselines: self.baselines,
+            progress: Some(Arc::new(|label: &str, l: &str| {
+                eprintln!("fit [{label}]: {l}")
+            })),
+        })
     }
-
-    /// `--bounds` and `--start` per name; each must name a fitted parameter.
-    fn specs(&self) -> Result<Vec<ParamSpec>> {
-        let mut specs: Vec<ParamSpec> = Vec::new();
-        for k in &self.keys {
-            let k = k.trim();
-            if k.is_empty() {
-                bail!("--fit: an empty name in the list");
-            }
-            if specs.iter().any(|s| s.name == k) {
-                bail!("--fit {k}: named twice");
-            }
-            specs.push(ParamSpec {
-                name: k.to_string(),
-                ..Default::default()
-            });
-        }
-        for b in &self.bounds {
-            let (n, v) = name_value(b, "--bounds")?;
-            let Some((lo, hi)) = v.split_once(':') else {
-                bail!("--bounds {b}: expected KEY=LO:HI");
-            };
-            let (lo, hi) = (
-                number(lo.trim(), &format!("--bounds {n}"))?,
-                number(hi.trim(), &format!("--bounds {n}"))?,
-            );
-            let Some(s) = specs.iter_mut().find(|s| s.name == n) else {
-                bail!("--bounds {n}: `{n}` is not in --fit");
-            };
-            s.bounds = Some((lo, hi));
-        }
-        for st in &self.start {
-            let (n, v) = name_value(st, "--start")?;
-            let v = number(&v, &format!("--start {n}"))?;
-            let Some(s) = specs.iter_mut().find(|s| s.name == n) else {
-                bail!("--start {n}: `{n}` is not in --fit");
-            };
-            s.start = Some(v);
-        }
-        Ok(specs)
-    }
-}
-
-/// Scales of the training data at the maps' start values.
-pub(crate) fn data_scale(
-    sources: &[Source],
-    map: &[f64],
-    load_n: f64,
-) -> Result<(DataScale, f64, bool)> {
-    let (mut f, mut v, mut lmin, mut lmax) = (0.0f64, 0.0f64, f64::INFINITY, 0.0f64);
-    let (mut sum_abs, mut n) = (0.0, 0usize);
-    for s in sources {
-        let se = s.series(map)?;
-        for k in 0..se.len() {
-            f = f.max(se.friction[k].abs());
-            v = v.max(se.velocity[k].abs());
-            let l = se.load_at(k, load_n);
-            lmin = lmin.min(l);
-            lmax = lmax.max(l);
-            sum_abs += se.friction[k].abs();
-            n += 1;
-        }
-    }
-    if v == 0.0 {
-        bail!("the velocity is zero in every sample: there is no sliding to fit");
-    }
-    let scale = DataScale {
-        friction_n: f,
-        velocity_m_s: v,
-        load_min_n: lmin,
-    };
-    Ok((scale, sum_abs / n.max(1) as f64, lmax > 1.01 * lmin))
-}
-
-/// Data, the physics model's parameters and the fitted map coefficients.
-pub struct Prepared {
-    pub data: Data,
-    pub model: PhysicsModel,
-    pub map_fit: Vec<(usize, Parameter)>,
-    pub scale: DataScale,
-    pub mean_abs_n: f64,
-    pub loads_vary: bool,
-    /// The validation data hold loads outside the training data's range.
-    pub other_loads: bool,
-    pub names: Vec<String>,
-}
-
-pub fn prepare(config: &Config, args: &FitArgs) -> Result<Prepared> {
-    let mapping = args.mapping()?;
-    let source = |p: &PathBuf| -> Result<Source> {
-        let table = args.table(p)?;
-        Ok(Source::new(table, &mapping)?)
-    };
-    let train = args.data.iter().map(source).collect::<Result<Vec<_>>>()?;
-    let validate = args
-        .validate
-        .iter()
-        .map(source)
-        .collect::<Result<Vec<_>>>()?;
-    let map_names: Vec<String> = mapping.coefficients.iter().map(|c| c.0.clone()).collect();
-    let map_values: Vec<f64> = mapping.coefficients.iter().map(|c| c.1).collect();
-    let (scale, mean_abs_n, loads_vary) = data_scale(&train, &map_values, config.contact.load_n)?;
-    let other_loads = if validate.is_empty() {
-        false
-    } else {
-        let range = |sources: &[Source]| -> Result<(f64, f64)> {
-            let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
-            for s in sources {
-                let se = s.series(&map_values)?;
-                for k in 0..se.len() {
-                    let l = se.load_at(k, config.contact.load_n);
-                    lo = lo.min(l);
-                    hi = hi.max(l);
-                }
-            }
-            Ok((lo, hi))
-        };
-        let (tl, th) = range(&train)?;
-        let (vl, vh) = range(&validate)?;
-        vl < 0.99 * tl || vh > 1.01 * th
-    };
-    let specs = args.specs()?;
-    let mut key_specs = Vec::new();
-    let mut map_fit = Vec::new();
-    for s in specs {
-        if s.name.contains('.') {
-            key_specs.push(s);
-        } else if let Some(i) = map_names.iter().position(|n| *n == s.name) {
-            map_fit.push((i, map_parameter(&s, map_values[i])?));
-        } else {
-            bail!(
-                "--fit {}: neither a configuration key (dotted, e.g. roughness.sigma_m) nor a --map coefficient",
-                s.name
-            );
-        }
-    }
-    let model = PhysicsModel::new(config, &key_specs, &scale)?;
-    Ok(Prepared {
-        names: args.data.iter().map(|p| p.display().to_string()).collect(),
-        data: Data {
-            train,
-            validate,
-            holdout: args.holdout,
-            map_names,
-            map_values,
-        },
-        model,
-        map_fit,
-        scale,
-        mean_abs_n,
-        loads_vary,
-        other_loads,
-    })
-}
-
-fn options(args: &FitArgs, label: &str) -> Options {
-    let label = label.to_string();
-    Options {
-        starts: args.starts,
-        global_points: args.global_points,
-        seed: args.seed,
-        max_evaluations: args.max_evaluations,
-        progress: Some(Box::new(move |l| eprintln!("fit [{label}]: {l}"))),
-    }
-}
-
-/// RMS of the measured friction on held-out samples (validation data, else
-/// the held-out part), N: the scale of the held-out error.
-fn held_out_scale(o: &FitOutcome) -> f64 {
-    let (mut ss, mut n) = (0.0, 0usize);
-    let mut add = |f: f64| {
-        ss += f * f;
-        n += 1;
-    };
-    if o.validate.is_empty() {
-        for sf in &o.train {
-            for k in 0..sf.series.len() {
-                if !sf.series.fit[k] {
-                    add(sf.series.friction[k]);
-                }
-            }
-        }
-    } else {
-        for sf in &o.validate {
-            sf.series.friction.iter().for_each(|f| add(*f));
-        }
-    }
-    (ss / n.max(1) as f64).sqrt()
-}
-
-/// Fit the classic models with the same optimiser; load-only map
-/// coefficients stay at their starts (the load-linear levels absorb them).
-pub fn fit_baselines(p: &Prepared, args: &FitArgs) -> Result<Vec<FitOutcome>> {
-    let load_only: Vec<String> = p
-        .data
-        .train
-        .iter()
-        .flat_map(|s| s.load_only_coefficients())
-        .collect();
-    let map_fit: Vec<(usize, Parameter)> = p
-        .map_fit
-        .iter()
-        .filter(|(i, _)| !load_only.contains(&p.data.map_names[*i]))
-        .cloned()
-        .collect();
-    let all_steady = p.data.train.iter().all(Source::is_steady);
-    let mut out = Vec::new();
-    for kind in BaselineKind::ALL {
-        if kind == BaselineKind::LuGre && all_steady {
-            eprintln!("fit: LuGre skipped: on steady curves it is Stribeck");
-            continue;
-        }
-        let model = Baseline::new(
-            kind,
-            LoadForm::for_data(p.loads_vary, p.other_loads),
-            &p.scale,
-            p.mean_abs_n,
-        );
-        // A classic model costs microseconds per evaluation: give it ten
-        // times the budget, so that a non-converged baseline is never the
-        // budget's fault.
-        let mut opts = options(args, kind.label());
-        opts.max_evaluations = args.max_evaluations.saturating_mul(10);
-        let o = fit(&model, &p.data, map_fit.clone(), &opts)?;
-        out.push(o);
-    }
-    Ok(out)
 }
 
 fn slug(label: &str) -> String {
@@ -520,7 +293,11 @@ fn slug(label: &str) -> String {
 /// Run `fit`; exits with status 4 (after writing) when the fit did not
 /// converge.
 pub fn run(config: &Config, args: &FitArgs) -> Result<()> {
-    let p = prepare(config, args)?;
+    let req = args.request()?;
+    let p = prepare(config, &req)?;
+    for n in &p.notes {
+        eprintln!("fit: {n}");
+    }
     // Outputs are checked before any computation.
     let out_probe = friction_node::output::AtomicFile::create(&args.out)?;
     drop(out_probe);
@@ -536,32 +313,20 @@ pub fn run(config: &Config, args: &FitArgs) -> Result<()> {
         args.starts,
         args.global_points
     );
-    let ours = fit(
-        &p.model,
-        &p.data,
-        p.map_fit.clone(),
-        &options(args, "friction-node"),
-    )?;
-    let fitted_config = p
-        .model
-        .config(&ours.best[..n_model])
-        .context("the fitted configuration")?;
-    let mut map = p
-        .data
-        .map_names
-        .iter()
-        .cloned()
-        .zip(p.data.map_values.iter().copied())
-        .collect::<Vec<_>>();
-    for (j, (i, _)) in p.map_fit.iter().enumerate() {
-        map[*i].1 = ours.best[n_model + j];
-    }
+    let OursFitted {
+        outcome: ours,
+        config: fitted_config,
+        map,
+    } = fit_ours(&p, &req).context("the fitted configuration")?;
     let yaml = report::fitted_yaml(&fitted_config, &ours, &p.names, &map);
     friction_node::output::write_file(&args.out, yaml.as_bytes())?;
     println!("{}", report::summary(&ours, ""));
     let mut extra = String::new();
     if args.baselines {
-        let baselines = fit_baselines(&p, args)?;
+        let (baselines, skipped) = fit_baselines(&p, &req)?;
+        for s in skipped {
+            eprintln!("fit: {s}");
+        }
         let mut rows = vec![ModelRow::from(&ours)];
         rows.extend(baselines.iter().map(ModelRow::from));
         let table = report::models_table(&rows, held_out_scale(&ours));

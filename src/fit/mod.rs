@@ -27,6 +27,7 @@
 //! | `physics_model.rs` | our model as a predictor (transient and steady) |
 //! | `baselines.rs` | Coulomb + viscous, Stribeck, LuGre |
 //! | `problem.rs` | residuals, the parallel Jacobian, the LM run |
+//! | `request.rs` | a calibration as data (the command line's and Python's) and its steps |
 //! | `search.rs` | the global phase and the distinct optima |
 //! | `stats.rs` | standard errors, correlations, flags |
 //! | `report.rs` | the summary, the tables, plots, the fitted YAML |
@@ -38,6 +39,7 @@ pub mod baselines;
 pub mod params;
 pub mod physics_model;
 pub mod problem;
+pub mod request;
 pub mod report;
 pub mod search;
 pub mod series;

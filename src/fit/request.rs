@@ -1,0 +1,502 @@
+//! A calibration as data: what `fit`'s command line and the Python
+//! `friction_node.fit()` both build, and the steps from it to the fitted
+//! outcomes (data → sources → parameters → our fit → the classic models on
+//! the same data). Writing the fitted file and the report stays with the
+//! caller; nothing here prints.
+
+use super::params::{map_parameter, DataScale};
+use super::problem::{fit, FitOutcome, Options, Progress};
+use super::{
+    Baseline, BaselineKind, Data, Delimiter, FitError, LoadForm, Mapping, ParamSpec, Parameter,
+    PhysicsModel, Source, Table,
+};
+use crate::config::Config;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// Topics of bag data (velocity and friction are needed when a data path is
+/// a bag).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct TopicChoice {
+    pub velocity: Option<String>,
+    pub friction: Option<String>,
+    pub joint: Option<String>,
+    pub load: Option<String>,
+    pub temperature: Option<String>,
+}
+
+/// Everything a calibration needs besides the base configuration.
+#[derive(Clone)]
+pub struct FitRequest {
+    /// Training data: CSV files, MCAP files, rosbag2 directories.
+    pub data: Vec<PathBuf>,
+    /// Validation data (not fitted; the error is reported on it).
+    pub validate: Vec<PathBuf>,
+    /// Fitted parameters with their optional bounds and starts.
+    pub params: Vec<ParamSpec>,
+    /// Column expressions and map coefficients.
+    pub mapping: Mapping,
+    /// Fraction of each training file held out, in [0, 0.9].
+    pub holdout: f64,
+    /// CSV reading: column names of headerless data, rows skipped, separator.
+    pub columns: Option<Vec<String>>,
+    pub skip: usize,
+    pub delimiter: Delimiter,
+    /// Bag reading.
+    pub topics: TopicChoice,
+    /// Optimiser settings (as `fit`'s options).
+    pub starts: usize,
+    pub global_points: usize,
+    pub seed: u64,
+    pub max_evaluations: usize,
+    /// Also fit Coulomb + viscous, Stribeck and LuGre.
+    pub baselines: bool,
+    /// Progress lines, with the model's label.
+    pub progress: Option<Arc<dyn Fn(&str, &str) + Send + Sync>>,
+}
+
+impl Default for FitRequest {
+    /// The command line's defaults.
+    fn default() -> Self {
+        Self {
+            data: Vec::new(),
+            validate: Vec::new(),
+            params: Vec::new(),
+            mapping: Mapping {
+                time: None,
+                velocity: "velocity_m_s".into(),
+                friction: "friction_n".into(),
+                load: None,
+                temperature: None,
+                smooth_s: 0.05,
+                coefficients: Vec::new(),
+            },
+            holdout: 0.0,
+            columns: None,
+            skip: 0,
+            delimiter: Delimiter::Auto,
+            topics: TopicChoice::default(),
+            starts: 3,
+            global_points: 16,
+            seed: 1,
+            max_evaluations: 200,
+            baselines: false,
+            progress: None,
+        }
+    }
+}
+
+fn range_error(what: &str, value: String, range: &str) -> FitError {
+    FitError::Data {
+        what: what.to_string(),
+        message: format!("{value} is out of range: must be {range}"),
+    }
+}
+
+impl FitRequest {
+    /// The ranges the command line enforces.
+    pub fn check(&self) -> Result<(), FitError> {
+        if self.data.is_empty() {
+            return Err(FitError::Data {
+                what: "data".into(),
+                message: "no data files given".into(),
+            });
+        }
+        if self.params.is_empty() {
+            return Err(FitError::Data {
+                what: "--fit".into(),
+                message: "no parameter to fit".into(),
+            });
+        }
+        if !(self.holdout.is_finite() && (0.0..=0.9).contains(&self.holdout)) {
+            return Err(range_error(
+                "--holdout",
+                self.holdout.to_string(),
+                "a fraction in [0, 0.9]",
+            ));
+        }
+        if !(1..=100).contains(&self.starts) {
+            return Err(range_error(
+                "--starts",
+                self.starts.to_string(),
+                "in [1, 100]",
+            ));
+        }
+        if self.global_points > 10_000 {
+            return Err(range_error(
+                "--global-points",
+                self.global_points.to_string(),
+                "in [0, 10000]",
+            ));
+        }
+        if !(10..=100_000).contains(&self.max_evaluations) {
+            return Err(range_error(
+                "--max-evaluations",
+                self.max_evaluations.to_string(),
+                "in [10, 100000]",
+            ));
+        }
+        let s = self.mapping.smooth_s;
+        if !(s.is_finite() && (1e-9..=1e3).contains(&s)) {
+            return Err(range_error(
+                "--smooth",
+                s.to_string(),
+                "a number of seconds in (0, 1e3]",
+            ));
+        }
+        Ok(())
+    }
+
+    fn options(&self, label: &str) -> Options {
+        let progress: Option<Progress> = self.progress.clone().map(|p| {
+            let label = label.to_string();
+            Box::new(move |l: &str| p(&label, l)) as Progress
+        });
+        Options {
+            starts: self.starts,
+            global_points: self.global_points,
+            seed: self.seed,
+            max_evaluations: self.max_evaluations,
+            progress,
+        }
+    }
+
+    /// One data file as a table; a bag also returns which topics were used.
+    pub fn table(&self, path: &Path) -> Result<(Table, Option<String>), FitError> {
+        if is_bag(path) {
+            #[cfg(feature = "mcap")]
+            {
+                let (Some(velocity), Some(friction)) =
+                    (&self.topics.velocity, &self.topics.friction)
+                else {
+                    return Err(FitError::Data {
+                        what: path.display().to_string(),
+                        message: "bag data needs --velocity-topic and --friction-topic".into(),
+                    });
+                };
+                let topics = super::bag_input::BagTopics {
+                    velocity: velocity.clone(),
+                    friction: friction.clone(),
+                    joint: self.topics.joint.clone(),
+                    load: self.topics.load.clone(),
+                    temperature: self.topics.temperature.clone(),
+                };
+                let (table, note, used) = super::bag_input::read(path, &topics)?;
+                let mut line = format!(
+                    "{}: velocity `{}`, friction `{}`, load {}, temperature {}",
+                    path.display(),
+                    used.velocity,
+                    used.friction,
+                    used.load.as_deref().map_or(
+                        "from the configuration (contact.load_n)".into(),
+                        |t| format!("`{t}`")
+                    ),
+                    used.temperature
+                        .as_deref()
+                        .map_or("none".into(), |t| format!("`{t}`")),
+                );
+                if let Some(n) = note {
+                    line.push_str(&format!("\nwarning: {n}"));
+                }
+                return Ok((table, Some(line)));
+            }
+            #[cfg(not(feature = "mcap"))]
+            return Err(FitError::Data {
+                what: path.display().to_string(),
+                message: "reading bags needs the `mcap` feature".into(),
+            });
+        }
+        Ok((
+            Table::read(path, self.delimiter, self.columns.as_deref(), self.skip)?,
+            None,
+        ))
+    }
+}
+
+/// A data path that is read as a bag.
+pub fn is_bag(p: &Path) -> bool {
+    p.is_dir() || matches!(p.extension().and_then(|e| e.to_str()), Some("mcap" | "db3"))
+}
+
+/// Fitted parameters from names, `(name, lo, hi)` bounds and `(name,
+/// start)` starts; every bound and start must name a fitted parameter.
+pub fn param_specs(
+    keys: &[String],
+    bounds: &[(String, f64, f64)],
+    starts: &[(String, f64)],
+) -> Result<Vec<ParamSpec>, FitError> {
+    let mut specs: Vec<ParamSpec> = Vec::new();
+    for k in keys {
+        let k = k.trim();
+        if k.is_empty() {
+            return Err(FitError::Key {
+                key: String::new(),
+                message: "an empty name in the list".into(),
+            });
+        }
+        if specs.iter().any(|s| s.name == k) {
+            return Err(FitError::Key {
+                key: k.into(),
+                message: "named twice".into(),
+            });
+        }
+        specs.push(ParamSpec {
+            name: k.to_string(),
+            ..Default::default()
+        });
+    }
+    for (n, lo, hi) in bounds {
+        let Some(s) = specs.iter_mut().find(|s| s.name == *n) else {
+            return Err(FitError::Bounds {
+                key: n.clone(),
+                message: format!("`{n}` is not in --fit"),
+            });
+        };
+        s.bounds = Some((*lo, *hi));
+    }
+    for (n, v) in starts {
+        let Some(s) = specs.iter_mut().find(|s| s.name == *n) else {
+            return Err(FitError::Data {
+                what: format!("--start {n}"),
+                message: format!("`{n}` is not in --fit"),
+            });
+        };
+        if !v.is_finite() {
+            return Err(FitError::Data {
+                what: format!("--start {n}"),
+                message: format!("`{v}` is not a finite number"),
+            });
+        }
+        s.start = Some(*v);
+    }
+    Ok(specs)
+}
+
+/// Scales of the training data at the maps' start values: the scale, the
+/// mean |F| and whether the load varies.
+pub fn data_scale(
+    sources: &[Source],
+    map: &[f64],
+    load_n: f64,
+) -> Result<(DataScale, f64, bool), FitError> {
+    let (mut f, mut v, mut lmin, mut lmax) = (0.0f64, 0.0f64, f64::INFINITY, 0.0f64);
+    let (mut sum_abs, mut n) = (0.0, 0usize);
+    for s in sources {
+        let se = s.series(map)?;
+        for k in 0..se.len() {
+            f = f.max(se.friction[k].abs());
+            v = v.max(se.velocity[k].abs());
+            let l = se.load_at(k, load_n);
+            lmin = lmin.min(l);
+            lmax = lmax.max(l);
+            sum_abs += se.friction[k].abs();
+            n += 1;
+        }
+    }
+    if v == 0.0 {
+        return Err(FitError::Data {
+            what: "data".into(),
+            message: "the velocity is zero in every sample: there is no sliding to fit".into(),
+        });
+    }
+    let scale = DataScale {
+        friction_n: f,
+        velocity_m_s: v,
+        load_min_n: lmin,
+    };
+    Ok((scale, sum_abs / n.max(1) as f64, lmax > 1.01 * lmin))
+}
+
+/// Data, the physics model's parameters and the fitted map coefficients.
+pub struct Prepared {
+    pub data: Data,
+    pub model: PhysicsModel,
+    pub map_fit: Vec<(usize, Parameter)>,
+    pub scale: DataScale,
+    pub mean_abs_n: f64,
+    pub loads_vary: bool,
+    /// The validation data hold loads outside the training data's range.
+    pub other_loads: bool,
+    /// The training files, as given.
+    pub names: Vec<String>,
+    /// What was read from each bag (topics used, warnings).
+    pub notes: Vec<String>,
+}
+
+fn load_range(sources: &[Source], map: &[f64], load_n: f64) -> Result<(f64, f64), FitError> {
+    let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+    for s in sources {
+        let se = s.series(map)?;
+        for k in 0..se.len() {
+            let l = se.load_at(k, load_n);
+            lo = lo.min(l);
+            hi = hi.max(l);
+        }
+    }
+    Ok((lo, hi))
+}
+
+/// Read the data and set up the parameters (everything checked before any
+/// simulation).
+pub fn prepare(config: &Config, req: &FitRequest) -> Result<Prepared, FitError> {
+    req.check()?;
+    let mut notes = Vec::new();
+    let mut source = |p: &PathBuf| -> Result<Source, FitError> {
+        let (table, note) = req.table(p)?;
+        notes.extend(note);
+        Source::new(table, &req.mapping)
+    };
+    let train = req.data.iter().map(&mut source).collect::<Result<Vec<_>, _>>()?;
+    let validate = req
+        .validate
+        .iter()
+        .map(&mut source)
+        .collect::<Result<Vec<_>, _>>()?;
+    let mapping = &req.mapping;
+    let map_names: Vec<String> = mapping.coefficients.iter().map(|c| c.0.clone()).collect();
+    let map_values: Vec<f64> = mapping.coefficients.iter().map(|c| c.1).collect();
+    let load_n = config.contact.load_n;
+    let (scale, mean_abs_n, loads_vary) = data_scale(&train, &map_values, load_n)?;
+    let other_loads = if validate.is_empty() {
+        false
+    } else {
+        let (tl, th) = load_range(&train, &map_values, load_n)?;
+        let (vl, vh) = load_range(&validate, &map_values, load_n)?;
+        vl < 0.99 * tl || vh > 1.01 * th
+    };
+    let mut key_specs = Vec::new();
+    let mut map_fit = Vec::new();
+    for s in &req.params {
+        if s.name.contains('.') {
+            key_specs.push(s.clone());
+        } else if let Some(i) = map_names.iter().position(|n| *n == s.name) {
+            map_fit.push((i, map_parameter(s, map_values[i])?));
+        } else {
+            return Err(FitError::Key {
+                key: s.name.clone(),
+                message:
+                    "neither a configuration key (dotted, e.g. roughness.sigma_m) nor a --map coefficient"
+                        .into(),
+            });
+        }
+    }
+    let model = PhysicsModel::new(config, &key_specs, &scale)?;
+    Ok(Prepared {
+        names: req.data.iter().map(|p| p.display().to_string()).collect(),
+        data: Data {
+            train,
+            validate,
+            holdout: req.holdout,
+            map_names,
+            map_values,
+        },
+        model,
+        map_fit,
+        scale,
+        mean_abs_n,
+        loads_vary,
+        other_loads,
+        notes,
+    })
+}
+
+/// Our model's fit: the outcome, the fitted configuration and the map
+/// coefficients (fitted or fixed) by name.
+pub struct OursFitted {
+    pub outcome: FitOutcome,
+    pub config: Config,
+    pub map: Vec<(String, f64)>,
+}
+
+/// Fit our model.
+pub fn fit_ours(p: &Prepared, req: &FitRequest) -> Result<OursFitted, FitError> {
+    let outcome = fit(
+        &p.model,
+        &p.data,
+        p.map_fit.clone(),
+        &req.options("friction-node"),
+    )?;
+    let n_model = p.model.parameters_len();
+    let config = p.model.config(&outcome.best[..n_model])?;
+    let mut map = p
+        .data
+        .map_names
+        .iter()
+        .cloned()
+        .zip(p.data.map_values.iter().copied())
+        .collect::<Vec<_>>();
+    for (j, (i, _)) in p.map_fit.iter().enumerate() {
+        map[*i].1 = outcome.best[n_model + j];
+    }
+    Ok(OursFitted {
+        outcome,
+        config,
+        map,
+    })
+}
+
+/// RMS of the measured friction on held-out samples (validation data, else
+/// the held-out part), N: the scale of the held-out error.
+pub fn held_out_scale(o: &FitOutcome) -> f64 {
+    let (mut ss, mut n) = (0.0, 0usize);
+    let mut add = |f: f64| {
+        ss += f * f;
+        n += 1;
+    };
+    if o.validate.is_empty() {
+        for sf in &o.train {
+            for k in 0..sf.series.len() {
+                if !sf.series.fit[k] {
+                    add(sf.series.friction[k]);
+                }
+            }
+        }
+    } else {
+        for sf in &o.validate {
+            sf.series.friction.iter().for_each(|f| add(*f));
+        }
+    }
+    (ss / n.max(1) as f64).sqrt()
+}
+
+/// Fit the classic models with the same optimiser; load-only map
+/// coefficients stay at their starts (the load-linear levels absorb them).
+/// Returns the outcomes and a note for each model skipped.
+pub fn fit_baselines(
+    p: &Prepared,
+    req: &FitRequest,
+) -> Result<(Vec<FitOutcome>, Vec<String>), FitError> {
+    let load_only: Vec<String> = p
+        .data
+        .train
+        .iter()
+        .flat_map(|s| s.load_only_coefficients())
+        .collect();
+    let map_fit: Vec<(usize, Parameter)> = p
+        .map_fit
+        .iter()
+        .filter(|(i, _)| !load_only.contains(&p.data.map_names[*i]))
+        .cloned()
+        .collect();
+    let all_steady = p.data.train.iter().all(Source::is_steady);
+    let (mut out, mut skipped) = (Vec::new(), Vec::new());
+    for kind in BaselineKind::ALL {
+        if kind == BaselineKind::LuGre && all_steady {
+            skipped.push("LuGre skipped: on steady curves it is Stribeck".to_string());
+            continue;
+        }
+        let model = Baseline::new(
+            kind,
+            LoadForm::for_data(p.loads_vary, p.other_loads),
+            &p.scale,
+            p.mean_abs_n,
+        );
+        // A classic model costs microseconds per evaluation: give it ten
+        // times the budget, so that a non-converged baseline is never the
+        // budget's fault.
+        let mut opts = req.options(kind.label());
+        opts.max_evaluations = req.max_evaluations.saturating_mul(10);
+        out.push(fit(&model, &p.data, map_fit.clone(), &opts)?);
+    }
+    Ok((out, skipped))
+}
