@@ -82,25 +82,32 @@ impl LoopMetrics {
     /// (shortest round-trip floats; empty for undefined values).
     pub fn csv_fields(&self) -> String {
         use crate::text::Num;
-        let opt = |x: Option<f64>| x.map_or(String::new(), |v| Num(v).to_string());
-        format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
-            Num(self.friction_loop_area),
-            Num(self.cof_loop_area),
-            opt(self.cof_v0_accelerating),
-            opt(self.cof_v0_decelerating),
-            Num(self.peak_cof),
-            Num(self.peak_cof_velocity),
-            Num(self.mean_cof),
-            Num(self.h0_min),
-            Num(self.h0_max),
-            Num(self.mean_asperity_share),
-            Num(self.mean_fluid_share),
-            opt(self.branch_cof_gap),
-            opt(self.branch_h0_gap),
-            Num(self.inertia_share),
-            Num(self.inertia_share_smooth)
-        )
+        self.values()
+            .iter()
+            .map(|x| x.map_or(String::new(), |v| Num(v).to_string()))
+            .collect::<Vec<_>>()
+            .join(",")
+    }
+
+    /// The metrics in the order of [`LOOP_METRIC_COLUMNS`] (None: undefined).
+    pub fn values(&self) -> [Option<f64>; Self::COLUMNS] {
+        [
+            Some(self.friction_loop_area),
+            Some(self.cof_loop_area),
+            self.cof_v0_accelerating,
+            self.cof_v0_decelerating,
+            Some(self.peak_cof),
+            Some(self.peak_cof_velocity),
+            Some(self.mean_cof),
+            Some(self.h0_min),
+            Some(self.h0_max),
+            Some(self.mean_asperity_share),
+            Some(self.mean_fluid_share),
+            self.branch_cof_gap,
+            self.branch_h0_gap,
+            Some(self.inertia_share),
+            Some(self.inertia_share_smooth),
+        ]
     }
 
     /// Number of columns in [`LOOP_METRIC_COLUMNS`].

@@ -246,7 +246,8 @@ pub fn fit_targets(
     for seed in 1..=seeds {
         let name = format!("recovery-seed{seed}.csv");
         let d = data(source(&name, &noisy_csv(&m, &clean, 0.02, seed))?, vec![]);
-        let (scale, _, _) = friction_node::fit::request::data_scale(&d.train, &[], base.contact.load_n)?;
+        let (scale, _, _) =
+            friction_node::fit::request::data_scale(&d.train, &[], base.contact.load_n)?;
         let model = PhysicsModel::new(&base, &specs, &scale)?;
         let o = fit(&model, &d, vec![], &progress("recovery"))?;
         let mut row = format!("| {seed} |");
@@ -311,7 +312,8 @@ pub fn fit_targets(
         )?,
         vec![],
     );
-    let (scale, _, _) = friction_node::fit::request::data_scale(&d.train, &[], base.contact.load_n)?;
+    let (scale, _, _) =
+        friction_node::fit::request::data_scale(&d.train, &[], base.contact.load_n)?;
     let model = PhysicsModel::new(&base, &dt_specs, &scale)?;
     println!("## Drivetrain terms beside the contact (from the defaults; global phase with three seeds)\n");
     println!(
@@ -361,7 +363,8 @@ pub fn fit_targets(
         &noisy_csv(&valid_m, &model_friction(&truth, &valid_m)?, 0.02, 3),
     )?;
     let d = data(train, vec![valid]);
-    let (scale, mean_abs, _) = friction_node::fit::request::data_scale(&d.train, &[], base.contact.load_n)?;
+    let (scale, mean_abs, _) =
+        friction_node::fit::request::data_scale(&d.train, &[], base.contact.load_n)?;
     let model = PhysicsModel::new(&base, &specs, &scale)?;
     let ours = fit(&model, &d, vec![], &progress("transfer: ours"))?;
     let mut rows = vec![ModelRow::from(&ours)];

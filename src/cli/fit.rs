@@ -273,23 +273,6 @@ impl FitArgs {
     }
 }
 
-fn slug(label: &str) -> String {
-    label
-        .chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() {
-                c.to_ascii_lowercase()
-            } else {
-                '-'
-            }
-        })
-        .collect::<String>()
-        .split('-')
-        .filter(|s| !s.is_empty())
-        .collect::<Vec<_>>()
-        .join("-")
-}
-
 /// Run `fit`; exits with status 4 (after writing) when the fit did not
 /// converge.
 pub fn run(config: &Config, args: &FitArgs) -> Result<()> {
@@ -334,7 +317,7 @@ pub fn run(config: &Config, args: &FitArgs) -> Result<()> {
         extra = format!("## Models on the same data, same optimiser\n\n{table}");
         if let Some(r) = &args.report {
             for b in &baselines {
-                let dir = r.join(slug(&b.label));
+                let dir = r.join(report::slug(&b.label));
                 friction_node::output::prepare_dir(&dir)?;
                 report::write_report(&dir, b, "")?;
             }

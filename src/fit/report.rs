@@ -407,3 +407,21 @@ mod plots {
         ])
     }
 }
+
+/// A model's label as a directory name (`Coulomb + viscous` → `coulomb-viscous`).
+pub fn slug(label: &str) -> String {
+    label
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() {
+                c.to_ascii_lowercase()
+            } else {
+                '-'
+            }
+        })
+        .collect::<String>()
+        .split('-')
+        .filter(|s| !s.is_empty())
+        .collect::<Vec<_>>()
+        .join("-")
+}

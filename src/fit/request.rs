@@ -14,6 +14,9 @@ use crate::config::Config;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+/// Progress lines with the label of the model being fitted.
+pub type LabelledProgress = Arc<dyn Fn(&str, &str) + Send + Sync>;
+
 /// Topics of bag data (velocity and friction are needed when a data path is
 /// a bag).
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -52,7 +55,7 @@ pub struct FitRequest {
     /// Also fit Coulomb + viscous, Stribeck and LuGre.
     pub baselines: bool,
     /// Progress lines, with the model's label.
-    pub progress: Option<Arc<dyn Fn(&str, &str) + Send + Sync>>,
+    pub progress: Option<LabelledProgress>,
 }
 
 impl Default for FitRequest {
@@ -346,7 +349,11 @@ pub fn prepare(config: &Config, req: &FitRequest) -> Result<Prepared, FitError> 
         notes.extend(note);
         Source::new(table, &req.mapping)
     };
-    let train = req.data.iter().map(&mut source).collect::<Result<Vec<_>, _>>()?;
+    let train = req
+        .data
+        .iter()
+        .map(&mut source)
+        .collect::<Result<Vec<_>, _>>()?;
     let validate = req
         .validate
         .iter()

@@ -1,0 +1,418 @@
+"""friction-node from Python: a physics-based estimate of sliding friction.
+
+The transient mixed-lubrication model of Driesen et al. 2023 (transient
+Reynolds equation with cavitation, Greenwood-Williamson asperity contact,
+load balance with inertia), the same Rust code as the ``friction-node``
+command and node. SI units throughout: m/s, N, s, Pa, degC.
+
+>>> import numpy as np, friction_node as fn
+>>> m = fn.Model(**{"solver.cells": 64})
+>>> t = np.arange(0, 2.0, m.dt)
+>>> run = m.run(t, np.sin(2 * np.pi * t))          # dict of numpy arrays
+>>> e = m.step(0.1)                                # one estimate
+>>> curve = fn.stribeck(np.logspace(-4, 0, 20))
+
+Configurations: ``Model(config)`` takes a parameter file (path), a dict of
+parameters (nested, or dotted keys), or None for the built-in default; any
+dotted-key overrides follow, as keyword arguments
+(``Model(**{"contact.load_n": 5720})``) or ``overrides={...}``. They are
+checked exactly like the command line's ``--set`` (unknown keys and
+out-of-range values raise ``ValueError`` naming the key).
+
+Errors: ``ValueError`` for bad configuration and input (non-finite or
+mismatched arrays, unknown keys, a file that is not a bag), ``OSError``
+(``FileNotFoundError``) for files. Long calls release the GIL.
+
+The fleet functions (many bags on a Dask cluster) are in
+``friction_node.fleet`` (``pip install ".[fleet]"``).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from typing import Any, Dict, Iterable, Mapping, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _core
+from ._core import Estimate, LOOP_METRIC_COLUMNS, SIMULATE_COLUMNS, STRIBECK_COLUMNS, __version__
+
+__all__ = [
+    "Model",
+    "Estimate",
+    "stribeck",
+    "replay",
+    "fit",
+    "ReplayResult",
+    "FitResult",
+    "SIMULATE_COLUMNS",
+    "STRIBECK_COLUMNS",
+    "LOOP_METRIC_COLUMNS",
+    "__version__",
+]
+
+PathLike = Union[str, "os.PathLike[str]"]
+Config = Union[None, PathLike, Mapping[str, Any]]
+
+
+def _value_text(v: Any) -> str:
+    """A Python value as the text of a ``--set key=value`` override."""
+    if isinstance(v, str):
+        return v
+    if isinstance(v, (bool, np.bool_)):
+        return "true" if v else "false"
+    if isinstance(v, (int, np.integer)):
+        return str(int(v))
+    if isinstance(v, (float, np.floating)):
+        return repr(float(v))
+    return json.dumps(v)
+
+
+def _overrides(overrides: Optional[Mapping[str, Any]], extra: Mapping[str, Any]) -> list:
+    merged: Dict[str, Any] = dict(overrides or {})
+    merged.update(extra)
+    out = []
+    for k, v in merged.items():
+        if not isinstance(k, str) or not k:
+            raise ValueError(f"override key {k!r}: expected a dotted configuration key")
+        out.append(f"{k}={_value_text(v)}")
+    return out
+
+
+def _flatten(d: Mapping[str, Any], prefix: str = "") -> Dict[str, Any]:
+    out: Dict[str, Any] = {}
+    for k, v in d.items():
+        key = f"{prefix}{k}"
+        if isinstance(v, Mapping):
+            out.update(_flatten(v, key + "."))
+        else:
+            out[key] = v
+    return out
+
+
+def _config_args(config: Config) -> Tuple[Optional[str], Optional[str], list]:
+    """(yaml text, path, overrides from a dict) of a configuration argument."""
+    if config is None:
+        return None, None, []
+    if isinstance(config, Mapping):
+        # A dict of parameters: the defaults with these keys set, checked
+        # like --set overrides (so an unknown key is named).
+        return None, None, _overrides(_flatten(config), {})
+    if isinstance(config, (str, os.PathLike)):
+        path = os.fspath(config)
+        if "\n" in path:
+            return path, None, []
+        return None, path, []
+    raise TypeError(
+        f"config: expected a file path, a dict of parameters or None, got {type(config).__name__}"
+    )
+
+
+def _array(x: Any, name: str, n: Optional[int] = None) -> np.ndarray:
+    try:
+        a = np.ascontiguousarray(x, dtype=np.float64)
+    except (TypeError, ValueError) as e:
+        raise ValueError(f"{name}: not an array of numbers ({e})") from None
+    if a.ndim == 0:
+        if n is None:
+            a = a.reshape(1)
+        else:
+            a = np.full(n, float(a))
+    if a.ndim != 1:
+        raise ValueError(f"{name}: expected a 1-D array, got shape {a.shape}")
+    if n is not None and a.shape[0] != n:
+        raise ValueError(
+            f"{name} has {a.shape[0]} samples, t has {n}: the arrays must have the same length"
+        )
+    bad = ~np.isfinite(a)
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise ValueError(f"{name}[{k}] = {a[k]}: not a finite number")
+    return a
+
+
+class Model:
+    """One lubricated contact's model, stepped in fixed or given steps.
+
+    ``Model(config=None, overrides=None, **dotted_keys)``: ``config`` is a
+    parameter file path (or its text), a dict of parameters, or None for
+    the built-in default (``launch-config/default.yaml``). The model starts
+    in the steady state at rest under ``contact.load_n``.
+    """
+
+    def __init__(self, config: Config = None, overrides: Optional[Mapping[str, Any]] = None, **keys: Any):
+        yaml, path, from_dict = _config_args(config)
+        self._core = _core.Model(yaml=yaml, path=path, overrides=from_dict + _overrides(overrides, keys))
+
+    @property
+    def dt(self) -> float:
+        """The configured step ``solver.dt_s``, s."""
+        return self._core.dt
+
+    @property
+    def load_n(self) -> float:
+        """The configured load ``contact.load_n``, N."""
+        return self._core.load_n
+
+    def config_yaml(self) -> str:
+        """The complete configuration as a parameter file."""
+        return self._core.config_yaml()
+
+    def step(self, velocity: float, load: Optional[float] = None, dt: Optional[float] = None) -> Estimate:
+        """Advance one step (``dt``: default ``solver.dt_s``, BDF2; another
+        length is one backward-Euler step) at ``velocity`` m/s under ``load``
+        N (default ``contact.load_n``). A numerical outcome is not an error:
+        the estimate's ``status`` says what the solver did."""
+        return self._core.step(float(velocity), None if load is None else float(load), None if dt is None else float(dt))
+
+    def reset(self, velocity: float = 0.0, load: Optional[float] = None) -> Estimate:
+        """Restart from the steady state (the squeeze-film history is forgotten)."""
+        return self._core.reset(float(velocity), None if load is None else float(load))
+
+    def set_temperature(self, temperature_c: float) -> None:
+        """The lubricant temperature, degC (with ``lubricant.viscosity_model:
+        vogel`` the viscosity follows it)."""
+        self._core.set_temperature(float(temperature_c))
+
+    def run(self, t: Any, velocity: Any, load: Any = None, temperature: Any = None, as_frame: bool = False):
+        """A whole run, as ``simulate`` does it: the steady state at the first
+        sample, then one step to each next time (``t`` strictly increasing, s;
+        steps of ``solver.dt_s`` continue BDF2). ``velocity`` m/s, ``load`` N
+        and ``temperature`` degC are arrays of ``len(t)`` (or scalars).
+
+        Returns a dict of numpy arrays, one per ``simulate`` column (row 0 is
+        the initial steady state), or a pandas DataFrame with
+        ``as_frame=True``. The GIL is released while the model runs."""
+        t = _array(t, "t")
+        n = t.shape[0]
+        v = _array(velocity, "velocity", n)
+        f = None if load is None else _array(load, "load", n)
+        tc = None if temperature is None else _array(temperature, "temperature", n)
+        cols = _columns(self._core.run(t, v, f, tc))
+        return _frame(cols) if as_frame else cols
+
+    def __repr__(self) -> str:
+        return repr(self._core)
+
+
+def _columns(d: dict) -> dict:
+    for k in ("status", "regime", "command_status"):
+        if k in d:
+            d[k] = np.asarray(d[k], dtype=object)
+    return d
+
+
+def _frame(cols: Mapping[str, np.ndarray]):
+    import pandas as pd
+
+    return pd.DataFrame(cols)
+
+
+def stribeck(
+    velocities: Any,
+    load: Optional[float] = None,
+    config: Config = None,
+    overrides: Optional[Mapping[str, Any]] = None,
+    as_frame: bool = False,
+    **keys: Any,
+):
+    """Steady states (the Stribeck curve) at ``velocities`` m/s under
+    ``load`` N (default ``contact.load_n``): the ``stribeck`` columns as a
+    dict of numpy arrays, in the input order (or a DataFrame)."""
+    yaml, path, from_dict = _config_args(config)
+    v = _array(velocities, "velocities")
+    cols = _columns(
+        _core.stribeck(v, None if load is None else float(load), yaml=yaml, path=path,
+                       overrides=from_dict + _overrides(overrides, keys))
+    )
+    return _frame(cols) if as_frame else cols
+
+
+class ReplayResult:
+    """What ``replay`` returns.
+
+    Attributes: ``estimates`` (DataFrame: the ``simulate`` columns,
+    ``stamp_ns`` and ``command_status``, one row per step), ``cycles``
+    (DataFrame of loop metrics per cycle), ``summary`` (dict: steps, span_s,
+    wall_s, commands_rejected, ...), ``identical`` (True/False when the bag
+    holds recorded estimates to compare with, else None) and
+    ``deviations`` (field, largest difference, step) when not identical.
+    """
+
+    def __init__(self, raw: dict):
+        import pandas as pd
+
+        self.estimates = pd.DataFrame(_columns(raw["estimates"]))
+        self.cycles = pd.DataFrame(raw["cycles"])
+        self.summary = raw["summary"]
+        self.identical = self.summary["identical"]
+        self.deviations = self.summary["deviations"]
+
+    def __repr__(self) -> str:
+        s = self.summary
+        verdict = {None: "no recorded estimates", True: "bit-identical", False: "DIFFERS"}[self.identical]
+        return (
+            f"ReplayResult({s['bag']}: {s['steps']} steps over {s['span_s']:.3f} s, "
+            f"{len(self.cycles)} cycles, {verdict})"
+        )
+
+
+def replay(
+    bag: PathLike,
+    config: Optional[PathLike] = None,
+    overrides: Optional[Mapping[str, Any]] = None,
+    topic: Optional[str] = None,
+    joint: Optional[str] = None,
+    load_topic: Optional[str] = None,
+    temperature_topic: Optional[str] = None,
+    velocity_map: Optional[str] = None,
+    load_map: Optional[str] = None,
+    out: Optional[PathLike] = None,
+    report: Optional[PathLike] = None,
+) -> ReplayResult:
+    """Re-run the model over the velocity recorded in a bag (MCAP, rosbag2
+    ``.db3`` or a rosbag2 directory), as ``friction-node replay`` does: the
+    configuration recorded in the bag unless ``config`` (a file) is given,
+    ``overrides`` on top. ``out`` (``.csv`` or ``.mcap``) and ``report`` (a
+    directory) write the command's files, atomically."""
+    raw = _core.replay(
+        os.fspath(bag),
+        config_path=None if config is None else os.fspath(config),
+        overrides=_overrides(overrides, {}),
+        topic=topic,
+        joint=joint,
+        load_topic=load_topic,
+        temperature_topic=temperature_topic,
+        velocity_map=velocity_map,
+        load_map=load_map,
+        out=None if out is None else os.fspath(out),
+        report_dir=None if report is None else os.fspath(report),
+    )
+    return ReplayResult(raw)
+
+
+class FitResult:
+    """What ``fit`` returns.
+
+    ``parameters`` (DataFrame: name, value, std_error, ci95_low, ci95_high,
+    start, bounds, at_bound), ``converged``, ``train_rms_n``,
+    ``held_out_rms_n``, ``models`` (DataFrame, one row per model: ours and,
+    with ``baselines=True``, Coulomb + viscous, Stribeck, LuGre on the same
+    data with the same optimiser), ``fitted_yaml`` (the complete fitted
+    parameter file), ``summary`` (the command's summary text), ``raw``.
+    """
+
+    def __init__(self, raw: dict):
+        import pandas as pd
+
+        self.raw = raw
+        self.parameters = pd.DataFrame(raw["parameters"])
+        self.converged = raw["converged"]
+        self.train_rms_n = raw["train_rms_n"]
+        self.held_out_rms_n = raw["held_out_rms_n"]
+        self.fitted_yaml = raw["fitted_yaml"]
+        self.summary = raw["summary"]
+        self.notes = raw["notes"]
+        rows = []
+        for m in raw["models"]:
+            row = {
+                "model": m["label"],
+                "converged": m["converged"],
+                "train_rms_n": m["train_rms_n"],
+                "held_out_rms_n": m["held_out_rms_n"],
+            }
+            row.update({p["name"]: p["value"] for p in m["parameters"]})
+            rows.append(row)
+        self.models = pd.DataFrame(rows)
+        self.models_table = raw.get("models_table")
+
+    def value(self, name: str) -> float:
+        """The fitted value of parameter ``name``."""
+        hit = self.parameters[self.parameters["name"] == name]
+        if hit.empty:
+            raise KeyError(f"{name!r} was not fitted (fitted: {', '.join(self.parameters['name'])})")
+        return float(hit["value"].iloc[0])
+
+    def __repr__(self) -> str:
+        vals = ", ".join(f"{r.name}={r.value:.4g}±{r.std_error:.2g}" for r in self.parameters.itertuples())
+        return f"FitResult({vals}; train RMS {self.train_rms_n:.4g} N, converged={self.converged})"
+
+
+def fit(
+    data: Union[PathLike, Sequence[PathLike]],
+    fit: Union[str, Sequence[str]],
+    config: Optional[PathLike] = None,
+    overrides: Optional[Mapping[str, Any]] = None,
+    bounds: Optional[Mapping[str, Tuple[float, float]]] = None,
+    start: Optional[Mapping[str, float]] = None,
+    holdout: float = 0.0,
+    validate: Iterable[PathLike] = (),
+    baselines: bool = False,
+    starts: int = 3,
+    global_points: int = 16,
+    seed: int = 1,
+    max_evaluations: int = 200,
+    columns: Optional[Sequence[str]] = None,
+    skip: int = 0,
+    delimiter: str = "auto",
+    time: Optional[str] = None,
+    velocity: str = "velocity_m_s",
+    friction: str = "friction_n",
+    load: Optional[str] = None,
+    temperature: Optional[str] = None,
+    smooth: float = 0.05,
+    map: Optional[Mapping[str, float]] = None,
+    velocity_topic: Optional[str] = None,
+    friction_topic: Optional[str] = None,
+    joint: Optional[str] = None,
+    load_topic: Optional[str] = None,
+    temperature_topic: Optional[str] = None,
+    out: Optional[PathLike] = None,
+    report: Optional[PathLike] = None,
+    progress: bool = False,
+) -> FitResult:
+    """Calibrate configuration keys (and input-map coefficients) to
+    recorded friction, as ``friction-node fit`` does (same arguments, same
+    defaults, same messages): ``data`` CSV files or bags, ``fit`` the keys
+    (e.g. ``["roughness.sigma_m", "contact.mu_boundary"]``), ``bounds``
+    ``{key: (lo, hi)}``, ``start`` ``{key: value}``. ``out`` writes the
+    fitted parameter file, ``report`` the summary, tables and plots."""
+    if isinstance(data, (str, os.PathLike)):
+        data = [data]
+    if isinstance(fit, str):
+        fit = [k for k in fit.split(",") if k.strip()]
+    raw = _core.fit(
+        [os.fspath(d) for d in data],
+        list(fit),
+        config_path=None if config is None else os.fspath(config),
+        overrides=_overrides(overrides, {}),
+        bounds=[(k, float(lo), float(hi)) for k, (lo, hi) in (bounds or {}).items()],
+        starts_at=[(k, float(v)) for k, v in (start or {}).items()],
+        holdout=float(holdout),
+        validate=[os.fspath(v) for v in validate],
+        baselines=bool(baselines),
+        starts=int(starts),
+        global_points=int(global_points),
+        seed=int(seed),
+        max_evaluations=int(max_evaluations),
+        columns=None if columns is None else list(columns),
+        skip=int(skip),
+        delimiter=delimiter,
+        time=time,
+        velocity=velocity,
+        friction=friction,
+        load=load,
+        temperature=temperature,
+        smooth=float(smooth),
+        map=[(k, float(v)) for k, v in (map or {}).items()],
+        velocity_topic=velocity_topic,
+        friction_topic=friction_topic,
+        joint=joint,
+        load_topic=load_topic,
+        temperature_topic=temperature_topic,
+        out=None if out is None else os.fspath(out),
+        report_dir=None if report is None else os.fspath(report),
+        progress=bool(progress),
+    )
+    return FitResult(raw)

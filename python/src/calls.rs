@@ -1,0 +1,449 @@
+//! `stribeck`, `replay` and `fit`: the command line's offline jobs, returning
+//! Python data instead of files (and writing the same files when asked).
+
+use crate::columns::Columns;
+use crate::errors;
+use crate::model::load_config;
+use friction_node::analysis::metrics::LOOP_METRIC_COLUMNS;
+use friction_node::fit::report::{self, ModelRow};
+use friction_node::fit::request::{
+    fit_baselines, fit_ours, held_out_scale, param_specs, prepare, FitRequest, LabelledProgress,
+    TopicChoice,
+};
+use friction_node::fit::{Delimiter, FitOutcome, Mapping};
+use friction_node::msgs;
+use numpy::{PyArray1, PyReadonlyArray1};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Instant;
+
+/// The built-in default parameter file.
+#[pyfunction]
+pub fn default_config_yaml() -> &'static str {
+    friction_node::config::DEFAULT_YAML
+}
+
+/// Steady states at `velocities` (any order; returned in that order) under
+/// `load` (default `contact.load_n`): the `stribeck` columns.
+#[pyfunction]
+#[pyo3(signature = (velocities, load=None, yaml=None, path=None, overrides=Vec::new()))]
+pub fn stribeck<'py>(
+    py: Python<'py>,
+    velocities: PyReadonlyArray1<'py, f64>,
+    load: Option<f64>,
+    yaml: Option<&str>,
+    path: Option<&str>,
+    overrides: Vec<String>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let config = load_config(yaml, path, &overrides)?;
+    let vs = velocities
+        .as_slice()
+        .map_err(|_| errors::value("velocities: the array is not contiguous"))?;
+    if vs.is_empty() {
+        return Err(errors::value("velocities is empty"));
+    }
+    let vmax = config.node.max_abs_velocity_m_s;
+    if let Some(k) = vs.iter().position(|v| !(v.is_finite() && v.abs() <= vmax)) {
+        return Err(errors::value(format!(
+            "velocities[{k}] = {}: a velocity must be finite with |v| ≤ node.max_abs_velocity_m_s = {vmax} m/s",
+            vs[k]
+        )));
+    }
+    let load = load.unwrap_or(config.contact.load_n);
+    let (lo, hi) = (config.node.min_load_n, config.node.max_load_n);
+    if !(load.is_finite() && load >= lo && load <= hi) {
+        return Err(errors::value(format!(
+            "load = {load}: a load must lie in [node.min_load_n, node.max_load_n] = [{lo}, {hi}] N"
+        )));
+    }
+    let rows = py
+        .detach(|| friction_node::offline::stribeck(&config, vs, load))
+        .map_err(|e| errors::value(e.to_string()))?;
+    let mut c = Columns::with_capacity(rows.len());
+    let t_ref = config.lubricant.reference_temperature_c;
+    for e in &rows {
+        c.push(e, 0.0, e.status.as_str(), t_ref);
+    }
+    let d = c.into_dict(py)?;
+    d.del_item("t_s")?;
+    Ok(d)
+}
+
+fn text_or_none(s: Option<String>) -> Option<String> {
+    s.filter(|s| !s.is_empty())
+}
+
+/// Re-run the model over a bag (see the Python wrapper).
+#[pyfunction]
+#[pyo3(signature = (bag, config_path=None, overrides=Vec::new(), topic=None, joint=None,
+    load_topic=None, temperature_topic=None, velocity_map=None, load_map=None, out=None,
+    report_dir=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn replay<'py>(
+    py: Python<'py>,
+    bag: PathBuf,
+    config_path: Option<PathBuf>,
+    overrides: Vec<String>,
+    topic: Option<String>,
+    joint: Option<String>,
+    load_topic: Option<String>,
+    temperature_topic: Option<String>,
+    velocity_map: Option<String>,
+    load_map: Option<String>,
+    out: Option<PathBuf>,
+    report_dir: Option<PathBuf>,
+) -> PyResult<Bound<'py, PyDict>> {
+    use friction_node::bag::Bag;
+    use friction_node::replay::{self as rp, OutputFormat, OutputStream, ReplayOptions};
+    let started = Instant::now();
+    let format = match &out {
+        Some(o) => Some(OutputFormat::from_path(o).ok_or_else(|| {
+            errors::value(format!(
+                "out = {}: the output must end in .mcap or .csv",
+                o.display()
+            ))
+        })?),
+        None => None,
+    };
+    let opts = ReplayOptions {
+        topic: text_or_none(topic),
+        joint: text_or_none(joint),
+        load_topic: text_or_none(load_topic),
+        temperature_topic: text_or_none(temperature_topic),
+        config: config_path,
+        overrides,
+        velocity_map,
+        load_map,
+    };
+    let in_bag = |e: PyErr| -> PyErr {
+        let message = format!("bag {}: {}", bag.display(), e.value(py));
+        if e.is_instance_of::<pyo3::exceptions::PyOSError>(py) {
+            e
+        } else {
+            errors::value(message)
+        }
+    };
+    let (prepared, result, written, wall, model_wall) = py
+        .detach(|| -> PyResult<_> {
+            let b = Bag::open(&bag).map_err(errors::bag)?;
+            let prepared = rp::prepare(&b, &opts).map_err(errors::replay)?;
+            if let Some(r) = &report_dir {
+                friction_node::output::prepare_dir(r).map_err(|e| errors::os(e.to_string()))?;
+            }
+            let mut stream = match (&out, format) {
+                (Some(o), Some(f)) => {
+                    Some(OutputStream::start(o, f, &prepared, &bag).map_err(errors::replay)?)
+                }
+                _ => None,
+            };
+            let model_started = Instant::now();
+            let result = rp::run(&prepared, &mut |_, _| {}, &mut |e, rec| {
+                if let Some(s) = stream.as_mut() {
+                    s.push(e, rec)
+                }
+            })
+            .map_err(errors::replay)?;
+            let model_wall = model_started.elapsed().as_secs_f64();
+            let written = match stream {
+                Some(s) => Some(s.finish(result.oracle.as_ref()).map_err(errors::replay)?),
+                None => None,
+            };
+            let wall = started.elapsed().as_secs_f64();
+            if let Some(r) = &report_dir {
+                rp::write_report(r, &bag, &prepared, &result, wall)
+                    .map_err(|e| errors::os(e.to_string()))?;
+            }
+            Ok((prepared, result, written, wall, model_wall))
+        })
+        .map_err(in_bag)?;
+    // Columns as the CSV output has them: t_s from the first stamp.
+    let mut c = Columns::with_capacity(result.estimates.len());
+    let t0 = result.estimates.first().map_or(0, |(_, r)| r.stamp_ns);
+    for (e, rec) in &result.estimates {
+        let t = rec.stamp_ns.saturating_sub(t0) as f64 / 1e9;
+        c.push(e, t, msgs::status_name(rec.status), rec.temperature_c);
+        c.push_stamp(rec.stamp_ns, msgs::command_status_name(rec.command_status));
+    }
+    let d = PyDict::new(py);
+    d.set_item("estimates", c.into_dict(py)?)?;
+    let cycles = rp::cycles(&result, prepared.config.contact.mass_kg);
+    let cd = PyDict::new(py);
+    cd.set_item(
+        "cycle",
+        PyArray1::from_vec(py, cycles.iter().map(|m| m.cycle as u64).collect()),
+    )?;
+    cd.set_item(
+        "t_start_s",
+        PyArray1::from_vec(py, cycles.iter().map(|m| m.t_start).collect()),
+    )?;
+    cd.set_item(
+        "t_end_s",
+        PyArray1::from_vec(py, cycles.iter().map(|m| m.t_end).collect()),
+    )?;
+    for (j, name) in LOOP_METRIC_COLUMNS.split(',').enumerate() {
+        let col: Vec<f64> = cycles
+            .iter()
+            .map(|m| m.values().get(j).copied().flatten().unwrap_or(f64::NAN))
+            .collect();
+        cd.set_item(name, PyArray1::from_vec(py, col))?;
+    }
+    d.set_item("cycles", cd)?;
+    let s = PyDict::new(py);
+    let e = &result.estimates;
+    let span = match (e.first(), e.last()) {
+        (Some(a), Some(b)) => b.1.stamp_ns.saturating_sub(a.1.stamp_ns) as f64 / 1e9,
+        _ => 0.0,
+    };
+    s.set_item("bag", bag.display().to_string())?;
+    s.set_item("input", prepared.mode.describe())?;
+    s.set_item("configuration", &prepared.config_source)?;
+    s.set_item("velocity_messages", prepared.velocity_messages)?;
+    s.set_item("steps", e.len())?;
+    s.set_item("span_s", span)?;
+    s.set_item("wall_s", wall)?;
+    s.set_item("model_wall_s", model_wall)?;
+    s.set_item("commands_rejected", result.commands_rejected)?;
+    s.set_item("gaps", prepared.gaps.len())?;
+    s.set_item("files", prepared.scan.files.len())?;
+    s.set_item(
+        "damage",
+        prepared.scan.damage.as_ref().map(|d| d.to_string()),
+    )?;
+    s.set_item("parameter_changes", prepared.parameter_changes.len())?;
+    match &result.oracle {
+        Some(o) => {
+            s.set_item("identical", o.identical)?;
+            s.set_item("compared", o.compared)?;
+            let devs = PyList::empty(py);
+            for (f, dmax, k) in &o.deviations {
+                devs.append((*f, *dmax, *k))?;
+            }
+            s.set_item("deviations", devs)?;
+        }
+        None => {
+            s.set_item("identical", py.None())?;
+            s.set_item("compared", 0)?;
+            s.set_item("deviations", PyList::empty(py))?;
+        }
+    }
+    s.set_item("out", written.map(|p| p.display().to_string()))?;
+    d.set_item("summary", s)?;
+    Ok(d)
+}
+
+fn outcome_dict<'py>(py: Python<'py>, o: &FitOutcome) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("label", &o.label)?;
+    d.set_item("converged", o.converged)?;
+    d.set_item("train_rms_n", o.train_rms)?;
+    d.set_item("train_max_n", o.train_max)?;
+    d.set_item("holdout_rms_n", o.holdout_rms)?;
+    d.set_item("validate_rms_n", o.validate_rms)?;
+    d.set_item("held_out_rms_n", o.held_out_rms())?;
+    d.set_item("validate_failure", &o.validate_failure)?;
+    d.set_item("simulations", o.simulations)?;
+    d.set_item("wall_s", o.wall_s)?;
+    d.set_item("sigma_n", o.statistics.sigma)?;
+    d.set_item("rank_deficient", o.statistics.rank_deficient)?;
+    let params = PyList::empty(py);
+    for (i, p) in o.params.iter().enumerate() {
+        let r = PyDict::new(py);
+        r.set_item("name", &p.name)?;
+        r.set_item("value", o.best[i])?;
+        r.set_item("start", p.start)?;
+        r.set_item(
+            "std_error",
+            o.statistics
+                .standard_error
+                .get(i)
+                .copied()
+                .unwrap_or(f64::NAN),
+        )?;
+        let (lo95, hi95) = o
+            .statistics
+            .interval95
+            .get(i)
+            .copied()
+            .unwrap_or((f64::NAN, f64::NAN));
+        r.set_item("ci95_low", lo95)?;
+        r.set_item("ci95_high", hi95)?;
+        r.set_item("lower_bound", p.lo)?;
+        r.set_item("upper_bound", p.hi)?;
+        r.set_item(
+            "at_bound",
+            o.statistics.at_bound.get(i).copied().unwrap_or(false),
+        )?;
+        params.append(r)?;
+    }
+    d.set_item("parameters", params)?;
+    d.set_item("correlation", o.statistics.correlation.clone())?;
+    d.set_item("summary", report::summary(o, ""))?;
+    Ok(d)
+}
+
+/// Calibrate (see the Python wrapper): the command line's `fit`.
+#[pyfunction]
+#[pyo3(signature = (data, keys, config_path=None, overrides=Vec::new(), bounds=Vec::new(),
+    starts_at=Vec::new(), holdout=0.0, validate=Vec::new(), baselines=false, starts=3,
+    global_points=16, seed=1, max_evaluations=200, columns=None, skip=0, delimiter="auto",
+    time=None, velocity="velocity_m_s".to_string(), friction="friction_n".to_string(),
+    load=None, temperature=None, smooth=0.05, map=Vec::new(), velocity_topic=None,
+    friction_topic=None, joint=None, load_topic=None, temperature_topic=None, out=None,
+    report_dir=None, progress=false))]
+#[allow(clippy::too_many_arguments)]
+pub fn fit<'py>(
+    py: Python<'py>,
+    data: Vec<PathBuf>,
+    keys: Vec<String>,
+    config_path: Option<PathBuf>,
+    overrides: Vec<String>,
+    bounds: Vec<(String, f64, f64)>,
+    starts_at: Vec<(String, f64)>,
+    holdout: f64,
+    validate: Vec<PathBuf>,
+    baselines: bool,
+    starts: usize,
+    global_points: usize,
+    seed: u64,
+    max_evaluations: usize,
+    columns: Option<Vec<String>>,
+    skip: usize,
+    delimiter: &str,
+    time: Option<String>,
+    velocity: String,
+    friction: String,
+    load: Option<String>,
+    temperature: Option<String>,
+    smooth: f64,
+    map: Vec<(String, f64)>,
+    velocity_topic: Option<String>,
+    friction_topic: Option<String>,
+    joint: Option<String>,
+    load_topic: Option<String>,
+    temperature_topic: Option<String>,
+    out: Option<PathBuf>,
+    report_dir: Option<PathBuf>,
+    progress: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let config = match &config_path {
+        Some(p) => load_config(None, Some(&p.display().to_string()), &overrides)?,
+        None => load_config(None, None, &overrides)?,
+    };
+    let delimiter = match delimiter {
+        "auto" => Delimiter::Auto,
+        "comma" | "," => Delimiter::Comma,
+        "semicolon" | ";" => Delimiter::Semicolon,
+        "tab" | "\t" => Delimiter::Tab,
+        "whitespace" => Delimiter::Whitespace,
+        other => {
+            return Err(errors::value(format!(
+                "delimiter = {other:?}: one of auto, comma, semicolon, tab, whitespace"
+            )))
+        }
+    };
+    if let Some((n, _)) = map.iter().find(|(n, _)| n.contains('.')) {
+        return Err(errors::value(format!(
+            "map {n}: a map coefficient's name has no dots (dotted names are configuration keys)"
+        )));
+    }
+    let req = FitRequest {
+        data,
+        validate,
+        params: param_specs(&keys, &bounds, &starts_at).map_err(errors::fit)?,
+        mapping: Mapping {
+            time,
+            velocity,
+            friction,
+            load,
+            temperature,
+            smooth_s: smooth,
+            coefficients: map,
+        },
+        holdout,
+        columns,
+        skip,
+        delimiter,
+        topics: TopicChoice {
+            velocity: velocity_topic,
+            friction: friction_topic,
+            joint,
+            load: load_topic,
+            temperature: temperature_topic,
+        },
+        starts,
+        global_points,
+        seed,
+        max_evaluations,
+        baselines,
+        progress: progress.then(|| {
+            Arc::new(|label: &str, l: &str| eprintln!("fit [{label}]: {l}")) as LabelledProgress
+        }),
+    };
+    let (p, ours, classic, skipped) = py.detach(|| -> PyResult<_> {
+        let p = prepare(&config, &req).map_err(errors::fit)?;
+        // Outputs are checked before any computation.
+        if let Some(o) = &out {
+            drop(
+                friction_node::output::AtomicFile::create(o)
+                    .map_err(|e| errors::os(e.to_string()))?,
+            );
+        }
+        if let Some(r) = &report_dir {
+            friction_node::output::prepare_dir(r).map_err(|e| errors::os(e.to_string()))?;
+        }
+        let ours = fit_ours(&p, &req).map_err(errors::fit)?;
+        let (classic, skipped) = if baselines {
+            fit_baselines(&p, &req).map_err(errors::fit)?
+        } else {
+            (Vec::new(), Vec::new())
+        };
+        Ok((p, ours, classic, skipped))
+    })?;
+    let yaml = report::fitted_yaml(&ours.config, &ours.outcome, &p.names, &ours.map);
+    let mut extra = String::new();
+    let d = outcome_dict(py, &ours.outcome)?;
+    if baselines {
+        let mut rows = vec![ModelRow::from(&ours.outcome)];
+        rows.extend(classic.iter().map(ModelRow::from));
+        let table = report::models_table(&rows, held_out_scale(&ours.outcome));
+        extra = format!("## Models on the same data, same optimiser\n\n{table}");
+        d.set_item("models_table", table)?;
+    }
+    let models = PyList::empty(py);
+    models.append(outcome_dict(py, &ours.outcome)?)?;
+    for b in &classic {
+        models.append(outcome_dict(py, b)?)?;
+    }
+    d.set_item("models", models)?;
+    d.set_item("map", ours.map.clone())?;
+    d.set_item("fitted_yaml", &yaml)?;
+    let mut notes = p.notes.clone();
+    notes.extend(skipped);
+    d.set_item("notes", notes)?;
+    if let Some(o) = &out {
+        friction_node::output::write_file(o, yaml.as_bytes())
+            .map_err(|e| errors::os(e.to_string()))?;
+    }
+    if let Some(r) = &report_dir {
+        write_fit_report(r, &ours.outcome, &classic, &extra)?;
+    }
+    Ok(d)
+}
+
+fn write_fit_report(
+    r: &Path,
+    ours: &FitOutcome,
+    classic: &[FitOutcome],
+    extra: &str,
+) -> PyResult<()> {
+    let os = |e: friction_node::output::OutputError| errors::os(e.to_string());
+    for b in classic {
+        let dir = r.join(report::slug(&b.label));
+        friction_node::output::prepare_dir(&dir).map_err(os)?;
+        report::write_report(&dir, b, "").map_err(os)?;
+    }
+    report::write_report(r, ours, extra).map_err(os)?;
+    Ok(())
+}

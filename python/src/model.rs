@@ -1,0 +1,324 @@
+//! `Model`: one contact's solver, stepped from Python, and `Model.run` over
+//! whole numpy series.
+
+use crate::columns::Columns;
+use crate::errors;
+use friction_node::config::{Config, Origin};
+use friction_node::physics::{Estimate as CoreEstimate, Solver, ViscosityModel};
+use numpy::PyReadonlyArray1;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// Read a configuration: parameter-file text, or a file, or the built-in
+/// default, then `key=value` overrides.
+pub fn load_config(
+    yaml: Option<&str>,
+    path: Option<&str>,
+    overrides: &[String],
+) -> PyResult<Config> {
+    match (yaml, path) {
+        (Some(_), Some(_)) => {
+            return Err(errors::value(
+                "give the configuration as text or as a file, not both",
+            ))
+        }
+        (Some(text), None) => Config::from_yaml(text, &Origin::Embedded, overrides),
+        (None, Some(p)) => Config::load(Some(std::path::Path::new(p)), overrides),
+        (None, None) => Config::load(None, overrides),
+    }
+    .map_err(errors::config)
+}
+
+/// One step's estimate (the fields of `friction_msgs/FrictionEstimate`),
+/// SI units.
+#[pyclass(module = "friction_node._core", frozen, get_all)]
+#[derive(Clone)]
+pub struct Estimate {
+    /// Model time at the end of the step, s.
+    pub time_s: f64,
+    pub velocity_m_s: f64,
+    pub load_n: f64,
+    /// Total friction (contact and drivetrain), signed like the velocity, N.
+    pub friction_force_n: f64,
+    /// The lubricated contact alone, N.
+    pub contact_friction_force_n: f64,
+    pub cof: f64,
+    pub h0_m: f64,
+    pub h_min_m: f64,
+    pub hydrodynamic_force_n: f64,
+    pub asperity_force_n: f64,
+    pub asperity_load_share: f64,
+    pub viscous_force_n: f64,
+    pub max_pressure_pa: f64,
+    /// Newton's last scaled residual.
+    pub residual: f64,
+    pub iterations: u32,
+    pub substeps: u32,
+    /// `converged`, `max_iterations`, `non_finite`, `non_finite_input`…
+    pub status: &'static str,
+    /// `boundary`, `mixed` or `hydrodynamic`.
+    pub regime: &'static str,
+}
+
+impl From<&CoreEstimate> for Estimate {
+    fn from(e: &CoreEstimate) -> Self {
+        Self {
+            time_s: e.time,
+            velocity_m_s: e.velocity,
+            load_n: e.load,
+            friction_force_n: e.friction_force,
+            contact_friction_force_n: e.contact_friction_force,
+            cof: e.cof,
+            h0_m: e.h0,
+            h_min_m: e.h_min,
+            hydrodynamic_force_n: e.hydrodynamic_force,
+            asperity_force_n: e.asperity_force,
+            asperity_load_share: e.asperity_load_share,
+            viscous_force_n: e.viscous_force,
+            max_pressure_pa: e.max_pressure,
+            residual: e.diagnostics.residual,
+            iterations: e.diagnostics.iterations,
+            substeps: e.diagnostics.substeps,
+            status: e.status.as_str(),
+            regime: e.regime.as_str(),
+        }
+    }
+}
+
+#[pymethods]
+impl Estimate {
+    fn __repr__(&self) -> String {
+        format!(
+            "Estimate(time_s={}, velocity_m_s={}, friction_force_n={}, cof={}, h_min_m={:e}, status='{}')",
+            self.time_s, self.velocity_m_s, self.friction_force_n, self.cof, self.h_min_m, self.status
+        )
+    }
+}
+
+/// One lubricated contact's model (see the Python wrapper's docstring).
+#[pyclass(module = "friction_node._core")]
+pub struct Model {
+    solver: Solver,
+    config: Config,
+    temperature_c: f64,
+}
+
+/// The values of an optional series, or `default` repeated.
+fn series<'a>(
+    a: &'a Option<PyReadonlyArray1<'_, f64>>,
+    name: &str,
+    n: usize,
+) -> PyResult<Option<&'a [f64]>> {
+    let Some(a) = a else { return Ok(None) };
+    let s = a
+        .as_slice()
+        .map_err(|_| errors::value(format!("{name}: the array is not contiguous")))?;
+    if s.len() != n {
+        return Err(errors::value(format!(
+            "{name} has {} samples, t has {n}: the arrays must have the same length",
+            s.len()
+        )));
+    }
+    Ok(Some(s))
+}
+
+fn check_range(name: &str, x: &[f64], lo: f64, hi: f64, what: &str) -> PyResult<()> {
+    if let Some(k) = x
+        .iter()
+        .position(|v| !(v.is_finite() && *v >= lo && *v <= hi))
+    {
+        return Err(errors::value(format!("{name}[{k}] = {}: {what}", x[k])));
+    }
+    Ok(())
+}
+
+impl Model {
+    fn viscosity_follows(&self) -> bool {
+        self.config.viscosity_model() != ViscosityModel::Constant
+    }
+}
+
+#[pymethods]
+impl Model {
+    #[new]
+    #[pyo3(signature = (yaml=None, path=None, overrides=Vec::new()))]
+    fn new(yaml: Option<&str>, path: Option<&str>, overrides: Vec<String>) -> PyResult<Self> {
+        let config = load_config(yaml, path, &overrides)?;
+        if !config.contacts.is_empty() {
+            return Err(errors::value(format!(
+                "the configuration lists {} contacts (`contacts`): a Model is one contact; \
+                 create one Model per contact from a configuration without `contacts`",
+                config.contacts.0.len()
+            )));
+        }
+        let mut solver = Solver::new(&config.model(), &config.solver_settings())
+            .map_err(|e| errors::value(e.to_string()))?;
+        solver.initialize_steady(0.0, config.contact.load_n);
+        Ok(Self {
+            temperature_c: config.lubricant.reference_temperature_c,
+            solver,
+            config,
+        })
+    }
+
+    /// The configured step `solver.dt_s`, s.
+    #[getter]
+    fn dt(&self) -> f64 {
+        self.solver.settings().dt
+    }
+
+    /// The configured load `contact.load_n`, N.
+    #[getter]
+    fn load_n(&self) -> f64 {
+        self.config.contact.load_n
+    }
+
+    /// The configuration as a complete parameter file.
+    fn config_yaml(&self) -> String {
+        self.config.to_yaml()
+    }
+
+    #[pyo3(signature = (velocity, load=None, dt=None))]
+    fn step(&mut self, velocity: f64, load: Option<f64>, dt: Option<f64>) -> Estimate {
+        let load = load.unwrap_or(self.config.contact.load_n);
+        let e = match dt {
+            Some(dt) if dt != self.solver.settings().dt => {
+                self.solver.step_over(velocity, load, dt)
+            }
+            _ => self.solver.step(velocity, load),
+        };
+        Estimate::from(&e)
+    }
+
+    #[pyo3(signature = (velocity=0.0, load=None))]
+    fn reset(&mut self, velocity: f64, load: Option<f64>) -> PyResult<Estimate> {
+        let load = load.unwrap_or(self.config.contact.load_n);
+        if !(velocity.is_finite() && load.is_finite() && load > 0.0) {
+            return Err(errors::value(format!(
+                "reset: velocity {velocity} m/s and load {load} N must be finite, the load positive"
+            )));
+        }
+        Ok(Estimate::from(
+            &self.solver.initialize_steady(velocity, load),
+        ))
+    }
+
+    fn set_temperature(&mut self, temperature_c: f64) -> PyResult<()> {
+        if !(temperature_c.is_finite() && (-60.0..=300.0).contains(&temperature_c)) {
+            return Err(errors::value(format!(
+                "temperature_c = {temperature_c}: must lie in [-60, 300] °C"
+            )));
+        }
+        self.temperature_c = temperature_c;
+        if self.viscosity_follows() {
+            self.solver
+                .set_liquid_viscosity(self.config.viscosity_at(temperature_c));
+        }
+        Ok(())
+    }
+
+    #[pyo3(signature = (t, velocity, load=None, temperature=None))]
+    fn run<'py>(
+        &mut self,
+        py: Python<'py>,
+        t: PyReadonlyArray1<'py, f64>,
+        velocity: PyReadonlyArray1<'py, f64>,
+        load: Option<PyReadonlyArray1<'py, f64>>,
+        temperature: Option<PyReadonlyArray1<'py, f64>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let t = t
+            .as_slice()
+            .map_err(|_| errors::value("t: the array is not contiguous"))?;
+        let n = t.len();
+        if n == 0 {
+            return Err(errors::value("t is empty"));
+        }
+        let velocity = Some(velocity);
+        let v = series(&velocity, "velocity", n)?.expect("given");
+        let load = series(&load, "load", n)?;
+        let temperature = series(&temperature, "temperature", n)?;
+        check_range("t", t, f64::MIN, f64::MAX, "not a finite time")?;
+        if let Some(k) = (1..n).find(|&k| t[k] <= t[k - 1]) {
+            return Err(errors::value(format!(
+                "t[{k}] = {} is not after t[{}] = {}: t must increase strictly",
+                t[k],
+                k - 1,
+                t[k - 1]
+            )));
+        }
+        let node = &self.config.node;
+        let vmax = node.max_abs_velocity_m_s;
+        check_range(
+            "velocity",
+            v,
+            -vmax,
+            vmax,
+            &format!("a velocity must be finite with |v| ≤ node.max_abs_velocity_m_s = {vmax} m/s"),
+        )?;
+        if let Some(l) = load {
+            let (lo, hi) = (node.min_load_n, node.max_load_n);
+            check_range(
+                "load",
+                l,
+                lo,
+                hi,
+                &format!("a load must lie in [node.min_load_n, node.max_load_n] = [{lo}, {hi}] N"),
+            )?;
+        }
+        if let Some(tc) = temperature {
+            let floor = match self.config.viscosity_model() {
+                ViscosityModel::Vogel(v) => v.c_c.max(-60.0),
+                ViscosityModel::Constant => -60.0,
+            };
+            if let Some(k) = tc
+                .iter()
+                .position(|x| !(x.is_finite() && *x > floor && *x <= 300.0))
+            {
+                return Err(errors::value(format!(
+                    "temperature[{k}] = {}: a temperature must lie in [-60, 300] °C and above lubricant.vogel_c_c",
+                    tc[k]
+                )));
+            }
+        }
+        let default_load = self.config.contact.load_n;
+        let follows = temperature.is_some() && self.viscosity_follows();
+        let dt = self.solver.settings().dt;
+        let config = &self.config;
+        let solver = &mut self.solver;
+        let t_ref = self.temperature_c;
+        let (columns, last_t) = py.detach(|| {
+            let mut c = Columns::with_capacity(n);
+            let temp = |k: usize| temperature.map_or(t_ref, |s| s[k]);
+            let f = |k: usize| load.map_or(default_load, |s| s[k]);
+            if follows {
+                solver.set_liquid_viscosity(config.viscosity_at(temp(0)));
+            }
+            let e = solver.initialize_steady(v[0], f(0));
+            c.push(&e, t[0], e.status.as_str(), temp(0));
+            for k in 1..n {
+                if follows {
+                    solver.set_liquid_viscosity(config.viscosity_at(temp(k)));
+                }
+                let h = t[k] - t[k - 1];
+                let e = if (h - dt).abs() <= 1e-9 * dt {
+                    solver.step(v[k], f(k))
+                } else {
+                    solver.step_over(v[k], f(k), h)
+                };
+                c.push(&e, t[k], e.status.as_str(), temp(k));
+            }
+            (c, temp(n - 1))
+        });
+        self.temperature_c = last_t;
+        columns.into_dict(py)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Model(cells={}, dt={} s, load_n={} N)",
+            self.config.solver.cells,
+            self.solver.settings().dt,
+            self.config.contact.load_n
+        )
+    }
+}

@@ -1,0 +1,136 @@
+"""The package from Python: numpy in and out, the same numbers as the
+command line for the same inputs, Python exceptions for bad input."""
+
+import csv
+import math
+
+import numpy as np
+import pytest
+
+import friction_node as fn
+
+
+def read_csv(path):
+    with open(path, newline="") as f:
+        rows = list(csv.DictReader(f))
+    return {k: [r[k] for r in rows] for k in rows[0]}
+
+
+def floats(col):
+    return np.array([float(x) for x in col])
+
+
+def test_run_is_bit_identical_to_the_cli_simulate(cli, tmp_path):
+    out = tmp_path / "run.csv"
+    cli("--set", "solver.cells=64", "simulate", "--velocity", "sine:0,1,1", "--duration", "2", "--out", out)
+    ref = read_csv(out)
+    t = np.concatenate([[0.0], floats(ref["t_s"])])
+    v = np.concatenate([[0.0], floats(ref["velocity_m_s"])])
+    m = fn.Model(**{"solver.cells": 64})
+    got = m.run(t, v)
+    assert len(got["friction_n"]) == len(t)
+    for col in ("friction_n", "h0_m", "h_min_m", "f_hyd_n", "f_asp_n", "cof", "contact_friction_n"):
+        np.testing.assert_array_equal(got[col][1:], floats(ref[col]), err_msg=col)
+    assert list(got["status"][1:]) == ref["status"]
+    assert list(got["iterations"][1:]) == [int(x) for x in ref["iterations"]]
+
+
+def test_run_as_a_frame_has_the_simulate_columns():
+    m = fn.Model(**{"solver.cells": 32})
+    t = np.arange(200) * m.dt
+    df = m.run(t, 0.5 * np.sin(2 * np.pi * t), load=np.full(200, 5000.0), as_frame=True)
+    assert set(fn.SIMULATE_COLUMNS.split(",")) <= set(df.columns)
+    assert len(df) == 200
+    assert (df["load_n"] == 5000.0).all()
+
+
+def test_step_by_step_equals_a_run():
+    a, b = fn.Model(**{"solver.cells": 32}), fn.Model(**{"solver.cells": 32})
+    t = np.arange(300) * a.dt
+    v = np.sin(2 * np.pi * t)
+    run = a.run(t, v)
+    b.reset(v[0])
+    stepped = [b.step(x) for x in v[1:]]
+    assert [e.friction_force_n for e in stepped] == list(run["friction_n"][1:])
+    assert stepped[-1].status == "converged"
+
+
+def test_configuration_from_a_dict_dotted_keys_or_overrides_is_the_same(repo):
+    by_dict = fn.Model({"contact": {"load_n": 5720.0}})
+    by_key = fn.Model(**{"contact.load_n": 5720})
+    by_overrides = fn.Model(overrides={"contact.load_n": 5720})
+    by_file = fn.Model(repo / "launch-config/default.yaml", **{"contact.load_n": 5720})
+    assert by_dict.load_n == by_key.load_n == by_overrides.load_n == by_file.load_n == 5720.0
+    assert by_dict.config_yaml() == by_key.config_yaml() == by_file.config_yaml()
+
+
+def test_stribeck_equals_the_cli(cli, tmp_path):
+    out = tmp_path / "s.csv"
+    cli("--set", "solver.cells=64", "stribeck", "--v-min", "1e-4", "--v-max", "1", "--points", "9", "--log", "--out", out)
+    ref = read_csv(out)
+    got = fn.stribeck(floats(ref["velocity_m_s"]), **{"solver.cells": 64})
+    for col in ("cof", "h0_m", "friction_n"):
+        np.testing.assert_array_equal(got[col], floats(ref[col]), err_msg=col)
+
+
+def test_replay_of_the_node_bag_is_bit_identical_and_equals_the_cli(cli, repo, tmp_path):
+    bag = repo / "bags/node_lockstep.mcap"
+    out = tmp_path / "cli.csv"
+    cli("replay", bag, "--out", out)
+    r = fn.replay(bag, out=tmp_path / "py.csv")
+    assert r.identical is True
+    assert r.summary["steps"] == len(r.estimates) == 2000
+    ref = read_csv(out)
+    np.testing.assert_array_equal(r.estimates["friction_n"].to_numpy(), floats(ref["friction_n"]))
+    assert (tmp_path / "py.csv").read_bytes() == out.read_bytes()
+
+
+def test_fit_recovers_boundary_friction_and_equals_the_cli(cli, tmp_path):
+    truth = fn.Model(**{"solver.cells": 32, "contact.boundary_friction": 0.22})
+    t = np.arange(2001) * truth.dt
+    v = np.sin(2 * np.pi * t)
+    run = truth.run(t, v)
+    data = tmp_path / "data.csv"
+    np.savetxt(data, np.column_stack([t, v, run["friction_n"]]), delimiter=",",
+               header="t_s,velocity_m_s,friction_n", comments="")
+    r = fn.fit(data, ["contact.boundary_friction"], overrides={"solver.cells": 32}, starts=1, global_points=0)
+    assert r.converged
+    assert r.value("contact.boundary_friction") == pytest.approx(0.22, rel=1e-3)
+    assert r.train_rms_n < 1.0
+    out = tmp_path / "cli.yaml"
+    cli("--set", "solver.cells=32", "fit", data, "--fit", "contact.boundary_friction",
+        "--starts", "1", "--global-points", "0", "--out", out)
+    assert r.fitted_yaml == out.read_text()
+
+
+@pytest.mark.parametrize(
+    "call, error, words",
+    [
+        (lambda: fn.Model(**{"contact.nope": 1}), ValueError, "contact.nope"),
+        (lambda: fn.Model(**{"contact.load_n": -1}), ValueError, "contact.load_n"),
+        (lambda: fn.Model("/no/such/config.yaml"), FileNotFoundError, "/no/such/config.yaml"),
+        (lambda: fn.Model().run([0, 0.001, 0.002], [0, math.nan, 1]), ValueError, "velocity[1]"),
+        (lambda: fn.Model().run([0, 0.001], [0, 1, 2]), ValueError, "same length"),
+        (lambda: fn.Model().run([0, 0.002, 0.001], [0, 0, 0]), ValueError, "t[2]"),
+        (lambda: fn.Model().run([0, 0.001], [0, 1e6]), ValueError, "max_abs_velocity"),
+        (lambda: fn.Model().run([0, 0.001], [0, 1], load=[1.0, -5.0]), ValueError, "load[1]"),
+        (lambda: fn.Model().run([0, 0.001], [[0, 1]]), ValueError, "1-D"),
+        (lambda: fn.stribeck([0.1, math.inf]), ValueError, "velocities[1]"),
+        (lambda: fn.replay("/no/such/bag.mcap"), FileNotFoundError, "/no/such/bag.mcap"),
+        (lambda: fn.replay(__file__), ValueError, "not a bag"),
+        (lambda: fn.fit("/no/such/data.csv", ["contact.boundary_friction"]), FileNotFoundError, "data.csv"),
+    ],
+)
+def test_bad_input_is_a_python_exception_naming_it(call, error, words):
+    with pytest.raises(error) as e:
+        call()
+    assert words in str(e.value)
+
+
+def test_fit_names_an_unknown_key_and_a_bound_outside_the_fit(tmp_path):
+    data = tmp_path / "d.csv"
+    data.write_text("t_s,velocity_m_s,friction_n\n0,0,0\n0.001,0.1,100\n0.002,0.2,120\n")
+    with pytest.raises(ValueError, match="contact.nope"):
+        fn.fit(data, ["contact.nope"])
+    with pytest.raises(ValueError, match="roughness.sigma_m"):
+        fn.fit(data, ["contact.boundary_friction"], bounds={"roughness.sigma_m": (1e-6, 1e-5)})
