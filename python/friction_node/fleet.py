@@ -44,7 +44,15 @@ CONNECT_TIMEOUT_S = 5.0
 
 
 def _is_url(s: str) -> bool:
-    return "://" in s and not s.startswith("file://")
+    return "://" in s and not s.startswith(("file://", "local://"))
+
+
+def _plain(s: str) -> str:
+    """A ``file://`` or ``local://`` URL as a plain path."""
+    for prefix in ("file://", "local://"):
+        if s.startswith(prefix) and "::" not in s:
+            return s[len(prefix):]
+    return s
 
 
 def expand(bags: Union[str, os.PathLike, Iterable[Union[str, os.PathLike]]]) -> List[str]:
@@ -56,9 +64,7 @@ def expand(bags: Union[str, os.PathLike, Iterable[Union[str, os.PathLike]]]) -> 
         bags = [bags]
     out: List[str] = []
     for b in bags:
-        b = os.fspath(b)
-        if b.startswith("file://"):
-            b = b[len("file://"):]
+        b = _plain(os.fspath(b))
         has_glob = any(c in b for c in "*?[")
         if not has_glob:
             out.append(b)
@@ -67,8 +73,10 @@ def expand(bags: Union[str, os.PathLike, Iterable[Union[str, os.PathLike]]]) -> 
             import fsspec
 
             fs, _, paths = fsspec.get_fs_token_paths(b)
-            proto = fs.protocol if isinstance(fs.protocol, str) else fs.protocol[0]
-            hits = sorted(f"{proto}://{p}" for p in paths)
+            head, chain = (b.split("::", 1) + [""])[:2]
+            proto = head.split("://", 1)[0]
+            suffix = f"::{chain}" if chain else ""
+            hits = sorted(f"{proto}://{p.lstrip('/') if chain else p}{suffix}" for p in paths)
         else:
             hits = sorted(_glob.glob(b, recursive=True))
             # A rosbag2 directory's split files are one bag: keep the directory.
@@ -90,7 +98,7 @@ def _output_names(bags: Sequence[str]) -> List[str]:
     """A distinct file stem per bag (its name; its index when names repeat)."""
     stems = []
     for b in bags:
-        base = os.path.basename(b.rstrip("/")) or "bag"
+        base = os.path.basename(b.split("::", 1)[0].rstrip("/")) or "bag"
         stem = base.rsplit(".", 1)[0] if "." in base else base
         stems.append(stem)
     counts: Dict[str, int] = {}
@@ -314,6 +322,8 @@ def replay(
     if unknown:
         raise TypeError(f"unknown replay option(s): {', '.join(sorted(unknown))}")
     paths = expand(bags)
+    if out_dir is not None:
+        out_dir = _plain(os.fspath(out_dir))
     if out_dir is not None and not _is_url(out_dir):
         os.makedirs(out_dir, exist_ok=True)
     stems = _output_names(paths)

@@ -123,3 +123,25 @@ def test_the_fleet_command_line_replays_and_exits_1_when_a_bag_failed(bag_dir, t
     )
     assert bad.returncode == 2
     assert "cannot reach the Dask scheduler at 'tcp://127.0.0.1:9'" in bad.stderr
+
+
+def test_fsspec_urls_are_fetched_to_the_worker_and_outputs_delivered_whole(bag_dir, cluster_client, tmp_path):
+    import zipfile
+
+    import fsspec
+
+    # A zip archive read through fsspec stands for s3:// or gs:// here: the
+    # worker fetches each bag, replays it and writes its output.
+    archive = tmp_path / "bags.zip"
+    with zipfile.ZipFile(archive, "w") as z:
+        z.write(bag_dir / "node_a.mcap", "node_a.mcap")
+        z.write(bag_dir / "node_b.mcap", "node_b.mcap")
+    r = fleet.replay(f"zip://node_*.mcap::{archive}", client=cluster_client,
+                     out_dir=f"file://{tmp_path}/out", progress=False)
+    assert r.bags["ok"].all(), r.bags["error"].tolist()
+    assert r.bags["identical"].tolist() == [True, True]
+    assert sorted(os.listdir(tmp_path / "out")) == ["node_a.csv", "node_b.csv"]
+    # Delivery to an object store: the file arrives whole, in one piece.
+    fleet._deliver(str(tmp_path / "out/node_a.csv"), "memory://fleet/node_a.csv")
+    with fsspec.open("memory://fleet/node_a.csv", "rb") as f:
+        assert f.read() == (tmp_path / "out/node_a.csv").read_bytes()
