@@ -29,8 +29,7 @@ fn main() {
     let load = config.contact.load_n;
     for _ in 0..repeats {
         let started = Instant::now();
-        let mut solver =
-            Solver::new(&config.model(), &config.solver_settings()).expect("a solver");
+        let mut solver = Solver::new(&config.model(), &config.solver_settings()).expect("a solver");
         let mut columns: Vec<Vec<f64>> = (0..19).map(|_| Vec::with_capacity(n)).collect();
         let e = solver.initialize_steady(v[0], load);
         columns[0].push(e.friction_force);
