@@ -21,7 +21,8 @@
 //! | file | content |
 //! |---|---|
 //! | `table.rs` | CSV tables (header or `--columns`, any separator) |
-//! | `series.rs` | column expressions and maps → the model's inputs |
+//! | `series.rs` | a table and its mapping → the model's inputs |
+//! | `expr.rs` | column expressions: compiling, affine fast path, `ddt` |
 //! | `bag_input.rs` | topics of a bag → a table |
 //! | `params.rs` | fitted parameters: bounds, scales, configuration keys |
 //! | `physics_model.rs` | our model as a predictor (transient and steady) |
@@ -36,6 +37,7 @@
 #[cfg(feature = "mcap")]
 pub mod bag_input;
 pub mod baselines;
+mod expr;
 pub mod params;
 pub mod physics_model;
 pub mod problem;

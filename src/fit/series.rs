@@ -11,11 +11,9 @@
 //! A table without a time column (and no `--time`) is a steady curve: each
 //! row a steady operating point.
 
+use super::expr::{compile, derivative, Expr, Var};
 use super::table::Table;
 use super::FitError;
-use evalexpr::{
-    build_operator_tree, Context, DefaultNumericTypes, EvalexprError, EvalexprResult, Node, Value,
-};
 use std::path::PathBuf;
 
 /// How the model's inputs come from a table's columns.
@@ -101,106 +99,9 @@ impl Series {
     }
 }
 
-/// Where a variable of an expression comes from.
-#[derive(Debug, Clone, Copy)]
-enum Var {
-    Column(usize),
-    Derived(usize),
-    Coefficient(usize),
-}
-
-/// One compiled expression and the identifiers it reads.
-struct Expr {
-    text: String,
-    node: Node<DefaultNumericTypes>,
-    /// The identifiers it reads, resolved once the derived columns exist.
-    vars: Vec<(String, Var)>,
-    /// Its values when it reads no map coefficient (computed once).
-    fixed: Option<Vec<f64>>,
-    /// When it is affine in the coefficients it reads (checked at
-    /// construction): its values at the start coefficients c₀ and its slope
-    /// per coefficient, so that e(c) = e(c₀) + Σ (cᵢ − c₀ᵢ) gᵢ row by row
-    /// without evaluating the expression again.
-    affine: Option<Affine>,
-}
-
-/// An expression's values as an affine function of the coefficients.
-struct Affine {
-    c0: Vec<f64>,
-    base: Vec<f64>,
-    /// (coefficient index, slope column).
-    slopes: Vec<(usize, Vec<f64>)>,
-}
-
-impl Affine {
-    fn at(&self, coeffs: &[f64]) -> Vec<f64> {
-        let mut out = self.base.clone();
-        for (i, g) in &self.slopes {
-            let d = coeffs.get(*i).copied().unwrap_or(f64::NAN) - self.c0[*i];
-            if d != 0.0 {
-                for (o, gk) in out.iter_mut().zip(g) {
-                    *o += d * gk;
-                }
-            }
-        }
-        out
-    }
-}
-
-impl Expr {
-    fn reads_coefficients(&self) -> bool {
-        self.vars
-            .iter()
-            .any(|(_, v)| matches!(v, Var::Coefficient(_)))
-    }
-}
-
-/// The variables of one expression at one row: a few names, looked up
-/// linearly, their values overwritten row by row (no allocation per row).
-struct RowContext {
-    names: Vec<String>,
-    values: Vec<Value<DefaultNumericTypes>>,
-}
-
-impl Context for RowContext {
-    type NumericTypes = DefaultNumericTypes;
-
-    fn get_value(&self, identifier: &str) -> Option<&Value<DefaultNumericTypes>> {
-        self.names
-            .iter()
-            .position(|n| n == identifier)
-            .map(|i| &self.values[i])
-    }
-
-    fn call_function(
-        &self,
-        identifier: &str,
-        _argument: &Value<DefaultNumericTypes>,
-    ) -> evalexpr::error::EvalexprResultValue<DefaultNumericTypes> {
-        Err(EvalexprError::FunctionIdentifierNotFound(
-            identifier.to_string(),
-        ))
-    }
-
-    fn are_builtin_functions_disabled(&self) -> bool {
-        false
-    }
-
-    fn set_builtin_functions_disabled(
-        &mut self,
-        disabled: bool,
-    ) -> EvalexprResult<(), DefaultNumericTypes> {
-        if disabled {
-            Err(EvalexprError::BuiltinFunctionsCannotBeDisabled)
-        } else {
-            Ok(())
-        }
-    }
-}
-
 /// A table with its mapping, ready to give series for any coefficients.
 pub struct Source {
-    table: Table,
+    pub(super) table: Table,
     name: String,
     steady: bool,
     time: Option<Expr>,
@@ -209,106 +110,10 @@ pub struct Source {
     load: Option<Expr>,
     temperature: Option<Expr>,
     /// Derived columns `ddt__NAME`.
-    derived: Vec<(String, Vec<f64>)>,
+    pub(super) derived: Vec<(String, Vec<f64>)>,
     coefficients: Vec<String>,
     /// The times (they cannot depend on coefficients).
     times: Vec<f64>,
-}
-
-fn compile(
-    what: &str,
-    text: &str,
-    table: &Table,
-    derived: &mut Vec<(String, String)>,
-    coefficients: &[(String, f64)],
-) -> Result<Expr, FitError> {
-    // ddt(NAME) → ddt__NAME, a derived column.
-    let mut t = text.to_string();
-    while let Some(i) = t.find("ddt(") {
-        let rest = &t[i + 4..];
-        let Some(j) = rest.find(')') else {
-            return Err(FitError::Expression {
-                what: what.into(),
-                text: text.into(),
-                message: "`ddt(` without `)`".into(),
-            });
-        };
-        let col = rest[..j].trim().to_string();
-        if table.column(&col).is_none() {
-            return Err(FitError::Expression {
-                what: what.into(),
-                text: text.into(),
-                message: format!(
-                    "ddt({col}): no column `{col}` (columns: {})",
-                    table.names.join(", ")
-                ),
-            });
-        }
-        let id = format!("ddt__{col}");
-        if !derived.iter().any(|(d, _)| *d == id) {
-            derived.push((id.clone(), col));
-        }
-        t = format!("{}{}{}", &t[..i], id, &rest[j + 1..]);
-    }
-    let node =
-        build_operator_tree::<DefaultNumericTypes>(&t).map_err(|e| FitError::Expression {
-            what: what.into(),
-            text: text.into(),
-            message: e.to_string(),
-        })?;
-    for id in node.iter_variable_identifiers() {
-        let known = table.column(id).is_some()
-            || derived.iter().any(|(d, _)| d == id)
-            || coefficients.iter().any(|(c, _)| c == id);
-        if !known {
-            return Err(FitError::Expression {
-                what: what.into(),
-                text: text.into(),
-                message: format!(
-                    "`{id}` is neither a column ({}) nor a map coefficient (--map NAME=VALUE)",
-                    table.names.join(", ")
-                ),
-            });
-        }
-    }
-    Ok(Expr {
-        text: text.to_string(),
-        node,
-        vars: Vec::new(),
-        fixed: None,
-        affine: None,
-    })
-}
-
-/// d/dt of `y` by a local linear fit over ±`half` s (at least ±1 sample).
-fn derivative(t: &[f64], y: &[f64], half: f64) -> Vec<f64> {
-    let n = t.len();
-    let (mut lo, mut hi) = (0usize, 0usize);
-    (0..n)
-        .map(|k| {
-            while t[k] - t[lo] > half && lo + 1 < k {
-                lo += 1;
-            }
-            while hi + 1 < n && (t[hi + 1] - t[k] <= half || hi < k + 1) {
-                hi += 1;
-            }
-            let a = lo.min(k.saturating_sub(1));
-            let b = hi.max((k + 1).min(n - 1));
-            let m = (b - a + 1) as f64;
-            let (st, sy) = (t[a..=b].iter().sum::<f64>(), y[a..=b].iter().sum::<f64>());
-            let (mt, my) = (st / m, sy / m);
-            let (mut num, mut den) = (0.0, 0.0);
-            for j in a..=b {
-                num += (t[j] - mt) * (y[j] - my);
-                den += (t[j] - mt) * (t[j] - mt);
-            }
-            if den > 0.0 {
-                num / den
-            } else {
-                0.0
-            }
-        })
-        .collect()
 }
 
 impl Source {
@@ -467,73 +272,6 @@ impl Source {
         Ok(s)
     }
 
-    /// `e` as an affine function of its coefficients about `c0`, if it is
-    /// one: slopes from unit steps, then checked at two other points (to
-    /// 1e-9 of the values' scale). None for a non-affine expression, one
-    /// that reads no coefficient, or one that fails to evaluate (the error
-    /// then shows when the series is asked for).
-    fn affine(&self, e: &Expr, c0: &[f64]) -> Option<Affine> {
-        if e.fixed.is_some() || !e.reads_coefficients() {
-            return None;
-        }
-        let eval = |c: &[f64]| self.eval_column(e, "", c).ok();
-        let base = eval(c0)?;
-        let mut slopes = Vec::new();
-        let used: Vec<usize> = e
-            .vars
-            .iter()
-            .filter_map(|(_, v)| match v {
-                Var::Coefficient(i) => Some(*i),
-                _ => None,
-            })
-            .collect();
-        for &i in &used {
-            let h = if c0[i] != 0.0 { c0[i].abs() } else { 1.0 };
-            let mut c = c0.to_vec();
-            c[i] += h;
-            let g: Vec<f64> = eval(&c)?
-                .iter()
-                .zip(&base)
-                .map(|(a, b)| (a - b) / h)
-                .collect();
-            slopes.push((i, g));
-        }
-        let a = Affine {
-            c0: c0.to_vec(),
-            base,
-            slopes,
-        };
-        let scale = a
-            .base
-            .iter()
-            .fold(0.0f64, |m, v| m.max(v.abs()))
-            .max(1e-300);
-        for factor in [0.37, 2.9] {
-            let c: Vec<f64> = c0
-                .iter()
-                .enumerate()
-                .map(|(i, v)| {
-                    if used.contains(&i) {
-                        v * factor + 0.13 * (1.0 + v.abs())
-                    } else {
-                        *v
-                    }
-                })
-                .collect();
-            let direct = eval(&c)?;
-            let predicted = a.at(&c);
-            let worst = direct
-                .iter()
-                .zip(&predicted)
-                .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
-            let sc = scale.max(direct.iter().fold(0.0f64, |m, v| m.max(v.abs())));
-            if worst.is_nan() || worst > 1e-9 * sc {
-                return None;
-            }
-        }
-        Some(a)
-    }
-
     pub fn name(&self) -> &str {
         &self.name
     }
@@ -566,70 +304,6 @@ impl Source {
         ids(load)
             .into_iter()
             .filter(|c| self.coefficients.contains(c) && !elsewhere.contains(c))
-            .collect()
-    }
-
-    /// `e` at every row, for map coefficients `coeffs`.
-    fn eval_column(&self, e: &Expr, what: &str, coeffs: &[f64]) -> Result<Vec<f64>, FitError> {
-        if let Some(v) = &e.fixed {
-            return Ok(v.clone());
-        }
-        if let Some(a) = &e.affine {
-            let v = a.at(coeffs);
-            if let Some(k) = v.iter().position(|x| !x.is_finite()) {
-                return Err(FitError::Data {
-                    what: self.name.clone(),
-                    message: format!("{what} `{}` is not finite at row {}", e.text, k + 1),
-                });
-            }
-            return Ok(v);
-        }
-        // The time expression is compiled but not resolved (it reads
-        // columns only): resolve it here.
-        let vars: Vec<(String, Var)> = if e.vars.is_empty() {
-            e.node
-                .iter_variable_identifiers()
-                .filter_map(|id| {
-                    self.table
-                        .names
-                        .iter()
-                        .position(|n| n == id)
-                        .map(|i| (id.to_string(), Var::Column(i)))
-                })
-                .collect()
-        } else {
-            e.vars.clone()
-        };
-        let mut ctx = RowContext {
-            names: vars.iter().map(|(n, _)| n.clone()).collect(),
-            values: vec![Value::Float(0.0); vars.len()],
-        };
-        (0..self.table.rows())
-            .map(|k| {
-                for (slot, (_, var)) in ctx.values.iter_mut().zip(&vars) {
-                    *slot = Value::Float(match *var {
-                        Var::Column(i) => self.table.columns[i][k],
-                        Var::Derived(i) => self.derived[i].1[k],
-                        Var::Coefficient(i) => coeffs.get(i).copied().unwrap_or(f64::NAN),
-                    });
-                }
-                let v =
-                    e.node
-                        .eval_number_with_context(&ctx)
-                        .map_err(|x| FitError::Expression {
-                            what: what.into(),
-                            text: e.text.clone(),
-                            message: format!("row {}: {x}", k + 1),
-                        })?;
-                if v.is_finite() {
-                    Ok(v)
-                } else {
-                    Err(FitError::Data {
-                        what: self.name.clone(),
-                        message: format!("{what} `{}` is not finite at row {}", e.text, k + 1),
-                    })
-                }
-            })
             .collect()
     }
 

@@ -1,0 +1,291 @@
+//! The inputs of a replay: the bag's velocity, load, temperature and
+//! parameter-change topics (or a friction-node bag's recorded estimates)
+//! decoded into the node's commands, with the `--velocity-map` and
+//! `--load-map` expressions applied.
+
+use super::*;
+
+/// `expr` of `x` applied to every sample's value; a parse error, an
+/// unknown name or a non-finite result names the flag and the sample.
+fn map_samples(
+    flag: &'static str,
+    expr: &str,
+    samples: &mut [(u64, f64)],
+) -> Result<(), ReplayError> {
+    use evalexpr::{ContextWithMutableVariables, DefaultNumericTypes, HashMapContext, Value};
+    let err = |message: String| ReplayError::Map {
+        flag,
+        expr: expr.to_string(),
+        message,
+    };
+    let node = evalexpr::build_operator_tree::<DefaultNumericTypes>(expr)
+        .map_err(|e| err(e.to_string()))?;
+    if let Some(id) = node.iter_variable_identifiers().find(|id| *id != "x") {
+        return Err(err(format!(
+            "`{id}` is unknown: the expression reads the topic's value as `x`"
+        )));
+    }
+    let mut ctx = HashMapContext::<DefaultNumericTypes>::new();
+    for (k, s) in samples.iter_mut().enumerate() {
+        ctx.set_value("x".into(), Value::Float(s.1))
+            .map_err(|e| err(e.to_string()))?;
+        let v = node
+            .eval_number_with_context(&ctx)
+            .map_err(|e| err(format!("message {}: {e}", k + 1)))?;
+        if !v.is_finite() {
+            return Err(err(format!("message {}: x = {} gives {v}", k + 1, s.1)));
+        }
+        s.1 = v;
+    }
+    Ok(())
+}
+
+/// What [`decode_inputs`] read.
+pub(super) struct Inputs {
+    pub(super) commands: Vec<Command>,
+    pub(super) recorded: Vec<EstimateRecord>,
+    pub(super) mode: InputMode,
+    pub(super) gaps: Vec<Silence>,
+    pub(super) velocity_messages: usize,
+    /// Where reading stopped early (everything before it is kept).
+    pub(super) damage: Option<Damage>,
+    pub(super) parameter_changes: Vec<ParameterChange>,
+}
+
+/// The recorded estimates as the commands each step applied: the load and
+/// the temperature when they change, then the velocity.
+fn estimates_as_commands(recorded: &[EstimateRecord], reference_c: f64) -> Vec<Command> {
+    let mut commands = Vec::with_capacity(recorded.len() + 1);
+    let mut last_load = None;
+    let mut last_temperature = reference_c;
+    for r in recorded {
+        if r.temperature_c.is_finite() && r.temperature_c != last_temperature {
+            commands.push(Command {
+                kind: CommandKind::Temperature,
+                value: r.temperature_c,
+                stamp_ns: r.stamp_ns,
+            });
+            last_temperature = r.temperature_c;
+        }
+        if last_load != Some(r.load_n) {
+            commands.push(Command {
+                kind: CommandKind::Load,
+                value: r.load_n,
+                stamp_ns: r.stamp_ns,
+            });
+            last_load = Some(r.load_n);
+        }
+        commands.push(Command {
+            kind: CommandKind::Velocity,
+            value: r.velocity_m_s,
+            stamp_ns: r.stamp_ns,
+        });
+    }
+    // Time order; at equal stamps a set point applies to that velocity's step.
+    commands.sort_by_key(|c| (c.stamp_ns, c.kind == CommandKind::Velocity));
+    commands
+}
+
+pub(super) fn decode_inputs(
+    bag: &Bag,
+    scan: &BagScan,
+    config: &Config,
+    mode: InputMode,
+    opts: &ReplayOptions,
+) -> Result<Inputs, ReplayError> {
+    let mut recorded = Vec::new();
+    let mut velocity: Vec<(u64, f64)> = Vec::new();
+    let mut load: Vec<(u64, f64)> = Vec::new();
+    let mut temperature: Vec<(u64, f64)> = Vec::new();
+    let optional =
+        |t: &Option<String>, kind: SampleKind| -> Result<Option<TopicDecoder>, ReplayError> {
+            match t {
+                Some(t) => Ok(Some(TopicDecoder::new(scan.require(t)?, kind)?)),
+                None => Ok(None),
+            }
+        };
+    let (mut vel_dec, mut load_dec, mut temp_dec, est_channel) = match &mode {
+        InputMode::Topics {
+            velocity: v,
+            kind,
+            load: l,
+            temperature: t,
+        } => (
+            Some(TopicDecoder::new(scan.require(v)?, kind.clone())?),
+            optional(l, SampleKind::Float64)?,
+            optional(t, SampleKind::Temperature)?,
+            None,
+        ),
+        InputMode::RecordedEstimates { topic } => (None, None, None, Some(scan.require(topic)?)),
+    };
+    let legacy = est_channel.is_some_and(|c| msgs::is_legacy_estimate_schema(&c.schema_text));
+    let mut est_index = 0u64;
+    // The node's parameter changes (recorded estimates only).
+    let node_fqn = {
+        let ns = config.ros.namespace.trim_end_matches('/');
+        format!("{ns}/{}", config.ros.node_name)
+    };
+    let events_channel = est_channel.and_then(|_| {
+        scan.channels
+            .iter()
+            .find(|c| c.schema_name == "rcl_interfaces/msg/ParameterEvent")
+    });
+    let mut parameter_changes = Vec::new();
+    // A message that does not decode is damage: replay what came before.
+    let mut damage: Option<Damage> = None;
+    let mut decode_error: Option<BagError> = None;
+    let (mut read, mut last_log) = (0u64, None);
+    for m in bag.messages()? {
+        let m = match m {
+            Ok(m) => m,
+            Err(d) => {
+                damage = Some(d);
+                break;
+            }
+        };
+        let view = m.view();
+        let result = if let Some(c) = events_channel.filter(|c| c.topic == view.topic) {
+            msgs::from_cdr::<msgs::ros_interfaces::ParameterEvent>(view.data)
+                .map_err(|message| BagError::Decode {
+                    topic: c.topic.clone(),
+                    type_name: c.schema_name.clone(),
+                    index: parameter_changes.len() as u64 + 1,
+                    message,
+                })
+                .map(|ev| {
+                    if ev.node == node_fqn && !ev.changed_parameters.is_empty() {
+                        parameter_changes.push(ParameterChange {
+                            stamp_ns: ev.stamp.to_ns(),
+                            changed: ev
+                                .changed_parameters
+                                .into_iter()
+                                .map(|p| (p.name, p.value))
+                                .collect(),
+                        });
+                    }
+                })
+        } else if let Some(c) = est_channel.filter(|c| c.topic == view.topic) {
+            est_index += 1;
+            msgs::decode_estimate(view.data, legacy)
+                .map_err(|message| BagError::Decode {
+                    topic: c.topic.clone(),
+                    type_name: c.schema_name.clone(),
+                    index: est_index,
+                    message,
+                })
+                .map(|r| recorded.push(r))
+        } else if let Some(d) = vel_dec.as_mut().filter(|d| d.topic() == view.topic) {
+            d.sample(&view).map(|s| velocity.push(s))
+        } else if let Some(d) = load_dec.as_mut().filter(|d| d.topic() == view.topic) {
+            d.sample(&view).map(|s| load.push(s))
+        } else if let Some(d) = temp_dec.as_mut().filter(|d| d.topic() == view.topic) {
+            d.sample(&view).map(|s| temperature.push(s))
+        } else {
+            Ok(())
+        };
+        if let Err(e) = result {
+            // A joint that was never there is a usage error, not damage.
+            if matches!(
+                e,
+                BagError::JointRequired { .. } | BagError::JointMissing { .. }
+            ) {
+                return Err(e.into());
+            }
+            damage = Some(Damage {
+                after_messages: read,
+                last_log_time_ns: last_log,
+                file: bag.path().to_path_buf(),
+                error: e.to_string(),
+            });
+            decode_error = Some(e);
+            break;
+        }
+        read += 1;
+        last_log = Some(view.log_time);
+    }
+    if recorded.is_empty() && velocity.is_empty() {
+        if let Some(e) = decode_error {
+            // Nothing before it: the decode error is the answer.
+            return Err(e.into());
+        }
+        return Err(ReplayError::Empty {
+            topic: match &mode {
+                InputMode::Topics { velocity, .. } => velocity.clone(),
+                InputMode::RecordedEstimates { topic } => topic.clone(),
+            },
+            damage: damage.or_else(|| scan.damage.clone()),
+        });
+    }
+    let mode = match (mode, &vel_dec) {
+        (
+            InputMode::Topics {
+                velocity,
+                load,
+                temperature,
+                ..
+            },
+            Some(d),
+        ) => InputMode::Topics {
+            velocity,
+            kind: d.kind.clone(),
+            load,
+            temperature,
+        },
+        (m, _) => m,
+    };
+    if let Some(e) = &opts.velocity_map {
+        map_samples("--velocity-map", e, &mut velocity)?;
+    }
+    if let Some(e) = &opts.load_map {
+        map_samples("--load-map", e, &mut load)?;
+    }
+    let velocity_messages = velocity.len() + recorded.len();
+    if let InputMode::Topics {
+        velocity: topic, ..
+    } = &mode
+    {
+        let (lo, hi) = velocity
+            .iter()
+            .fold((u64::MAX, 0), |(a, b), s| (a.min(s.0), b.max(s.0)));
+        let span_s = hi.saturating_sub(lo) as f64 / 1e9;
+        if span_s / config.solver.dt_s > MAX_REPLAY_STEPS as f64 {
+            return Err(ReplayError::TooLong {
+                topic: topic.clone(),
+                span_s,
+                dt_s: config.solver.dt_s,
+            });
+        }
+    }
+    let (commands, gaps) = match &mode {
+        InputMode::Topics { .. } => {
+            let hold = Hold {
+                dt_s: config.solver.dt_s,
+                timeout_s: config.node.command_timeout_s,
+                behaviour: config.node.timeout_behaviour,
+                deceleration_m_s2: config.node.timeout_deceleration_m_s2,
+            };
+            bag::resample::resample_held(
+                &mut velocity,
+                &mut [
+                    (CommandKind::Load, &mut load[..]),
+                    (CommandKind::Temperature, &mut temperature[..]),
+                ],
+                &hold,
+            )
+        }
+        InputMode::RecordedEstimates { .. } => (
+            estimates_as_commands(&recorded, config.lubricant.reference_temperature_c),
+            Vec::new(),
+        ),
+    };
+    parameter_changes.sort_by_key(|c| c.stamp_ns);
+    Ok(Inputs {
+        commands,
+        recorded,
+        mode,
+        gaps,
+        velocity_messages,
+        damage,
+        parameter_changes,
+    })
+}
