@@ -11,6 +11,10 @@
 //! has; `PYTHON` chooses the interpreter (default `python3`). A missing
 //! interpreter fails the test with the reason: it is never skipped.
 
+// The suite compares with the binary's replay (feature `mcap`) and drives a
+// node over iceoryx2: it runs with the default features.
+#![cfg(all(feature = "mcap", feature = "iceoryx2"))]
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 

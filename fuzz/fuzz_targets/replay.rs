@@ -20,7 +20,7 @@ fuzz_target!(|data: &[u8]| {
     };
     p.commands.truncate(200);
     p.recorded.truncate(200);
-    if let Ok(r) = replay::run(&p, &mut |_, _| {}, &mut |_, _| {}) {
+    if let Ok(r) = replay::run(&p, &mut |_, _| {}, &mut |_, _, _| {}) {
         for (_, rec) in &r.estimates {
             assert!(rec.friction_force_n.is_finite() || rec.status != 0);
         }

@@ -197,7 +197,7 @@ class Model:
 
 
 def _columns(d: dict) -> dict:
-    for k in ("status", "regime", "command_status"):
+    for k in ("status", "regime", "command_status", "contact"):
         if k in d:
             d[k] = np.asarray(d[k], dtype=object)
     return d
@@ -238,6 +238,10 @@ class ReplayResult:
     wall_s, commands_rejected, ...), ``identical`` (True/False when the bag
     holds recorded estimates to compare with, else None) and
     ``deviations`` (field, largest difference, step) when not identical.
+    A recording of several contacts replays every contact: ``estimates``
+    then has a ``contact`` column, ``summary["contacts"]`` lists (name,
+    identical, steps compared) per contact, and ``cycles`` are the first
+    contact's.
     """
 
     def __init__(self, raw: dict):

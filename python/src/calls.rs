@@ -139,9 +139,9 @@ pub fn replay<'py>(
                 _ => None,
             };
             let model_started = Instant::now();
-            let result = rp::run(&prepared, &mut |_, _| {}, &mut |e, rec| {
+            let result = rp::run(&prepared, &mut |_, _| {}, &mut |e, rec, k| {
                 if let Some(s) = stream.as_mut() {
-                    s.push(e, rec)
+                    s.push(e, rec, k)
                 }
             })
             .map_err(errors::replay)?;
@@ -158,16 +158,39 @@ pub fn replay<'py>(
             Ok((prepared, result, written, wall, model_wall))
         })
         .map_err(in_bag)?;
-    // Columns as the CSV output has them: t_s from the first stamp.
-    let mut c = Columns::with_capacity(result.estimates.len());
+    // Columns as the CSV output has them: t_s from the first stamp; with
+    // several contacts every contact's rows, named in a `contact` column.
     let t0 = result.estimates.first().map_or(0, |(_, r)| r.stamp_ns);
-    for (e, rec) in &result.estimates {
-        let t = rec.stamp_ns.saturating_sub(t0) as f64 / 1e9;
-        c.push(e, t, msgs::status_name(rec.status), rec.temperature_c);
-        c.push_stamp(rec.stamp_ns, msgs::command_status_name(rec.command_status));
+    let one = [(String::new(), &result.estimates)];
+    let several: Vec<(String, &Vec<_>)> = result
+        .contacts
+        .iter()
+        .map(|c| (c.name.clone(), &c.estimates))
+        .collect();
+    let parts: Vec<(String, &Vec<_>)> = if several.is_empty() {
+        one.iter().map(|(n, e)| (n.clone(), *e)).collect()
+    } else {
+        several
+    };
+    let rows: usize = parts.iter().map(|(_, e)| e.len()).sum();
+    let mut c = Columns::with_capacity(rows);
+    let mut names = Vec::with_capacity(if result.contacts.is_empty() { 0 } else { rows });
+    for (name, estimates) in &parts {
+        for (e, rec) in estimates.iter() {
+            let t = rec.stamp_ns.saturating_sub(t0) as f64 / 1e9;
+            c.push(e, t, msgs::status_name(rec.status), rec.temperature_c);
+            c.push_stamp(rec.stamp_ns, msgs::command_status_name(rec.command_status));
+            if !result.contacts.is_empty() {
+                names.push(name.clone());
+            }
+        }
     }
     let d = PyDict::new(py);
-    d.set_item("estimates", c.into_dict(py)?)?;
+    let est = c.into_dict(py)?;
+    if !names.is_empty() {
+        est.set_item("contact", names)?;
+    }
+    d.set_item("estimates", est)?;
     let cycles = rp::cycles(&result, prepared.config.contact.mass_kg);
     let cd = PyDict::new(py);
     cd.set_item(
@@ -228,6 +251,16 @@ pub fn replay<'py>(
             s.set_item("deviations", PyList::empty(py))?;
         }
     }
+    let contacts = PyList::empty(py);
+    for c in &result.contacts {
+        let o = c.oracle.as_ref();
+        contacts.append((
+            c.name.clone(),
+            o.map(|o| o.identical),
+            o.map_or(0, |o| o.compared),
+        ))?;
+    }
+    s.set_item("contacts", contacts)?;
     s.set_item("out", written.map(|p| p.display().to_string()))?;
     d.set_item("summary", s)?;
     Ok(d)

@@ -134,3 +134,38 @@ def test_fit_names_an_unknown_key_and_a_bound_outside_the_fit(tmp_path):
         fn.fit(data, ["contact.nope"])
     with pytest.raises(ValueError, match="roughness.sigma_m"):
         fn.fit(data, ["contact.boundary_friction"], bounds={"roughness.sigma_m": (1e-6, 1e-5)})
+
+
+THREE = """\
+friction_node:
+  ros__parameters:
+    node: {transport: iceoryx2}
+    solver: {cells: 32}
+    contacts:
+      left:  {joint: x_left,  contact: {load_n: 5000.0}}
+      right: {joint: x_right, contact: {load_n: 4000.0}}
+      wrist: {joint: wrist, gain: 0.03, contact: {load_n: 800.0}}
+"""
+
+
+def test_replay_of_a_recording_of_several_contacts_checks_each_contact(cli, tmp_path):
+    import os
+
+    cfg = tmp_path / "three.yaml"
+    cfg.write_text(THREE)
+    svc = f"fn_py_three_{os.getpid()}"
+    services = []
+    for key in ("cmd_velocity", "normal_load", "temperature", "friction", "loop_statistics",
+                "cmd_event", "joint_state", "efforts", "contact_friction"):
+        services += ["--set", f"iceoryx2.{key}_service={svc}/{key}"]
+    bag = tmp_path / "three.mcap"
+    cli("--config", cfg, *services, "run", "--demo", "1", "--record", bag, "--quiet")
+    r = fn.replay(bag, out=tmp_path / "py.csv")
+    assert [(name, same) for name, same, _ in r.summary["contacts"]] == [
+        ("left", True), ("right", True), ("wrist", True)]
+    assert r.identical is True
+    counts = r.estimates["contact"].value_counts()
+    assert set(counts.index) == {"left", "right", "wrist"}
+    assert counts.nunique() == 1 and counts.iloc[0] > 500
+    cli("replay", bag, "--out", tmp_path / "cli.csv")
+    assert (tmp_path / "py.csv").read_bytes() == (tmp_path / "cli.csv").read_bytes()

@@ -83,6 +83,7 @@ pub fn run(
                     ..Default::default()
                 },
                 logged_ns: t,
+                contact: 0,
             });
             if stats_every > 0 && k.is_multiple_of(stats_every) {
                 push(RecordItem::Statistics {

@@ -88,7 +88,7 @@ pub fn run(args: ReplayArgs, config: Option<PathBuf>, overrides: Vec<String>) ->
     let result = replay::run(
         &prepared,
         &mut |done, _| bar.set_position(done as u64),
-        &mut |e, rec| stream.push(e, rec),
+        &mut |e, rec, k| stream.push(e, rec, k),
     )?;
     let model_wall = model_started.elapsed().as_secs_f64();
     bar.finish_and_clear();
@@ -127,6 +127,32 @@ pub fn run(args: ReplayArgs, config: Option<PathBuf>, overrides: Vec<String>) ->
     }
     if let Some(d) = &prepared.scan.damage {
         println!("damaged bag      stopped {d}");
+    }
+    if !result.contacts.is_empty() {
+        println!(
+            "contacts         {} replayed together (the report and figures show the first, `{}`)",
+            result.contacts.len(),
+            result.contacts[0].name
+        );
+        for c in &result.contacts {
+            if let Some(o) = &c.oracle {
+                println!(
+                    "  {:<22} {}",
+                    c.name,
+                    if o.identical {
+                        format!("bit-identical ({} steps)", o.compared)
+                    } else {
+                        let worst = o
+                            .deviations
+                            .iter()
+                            .map(|d| format!("{} {:.3e}", d.0, d.1))
+                            .collect::<Vec<_>>()
+                            .join(", ");
+                        format!("DIFFERS over {} steps: {worst}", o.compared)
+                    }
+                );
+            }
+        }
     }
     let mut identical = true;
     if let Some(o) = &result.oracle {

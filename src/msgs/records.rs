@@ -440,10 +440,12 @@ pub enum RecordItem {
     Command { command: Command, received_ns: u64 },
     /// A received ROS 2 sample, recorded byte for byte.
     Raw(RawSample),
-    /// An estimate and when it was published (wall clock, ns).
+    /// An estimate of contact `contact` (0 with one contact) and when it
+    /// was published (wall clock, ns).
     Estimate {
         record: EstimateRecord,
         logged_ns: u64,
+        contact: u16,
     },
     /// Loop statistics and when they were published (wall clock, ns).
     Statistics {

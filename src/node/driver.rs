@@ -78,15 +78,44 @@ impl ProfileState {
     }
 }
 
+/// What the demo drives: the loop's mode and step, for how long, the
+/// velocity profile and, with several contacts, the joints (each gets the
+/// profile's velocity, in one JointState per step).
+#[derive(Debug, Clone)]
+pub struct DemoPlan {
+    pub mode: StepMode,
+    pub dt: f64,
+    pub seconds: f64,
+    pub profile: Profile,
+    pub joints: Vec<String>,
+}
+
+/// Wait up to `timeout` for the efforts of a lockstep step.
+fn efforts_timeout(peer: &mut dyn transport::PeerPort, timeout: Duration) -> bool {
+    let until = Instant::now() + timeout;
+    while Instant::now() < until {
+        match peer.try_recv_efforts() {
+            Ok(Some(_)) => return true,
+            Ok(None) => std::thread::sleep(Duration::from_micros(50)),
+            Err(_) => return false,
+        }
+    }
+    false
+}
+
 pub fn drive(
     spec: BackendSpec,
-    mode: StepMode,
-    dt: f64,
-    seconds: f64,
-    profile: Profile,
+    plan: DemoPlan,
     ready: std::sync::mpsc::Sender<Result<(), String>>,
     stop: Arc<AtomicBool>,
 ) -> DemoReport {
+    let DemoPlan {
+        mode,
+        dt,
+        seconds,
+        profile,
+        joints,
+    } = plan;
     let mut report = DemoReport::default();
     let mut peer = match spec.open_peer() {
         Ok(p) => p,
@@ -124,6 +153,26 @@ pub fn drive(
             value: velocity.at(t, dt),
             stamp_ns: t0 + (t * 1e9) as u64,
         };
+        if !joints.is_empty() {
+            let js = transport::JointStateCommand {
+                stamp_ns: c.stamp_ns,
+                name: joints.clone(),
+                velocity: vec![c.value; joints.len()],
+            };
+            if let Err(e) = peer.send_joint_state(&js) {
+                report.error.get_or_insert(e.to_string());
+                continue;
+            }
+            report.commands_sent += 1;
+            if mode == StepMode::Lockstep && efforts_timeout(peer.as_mut(), Duration::from_secs(2))
+            {
+                report.estimates_received += 1;
+            }
+            while let Ok(Some(_)) = peer.try_recv_efforts() {
+                report.estimates_received += 1;
+            }
+            continue;
+        }
         if let Err(e) = peer.send(&c) {
             report.error.get_or_insert(e.to_string());
             continue;

@@ -76,6 +76,7 @@ impl Loop {
             if q.push(RecordItem::Estimate {
                 record: rec,
                 logged_ns,
+                contact: u16::try_from(k).expect("at most MAX_CONTACTS contacts"),
             })
             .is_err()
             {

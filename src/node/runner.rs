@@ -191,13 +191,6 @@ pub fn run_node(
             }
         })
     });
-    if config.contacts.0.len() > 1 && (record_path.is_some() || config.recording.snapshot_s > 0) {
-        return Err(RunError::Option(format!(
-            "recording.*: the configuration lists {} contacts, and recording several contacts \
-             is not built yet (run without --record, recording.enabled and recording.snapshot_s)",
-            config.contacts.0.len()
-        )));
-    }
     #[cfg(feature = "mcap")]
     let recorder = if record_path.is_some() || config.recording.snapshot_s > 0 {
         let snapshot_dir = record_path
@@ -312,14 +305,20 @@ pub fn run_node(
         }
         let (tx, rx) = std::sync::mpsc::channel();
         let spec = specs[0].clone();
-        let (mode, dt, s2) = (
-            config.node.step_mode,
-            config.solver.dt_s,
-            driver_stop.clone(),
-        );
-        let profile = opts.profile;
+        let plan = super::driver::DemoPlan {
+            mode: config.node.step_mode,
+            dt: config.solver.dt_s,
+            seconds,
+            profile: opts.profile,
+            joints: if config.contacts.0.len() > 1 {
+                config.contacts.0.iter().map(|c| c.joint.clone()).collect()
+            } else {
+                Vec::new()
+            },
+        };
+        let s2 = driver_stop.clone();
         driver = Some(std::thread::spawn(move || {
-            super::driver::drive(spec, mode, dt, seconds, profile, tx, s2)
+            super::driver::drive(spec, plan, tx, s2)
         }));
         match rx.recv_timeout(Duration::from_secs(30)) {
             Ok(Ok(())) => {}

@@ -45,7 +45,7 @@ impl TopicTable {
         };
         let cq = offered_qos_yaml(&config.ros.qos.commands);
         let eq = offered_qos_yaml(&config.ros.qos.estimates);
-        Self {
+        let mut table = Self {
             topics: vec![
                 (
                     TopicId::Velocity,
@@ -100,7 +100,36 @@ impl TopicTable {
                     }),
                 ),
             ],
+        };
+        if config.contacts.0.len() > 1 {
+            // Several contacts: the JointState input and each contact's
+            // estimate on its own topic (the node's published names).
+            table.topics.push((
+                TopicId::JointCommands,
+                names.joint_commands.clone(),
+                &msgs::JOINT_STATE,
+                offered_qos_yaml(&config.ros.qos.commands),
+            ));
+            for (k, name) in names.contact_friction.iter().enumerate() {
+                let k = u16::try_from(k).expect("at most MAX_CONTACTS contacts");
+                table.topics.push((
+                    TopicId::ContactFriction(k),
+                    name.clone(),
+                    &msgs::FRICTION_ESTIMATE,
+                    offered_qos_yaml(&config.ros.qos.estimates),
+                ));
+            }
         }
+        table
+    }
+
+    /// Indices [`TopicId::index`] spans for this table.
+    pub fn slots(&self) -> usize {
+        self.topics
+            .iter()
+            .map(|(id, ..)| id.index() + 1)
+            .max()
+            .unwrap_or(0)
     }
 }
 
@@ -109,13 +138,13 @@ type McapWriter = mcap::Writer<BufWriter<std::fs::File>>;
 /// One MCAP file being written.
 pub struct BagWriter {
     w: McapWriter,
-    /// Channel id of each [`TopicId`].
-    channels: [u16; super::entry::TOPICS],
+    /// Channel id of each [`TopicId`] (by index; None: not in this file).
+    channels: Vec<Option<u16>>,
     encoder: Encoder,
     sequence: u32,
     messages: u64,
     /// Messages per topic.
-    pub counts: [u64; super::entry::TOPICS],
+    pub counts: Vec<u64>,
     /// Log time of the first and last message, ns.
     pub first_log_ns: Option<u64>,
     pub last_log_ns: u64,
@@ -160,9 +189,11 @@ impl BagWriter {
             .chunk_size(Some(config.recording.chunk_size_bytes))
             .create(BufWriter::new(file))
             .map_err(mcap_err)?;
-        let mut channels = [0u16; super::entry::TOPICS];
+        let table = TopicTable::new(config, names);
+        let slots = table.slots();
+        let mut channels = vec![None; slots];
         let mut schemas: BTreeMap<String, u16> = BTreeMap::new();
-        for (id, topic, ty, qos) in TopicTable::new(config, names).topics {
+        for (id, topic, ty, qos) in table.topics {
             let name = ty.full_name();
             let schema = match schemas.get(&name) {
                 Some(s) => *s,
@@ -176,9 +207,10 @@ impl BagWriter {
             };
             let mut meta = BTreeMap::new();
             meta.insert("offered_qos_profiles".to_string(), qos);
-            channels[id.index()] = w
-                .add_channel(schema, &topic, "cdr", &meta)
-                .map_err(mcap_err)?;
+            channels[id.index()] = Some(
+                w.add_channel(schema, &topic, "cdr", &meta)
+                    .map_err(mcap_err)?,
+            );
         }
         let mut meta = extra;
         meta.insert("config_yaml".to_string(), config.to_yaml());
@@ -196,13 +228,10 @@ impl BagWriter {
         Ok(Self {
             w,
             channels,
-            encoder: Encoder {
-                frame_id: config.node.frame_id.clone(),
-                command_type: config.ros.command_type,
-            },
+            encoder: Encoder::new(config),
             sequence: 0,
             messages: 0,
-            counts: [0; super::entry::TOPICS],
+            counts: vec![0; slots],
             first_log_ns: None,
             last_log_ns: 0,
             payload_bytes: 0,
@@ -236,11 +265,14 @@ impl BagWriter {
 
     /// Write one serialized message.
     pub fn write_entry(&mut self, e: &Entry) -> Result<(), String> {
+        let Some(channel_id) = self.channels.get(e.topic.index()).copied().flatten() else {
+            return Err(format!("{:?} is not a topic of this recording", e.topic));
+        };
         self.sequence = self.sequence.wrapping_add(1);
         self.w
             .write_to_known_channel(
                 &mcap::records::MessageHeader {
-                    channel_id: self.channels[e.topic.index()],
+                    channel_id,
                     sequence: self.sequence,
                     log_time: e.log_ns,
                     publish_time: e.publish_ns,

@@ -19,25 +19,50 @@ pub enum TopicId {
     /// `/parameter_events`: parameters changed while running, stamped with
     /// the first step that used them (replay re-applies them there).
     ParameterEvents,
+    /// Several contacts: the joint velocity commands (`sensor_msgs/JointState`).
+    JointCommands,
+    /// Several contacts: contact k's FrictionEstimate (`~/contacts/NAME/friction`).
+    ContactFriction(u16),
 }
 
-/// How many topics the recorder writes.
-pub const TOPICS: usize = 8;
+/// Topics before the per-contact ones.
+pub const BASE_TOPICS: usize = 9;
 
 impl TopicId {
-    pub const ALL: [TopicId; TOPICS] = [
-        TopicId::Velocity,
-        TopicId::Load,
-        TopicId::Friction,
-        TopicId::FrictionForce,
-        TopicId::FilmProfile,
-        TopicId::Statistics,
-        TopicId::Temperature,
-        TopicId::ParameterEvents,
-    ];
-
+    /// Dense index: the base topics, then one per contact.
     pub fn index(self) -> usize {
-        self as usize
+        match self {
+            TopicId::Velocity => 0,
+            TopicId::Load => 1,
+            TopicId::Friction => 2,
+            TopicId::FrictionForce => 3,
+            TopicId::FilmProfile => 4,
+            TopicId::Statistics => 5,
+            TopicId::Temperature => 6,
+            TopicId::ParameterEvents => 7,
+            TopicId::JointCommands => 8,
+            TopicId::ContactFriction(k) => BASE_TOPICS + usize::from(k),
+        }
+    }
+
+    /// How many indices a recording of `contacts` contacts uses.
+    pub fn count(contacts: usize) -> usize {
+        BASE_TOPICS + if contacts > 1 { contacts } else { 0 }
+    }
+}
+
+impl Encoder {
+    /// The encoder of a recording of `config`.
+    pub fn new(config: &crate::config::Config) -> Self {
+        Self {
+            frame_id: config.node.frame_id.clone(),
+            command_type: config.ros.command_type,
+            joints: if config.contacts.0.len() > 1 {
+                config.contacts.0.iter().map(|c| c.joint.clone()).collect()
+            } else {
+                Vec::new()
+            },
+        }
     }
 }
 
@@ -65,6 +90,10 @@ impl Entry {
 pub struct Encoder {
     pub frame_id: String,
     pub command_type: CommandType,
+    /// Several contacts: the joint of each contact (configured order); empty
+    /// for one contact. Estimates then go to their contact's topic and joint
+    /// commands to the JointState topic.
+    pub joints: Vec<String>,
 }
 
 fn cdr<T: serde::Serialize>(m: &T) -> Result<Vec<u8>, String> {
@@ -89,10 +118,24 @@ impl Encoder {
             (CommandKind::Velocity, CommandType::Float64) => {
                 (TopicId::Velocity, cdr(&Float64 { data: c.value })?)
             }
-            (CommandKind::JointVelocity { .. }, _) => {
-                return Err(
-                    "a joint velocity: recording several contacts is not built yet".to_string(),
-                )
+            (CommandKind::JointVelocity { contact, .. }, _) => {
+                let Some(joint) = self.joints.get(usize::from(contact)) else {
+                    return Err(format!(
+                        "a joint velocity for contact {contact}, but the recording has {} contacts",
+                        self.joints.len()
+                    ));
+                };
+                let m = msgs::JointState {
+                    header: Header {
+                        stamp: Time::from_ns(c.stamp_ns),
+                        frame_id: self.frame_id.clone(),
+                    },
+                    name: vec![joint.clone()],
+                    position: Vec::new(),
+                    velocity: vec![c.value],
+                    effort: Vec::new(),
+                };
+                (TopicId::JointCommands, cdr(&m)?)
             }
             (CommandKind::Velocity, CommandType::TwistStamped) => {
                 let mut m = TwistStamped {
@@ -125,8 +168,8 @@ impl Encoder {
             } => out.push(self.command(command, *received_ns)?),
             RecordItem::Raw(r) => out.push(Entry {
                 topic: match r.kind {
-                    // Raw samples are ROS 2's, which serves one contact.
-                    CommandKind::Velocity | CommandKind::JointVelocity { .. } => TopicId::Velocity,
+                    CommandKind::Velocity => TopicId::Velocity,
+                    CommandKind::JointVelocity { .. } => TopicId::JointCommands,
                     CommandKind::Load => TopicId::Load,
                     CommandKind::Temperature => TopicId::Temperature,
                 },
@@ -137,7 +180,28 @@ impl Encoder {
             &RecordItem::Estimate {
                 record: ref e,
                 logged_ns: log_ns,
+                contact,
             } => {
+                if !self.joints.is_empty() {
+                    if usize::from(contact) >= self.joints.len() {
+                        return Err(format!(
+                            "an estimate of contact {contact}, but the recording has {} contacts",
+                            self.joints.len()
+                        ));
+                    }
+                    out.push(Entry {
+                        topic: TopicId::ContactFriction(contact),
+                        log_ns,
+                        publish_ns: e.stamp_ns,
+                        data: cdr(&e.to_wire(&self.frame_id))?,
+                    });
+                    return Ok(());
+                }
+                if contact != 0 {
+                    return Err(format!(
+                        "an estimate of contact {contact} in a one-contact recording"
+                    ));
+                }
                 out.push(Entry {
                     topic: TopicId::Friction,
                     log_ns,

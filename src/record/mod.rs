@@ -169,10 +169,7 @@ impl Recorder {
         let r = &config.recording;
         let w = Writer {
             out,
-            encoder: Encoder {
-                frame_id: config.node.frame_id.clone(),
-                command_type: config.ros.command_type,
-            },
+            encoder: Encoder::new(config),
             ring: (r.snapshot_s > 0)
                 .then(|| snapshot::Ring::new(r.snapshot_s, r.snapshot_max_bytes)),
             config: config.clone(),

@@ -29,7 +29,7 @@ struct Done {
     name: String,
     path: PathBuf,
     info: FileInfo,
-    counts: [u64; super::entry::TOPICS],
+    counts: Vec<u64>,
 }
 
 /// The split directory being written.
@@ -175,7 +175,7 @@ impl SplitDir {
                     },
                     message_count: w.messages(),
                 },
-                counts: w.counts,
+                counts: w.counts.clone(),
             });
             self.finalisers.push(std::thread::spawn(move || w.finish()));
         }
@@ -226,10 +226,10 @@ impl SplitDir {
     /// `metadata.yaml` for the files present (written atomically).
     fn write_metadata(&self) -> Result<(), String> {
         let table = TopicTable::new(&self.config, &self.names);
-        let mut counts = [0u64; super::entry::TOPICS];
+        let mut counts = vec![0u64; table.slots()];
         let mut files = Vec::new();
         for d in &self.done {
-            for (c, n) in counts.iter_mut().zip(d.counts) {
+            for (c, n) in counts.iter_mut().zip(&d.counts) {
                 *c += n;
             }
             files.push(FileInfo {
@@ -238,7 +238,7 @@ impl SplitDir {
             });
         }
         if let Some(w) = &self.current {
-            for (c, n) in counts.iter_mut().zip(w.counts) {
+            for (c, n) in counts.iter_mut().zip(&w.counts) {
                 *c += n;
             }
             let first = w.first_log_ns.unwrap_or(0);
@@ -354,7 +354,7 @@ impl SplitDir {
                     },
                     message_count: w.messages(),
                 },
-                counts: w.counts,
+                counts: w.counts.clone(),
             });
         }
         self.failed.get_or_insert(message);
@@ -389,7 +389,7 @@ impl SplitDir {
                     },
                     message_count: w.messages(),
                 },
-                counts: w.counts,
+                counts: w.counts.clone(),
             };
             if let Err(e) = w.finish() {
                 result = Err(e);

@@ -44,6 +44,7 @@ fn map_samples(
 pub(super) struct Inputs {
     pub(super) commands: Vec<Command>,
     pub(super) recorded: Vec<EstimateRecord>,
+    pub(super) recorded_contacts: Vec<(String, Vec<EstimateRecord>)>,
     pub(super) mode: InputMode,
     pub(super) gaps: Vec<Silence>,
     pub(super) velocity_messages: usize,
@@ -117,7 +118,16 @@ pub(super) fn decode_inputs(
             None,
         ),
         InputMode::RecordedEstimates { topic } => (None, None, None, Some(scan.require(topic)?)),
+        InputMode::RecordedContacts { topics } => {
+            (None, None, None, Some(scan.require(&topics[0])?))
+        }
     };
+    // Several contacts: each contact's estimate topic, and what it recorded.
+    let contact_topics: Vec<String> = match &mode {
+        InputMode::RecordedContacts { topics } => topics.clone(),
+        _ => Vec::new(),
+    };
+    let mut per_contact: Vec<Vec<EstimateRecord>> = vec![Vec::new(); contact_topics.len()];
     let legacy = est_channel.is_some_and(|c| msgs::is_legacy_estimate_schema(&c.schema_text));
     let mut est_index = 0u64;
     // The node's parameter changes (recorded estimates only).
@@ -164,6 +174,16 @@ pub(super) fn decode_inputs(
                         });
                     }
                 })
+        } else if let Some(k) = contact_topics.iter().position(|t| *t == view.topic) {
+            est_index += 1;
+            msgs::decode_estimate(view.data, false)
+                .map_err(|message| BagError::Decode {
+                    topic: view.topic.to_string(),
+                    type_name: "friction_msgs/msg/FrictionEstimate".into(),
+                    index: est_index,
+                    message,
+                })
+                .map(|r| per_contact[k].push(r))
         } else if let Some(c) = est_channel.filter(|c| c.topic == view.topic) {
             est_index += 1;
             msgs::decode_estimate(view.data, legacy)
@@ -203,6 +223,12 @@ pub(super) fn decode_inputs(
         read += 1;
         last_log = Some(view.log_time);
     }
+    if !per_contact.is_empty() {
+        // Steps every contact recorded (damage may cut them unevenly).
+        let steps = per_contact.iter().map(Vec::len).min().unwrap_or(0);
+        per_contact.iter_mut().for_each(|r| r.truncate(steps));
+        recorded = per_contact[0].clone();
+    }
     if recorded.is_empty() && velocity.is_empty() {
         if let Some(e) = decode_error {
             // Nothing before it: the decode error is the answer.
@@ -212,6 +238,7 @@ pub(super) fn decode_inputs(
             topic: match &mode {
                 InputMode::Topics { velocity, .. } => velocity.clone(),
                 InputMode::RecordedEstimates { topic } => topic.clone(),
+                InputMode::RecordedContacts { topics } => topics[0].clone(),
             },
             damage: damage.or_else(|| scan.damage.clone()),
         });
@@ -277,15 +304,88 @@ pub(super) fn decode_inputs(
             estimates_as_commands(&recorded, config.lubricant.reference_temperature_c),
             Vec::new(),
         ),
+        InputMode::RecordedContacts { .. } => (
+            contacts_as_commands(
+                &per_contact,
+                &config
+                    .contacts
+                    .0
+                    .iter()
+                    .map(|c| c.contact.load_n)
+                    .collect::<Vec<_>>(),
+                config.lubricant.reference_temperature_c,
+            ),
+            Vec::new(),
+        ),
     };
+    let recorded_contacts = config
+        .contacts
+        .0
+        .iter()
+        .map(|c| c.name.clone())
+        .zip(per_contact)
+        .collect();
     parameter_changes.sort_by_key(|c| c.stamp_ns);
     Ok(Inputs {
         commands,
         recorded,
+        recorded_contacts,
         mode,
         gaps,
         velocity_messages,
         damage,
         parameter_changes,
     })
+}
+
+/// Several contacts' recorded estimates as the commands each step applied:
+/// the temperature changes and the load commands (a load command applies to
+/// every contact: until one came, each contact ran on its configured load
+/// `configured[k]`), then one joint velocity per contact, the last marked so
+/// that the lockstep loop steps once for all.
+fn contacts_as_commands(
+    recorded: &[Vec<EstimateRecord>],
+    configured: &[f64],
+    reference_c: f64,
+) -> Vec<Command> {
+    let n = recorded.len();
+    let steps = recorded.first().map_or(0, Vec::len);
+    let mut commands = Vec::with_capacity(steps * (n + 1));
+    let mut applied: Option<f64> = None;
+    let mut last_temperature = reference_c;
+    for i in 0..steps {
+        let r0 = &recorded[0][i];
+        if r0.temperature_c.is_finite() && r0.temperature_c != last_temperature {
+            commands.push(Command {
+                kind: CommandKind::Temperature,
+                value: r0.temperature_c,
+                stamp_ns: r0.stamp_ns,
+            });
+            last_temperature = r0.temperature_c;
+        }
+        let own = recorded
+            .iter()
+            .zip(configured)
+            .all(|(r, &c)| r[i].load_n == c);
+        let common = recorded.iter().all(|r| r[i].load_n == r0.load_n);
+        if !(applied.is_none() && own) && common && applied != Some(r0.load_n) {
+            commands.push(Command {
+                kind: CommandKind::Load,
+                value: r0.load_n,
+                stamp_ns: r0.stamp_ns,
+            });
+            applied = Some(r0.load_n);
+        }
+        for (k, r) in recorded.iter().enumerate() {
+            commands.push(Command {
+                kind: CommandKind::JointVelocity {
+                    contact: u16::try_from(k).expect("at most MAX_CONTACTS contacts"),
+                    last: k + 1 == n,
+                },
+                value: r[i].velocity_m_s,
+                stamp_ns: r0.stamp_ns,
+            });
+        }
+    }
+    commands
 }

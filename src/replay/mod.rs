@@ -92,11 +92,12 @@ pub enum ReplayError {
     #[error(transparent)]
     Node(#[from] NodeError),
     #[error(
-        "the configuration lists {0} contacts (`contacts`): replay re-simulates one contact \
-         today (replay of a multi-joint bag is not built yet); replay with a configuration \
-         without `contacts`, once per contact"
+        "the configuration lists {0} contacts (`contacts`): a bag is replayed for several \
+         contacts from a friction-node recording of them (its `~/contacts/NAME/friction` \
+         topics); {1}. Replay a foreign bag with a configuration without `contacts`, once \
+         per joint (--joint)"
     )]
-    SeveralContacts(usize),
+    SeveralContacts(usize, String),
 }
 
 fn damage_note(d: &Option<Damage>) -> String {
@@ -122,6 +123,9 @@ pub enum InputMode {
     },
     /// A friction-node bag: the recorded estimates' velocity and load.
     RecordedEstimates { topic: String },
+    /// A friction-node bag of several contacts: each contact's recorded
+    /// estimates (configured order), stepped together.
+    RecordedContacts { topics: Vec<String> },
 }
 
 impl InputMode {
@@ -151,6 +155,11 @@ impl InputMode {
             InputMode::RecordedEstimates { topic } => {
                 format!("the recorded estimates `{topic}` (velocity and load each step applied)")
             }
+            InputMode::RecordedContacts { topics } => format!(
+                "the recorded estimates of {} contacts (`{}` …; velocity and load each step applied)",
+                topics.len(),
+                topics.first().map_or("", String::as_str)
+            ),
         }
     }
 }
@@ -187,8 +196,12 @@ pub struct PreparedReplay {
     pub mode: InputMode,
     /// Commands in time order.
     pub commands: Vec<Command>,
-    /// The recorded estimates (friction-node bags).
+    /// The recorded estimates (friction-node bags; the first contact's when
+    /// there are several).
     pub recorded: Vec<EstimateRecord>,
+    /// Several contacts: each contact's name and recorded estimates
+    /// (configured order); empty for one contact.
+    pub recorded_contacts: Vec<(String, Vec<EstimateRecord>)>,
     pub scan: BagScan,
     /// Silences in the velocity topic longer than the command timeout.
     pub gaps: Vec<Silence>,
@@ -297,8 +310,35 @@ fn temperature_channel(
 pub fn prepare(bag: &Bag, opts: &ReplayOptions) -> Result<PreparedReplay, ReplayError> {
     let mut scan = bag.scan()?;
     let (config, config_source) = choose_config(&scan, opts)?;
-    if config.contacts.0.len() > 1 {
-        return Err(ReplayError::SeveralContacts(config.contacts.0.len()));
+    let several = config.contacts.0.len() > 1;
+    if several {
+        let n = config.contacts.0.len();
+        if opts.topic.is_some() {
+            return Err(ReplayError::SeveralContacts(n, "--topic was given".into()));
+        }
+        let topics = crate::transport::names::TopicNames::from_config(&config).contact_friction;
+        if let Some(t) = topics.iter().find(|t| scan.channel(t).is_none()) {
+            return Err(ReplayError::SeveralContacts(
+                n,
+                format!("this bag has no `{t}`"),
+            ));
+        }
+        for t in &topics {
+            let c = scan.require(t)?;
+            msgs::check_estimate_schema(&c.schema_text).map_err(|message| {
+                BagError::SchemaMismatch {
+                    topic: c.topic.clone(),
+                    type_name: c.schema_name.clone(),
+                    message,
+                }
+            })?;
+        }
+        if opts.velocity_map.is_some() || opts.load_map.is_some() {
+            return Err(ReplayError::SeveralContacts(
+                n,
+                "--velocity-map and --load-map apply to topics, not to recorded estimates".into(),
+            ));
+        }
     }
     // A friction-node bag without --topic: drive it by its estimates.
     let estimates = scan
@@ -306,6 +346,9 @@ pub fn prepare(bag: &Bag, opts: &ReplayOptions) -> Result<PreparedReplay, Replay
         .iter()
         .find(|c| c.schema_name == "friction_msgs/msg/FrictionEstimate");
     let mode = match (&opts.topic, estimates, &scan.recorded_config) {
+        _ if several => InputMode::RecordedContacts {
+            topics: crate::transport::names::TopicNames::from_config(&config).contact_friction,
+        },
         (None, Some(c), Some(_)) => {
             msgs::check_estimate_schema(&c.schema_text).map_err(|message| {
                 BagError::SchemaMismatch {
@@ -365,6 +408,7 @@ pub fn prepare(bag: &Bag, opts: &ReplayOptions) -> Result<PreparedReplay, Replay
         mode: inputs.mode,
         commands: inputs.commands,
         recorded: inputs.recorded,
+        recorded_contacts: inputs.recorded_contacts,
         scan,
         gaps: inputs.gaps,
         velocity_messages: inputs.velocity_messages,
@@ -375,22 +419,41 @@ pub fn prepare(bag: &Bag, opts: &ReplayOptions) -> Result<PreparedReplay, Replay
 /// The replayed estimates.
 #[derive(Debug, Clone)]
 pub struct ReplayResult {
-    /// One per step: the core estimate and the published record.
+    /// One per step: the core estimate and the published record (the first
+    /// contact's when there are several).
     pub estimates: Vec<(Estimate, EstimateRecord)>,
     pub commands_rejected: u64,
+    /// Every contact's verdict together (all identical, deviations of all).
+    pub oracle: Option<Oracle>,
+    /// Several contacts: each contact's name, estimates and oracle.
+    pub contacts: Vec<ContactReplay>,
+}
+
+/// One contact of a replay of several.
+#[derive(Debug, Clone)]
+pub struct ContactReplay {
+    pub name: String,
+    pub estimates: Vec<(Estimate, EstimateRecord)>,
     pub oracle: Option<Oracle>,
 }
 
 /// Run the model over the prepared input; `progress(done, total)` now and
-/// then, `on_step` after every step (e.g. [`OutputStream::push`]).
+/// then, `on_step` after every step of every contact (with the contact's
+/// index; e.g. [`OutputStream::push`]).
 pub fn run(
     p: &PreparedReplay,
     progress: &mut dyn FnMut(usize, usize),
-    on_step: &mut dyn FnMut(&Estimate, &EstimateRecord),
+    on_step: &mut dyn FnMut(&Estimate, &EstimateRecord, u16),
 ) -> Result<ReplayResult, ReplayError> {
     let mut cfg = p.config.clone();
     cfg.node.step_mode = crate::config::StepMode::Lockstep;
-    let link = MemoryLink::new(16);
+    let joints: Vec<String> = cfg.contacts.0.iter().map(|c| c.joint.clone()).collect();
+    let several = !p.recorded_contacts.is_empty();
+    let link = if several {
+        MemoryLink::new(16).with_joints(&joints)
+    } else {
+        MemoryLink::new(16)
+    };
     let mut peer = link.peer();
     let mut l = Loop::new(
         &cfg,
@@ -400,6 +463,11 @@ pub fn run(
         Arc::new(LiveStatus::default()),
     )?;
     let mut out = Vec::with_capacity(p.commands.len());
+    let mut per_contact: Vec<Vec<(Estimate, EstimateRecord)>> = p
+        .recorded_contacts
+        .iter()
+        .map(|(_, r)| Vec::with_capacity(r.len()))
+        .collect();
     let total = p.commands.len();
     // Recorded parameter changes, re-applied before the step that used them.
     let mut current = p.config.clone();
@@ -423,9 +491,20 @@ pub fn run(
             }
         }
         l.feed(*c);
-        if let Ok(Some(rec)) = peer.try_recv() {
+        if several {
+            while let Ok(Some((i, rec))) = peer.try_recv_contact() {
+                let e = l.contacts().estimates()[i];
+                let contact = u16::try_from(i).expect("at most MAX_CONTACTS contacts");
+                on_step(&e, &rec, contact);
+                if i == 0 {
+                    out.push((e, rec));
+                }
+                per_contact[i].push((e, rec));
+            }
+            while let Ok(Some(_)) = peer.try_recv_efforts() {}
+        } else if let Ok(Some(rec)) = peer.try_recv() {
             let e = l.contacts().estimates()[0];
-            on_step(&e, &rec);
+            on_step(&e, &rec, 0);
             out.push((e, rec));
         }
         if k % 4096 == 0 {
@@ -433,11 +512,27 @@ pub fn run(
         }
     }
     progress(total, total);
-    let oracle = matches!(p.mode, InputMode::RecordedEstimates { .. })
-        .then(|| oracle::compare(&out, &p.recorded));
+    let contacts: Vec<ContactReplay> = p
+        .recorded_contacts
+        .iter()
+        .zip(per_contact)
+        .map(|((name, recorded), estimates)| ContactReplay {
+            name: name.clone(),
+            oracle: Some(oracle::compare(&estimates, recorded)),
+            estimates,
+        })
+        .collect();
+    let oracle = match &p.mode {
+        InputMode::RecordedEstimates { .. } => Some(oracle::compare(&out, &p.recorded)),
+        InputMode::RecordedContacts { .. } => Some(oracle::combine(
+            contacts.iter().filter_map(|c| c.oracle.as_ref()),
+        )),
+        InputMode::Topics { .. } => None,
+    };
     Ok(ReplayResult {
         estimates: out,
         commands_rejected: l.summary().commands_rejected,
         oracle,
+        contacts,
     })
 }

@@ -63,3 +63,23 @@ pub fn compare(replayed: &[(Estimate, EstimateRecord)], recorded: &[EstimateReco
             .then_some((recorded.len(), replayed.len())),
     }
 }
+
+/// Several contacts' verdicts as one: identical when all are, every
+/// deviation, the steps compared summed, the first count mismatch.
+pub fn combine<'a>(oracles: impl Iterator<Item = &'a Oracle>) -> Oracle {
+    let mut all = Oracle {
+        compared: 0,
+        identical: true,
+        deviations: Vec::new(),
+        count_mismatch: None,
+    };
+    for o in oracles {
+        all.compared += o.compared;
+        all.identical &= o.identical;
+        all.deviations.extend(o.deviations.iter().cloned());
+        if all.count_mismatch.is_none() {
+            all.count_mismatch = o.count_mismatch;
+        }
+    }
+    all
+}

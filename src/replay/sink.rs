@@ -30,7 +30,8 @@ impl OutputFormat {
     }
 }
 
-type Step = (Estimate, EstimateRecord);
+/// One contact's step: the estimate, its record and the contact's index.
+type Step = (Estimate, EstimateRecord, u16);
 
 /// One output file, written to a temporary sibling and renamed over the
 /// destination only when complete.
@@ -42,11 +43,14 @@ trait Sink: Send {
 struct CsvSink {
     file: crate::output::AtomicFile,
     t0: Option<u64>,
+    /// Several contacts: their names, for the last column (empty: one contact,
+    /// no such column).
+    contacts: Vec<String>,
 }
 
 impl Sink for CsvSink {
     fn write(&mut self, steps: &[Step]) -> Result<(), String> {
-        for (e, rec) in steps {
+        for (e, rec, k) in steps {
             let t0 = *self.t0.get_or_insert(rec.stamp_ns);
             let mut e = *e;
             e.time = rec.stamp_ns.saturating_sub(t0) as f64 / 1e9;
@@ -55,9 +59,13 @@ impl Sink for CsvSink {
                 msgs::status_name(rec.status),
                 rec.temperature_c,
             );
+            let contact = match self.contacts.get(usize::from(*k)) {
+                Some(name) => format!(",{name}"),
+                None => String::new(),
+            };
             self.file
                 .line(format_args!(
-                    "{row},{},{}",
+                    "{row},{},{}{contact}",
                     rec.stamp_ns,
                     msgs::command_status_name(rec.command_status)
                 ))
@@ -108,11 +116,12 @@ impl McapSink {
 
 impl Sink for McapSink {
     fn write(&mut self, steps: &[Step]) -> Result<(), String> {
-        for (_, rec) in steps {
+        for (_, rec, k) in steps {
             self.commands_up_to(rec.stamp_ns)?;
             self.writer()?.write_item(&msgs::RecordItem::Estimate {
                 record: *rec,
                 logged_ns: rec.stamp_ns,
+                contact: *k,
             })?;
         }
         Ok(())
@@ -199,12 +208,19 @@ impl OutputStream {
             OutputFormat::Csv => {
                 let mut file =
                     crate::output::AtomicFile::create(path).map_err(|e| out_err(e.to_string()))?;
+                let contacts: Vec<String> =
+                    p.recorded_contacts.iter().map(|(n, _)| n.clone()).collect();
                 file.line(format_args!(
-                    "{},stamp_ns,command_status",
-                    crate::offline::SIMULATE_COLUMNS
+                    "{},stamp_ns,command_status{}",
+                    crate::offline::SIMULATE_COLUMNS,
+                    if contacts.is_empty() { "" } else { ",contact" }
                 ))
                 .map_err(|e| out_err(e.to_string()))?;
-                Box::new(CsvSink { file, t0: None })
+                Box::new(CsvSink {
+                    file,
+                    t0: None,
+                    contacts,
+                })
             }
             OutputFormat::Mcap => {
                 // A device (e.g. /dev/null) is written in place, never renamed over.
@@ -218,6 +234,9 @@ impl OutputStream {
                         InputMode::Topics { velocity, .. } => format!("topic {velocity}"),
                         InputMode::RecordedEstimates { topic } => {
                             format!("recorded estimates {topic}")
+                        }
+                        InputMode::RecordedContacts { topics } => {
+                            format!("recorded estimates of {} contacts", topics.len())
                         }
                     },
                 );
@@ -266,9 +285,9 @@ impl OutputStream {
         })
     }
 
-    /// Queue one step.
-    pub fn push(&mut self, e: &Estimate, rec: &EstimateRecord) {
-        self.batch.push((*e, *rec));
+    /// Queue one step (of contact `contact`; 0 with one contact).
+    pub fn push(&mut self, e: &Estimate, rec: &EstimateRecord, contact: u16) {
+        self.batch.push((*e, *rec, contact));
         if self.batch.len() >= BATCH {
             self.send();
         }

@@ -1,0 +1,199 @@
+//! Recording and replay of several contacts: the node records each
+//! contact's estimate on its own topic (`~/contacts/NAME/friction`) and the
+//! joint commands as JointState; replay re-simulates every contact together
+//! and checks each against its recording (the oracle per contact), through
+//! CSV and MCAP outputs, and a changed contact is the only one that differs.
+
+#![cfg(all(feature = "mcap", feature = "iceoryx2"))]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const CONFIG: &str = "\
+friction_node:
+  ros__parameters:
+    node:
+      transport: iceoryx2
+    solver:
+      cells: 48
+    contacts:
+      left:  {joint: x_left,  contact: {load_n: 5000.0}}
+      right: {joint: x_right, contact: {load_n: 4000.0}}
+      wrist: {joint: wrist, gain: 0.03, contact: {load_n: 800.0}, solver: {cells: 32}}
+";
+
+fn dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("fn-contacts-replay-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn node(d: &Path, args: &[&str]) -> Output {
+    let svc = format!(
+        "fn_{}",
+        d.file_name().unwrap().to_string_lossy().replace('-', "_")
+    );
+    let mut c = Command::new(env!("CARGO_BIN_EXE_friction-node"));
+    c.arg("--config").arg(d.join("three.yaml"));
+    for (key, suffix) in [
+        ("cmd_velocity_service", "v"),
+        ("normal_load_service", "l"),
+        ("temperature_service", "t"),
+        ("friction_service", "f"),
+        ("loop_statistics_service", "s"),
+        ("cmd_event_service", "e"),
+        ("joint_state_service", "j"),
+        ("efforts_service", "x"),
+        ("contact_friction_service", "c"),
+    ] {
+        c.arg("--set").arg(format!("iceoryx2.{key}={svc}/{suffix}"));
+    }
+    c.args(args).output().unwrap()
+}
+
+fn ok(o: &Output) -> String {
+    let out = String::from_utf8_lossy(&o.stdout).into_owned();
+    assert!(
+        o.status.success(),
+        "exit {:?}\n{out}\n{}",
+        o.status,
+        String::from_utf8_lossy(&o.stderr)
+    );
+    out
+}
+
+/// A recorded run of three contacts driven by the demo's JointStates.
+fn recording(d: &Path) -> PathBuf {
+    std::fs::write(d.join("three.yaml"), CONFIG).unwrap();
+    let bag = d.join("three.mcap");
+    ok(&node(
+        d,
+        &[
+            "run",
+            "--demo",
+            "1",
+            "--record",
+            bag.to_str().unwrap(),
+            "--quiet",
+        ],
+    ));
+    bag
+}
+
+#[test]
+fn a_recording_of_three_contacts_replays_bit_identical_for_each_contact() {
+    let d = dir("identical");
+    let bag = recording(&d);
+    // The bag: each contact's estimates and the joint commands, readable alone.
+    let reader = friction_node::bag::Bag::open(&bag).unwrap();
+    let scan = reader.scan().unwrap();
+    let count = |t: &str| scan.channel(t).map_or(0, |c| c.messages);
+    for name in ["left", "right", "wrist"] {
+        assert!(
+            count(&format!("/friction_node/contacts/{name}/friction")) > 500,
+            "{}",
+            friction_node::bag::listing(&scan.listing())
+        );
+    }
+    assert!(count("/friction_node/joint_commands") > 1500);
+    let csv = d.join("replay.csv");
+    let out = ok(&node(
+        &d,
+        &[
+            "replay",
+            bag.to_str().unwrap(),
+            "--out",
+            csv.to_str().unwrap(),
+            "--expect-identical",
+        ],
+    ));
+    for name in ["left", "right", "wrist"] {
+        assert!(
+            out.lines()
+                .any(|l| l.trim_start().starts_with(name) && l.contains("bit-identical")),
+            "{out}"
+        );
+    }
+    // Every contact's rows, named in the last column.
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = text.lines();
+    assert!(lines.next().unwrap().ends_with(",contact"));
+    let rows: Vec<&str> = lines.collect();
+    let per = |n: &str| {
+        rows.iter()
+            .filter(|r| r.ends_with(&format!(",{n}")))
+            .count()
+    };
+    assert!(per("left") > 500);
+    assert_eq!(per("left"), per("right"));
+    assert_eq!(per("left"), per("wrist"));
+    assert_eq!(rows.len(), 3 * per("left"));
+    // Replayed to MCAP, and that replayed again: still identical.
+    let again = d.join("replay.mcap");
+    ok(&node(
+        &d,
+        &[
+            "replay",
+            bag.to_str().unwrap(),
+            "--out",
+            again.to_str().unwrap(),
+            "--expect-identical",
+        ],
+    ));
+    ok(&node(
+        &d,
+        &[
+            "replay",
+            again.to_str().unwrap(),
+            "--out",
+            d.join("twice.csv").to_str().unwrap(),
+            "--expect-identical",
+        ],
+    ));
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn a_changed_contact_is_the_only_one_the_oracle_flags() {
+    let d = dir("changed");
+    let bag = recording(&d);
+    let o = node(
+        &d,
+        &[
+            "replay",
+            bag.to_str().unwrap(),
+            "--set",
+            "contacts.wrist.lubricant.viscosity_pa_s=0.2",
+            "--out",
+            d.join("x.csv").to_str().unwrap(),
+            "--expect-identical",
+        ],
+    );
+    assert_eq!(o.status.code(), Some(3));
+    let out = String::from_utf8_lossy(&o.stdout);
+    let line = |n: &str| {
+        out.lines()
+            .find(|l| l.trim_start().starts_with(n))
+            .unwrap_or_else(|| panic!("no line for {n}:\n{out}"))
+            .to_string()
+    };
+    assert!(line("left").contains("bit-identical"), "{out}");
+    assert!(line("right").contains("bit-identical"), "{out}");
+    assert!(line("wrist").contains("DIFFERS"), "{out}");
+    // A velocity topic cannot drive several contacts: a clear refusal.
+    let o = node(
+        &d,
+        &[
+            "replay",
+            bag.to_str().unwrap(),
+            "--topic",
+            "/friction_node/joint_commands",
+            "--out",
+            d.join("y.csv").to_str().unwrap(),
+        ],
+    );
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("3 contacts"));
+    let _ = std::fs::remove_dir_all(&d);
+}
