@@ -181,8 +181,9 @@ fn a_changed_contact_is_the_only_one_the_oracle_flags() {
     assert!(line("left").contains("bit-identical"), "{out}");
     assert!(line("right").contains("bit-identical"), "{out}");
     assert!(line("wrist").contains("DIFFERS"), "{out}");
-    // A velocity topic cannot drive several contacts: a clear refusal.
-    let o = node(
+    // Driven by its recorded joint commands instead (a JointState topic):
+    // every contact re-simulated, with nothing to compare to.
+    let out = ok(&node(
         &d,
         &[
             "replay",
@@ -192,8 +193,104 @@ fn a_changed_contact_is_the_only_one_the_oracle_flags() {
             "--out",
             d.join("y.csv").to_str().unwrap(),
         ],
+    ));
+    assert!(out.contains("3 replayed together"), "{out}");
+    // A Float64 topic cannot drive several contacts: a clear refusal.
+    let o = node(
+        &d,
+        &[
+            "replay",
+            bag.to_str().unwrap(),
+            "--topic",
+            "/friction_node/cmd_velocity",
+            "--out",
+            d.join("z.csv").to_str().unwrap(),
+        ],
     );
     assert!(!o.status.success());
-    assert!(String::from_utf8_lossy(&o.stderr).contains("3 contacts"));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("3 contacts") && err.contains("JointState"),
+        "{err}"
+    );
+    assert!(!d.join("z.csv").exists());
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn a_joint_state_bag_drives_every_configured_joint_each_as_its_one_joint_replay() {
+    let d = dir("joints");
+    std::fs::write(
+        d.join("two.yaml"),
+        "friction_node:\n  ros__parameters:\n    contacts:\n      slide: {joint: slider}\n      \
+         yaw: {joint: base_yaw, gain: 0.05, contact: {load_n: 3000.0}}\n",
+    )
+    .unwrap();
+    let bag = Path::new(env!("CARGO_MANIFEST_DIR")).join("bags/foreign_joint_states.mcap");
+    let bin = env!("CARGO_BIN_EXE_friction-node");
+    let two = d.join("two.csv");
+    let o = Command::new(bin)
+        .arg("--config")
+        .arg(d.join("two.yaml"))
+        .args([
+            "replay",
+            bag.to_str().unwrap(),
+            "--out",
+            two.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    let out = ok(&o);
+    assert!(out.contains("2 replayed together"), "{out}");
+    let one = d.join("one.csv");
+    ok(&Command::new(bin)
+        .args([
+            "replay",
+            bag.to_str().unwrap(),
+            "--topic",
+            "/joint_states",
+            "--joint",
+            "slider",
+            "--out",
+            one.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap());
+    // The slider's rows are the one-joint replay's, bit for bit (load topic
+    // and resampling included); the yaw joint has as many of its own.
+    let two = std::fs::read_to_string(&two).unwrap();
+    let one = std::fs::read_to_string(&one).unwrap();
+    let slide: Vec<&str> = two
+        .lines()
+        .skip(1)
+        .filter_map(|l| l.strip_suffix(",slide"))
+        .collect();
+    let single: Vec<&str> = one.lines().skip(1).collect();
+    assert!(single.len() > 1900);
+    assert_eq!(slide, single);
+    let yaw = two.lines().filter(|l| l.ends_with(",yaw")).count();
+    assert_eq!(yaw, single.len());
+    // A configured joint the bag does not have is named.
+    std::fs::write(
+        d.join("bad.yaml"),
+        "friction_node:\n  ros__parameters:\n    contacts:\n      slide: {joint: slider}\n      \
+         knee: {joint: knee}\n",
+    )
+    .unwrap();
+    let o = Command::new(bin)
+        .arg("--config")
+        .arg(d.join("bad.yaml"))
+        .args([
+            "replay",
+            bag.to_str().unwrap(),
+            "--out",
+            d.join("x.csv").to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("knee"), "{err}");
+    assert!(!d.join("x.csv").exists());
     let _ = std::fs::remove_dir_all(&d);
 }

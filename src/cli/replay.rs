@@ -51,7 +51,13 @@ pub fn run(args: ReplayArgs, config: Option<PathBuf>, overrides: Vec<String>) ->
     let steps = prepared
         .commands
         .iter()
-        .filter(|c| c.kind == friction_node::msgs::CommandKind::Velocity)
+        .filter(|c| {
+            matches!(
+                c.kind,
+                friction_node::msgs::CommandKind::Velocity
+                    | friction_node::msgs::CommandKind::JointVelocity { last: true, .. }
+            )
+        })
         .count();
     eprintln!(
         "replay {}: {} ({} velocity messages → {} steps of {} s), configuration {}",
@@ -135,6 +141,9 @@ pub fn run(args: ReplayArgs, config: Option<PathBuf>, overrides: Vec<String>) ->
             result.contacts[0].name
         );
         for c in &result.contacts {
+            if c.oracle.is_none() {
+                println!("  {:<22} {} steps", c.name, c.estimates.len());
+            }
             if let Some(o) = &c.oracle {
                 println!(
                     "  {:<22} {}",

@@ -121,7 +121,26 @@ pub(super) fn decode_inputs(
         InputMode::RecordedContacts { topics } => {
             (None, None, None, Some(scan.require(&topics[0])?))
         }
+        InputMode::JointStates {
+            load: l,
+            temperature: t,
+            ..
+        } => (
+            None,
+            optional(l, SampleKind::Float64)?,
+            optional(t, SampleKind::Temperature)?,
+            None,
+        ),
     };
+    // Several contacts from a JointState topic: one decoder per joint.
+    let mut joint_decs: Vec<TopicDecoder> = match &mode {
+        InputMode::JointStates { topic, joints, .. } => joints
+            .iter()
+            .map(|j| TopicDecoder::new(scan.require(topic)?, SampleKind::JointVelocity(j.clone())))
+            .collect::<Result<_, _>>()?,
+        _ => Vec::new(),
+    };
+    let mut joint_samples: Vec<Vec<(u64, f64)>> = vec![Vec::new(); joint_decs.len()];
     // Several contacts: each contact's estimate topic, and what it recorded.
     let contact_topics: Vec<String> = match &mode {
         InputMode::RecordedContacts { topics } => topics.clone(),
@@ -194,6 +213,20 @@ pub(super) fn decode_inputs(
                     message,
                 })
                 .map(|r| recorded.push(r))
+        } else if joint_decs.first().is_some_and(|d| d.topic() == view.topic) {
+            // A message without one of the joints leaves it held (as the
+            // node does); a joint that never appears is an error below.
+            joint_decs
+                .iter_mut()
+                .zip(joint_samples.iter_mut())
+                .try_for_each(|(d, out)| match d.sample(&view) {
+                    Ok(s) => {
+                        out.push(s);
+                        Ok(())
+                    }
+                    Err(BagError::JointMissing { .. }) => Ok(()),
+                    Err(e) => Err(e),
+                })
         } else if let Some(d) = vel_dec.as_mut().filter(|d| d.topic() == view.topic) {
             d.sample(&view).map(|s| velocity.push(s))
         } else if let Some(d) = load_dec.as_mut().filter(|d| d.topic() == view.topic) {
@@ -229,6 +262,20 @@ pub(super) fn decode_inputs(
         per_contact.iter_mut().for_each(|r| r.truncate(steps));
         recorded = per_contact[0].clone();
     }
+    if let (InputMode::JointStates { topic, joints, .. }, false) = (&mode, joint_samples.is_empty())
+    {
+        if let Some(k) = joint_samples.iter().position(Vec::is_empty) {
+            if damage.is_none() {
+                return Err(BagError::JointMissing {
+                    topic: topic.clone(),
+                    joint: joints[k].clone(),
+                    joints: scan_joints(bag, topic),
+                }
+                .into());
+            }
+        }
+        velocity = joint_samples[0].clone();
+    }
     if recorded.is_empty() && velocity.is_empty() {
         if let Some(e) = decode_error {
             // Nothing before it: the decode error is the answer.
@@ -239,6 +286,7 @@ pub(super) fn decode_inputs(
                 InputMode::Topics { velocity, .. } => velocity.clone(),
                 InputMode::RecordedEstimates { topic } => topic.clone(),
                 InputMode::RecordedContacts { topics } => topics[0].clone(),
+                InputMode::JointStates { topic, .. } => topic.clone(),
             },
             damage: damage.or_else(|| scan.damage.clone()),
         });
@@ -269,7 +317,8 @@ pub(super) fn decode_inputs(
     let velocity_messages = velocity.len() + recorded.len();
     if let InputMode::Topics {
         velocity: topic, ..
-    } = &mode
+    }
+    | InputMode::JointStates { topic, .. } = &mode
     {
         let (lo, hi) = velocity
             .iter()
@@ -304,6 +353,15 @@ pub(super) fn decode_inputs(
             estimates_as_commands(&recorded, config.lubricant.reference_temperature_c),
             Vec::new(),
         ),
+        InputMode::JointStates { .. } => {
+            let hold = Hold {
+                dt_s: config.solver.dt_s,
+                timeout_s: config.node.command_timeout_s,
+                behaviour: config.node.timeout_behaviour,
+                deceleration_m_s2: config.node.timeout_deceleration_m_s2,
+            };
+            joints_as_commands(&mut joint_samples, &mut load, &mut temperature, &hold)
+        }
         InputMode::RecordedContacts { .. } => (
             contacts_as_commands(
                 &per_contact,
@@ -336,6 +394,75 @@ pub(super) fn decode_inputs(
         damage,
         parameter_changes,
     })
+}
+
+/// Several joints' velocities (and the load and temperature) as the
+/// commands of each step: every joint resampled onto the step grid exactly
+/// as one joint's topic is (interpolation, hold and timeout rules), on the
+/// first joint's grid; at each step the set points that changed, then one
+/// joint velocity per contact, the last marked so that the lockstep loop
+/// steps once for all. Silences are the first joint's.
+fn joints_as_commands(
+    joints: &mut [Vec<(u64, f64)>],
+    load: &mut [(u64, f64)],
+    temperature: &mut [(u64, f64)],
+    hold: &Hold,
+) -> (Vec<Command>, Vec<Silence>) {
+    let Some((first, others)) = joints.split_first_mut() else {
+        return (Vec::new(), Vec::new());
+    };
+    let (reference, gaps) = bag::resample::resample_held(
+        first,
+        &mut [
+            (CommandKind::Load, load),
+            (CommandKind::Temperature, temperature),
+        ],
+        hold,
+    );
+    let resampled: Vec<Vec<Command>> = others
+        .iter_mut()
+        .map(|s| bag::resample::resample_held(s, &mut [], hold).0)
+        .collect();
+    let n = resampled.len() + 1;
+    let mut cursors = vec![0usize; resampled.len()];
+    let mut out = Vec::with_capacity(reference.len() * n);
+    for c in reference {
+        if c.kind != CommandKind::Velocity {
+            out.push(c);
+            continue;
+        }
+        out.push(Command {
+            kind: CommandKind::JointVelocity {
+                contact: 0,
+                last: false,
+            },
+            ..c
+        });
+        for (k, r) in resampled.iter().enumerate() {
+            let i = &mut cursors[k];
+            while *i < r.len() && r[*i].stamp_ns < c.stamp_ns {
+                *i += 1;
+            }
+            if let Some(v) = r.get(*i).filter(|v| v.stamp_ns == c.stamp_ns) {
+                out.push(Command {
+                    kind: CommandKind::JointVelocity {
+                        contact: u16::try_from(k + 1).expect("at most MAX_CONTACTS contacts"),
+                        last: false,
+                    },
+                    value: v.value,
+                    stamp_ns: c.stamp_ns,
+                });
+            }
+        }
+        if let Some(Command {
+            kind: CommandKind::JointVelocity { last, .. },
+            ..
+        }) = out.last_mut()
+        {
+            *last = true;
+        }
+    }
+    (out, gaps)
 }
 
 /// Several contacts' recorded estimates as the commands each step applied:
@@ -388,4 +515,25 @@ fn contacts_as_commands(
         }
     }
     commands
+}
+
+/// The joint names a JointState topic carries (for an error message).
+fn scan_joints(bag: &Bag, topic: &str) -> Vec<String> {
+    let mut names: Vec<String> = Vec::new();
+    if let Ok(messages) = bag.messages() {
+        for m in messages.flatten().take(10_000) {
+            let view = m.view();
+            if view.topic != topic {
+                continue;
+            }
+            if let Ok(js) = msgs::from_cdr::<msgs::JointState>(view.data) {
+                for n in js.name {
+                    if !names.contains(&n) {
+                        names.push(n);
+                    }
+                }
+            }
+        }
+    }
+    names
 }

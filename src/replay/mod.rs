@@ -126,6 +126,16 @@ pub enum InputMode {
     /// A friction-node bag of several contacts: each contact's recorded
     /// estimates (configured order), stepped together.
     RecordedContacts { topics: Vec<String> },
+    /// Several contacts from a `sensor_msgs/JointState` topic: every
+    /// configured joint's velocity, resampled onto the step grid like one
+    /// joint's, and the load and temperature topics (applied to every
+    /// contact).
+    JointStates {
+        topic: String,
+        joints: Vec<String>,
+        load: Option<String>,
+        temperature: Option<String>,
+    },
 }
 
 impl InputMode {
@@ -159,6 +169,20 @@ impl InputMode {
                 "the recorded estimates of {} contacts (`{}` …; velocity and load each step applied)",
                 topics.len(),
                 topics.first().map_or("", String::as_str)
+            ),
+            InputMode::JointStates {
+                topic,
+                joints,
+                load,
+                temperature,
+            } => format!(
+                "velocity of joints {} from `{topic}` (sensor_msgs/msg/JointState){}{}",
+                joints.join(", "),
+                load.as_ref()
+                    .map_or(String::new(), |l| format!(", load `{l}`")),
+                temperature
+                    .as_ref()
+                    .map_or(String::new(), |t| format!(", temperature `{t}`"))
             ),
         }
     }
@@ -311,19 +335,21 @@ pub fn prepare(bag: &Bag, opts: &ReplayOptions) -> Result<PreparedReplay, Replay
     let mut scan = bag.scan()?;
     let (config, config_source) = choose_config(&scan, opts)?;
     let several = config.contacts.0.len() > 1;
-    if several {
-        let n = config.contacts.0.len();
-        if opts.topic.is_some() {
-            return Err(ReplayError::SeveralContacts(n, "--topic was given".into()));
-        }
-        let topics = crate::transport::names::TopicNames::from_config(&config).contact_friction;
-        if let Some(t) = topics.iter().find(|t| scan.channel(t).is_none()) {
-            return Err(ReplayError::SeveralContacts(
-                n,
-                format!("this bag has no `{t}`"),
-            ));
-        }
-        for t in &topics {
+    let n_contacts = config.contacts.0.len();
+    let contact_topics = crate::transport::names::TopicNames::from_config(&config).contact_friction;
+    // Several contacts: a recording of them (every contact's topic, no
+    // --topic) replays its estimates; otherwise a JointState topic drives
+    // every configured joint.
+    let recorded_contacts =
+        several && opts.topic.is_none() && contact_topics.iter().all(|t| scan.channel(t).is_some());
+    if several && (opts.velocity_map.is_some() || opts.load_map.is_some()) {
+        return Err(ReplayError::SeveralContacts(
+            n_contacts,
+            "--velocity-map and --load-map apply to one velocity topic".into(),
+        ));
+    }
+    if recorded_contacts {
+        for t in &contact_topics {
             let c = scan.require(t)?;
             msgs::check_estimate_schema(&c.schema_text).map_err(|message| {
                 BagError::SchemaMismatch {
@@ -333,22 +359,65 @@ pub fn prepare(bag: &Bag, opts: &ReplayOptions) -> Result<PreparedReplay, Replay
                 }
             })?;
         }
-        if opts.velocity_map.is_some() || opts.load_map.is_some() {
+    }
+    let joint_states = if several && !recorded_contacts {
+        let topic = match &opts.topic {
+            Some(t) => scan.require(t)?.clone(),
+            None => {
+                let js: Vec<&ChannelInfo> = scan
+                    .channels
+                    .iter()
+                    .filter(|c| c.schema_name == "sensor_msgs/msg/JointState")
+                    .collect();
+                match js.as_slice() {
+                    [one] => (*one).clone(),
+                    [] => {
+                        return Err(ReplayError::SeveralContacts(
+                            n_contacts,
+                            "this bag has neither their recorded estimates nor a sensor_msgs/msg/JointState topic"
+                                .into(),
+                        ))
+                    }
+                    _ => {
+                        return Err(ReplayError::AmbiguousVelocity {
+                            candidates: js
+                                .iter()
+                                .map(|c| (c.topic.clone(), c.schema_name.clone(), c.messages))
+                                .collect(),
+                        })
+                    }
+                }
+            }
+        };
+        if topic.schema_name != "sensor_msgs/msg/JointState" {
             return Err(ReplayError::SeveralContacts(
-                n,
-                "--velocity-map and --load-map apply to topics, not to recorded estimates".into(),
+                n_contacts,
+                format!(
+                    "`{}` is {}, and several contacts take a sensor_msgs/msg/JointState topic",
+                    topic.topic, topic.schema_name
+                ),
             ));
         }
-    }
+        check_schema(&topic, SampleKind::JointVelocity(String::new()).msg_type())?;
+        Some(InputMode::JointStates {
+            topic: topic.topic,
+            joints: config.contacts.0.iter().map(|c| c.joint.clone()).collect(),
+            load: load_channel(&scan, opts)?,
+            temperature: temperature_channel(&scan, opts)?,
+        })
+    } else {
+        None
+    };
     // A friction-node bag without --topic: drive it by its estimates.
     let estimates = scan
         .channels
         .iter()
         .find(|c| c.schema_name == "friction_msgs/msg/FrictionEstimate");
     let mode = match (&opts.topic, estimates, &scan.recorded_config) {
-        _ if several => InputMode::RecordedContacts {
-            topics: crate::transport::names::TopicNames::from_config(&config).contact_friction,
+        _ if recorded_contacts => InputMode::RecordedContacts {
+            topics: contact_topics,
         },
+        _ if joint_states.is_some() => joint_states.expect("several contacts from JointState"),
         (None, Some(c), Some(_)) => {
             msgs::check_estimate_schema(&c.schema_text).map_err(|message| {
                 BagError::SchemaMismatch {
@@ -448,7 +517,7 @@ pub fn run(
     let mut cfg = p.config.clone();
     cfg.node.step_mode = crate::config::StepMode::Lockstep;
     let joints: Vec<String> = cfg.contacts.0.iter().map(|c| c.joint.clone()).collect();
-    let several = !p.recorded_contacts.is_empty();
+    let several = joints.len() > 1;
     let link = if several {
         MemoryLink::new(16).with_joints(&joints)
     } else {
@@ -463,11 +532,11 @@ pub fn run(
         Arc::new(LiveStatus::default()),
     )?;
     let mut out = Vec::with_capacity(p.commands.len());
-    let mut per_contact: Vec<Vec<(Estimate, EstimateRecord)>> = p
-        .recorded_contacts
-        .iter()
-        .map(|(_, r)| Vec::with_capacity(r.len()))
-        .collect();
+    let mut per_contact: Vec<Vec<(Estimate, EstimateRecord)>> = if several {
+        vec![Vec::new(); joints.len()]
+    } else {
+        Vec::new()
+    };
     let total = p.commands.len();
     // Recorded parameter changes, re-applied before the step that used them.
     let mut current = p.config.clone();
@@ -512,13 +581,18 @@ pub fn run(
         }
     }
     progress(total, total);
-    let contacts: Vec<ContactReplay> = p
-        .recorded_contacts
+    let contacts: Vec<ContactReplay> = cfg
+        .contacts
+        .0
         .iter()
         .zip(per_contact)
-        .map(|((name, recorded), estimates)| ContactReplay {
-            name: name.clone(),
-            oracle: Some(oracle::compare(&estimates, recorded)),
+        .enumerate()
+        .map(|(k, (c, estimates))| ContactReplay {
+            name: c.name.clone(),
+            oracle: p
+                .recorded_contacts
+                .get(k)
+                .map(|(_, recorded)| oracle::compare(&estimates, recorded)),
             estimates,
         })
         .collect();
@@ -527,7 +601,7 @@ pub fn run(
         InputMode::RecordedContacts { .. } => Some(oracle::combine(
             contacts.iter().filter_map(|c| c.oracle.as_ref()),
         )),
-        InputMode::Topics { .. } => None,
+        InputMode::Topics { .. } | InputMode::JointStates { .. } => None,
     };
     Ok(ReplayResult {
         estimates: out,

@@ -208,8 +208,11 @@ impl OutputStream {
             OutputFormat::Csv => {
                 let mut file =
                     crate::output::AtomicFile::create(path).map_err(|e| out_err(e.to_string()))?;
-                let contacts: Vec<String> =
-                    p.recorded_contacts.iter().map(|(n, _)| n.clone()).collect();
+                let contacts: Vec<String> = if p.config.contacts.0.len() > 1 {
+                    p.config.contacts.0.iter().map(|c| c.name.clone()).collect()
+                } else {
+                    Vec::new()
+                };
                 file.line(format_args!(
                     "{},stamp_ns,command_status{}",
                     crate::offline::SIMULATE_COLUMNS,
@@ -238,6 +241,7 @@ impl OutputStream {
                         InputMode::RecordedContacts { topics } => {
                             format!("recorded estimates of {} contacts", topics.len())
                         }
+                        InputMode::JointStates { topic, .. } => format!("joint states {topic}"),
                     },
                 );
                 let names = crate::transport::names::TopicNames::from_config(&p.config);
