@@ -109,6 +109,11 @@ def _config_args(config: Config) -> Tuple[Optional[str], Optional[str], list]:
     )
 
 
+def _path(p: Optional[PathLike]) -> Optional[str]:
+    """A path argument as text (None stays None)."""
+    return None if p is None else os.fspath(p)
+
+
 def _array(x: Any, name: str, n: Optional[int] = None) -> np.ndarray:
     try:
         a = np.ascontiguousarray(x, dtype=np.float64)
@@ -282,7 +287,7 @@ def replay(
     directory) write the command's files, atomically."""
     raw = _core.replay(
         os.fspath(bag),
-        config_path=None if config is None else os.fspath(config),
+        config_path=_path(config),
         overrides=_overrides(overrides, {}),
         topic=topic,
         joint=joint,
@@ -290,8 +295,8 @@ def replay(
         temperature_topic=temperature_topic,
         velocity_map=velocity_map,
         load_map=load_map,
-        out=None if out is None else os.fspath(out),
-        report_dir=None if report is None else os.fspath(report),
+        out=_path(out),
+        report_dir=_path(report),
     )
     return ReplayResult(raw)
 
@@ -389,7 +394,7 @@ def fit(
     raw = _core.fit(
         [os.fspath(d) for d in data],
         list(fit),
-        config_path=None if config is None else os.fspath(config),
+        config_path=_path(config),
         overrides=_overrides(overrides, {}),
         bounds=[(k, float(lo), float(hi)) for k, (lo, hi) in (bounds or {}).items()],
         starts_at=[(k, float(v)) for k, v in (start or {}).items()],
@@ -415,8 +420,8 @@ def fit(
         joint=joint,
         load_topic=load_topic,
         temperature_topic=temperature_topic,
-        out=None if out is None else os.fspath(out),
-        report_dir=None if report is None else os.fspath(report),
+        out=_path(out),
+        report_dir=_path(report),
         progress=bool(progress),
     )
     return FitResult(raw)

@@ -53,6 +53,28 @@ pub(super) struct Inputs {
     pub(super) parameter_changes: Vec<ParameterChange>,
 }
 
+/// A temperature command when the recorded temperature changed.
+fn push_temperature(commands: &mut Vec<Command>, last: &mut f64, r: &EstimateRecord) {
+    if r.temperature_c.is_finite() && r.temperature_c != *last {
+        commands.push(Command {
+            kind: CommandKind::Temperature,
+            value: r.temperature_c,
+            stamp_ns: r.stamp_ns,
+        });
+        *last = r.temperature_c;
+    }
+}
+
+/// The node's command-hold rules, for resampling a topic onto the step grid.
+fn hold_of(config: &Config) -> Hold {
+    Hold {
+        dt_s: config.solver.dt_s,
+        timeout_s: config.node.command_timeout_s,
+        behaviour: config.node.timeout_behaviour,
+        deceleration_m_s2: config.node.timeout_deceleration_m_s2,
+    }
+}
+
 /// The recorded estimates as the commands each step applied: the load and
 /// the temperature when they change, then the velocity.
 fn estimates_as_commands(recorded: &[EstimateRecord], reference_c: f64) -> Vec<Command> {
@@ -60,14 +82,7 @@ fn estimates_as_commands(recorded: &[EstimateRecord], reference_c: f64) -> Vec<C
     let mut last_load = None;
     let mut last_temperature = reference_c;
     for r in recorded {
-        if r.temperature_c.is_finite() && r.temperature_c != last_temperature {
-            commands.push(Command {
-                kind: CommandKind::Temperature,
-                value: r.temperature_c,
-                stamp_ns: r.stamp_ns,
-            });
-            last_temperature = r.temperature_c;
-        }
+        push_temperature(&mut commands, &mut last_temperature, r);
         if last_load != Some(r.load_n) {
             commands.push(Command {
                 kind: CommandKind::Load,
@@ -334,12 +349,7 @@ pub(super) fn decode_inputs(
     }
     let (commands, gaps) = match &mode {
         InputMode::Topics { .. } => {
-            let hold = Hold {
-                dt_s: config.solver.dt_s,
-                timeout_s: config.node.command_timeout_s,
-                behaviour: config.node.timeout_behaviour,
-                deceleration_m_s2: config.node.timeout_deceleration_m_s2,
-            };
+            let hold = hold_of(config);
             bag::resample::resample_held(
                 &mut velocity,
                 &mut [
@@ -354,12 +364,7 @@ pub(super) fn decode_inputs(
             Vec::new(),
         ),
         InputMode::JointStates { .. } => {
-            let hold = Hold {
-                dt_s: config.solver.dt_s,
-                timeout_s: config.node.command_timeout_s,
-                behaviour: config.node.timeout_behaviour,
-                deceleration_m_s2: config.node.timeout_deceleration_m_s2,
-            };
+            let hold = hold_of(config);
             joints_as_commands(&mut joint_samples, &mut load, &mut temperature, &hold)
         }
         InputMode::RecordedContacts { .. } => (
@@ -482,14 +487,7 @@ fn contacts_as_commands(
     let mut last_temperature = reference_c;
     for i in 0..steps {
         let r0 = &recorded[0][i];
-        if r0.temperature_c.is_finite() && r0.temperature_c != last_temperature {
-            commands.push(Command {
-                kind: CommandKind::Temperature,
-                value: r0.temperature_c,
-                stamp_ns: r0.stamp_ns,
-            });
-            last_temperature = r0.temperature_c;
-        }
+        push_temperature(&mut commands, &mut last_temperature, r0);
         let own = recorded
             .iter()
             .zip(configured)

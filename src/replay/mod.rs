@@ -330,6 +330,15 @@ fn temperature_channel(
     }
 }
 
+/// A FrictionEstimate channel whose schema this build decodes.
+fn check_estimates(c: &ChannelInfo) -> Result<(), BagError> {
+    msgs::check_estimate_schema(&c.schema_text).map_err(|message| BagError::SchemaMismatch {
+        topic: c.topic.clone(),
+        type_name: c.schema_name.clone(),
+        message,
+    })
+}
+
 /// Validate the bag against the options and decode every input.
 pub fn prepare(bag: &Bag, opts: &ReplayOptions) -> Result<PreparedReplay, ReplayError> {
     let mut scan = bag.scan()?;
@@ -350,14 +359,7 @@ pub fn prepare(bag: &Bag, opts: &ReplayOptions) -> Result<PreparedReplay, Replay
     }
     if recorded_contacts {
         for t in &contact_topics {
-            let c = scan.require(t)?;
-            msgs::check_estimate_schema(&c.schema_text).map_err(|message| {
-                BagError::SchemaMismatch {
-                    topic: c.topic.clone(),
-                    type_name: c.schema_name.clone(),
-                    message,
-                }
-            })?;
+            check_estimates(scan.require(t)?)?;
         }
     }
     let joint_states = if several && !recorded_contacts {
@@ -419,13 +421,7 @@ pub fn prepare(bag: &Bag, opts: &ReplayOptions) -> Result<PreparedReplay, Replay
         },
         _ if joint_states.is_some() => joint_states.expect("several contacts from JointState"),
         (None, Some(c), Some(_)) => {
-            msgs::check_estimate_schema(&c.schema_text).map_err(|message| {
-                BagError::SchemaMismatch {
-                    topic: c.topic.clone(),
-                    type_name: c.schema_name.clone(),
-                    message,
-                }
-            })?;
+            check_estimates(c)?;
             InputMode::RecordedEstimates {
                 topic: c.topic.clone(),
             }
