@@ -6,7 +6,7 @@
 
 use crate::config::Config;
 use crate::offline::{SimulationError, Timing};
-use crate::physics::{Method, Solver};
+use crate::physics::{Isa, Method, Solver};
 use std::time::Instant;
 
 /// Results for one grid size.
@@ -24,6 +24,11 @@ pub struct BenchCase {
     pub reference_mean_picard: f64,
     /// Allocations per Newton step (None without a counting allocator).
     pub allocations_per_step: Option<f64>,
+    /// The instruction-set version of the step that ran.
+    pub isa: Isa,
+    /// The same steps with the baseline version, when another one ran
+    /// (timed right after, same states: the vectorisation's gain).
+    pub baseline: Option<Timing>,
 }
 
 impl BenchCase {
@@ -82,6 +87,24 @@ pub fn run(config: &Config, opts: &BenchOptions<'_>) -> Result<Vec<BenchCase>, S
             it_sum += e.diagnostics.iterations as u64;
             it_max = it_max.max(e.diagnostics.iterations);
         }
+        let isa = s.isa();
+        let baseline = (isa != Isa::Baseline).then(|| {
+            (opts.progress)(&format!(
+                "N = {cells}: the same steps, baseline instruction set"
+            ));
+            let mut b = Solver::new(&cfg.model(), &st).expect("validated above");
+            b.set_isa(Isa::Baseline);
+            b.initialize_steady(0.0, load);
+            let mut times = Vec::with_capacity(steps);
+            for k in 1..=per_cycle + steps {
+                let start = Instant::now();
+                b.step(velocity(k as f64 * st.dt), load);
+                if k > per_cycle {
+                    times.push(start.elapsed().as_nanos() as u64);
+                }
+            }
+            Timing::from_ns(&times)
+        });
         // Side by side from identical states at equal tolerance.
         let tol = cfg.solver.reference.motion_tolerance;
         let (mut tn, mut tr, mut picard) = (Vec::new(), Vec::new(), 0u64);
@@ -116,6 +139,8 @@ pub fn run(config: &Config, opts: &BenchOptions<'_>) -> Result<Vec<BenchCase>, S
             allocations_per_step: opts
                 .allocation_counter
                 .map(|_| allocs as f64 / steps as f64),
+            isa,
+            baseline,
         });
     }
     Ok(out)
@@ -124,10 +149,10 @@ pub fn run(config: &Config, opts: &BenchOptions<'_>) -> Result<Vec<BenchCase>, S
 /// Human-readable table.
 pub fn table(cases: &[BenchCase]) -> String {
     let mut s = String::new();
-    s.push_str("     N | Newton µs/step: median    p99  p99.9    max | iter mean/max | allocs/step | µs/step/cell | ref. µs/step (median) | Newton @tol µs | speed-up\n");
+    s.push_str("     N | Newton µs/step: median    p99  p99.9    max | iter mean/max | allocs/step | µs/step/cell | ref. µs/step (median) | Newton @tol µs | speed-up | ISA (baseline median µs)\n");
     for c in cases {
         s.push_str(&format!(
-            "{:>6} | {:>22.1} {:>6.1} {:>6.1} {:>6.1} | {:>8.2}/{:<4} | {:>11} | {:>12.4} | {:>21.0} | {:>14.1} | {:>7.0}×\n",
+            "{:>6} | {:>22.1} {:>6.1} {:>6.1} {:>6.1} | {:>8.2}/{:<4} | {:>11} | {:>12.4} | {:>21.0} | {:>14.1} | {:>7.0}× | {:?}{}\n",
             c.cells,
             c.newton.median_us,
             c.newton.p99_us,
@@ -140,6 +165,10 @@ pub fn table(cases: &[BenchCase]) -> String {
             c.reference.median_us,
             c.newton_equal_tol.median_us,
             c.speedup(),
+            c.isa,
+            c.baseline
+                .as_ref()
+                .map_or(String::new(), |b| format!(" ({:.1})", b.median_us)),
         ));
     }
     s
@@ -147,10 +176,10 @@ pub fn table(cases: &[BenchCase]) -> String {
 
 /// CSV of the results.
 pub fn csv(cases: &[BenchCase]) -> String {
-    let mut s = String::from("cells,steps,newton_median_us,newton_p99_us,newton_p999_us,newton_max_us,newton_mean_iterations,newton_max_iterations,allocations_per_step,reference_median_us,reference_samples,reference_mean_picard_iterations,newton_equal_tol_median_us,speedup\n");
+    let mut s = String::from("cells,steps,newton_median_us,newton_p99_us,newton_p999_us,newton_max_us,newton_mean_iterations,newton_max_iterations,allocations_per_step,reference_median_us,reference_samples,reference_mean_picard_iterations,newton_equal_tol_median_us,speedup,isa,baseline_isa_median_us\n");
     for c in cases {
         s.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:?},{}\n",
             c.cells,
             c.steps,
             c.newton.median_us,
@@ -165,7 +194,11 @@ pub fn csv(cases: &[BenchCase]) -> String {
             c.reference_samples,
             c.reference_mean_picard,
             c.newton_equal_tol.median_us,
-            c.speedup()
+            c.speedup(),
+            c.isa,
+            c.baseline
+                .as_ref()
+                .map_or(String::new(), |b| b.median_us.to_string()),
         ));
     }
     s

@@ -134,52 +134,88 @@ pub struct CellState {
     pub dmu: f64,
 }
 
+/// Whether |z| = |β (p − p0)| is beyond [`SATURATED`] (pure liquid or gas
+/// to double precision, no exponential needed). NaN is not saturated.
+#[inline(always)]
+#[allow(clippy::manual_range_contains)] // a range would call NaN saturated
+pub(crate) fn saturated(z: f64) -> bool {
+    z > SATURATED || z < -SATURATED
+}
+
 impl MixtureEos {
     #[inline(always)]
     pub fn cell(&self, p: f64) -> CellState {
         let z = self.beta * (p - self.p0);
-        if z > SATURATED {
-            return CellState {
-                rho: self.rho_l,
-                drho: 0.0,
-                gr: self.rho_l / self.mu_l,
-                dgr: 0.0,
-                mu: self.mu_l,
-                dmu: 0.0,
-            };
+        let e = if saturated(z) { 0.0 } else { (2.0 * z).exp() };
+        self.cell_from_exp(p, e)
+    }
+
+    /// [`MixtureEos::cell`] given e = exp(2β(p − p0)) (any value where
+    /// saturated).
+    #[inline(always)]
+    pub fn cell_from_exp(&self, p: f64, e: f64) -> CellState {
+        self.constants().state(p, e)
+    }
+
+    /// The constants of [`MixtureEos::cell`], computed once for a loop over
+    /// cells.
+    #[inline(always)]
+    pub fn constants(&self) -> CellConstants {
+        CellConstants {
+            eos: *self,
+            gr_liquid: self.rho_l / self.mu_l,
+            gr_gas: self.rho_g / self.mu_g,
         }
-        if z < -SATURATED {
-            return CellState {
-                rho: self.rho_g,
-                drho: 0.0,
-                gr: self.rho_g / self.mu_g,
-                dgr: 0.0,
-                mu: self.mu_g,
-                dmu: 0.0,
-            };
-        }
-        let e = (2.0 * z).exp();
+    }
+}
+
+/// [`MixtureEos`] with the constants of its saturated states.
+#[derive(Debug, Clone, Copy)]
+pub struct CellConstants {
+    eos: MixtureEos,
+    gr_liquid: f64,
+    gr_gas: f64,
+}
+
+impl CellConstants {
+    /// [`MixtureEos::cell`] at `p` given e = exp(2β(p − p0)) (any value
+    /// where saturated). Branch-free: the saturated states are selected, so a
+    /// loop over cells vectorises.
+    #[inline(always)]
+    pub fn state(&self, p: f64, e: f64) -> CellState {
+        let k = &self.eos;
+        let z = k.beta * (p - k.p0);
         let one_e = 1.0 + e;
-        let num = self.rho_l * e + self.rho_g;
-        let den = self.mu_l * e + self.mu_g;
+        let num = k.rho_l * e + k.rho_g;
+        let den = k.mu_l * e + k.mu_g;
         let inv = 1.0 / (one_e * den);
         let alpha = den * inv;
         let inv_den = one_e * inv;
         // dα/dp = −2β α (1−α), with 1 − α = e α
-        let dalpha = -2.0 * self.beta * alpha * (e * alpha);
+        let dalpha = -2.0 * k.beta * alpha * (e * alpha);
         let gr = num * inv_den;
-        CellState {
-            rho: self.rho_l * (e * alpha) + self.rho_g * alpha,
-            drho: (self.rho_g - self.rho_l) * dalpha,
+        let mixed = CellState {
+            rho: k.rho_l * (e * alpha) + k.rho_g * alpha,
+            drho: (k.rho_g - k.rho_l) * dalpha,
             gr,
-            dgr: 2.0
-                * self.beta
-                * e
-                * (self.rho_l * self.mu_g - self.mu_l * self.rho_g)
-                * inv_den
-                * inv_den,
-            mu: self.mu_l * (e * alpha) + self.mu_g * alpha,
-            dmu: (self.mu_g - self.mu_l) * dalpha,
+            dgr: 2.0 * k.beta * e * (k.rho_l * k.mu_g - k.mu_l * k.rho_g) * inv_den * inv_den,
+            mu: k.mu_l * (e * alpha) + k.mu_g * alpha,
+            dmu: (k.mu_g - k.mu_l) * dalpha,
+        };
+        let pure = |rho: f64, gr: f64, mu: f64| CellState {
+            rho,
+            drho: 0.0,
+            gr,
+            dgr: 0.0,
+            mu,
+            dmu: 0.0,
+        };
+        if z > SATURATED {
+            pure(k.rho_l, self.gr_liquid, k.mu_l)
+        } else if z < -SATURATED {
+            pure(k.rho_g, self.gr_gas, k.mu_g)
+        } else {
+            mixed
         }
     }
 }

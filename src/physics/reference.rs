@@ -117,8 +117,8 @@ impl Solver {
             iters = it;
             for i in 0..n {
                 let s = d.eos.eval(self.p[i]);
-                w.cells[i].rho = s.rho;
-                w.cells[i].gr = s.rho / s.mu;
+                w.cells.rho[i] = s.rho;
+                w.cells.gr[i] = s.rho / s.mu;
             }
             // Face conductances K_f (stored in dql) and Couette fluxes (q).
             for f in 0..=n {
@@ -131,24 +131,24 @@ impl Solver {
                 let (rl, gl) = if f == 0 {
                     (d.rho_b, d.gr_b)
                 } else {
-                    (w.cells[f - 1].rho, w.cells[f - 1].gr)
+                    (w.cells.rho[f - 1], w.cells.gr[f - 1])
                 };
                 let (rr, gr) = if f == n {
                     (d.rho_b, d.gr_b)
                 } else {
-                    (w.cells[f].rho, w.cells[f].gr)
+                    (w.cells.rho[f], w.cells.gr[f])
                 };
-                w.faces[f].dql = phi * hf * hf * hf * inv_df / 12.0 * 0.5 * (gl + gr);
-                w.faces[f].q = half_v * (hf + d.sigma * phis) * 0.5 * (rl + rr);
+                w.faces.dql[f] = phi * hf * hf * hf * inv_df / 12.0 * 0.5 * (gl + gr);
+                w.faces.q[f] = half_v * (hf + d.sigma * phis) * 0.5 * (rl + rr);
             }
             for i in 0..n {
-                let (kl, kr) = (w.faces[i].dql, w.faces[i + 1].dql);
-                let mut rhs = -w0 * (w.faces[i + 1].q - w.faces[i].q);
+                let (kl, kr) = (w.faces.dql[i], w.faces.dql[i + 1]);
+                let mut rhs = -w0 * (w.faces.q[i + 1] - w.faces.q[i]);
                 if let Some(c) = coef {
                     let hc = h0 + d.grid.g_cell[i];
                     rhs -= dx
                         * inv_dt
-                        * (c.a[0] * w.cells[i].rho * hc
+                        * (c.a[0] * w.cells.rho[i] * hc
                             + c.a[1] * self.hist[0].rho_h[i]
                             + c.a[2] * self.hist[1].rho_h[i]);
                     rhs -= c.w[1] * self.hist[0].div[i] + c.w[2] * self.hist[1].div[i];
@@ -162,19 +162,19 @@ impl Solver {
                 if i + 1 == n {
                     rhs += w0 * kr * d.p_amb;
                 }
-                w.rows[i].a = if i == 0 { 0.0 } else { -w0 * kl };
-                w.rows[i].b = w0 * (kl + kr);
-                w.rows[i].c = if i + 1 == n { 0.0 } else { -w0 * kr };
-                w.rows[i].r = rhs;
+                w.rows.a[i] = if i == 0 { 0.0 } else { -w0 * kl };
+                w.rows.b[i] = w0 * (kl + kr);
+                w.rows.c[i] = if i + 1 == n { 0.0 } else { -w0 * kr };
+                w.rows.r[i] = rhs;
             }
             // Thomas: P̂ into w.tmp.
             let mut prev_cp = 0.0;
             let mut prev = 0.0;
             for i in 0..n {
-                let row = w.rows[i];
-                let m = row.b - row.a * prev_cp;
-                prev_cp = row.c / m;
-                prev = (row.r - row.a * prev) / m;
+                let (ra, rb, rc, rr) = (w.rows.a[i], w.rows.b[i], w.rows.c[i], w.rows.r[i]);
+                let m = rb - ra * prev_cp;
+                prev_cp = rc / m;
+                prev = (rr - ra * prev) / m;
                 w.factors[i].cp = prev_cp;
                 w.tmp[i] = prev;
             }

@@ -7,6 +7,7 @@
 
 use super::bordered::Factor;
 use super::{Ctx, Disc, H0Mode, Level};
+use crate::physics::eos::saturated as eos_saturated;
 use crate::physics::scheme::StepCoefficients;
 
 /// Mixture properties of one cell at the current iterate.
@@ -17,8 +18,42 @@ pub(crate) struct CellProps {
     /// ρ/μ and its pressure derivative.
     pub gr: f64,
     pub dgr: f64,
-    pub mu: f64,
-    pub dmu: f64,
+}
+
+/// Mixture properties of every cell (one column per property, so the
+/// loops over cells vectorise).
+#[derive(Debug, Clone)]
+pub(crate) struct CellColumns {
+    pub rho: Vec<f64>,
+    pub drho: Vec<f64>,
+    /// ρ/μ and its pressure derivative.
+    pub gr: Vec<f64>,
+    pub dgr: Vec<f64>,
+    pub mu: Vec<f64>,
+    pub dmu: Vec<f64>,
+}
+
+impl CellColumns {
+    fn new(n: usize) -> Self {
+        Self {
+            rho: vec![0.0; n],
+            drho: vec![0.0; n],
+            gr: vec![0.0; n],
+            dgr: vec![0.0; n],
+            mu: vec![0.0; n],
+            dmu: vec![0.0; n],
+        }
+    }
+
+    #[inline(always)]
+    fn props(&self, i: usize) -> CellProps {
+        CellProps {
+            rho: self.rho[i],
+            drho: self.drho[i],
+            gr: self.gr[i],
+            dgr: self.dgr[i],
+        }
+    }
 }
 
 /// Mass flux through one face and its derivatives.
@@ -30,22 +65,70 @@ pub(crate) struct FaceFlux {
     pub dqh: f64,
 }
 
-/// One row of the bordered system: tridiagonal (a, b, c), border column, residual.
-#[derive(Debug, Clone, Copy, Default)]
-pub(crate) struct Row {
-    pub a: f64,
-    pub b: f64,
-    pub c: f64,
-    pub col: f64,
-    pub r: f64,
+/// Mass flux through every face (N + 1) and its derivatives in the left and
+/// right pressure and in h0.
+#[derive(Debug, Clone)]
+pub(crate) struct FaceColumns {
+    pub q: Vec<f64>,
+    pub dql: Vec<f64>,
+    pub dqr: Vec<f64>,
+    pub dqh: Vec<f64>,
+}
+
+impl FaceColumns {
+    fn new(faces: usize) -> Self {
+        Self {
+            q: vec![0.0; faces],
+            dql: vec![0.0; faces],
+            dqr: vec![0.0; faces],
+            dqh: vec![0.0; faces],
+        }
+    }
+
+    #[inline(always)]
+    fn set(&mut self, i: usize, f: FaceFlux) {
+        self.q[i] = f.q;
+        self.dql[i] = f.dql;
+        self.dqr[i] = f.dqr;
+        self.dqh[i] = f.dqh;
+    }
+}
+
+/// The bordered system, one column per coefficient: tridiagonal (a, b, c),
+/// border column ∂R/∂h0 (`col`), residual (`r`).
+#[derive(Debug, Clone)]
+pub(crate) struct RowColumns {
+    pub a: Vec<f64>,
+    pub b: Vec<f64>,
+    pub c: Vec<f64>,
+    pub col: Vec<f64>,
+    pub r: Vec<f64>,
+}
+
+impl RowColumns {
+    fn new(n: usize) -> Self {
+        Self {
+            a: vec![0.0; n],
+            b: vec![0.0; n],
+            c: vec![0.0; n],
+            col: vec![0.0; n],
+            r: vec![0.0; n],
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        self.b.len()
+    }
 }
 
 /// Work arrays (allocated once).
 #[derive(Debug, Clone)]
 pub(crate) struct Work {
-    pub cells: Vec<CellProps>,
-    pub faces: Vec<FaceFlux>,
-    pub rows: Vec<Row>,
+    pub cells: CellColumns,
+    /// exp(2β(p − p0)) per cell (0 where the EOS is saturated).
+    pub exp2z: Vec<f64>,
+    pub faces: FaceColumns,
+    pub rows: RowColumns,
     pub g: f64,
     pub dgdh: f64,
     pub f_net: f64,
@@ -55,6 +138,8 @@ pub(crate) struct Work {
     pub balance: bool,
     /// Scratch of length N (post-processing, Picard).
     pub tmp: Vec<f64>,
+    /// Scratch of length N (post-processing: μ, then the shear per cell).
+    pub shear: Vec<f64>,
     pub dp: Vec<f64>,
     pub dbar: Vec<f64>,
     pub p_trial: Vec<f64>,
@@ -75,9 +160,10 @@ pub(crate) struct Work {
 impl Work {
     pub(super) fn new(n: usize) -> Self {
         Self {
-            cells: vec![CellProps::default(); n],
-            faces: vec![FaceFlux::default(); n + 1],
-            rows: vec![Row::default(); n],
+            cells: CellColumns::new(n),
+            exp2z: vec![0.0; n],
+            faces: FaceColumns::new(n + 1),
+            rows: RowColumns::new(n),
             g: 0.0,
             dgdh: 0.0,
             f_net: 0.0,
@@ -86,6 +172,7 @@ impl Work {
             c_row: 0.0,
             balance: true,
             tmp: vec![0.0; n],
+            shear: vec![0.0; n],
             dp: vec![0.0; n],
             dbar: vec![0.0; n],
             p_trial: vec![0.0; n],
@@ -158,7 +245,9 @@ impl FluxCtx<'_> {
 }
 
 /// Assemble residual and Jacobian at (p, h0). Returns false when anything is
-/// non-finite.
+/// non-finite. (Always inlined: it is compiled into each instruction-set
+/// version of the step, see `step.rs`.)
+#[inline(always)]
 pub(crate) fn assemble(
     d: &Disc,
     hist: &[Level; 2],
@@ -168,63 +257,265 @@ pub(crate) fn assemble(
     w: &mut Work,
 ) -> bool {
     let n = d.grid.n;
-    let dx = d.grid.dx;
-    let inv_dx = 1.0 / dx;
     let p = &p[..n];
-    // Pass 1: cell properties (independent per cell, so the exp latencies
-    // overlap; fusing the passes was measured slower).
-    let cells = &mut w.cells[..n];
-    for (c, &pi) in cells.iter_mut().zip(p) {
-        let s = d.eos.cell(pi);
-        *c = CellProps {
-            rho: s.rho,
-            drho: s.drho,
-            gr: s.gr,
-            dgr: s.dgr,
-            mu: s.mu,
-            dmu: s.dmu,
+    cell_pass(d, p, w);
+    face_pass(d, p, h0, ctx, w);
+    let finite = row_pass(d, hist, h0, ctx, w);
+    let sum_p = lane_sum(p, d.p_amb);
+    let (sum_asp, sum_dasp) = d.contact.pressure_sum(h0);
+    let bdx = d.grid.width * d.grid.dx;
+    let f_net = bdx * (sum_p + sum_asp) - ctx.load;
+    w.f_net = f_net;
+    let (h1, h2) = (&hist[0], &hist[1]);
+    match ctx.time {
+        Some((c, dt)) => {
+            let inv_dt2 = 1.0 / (dt * dt);
+            w.g = d.mass * (h0 - 2.0 * h1.h0 + h2.h0) * inv_dt2
+                - (c.w[0] * f_net + c.w[1] * h1.f_net + c.w[2] * h2.f_net);
+            w.dgdh = d.mass * inv_dt2 - c.w[0] * bdx * sum_dasp;
+            w.c_row = -c.w[0] * bdx;
+        }
+        None => {
+            w.g = -f_net;
+            w.dgdh = -bdx * sum_dasp;
+            w.c_row = -bdx;
+        }
+    }
+    w.balance = ctx.gap == H0Mode::Balance;
+    finite && w.g.is_finite()
+}
+
+/// Σ (x − offset) over `xs`, in eight interleaved partial sums (the serial
+/// sum is latency-bound; these vectorise). Not the serial sum's rounding.
+#[inline(always)]
+pub(crate) fn lane_sum(xs: &[f64], offset: f64) -> f64 {
+    const L: usize = 8;
+    let mut acc = [0.0f64; L];
+    let chunks = xs.chunks_exact(L);
+    let rest = chunks.remainder();
+    for c in chunks {
+        for k in 0..L {
+            acc[k] += c[k] - offset;
+        }
+    }
+    for (k, x) in rest.iter().enumerate() {
+        acc[k] += x - offset;
+    }
+    ((acc[0] + acc[4]) + (acc[1] + acc[5])) + ((acc[2] + acc[6]) + (acc[3] + acc[7]))
+}
+
+/// The largest of `xs` (−∞ when empty), lane-wise so it vectorises; NaN
+/// entries are ignored like [`f64::max`] does.
+#[inline(always)]
+pub(crate) fn lane_max(xs: &[f64]) -> f64 {
+    const L: usize = 8;
+    let mut acc = [f64::NEG_INFINITY; L];
+    let chunks = xs.chunks_exact(L);
+    let rest = chunks.remainder();
+    for c in chunks {
+        for k in 0..L {
+            acc[k] = if c[k] > acc[k] { c[k] } else { acc[k] };
+        }
+    }
+    for (k, &x) in rest.iter().enumerate() {
+        acc[k] = acc[k].max(x);
+    }
+    acc.iter().fold(f64::NEG_INFINITY, |m, &x| m.max(x))
+}
+
+/// max(floor, max |x_i|), lane-wise so it vectorises; NaN entries are
+/// ignored like [`f64::max`] does.
+#[inline(always)]
+pub(crate) fn lane_max_abs(xs: &[f64], floor: f64) -> f64 {
+    const L: usize = 8;
+    let mut acc = [floor; L];
+    let chunks = xs.chunks_exact(L);
+    let rest = chunks.remainder();
+    for c in chunks {
+        for k in 0..L {
+            let a = c[k].abs();
+            acc[k] = if a > acc[k] { a } else { acc[k] };
+        }
+    }
+    for (k, &x) in rest.iter().enumerate() {
+        acc[k] = acc[k].max(x.abs());
+    }
+    acc.iter().fold(floor, |m, &x| m.max(x))
+}
+
+/// Whether every a_i + b_i is finite (lane-wise, so it vectorises).
+#[inline(always)]
+fn all_finite(a: &[f64], b: &[f64]) -> bool {
+    const L: usize = 8;
+    let mut acc = [0.0f64; L];
+    let (ca, cb) = (a.chunks_exact(L), b.chunks_exact(L));
+    let (ra, rb) = (ca.remainder(), cb.remainder());
+    for (x, y) in ca.zip(cb) {
+        for k in 0..L {
+            // Zero for finite values, NaN otherwise (inf − inf or NaN).
+            acc[k] += (x[k] + y[k]) * 0.0;
+        }
+    }
+    for (k, (x, y)) in ra.iter().zip(rb).enumerate() {
+        acc[k] += (x + y) * 0.0;
+    }
+    acc.iter().all(|&v| v == 0.0)
+}
+
+/// Pass 1: mixture properties of every cell. The exponentials first, in a
+/// loop with nothing else live (a libm call clobbers every vector register),
+/// then the rational part, branch-free with the saturated states selected
+/// (bit-identical to [`crate::physics::eos::MixtureEos::cell`]).
+#[inline(always)]
+fn cell_pass(d: &Disc, p: &[f64], w: &mut Work) {
+    let n = p.len();
+    let eos = &d.eos;
+    let e_buf = &mut w.exp2z[..n];
+    for (e, &pi) in e_buf.iter_mut().zip(p) {
+        let z = eos.beta * (pi - eos.p0);
+        *e = if eos_saturated(z) {
+            0.0
+        } else {
+            (2.0 * z).exp()
         };
     }
-    // Pass 2: face fluxes.
+    let c = &mut w.cells;
+    let (rho, drho, gr, dgr, mu, dmu) = (
+        &mut c.rho[..n],
+        &mut c.drho[..n],
+        &mut c.gr[..n],
+        &mut c.dgr[..n],
+        &mut c.mu[..n],
+        &mut c.dmu[..n],
+    );
+    let e_buf = &w.exp2z[..n];
+    let k = eos.constants();
+    for i in 0..n {
+        let s = k.state(p[i], e_buf[i]);
+        rho[i] = s.rho;
+        drho[i] = s.drho;
+        gr[i] = s.gr;
+        dgr[i] = s.dgr;
+        mu[i] = s.mu;
+        dmu[i] = s.dmu;
+    }
+}
+
+/// Pass 2: the mass flux through every face. Without flow factors the
+/// interior faces run a specialised loop (no per-face branch; vectorises).
+#[inline(always)]
+fn face_pass(d: &Disc, p: &[f64], h0: f64, ctx: &Ctx, w: &mut Work) {
+    let n = p.len();
+    let inv_dx = 1.0 / d.grid.dx;
     let boundary = CellProps {
         rho: d.rho_b,
         drho: 0.0,
         gr: d.gr_b,
         dgr: 0.0,
-        ..CellProps::default()
     };
     let fx = FluxCtx {
         d,
         half_v: 0.5 * ctx.v,
         upwind_left: ctx.v >= 0.0,
     };
-    let faces = &mut w.faces[..=n];
     let gf = &d.grid.g_face[..=n];
-    faces[0] = fx.flux(
+    let cells = &w.cells;
+    let first = fx.flux(
         h0 + gf[0],
         2.0 * inv_dx,
         d.p_amb,
         &boundary,
         p[0],
-        &cells[0],
+        &cells.props(0),
     );
-    faces[n] = fx.flux(
+    let last = fx.flux(
         h0 + gf[n],
         2.0 * inv_dx,
         p[n - 1],
-        &cells[n - 1],
+        &cells.props(n - 1),
         d.p_amb,
         &boundary,
     );
-    for (((fc, g), cw), pw) in faces[1..n]
-        .iter_mut()
-        .zip(&gf[1..n])
-        .zip(cells.windows(2))
-        .zip(p.windows(2))
-    {
-        *fc = fx.flux(h0 + g, inv_dx, pw[0], &cw[0], pw[1], &cw[1]);
+    w.faces.set(0, first);
+    w.faces.set(n, last);
+    match (&d.ff, fx.upwind_left) {
+        (None, true) => smooth_faces::<true>(gf, p, h0, inv_dx, fx.half_v, cells, &mut w.faces),
+        (None, false) => smooth_faces::<false>(gf, p, h0, inv_dx, fx.half_v, cells, &mut w.faces),
+        (Some(_), _) => {
+            for i in 1..n {
+                let f = fx.flux(
+                    h0 + gf[i],
+                    inv_dx,
+                    p[i - 1],
+                    &cells.props(i - 1),
+                    p[i],
+                    &cells.props(i),
+                );
+                w.faces.set(i, f);
+            }
+        }
     }
-    // Pass 3: rows.
+}
+
+/// Interior faces without flow factors (φx = 1, φs = 0): [`FluxCtx::flux`]
+/// with those constants folded, bit-identical to it for finite values.
+#[inline(always)]
+fn smooth_faces<const UPWIND_LEFT: bool>(
+    gf: &[f64],
+    p: &[f64],
+    h0: f64,
+    inv_dx: f64,
+    half_v: f64,
+    cells: &CellColumns,
+    faces: &mut FaceColumns,
+) {
+    let n = p.len();
+    let k = inv_dx * (1.0 / 12.0);
+    let (rho, drho, gr, dgr) = (
+        &cells.rho[..n],
+        &cells.drho[..n],
+        &cells.gr[..n],
+        &cells.dgr[..n],
+    );
+    let (q, dql, dqr, dqh) = (
+        &mut faces.q[..n],
+        &mut faces.dql[..n],
+        &mut faces.dqr[..n],
+        &mut faces.dqh[..n],
+    );
+    for i in 1..n {
+        let (l, r) = (i - 1, i);
+        let hf = h0 + gf[i];
+        let h2 = hf * hf;
+        let cf = h2 * hf * k;
+        let dcf = 3.0 * h2 * k;
+        let gbar = 0.5 * (gr[l] + gr[r]);
+        let dpf = p[r] - p[l];
+        let cg = cf * gbar;
+        let qi = -cg * dpf;
+        let dl = cg - 0.5 * cf * dgr[l] * dpf;
+        let dr = -cg - 0.5 * cf * dgr[r] * dpf;
+        let dh = -dcf * gbar * dpf;
+        if UPWIND_LEFT {
+            q[i] = qi + half_v * hf * rho[l];
+            dqh[i] = dh + half_v * rho[l];
+            dql[i] = dl + half_v * hf * drho[l];
+            dqr[i] = dr;
+        } else {
+            q[i] = qi + half_v * hf * rho[r];
+            dqh[i] = dh + half_v * rho[r];
+            dql[i] = dl;
+            dqr[i] = dr + half_v * hf * drho[r];
+        }
+    }
+}
+
+/// Pass 3: the rows of the bordered system (mass balance of every cell).
+/// Returns false when a row is not finite.
+#[inline(always)]
+fn row_pass(d: &Disc, hist: &[Level; 2], h0: f64, ctx: &Ctx, w: &mut Work) -> bool {
+    let n = d.grid.n;
+    let dx = d.grid.dx;
     let w0 = ctx.w0();
     let (coef, inv_dt) = match ctx.time {
         Some((c, dt)) => (c, 1.0 / dt),
@@ -249,59 +540,36 @@ pub(crate) fn assemble(
         }
         w.hist_term_valid = key;
     }
-    let rows = &mut w.rows[..n];
     let gc = &d.grid.g_cell[..n];
     let hist_term = &w.hist_term[..n];
-    let source = &w.source[..n];
-    let has_source = w.has_source;
-    let mut sum_p = 0.0;
-    let mut finite = true;
-    for (i, (((row, fw), c), (&g, &pi))) in rows
-        .iter_mut()
-        .zip(faces.windows(2))
-        .zip(cells.iter())
-        .zip(gc.iter().zip(p))
-        .enumerate()
-    {
-        let hc = h0 + g;
-        let (fl, fr) = (&fw[0], &fw[1]);
-        let mut r = w0 * (fr.q - fl.q) + sa0 * c.rho * hc + hist_term[i];
-        if has_source {
-            r -= source[i];
-        }
-        let col = w0 * (fr.dqh - fl.dqh) + sa0 * c.rho;
-        *row = Row {
-            a: -w0 * fl.dql,
-            b: w0 * (fr.dql - fl.dqr) + sa0 * c.drho * hc,
-            c: w0 * fr.dqr,
-            col,
-            r,
-        };
-        sum_p += pi - d.p_amb;
-        finite &= (r + col).is_finite();
+    let (rho, drho) = (&w.cells.rho[..n], &w.cells.drho[..n]);
+    let f = &w.faces;
+    let (q, dql, dqr, dqh) = (&f.q[..=n], &f.dql[..=n], &f.dqr[..=n], &f.dqh[..=n]);
+    let rows = &mut w.rows;
+    let (ra, rb, rc, rcol, rr) = (
+        &mut rows.a[..n],
+        &mut rows.b[..n],
+        &mut rows.c[..n],
+        &mut rows.col[..n],
+        &mut rows.r[..n],
+    );
+    for i in 0..n {
+        let hc = h0 + gc[i];
+        rr[i] = w0 * (q[i + 1] - q[i]) + sa0 * rho[i] * hc + hist_term[i];
+        rcol[i] = w0 * (dqh[i + 1] - dqh[i]) + sa0 * rho[i];
+        ra[i] = -w0 * dql[i];
+        rb[i] = w0 * (dql[i + 1] - dqr[i]) + sa0 * drho[i] * hc;
+        rc[i] = w0 * dqr[i + 1];
     }
-    rows[0].a = 0.0;
-    rows[n - 1].c = 0.0;
-    let (sum_asp, sum_dasp) = d.contact.pressure_sum(h0);
-    let bdx = d.grid.width * dx;
-    let f_net = bdx * (sum_p + sum_asp) - ctx.load;
-    w.f_net = f_net;
-    match ctx.time {
-        Some((c, dt)) => {
-            let inv_dt2 = 1.0 / (dt * dt);
-            w.g = d.mass * (h0 - 2.0 * h1.h0 + h2.h0) * inv_dt2
-                - (c.w[0] * f_net + c.w[1] * h1.f_net + c.w[2] * h2.f_net);
-            w.dgdh = d.mass * inv_dt2 - c.w[0] * bdx * sum_dasp;
-            w.c_row = -c.w[0] * bdx;
-        }
-        None => {
-            w.g = -f_net;
-            w.dgdh = -bdx * sum_dasp;
-            w.c_row = -bdx;
+    if w.has_source {
+        for (r, s) in rr.iter_mut().zip(&w.source) {
+            *r -= s;
         }
     }
-    w.balance = ctx.gap == H0Mode::Balance;
-    finite && w.g.is_finite()
+    let finite = all_finite(rr, rcol);
+    ra[0] = 0.0;
+    rc[n - 1] = 0.0;
+    finite
 }
 
 #[cfg(test)]
@@ -315,7 +583,7 @@ mod jacobian_tests {
 
     fn residual(s: &mut Solver, p: &[f64], h0: f64, ctx: &Ctx) -> (Vec<f64>, f64) {
         assemble(&s.d, &s.hist, p, h0, ctx, &mut s.w);
-        (s.w.rows.iter().map(|r| r.r).collect(), s.w.g)
+        (s.w.rows.r.clone(), s.w.g)
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -368,16 +636,15 @@ mod jacobian_tests {
             + ctx.load
             + s.d.mass * h0 / (st.dt * st.dt);
         let n = p.len();
-        let scale: Vec<f64> = rows
-            .iter()
-            .map(|r| r.a.abs().max(r.b.abs()).max(r.c.abs()) + 1e-300)
+        let scale: Vec<f64> = (0..p.len())
+            .map(|i| rows.a[i].abs().max(rows.b[i].abs()).max(rows.c[i].abs()) + 1e-300)
             .collect();
         // Magnitude of the terms of each mass residual (storage levels and
         // face fluxes), for the rounding error of a difference quotient.
         let g_max = s.d.grid.g_cell.iter().cloned().fold(0.0, f64::max);
         let storage = s.d.grid.dx / st.dt * 4.0 * s.d.eos.rho_l * (h0 + g_max);
         let r_mag: Vec<f64> = (0..n)
-            .map(|i| storage + s.w.faces[i].q.abs() + s.w.faces[i + 1].q.abs())
+            .map(|i| storage + s.w.faces.q[i].abs() + s.w.faces.q[i + 1].abs())
             .collect();
         let close = |fd: f64, an: f64, sc: f64, round: f64, what: &str| {
             assert!(
@@ -395,11 +662,11 @@ mod jacobian_tests {
             for i in 0..n {
                 let fd = (rp[i] - rm[i]) / (2.0 * h);
                 let an = if i == j {
-                    rows[i].b
+                    rows.b[i]
                 } else if i + 1 == j {
-                    rows[i].c
+                    rows.c[i]
                 } else if j + 1 == i {
-                    rows[i].a
+                    rows.a[i]
                 } else {
                     0.0
                 };
@@ -416,11 +683,11 @@ mod jacobian_tests {
         let (rp, gp) = residual(&mut s, &p, h0 + hh, &ctx);
         let (rm, gm) = residual(&mut s, &p, h0 - hh, &ctx);
         for i in 0..n {
-            let col_scale = rows.iter().map(|r| r.col.abs()).fold(0.0, f64::max);
+            let col_scale = rows.col.iter().map(|c| c.abs()).fold(0.0, f64::max);
             let round = 8.0 * f64::EPSILON * r_mag[i] / hh;
             close(
                 (rp[i] - rm[i]) / (2.0 * hh),
-                rows[i].col,
+                rows.col[i],
                 col_scale,
                 round,
                 &format!("dR{i}/dh0"),

@@ -90,6 +90,45 @@ pub(crate) struct Disc {
     pub drivetrain: crate::physics::drivetrain::Drivetrain,
 }
 
+/// Which instruction-set version of the step runs (detected once, in
+/// [`Solver::new`]). The hot loops are written so that they vectorise; the
+/// step is compiled once per version with the wider vectors enabled and the
+/// CPU picks the widest it has. Rust never fuses a multiply and an add on
+/// its own, so every version computes the same numbers bit for bit (a test
+/// checks it); only the speed differs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Isa {
+    /// The target's baseline (SSE2 on x86-64).
+    Baseline,
+    /// AVX2 (x86-64).
+    Avx2,
+    /// AVX-512 F/DQ/VL (x86-64).
+    Avx512,
+}
+
+impl Isa {
+    /// The widest version this CPU runs.
+    pub fn detect() -> Self {
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::is_x86_feature_detected as has;
+            let avx2 = has!("avx2")
+                && has!("fma")
+                && has!("bmi1")
+                && has!("bmi2")
+                && has!("lzcnt")
+                && has!("popcnt");
+            if avx2 && has!("avx512f") && has!("avx512dq") && has!("avx512vl") {
+                return Isa::Avx512;
+            }
+            if avx2 {
+                return Isa::Avx2;
+            }
+        }
+        Isa::Baseline
+    }
+}
+
 /// One stored time level.
 #[derive(Debug, Clone)]
 pub(crate) struct Level {
@@ -201,6 +240,8 @@ pub struct Solver {
     contraction: f64,
     anchor: (f64, f64, f64),
     last: Option<Estimate>,
+    /// The instruction-set version of the step.
+    isa: Isa,
 }
 
 /// Model parameters prepared for a running solver: every table built and
@@ -316,9 +357,28 @@ impl Solver {
             contraction: CONTRACTION_MAX,
             anchor: (0.0, 0.0, 0.0),
             last: None,
+            isa: Isa::detect(),
         };
         s.w.p_anchor.copy_from_slice(&s.p);
         Ok(s)
+    }
+
+    /// The instruction-set version of the step in use.
+    pub fn isa(&self) -> Isa {
+        self.isa
+    }
+
+    /// Run another instruction-set version of the step; one this CPU does
+    /// not have falls back to [`Isa::Baseline`]. Returns the version set.
+    pub fn set_isa(&mut self, isa: Isa) -> Isa {
+        let best = Isa::detect();
+        let ok = match isa {
+            Isa::Baseline => true,
+            Isa::Avx2 => best != Isa::Baseline,
+            Isa::Avx512 => best == Isa::Avx512,
+        };
+        self.isa = if ok { isa } else { Isa::Baseline };
+        self.isa
     }
 
     pub fn settings(&self) -> &SolverSettings {

@@ -21,7 +21,7 @@
 //! path, they converge to the update tolerance). Norms are the scaled
 //! max-norm of (Δp / max(p_amb, max|p|), Δh0 / h0).
 
-use super::assembly::assemble;
+use super::assembly::{assemble, lane_max_abs};
 use super::bordered::{direction_with_old_factors, factor_solve};
 use super::{Ctx, H0Mode, Outcome, Solver};
 use crate::physics::estimate::Status;
@@ -47,6 +47,7 @@ pub(super) const CONTRACTION_MAX: f64 = 1e6;
 
 impl Solver {
     /// Newton on the current state as initial guess.
+    #[inline(always)]
     pub(crate) fn solve(&mut self, ctx: &Ctx) -> Outcome {
         let max_it = self.settings.max_iterations;
         let tol = self.settings.tolerance;
@@ -205,18 +206,19 @@ impl Solver {
 
 /// Scaled max-norm of an update: pressure relative to max(p_amb, max|p|),
 /// h0 relative to itself.
+#[inline(always)]
 pub(crate) fn scaled_norm(dp: &[f64], dh: f64, scale: (f64, f64)) -> f64 {
-    let dmax = dp.iter().fold(0.0f64, |m, d| m.max(d.abs()));
-    if dmax.is_nan() {
-        return f64::NAN;
-    }
+    // (NaN entries cannot reach here: the solve checks the sums of the
+    // direction and returns None.)
+    let dmax = lane_max_abs(dp, 0.0);
     (dmax / scale.0).max(dh.abs() / scale.1)
 }
 
 /// Scales of an iterate for [`scaled_norm`]: max(p_amb, max|p|) and h0. A
 /// line search measures the update and the trial correction on the scales
 /// of the *current* iterate, so that the merit is consistent.
+#[inline(always)]
 pub(crate) fn norm_scale(p: &[f64], h0: f64, p_amb: f64) -> (f64, f64) {
-    let pmax = p.iter().fold(p_amb, |m, x| m.max(x.abs()));
+    let pmax = lane_max_abs(p, p_amb);
     (pmax, h0.abs().max(f64::MIN_POSITIVE))
 }

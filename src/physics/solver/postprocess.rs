@@ -1,7 +1,7 @@
 //! From a solved state to an [`Estimate`]: forces, friction, COF, inertia,
 //! diagnostics; and, when the step advances time, the new history level.
 
-use super::assembly::assemble;
+use super::assembly::{assemble, lane_max, lane_sum};
 use super::{Ctx, H0Mode, Outcome, Solver};
 use crate::physics::estimate::{Diagnostics, Estimate, Regime};
 use crate::physics::scheme::StepCoefficients;
@@ -11,56 +11,70 @@ impl Solver {
     // Post-processing
     // ------------------------------------------------------------------
 
+    #[inline(always)]
     pub(super) fn finish(&mut self, ctx: &Ctx, out: Outcome, advance: bool) -> Estimate {
         let d = &self.d;
         let n = d.grid.n;
         let (b, dx) = (d.grid.width, d.grid.dx);
         let v = ctx.v;
-        let mut sum_p = 0.0;
         let sum_asp = d.contact.pressure_sum(self.h0).0;
         let sum_area = d.contact.area_sum(self.h0);
-        let mut visc = 0.0;
-        let mut p_max = f64::NEG_INFINITY;
-        let mut cav = 0usize;
         // After a converged Newton update the last assembly point differs from
         // the state by the update (≤ tolerance): first-order corrections of
         // the stored properties are exact to O(tolerance²).
         let lin = self.w.linearised.take().is_some();
-        // Vapour fraction α > ½ ⇔ ρ < (ρl + ρg)/2 (α = (ρl − ρ)/(ρl − ρg)).
-        let rho_half = 0.5 * (d.eos.rho_l + d.eos.rho_g);
         let p = &self.p[..n];
         let gc = &d.grid.g_cell[..n];
-        let tmp = &mut self.w.tmp[..n];
-        let vdx = v * dx;
-        for i in 0..n {
-            let h = self.h0 + gc[i];
-            let pi = p[i];
-            let (rho, mu) = if lin {
-                let c = &self.w.cells[i];
-                let dp = self.w.dp[i];
-                (c.rho + c.drho * dp, c.mu + c.dmu * dp)
-            } else {
-                let s = d.eos.eval(pi);
-                (s.rho, s.mu)
-            };
-            sum_p += pi - d.p_amb;
-            // Face pressures: the mean of the neighbours, p_amb at the edges;
-            // p_r − p_l = ½ (p_(i+1) − p_(i−1)).
-            let pl = if i == 0 {
-                d.p_amb
-            } else {
-                0.5 * (p[i - 1] + pi)
-            };
-            let pr = if i + 1 == n {
-                d.p_amb
-            } else {
-                0.5 * (pi + p[i + 1])
-            };
-            visc += -0.5 * h * (pr - pl) + mu * vdx / h;
-            p_max = p_max.max(pi);
-            cav += (rho < rho_half) as usize;
-            tmp[i] = rho * h;
+        let (rho, mu) = (&mut self.w.tmp[..n], &mut self.w.shear[..n]);
+        if lin {
+            let c = &self.w.cells;
+            let (c_rho, c_drho, c_mu, c_dmu) = (&c.rho[..n], &c.drho[..n], &c.mu[..n], &c.dmu[..n]);
+            let dp = &self.w.dp[..n];
+            for i in 0..n {
+                rho[i] = c_rho[i] + c_drho[i] * dp[i];
+                mu[i] = c_mu[i] + c_dmu[i] * dp[i];
+            }
+        } else {
+            for i in 0..n {
+                let s = d.eos.eval(p[i]);
+                rho[i] = s.rho;
+                mu[i] = s.mu;
+            }
         }
+        // Vapour fraction α > ½ ⇔ ρ < (ρl + ρg)/2 (α = (ρl − ρ)/(ρl − ρg)).
+        let rho_half = 0.5 * (d.eos.rho_l + d.eos.rho_g);
+        let cav = rho.iter().filter(|&&r| r < rho_half).count();
+        // Shear force per cell, −½ h (p_r − p_l) + μ v Δx / h, with the face
+        // pressures the mean of the neighbours (p_amb at the edges); into
+        // `mu`, and ρ h into `rho` (the new level's storage).
+        let vdx = v * dx;
+        let edge = |i: usize, pl: f64, pr: f64, rho: &mut [f64], mu: &mut [f64]| {
+            let h = self.h0 + gc[i];
+            mu[i] = -0.5 * h * (pr - pl) + mu[i] * vdx / h;
+            rho[i] *= h;
+        };
+        let (first_l, first_r) = (d.p_amb, if n > 1 { 0.5 * (p[0] + p[1]) } else { d.p_amb });
+        let (last_l, last_r) = (
+            if n > 1 {
+                0.5 * (p[n - 2] + p[n - 1])
+            } else {
+                d.p_amb
+            },
+            d.p_amb,
+        );
+        for i in 1..n.saturating_sub(1) {
+            let h = self.h0 + gc[i];
+            let (pl, pr) = (0.5 * (p[i - 1] + p[i]), 0.5 * (p[i] + p[i + 1]));
+            mu[i] = -0.5 * h * (pr - pl) + mu[i] * vdx / h;
+            rho[i] *= h;
+        }
+        edge(0, first_l, first_r, rho, mu);
+        if n > 1 {
+            edge(n - 1, last_l, last_r, rho, mu);
+        }
+        let visc = lane_sum(mu, 0.0);
+        let sum_p = lane_sum(p, d.p_amb);
+        let p_max = lane_max(p);
         let f_hyd = b * dx * sum_p;
         let f_asp = b * dx * sum_asp;
         let f_visc = b * visc;
@@ -123,7 +137,7 @@ impl Solver {
                 );
                 let lvl = &mut self.hist[0];
                 for i in 0..n {
-                    lvl.div[i] = self.w.faces[i + 1].q - self.w.faces[i].q;
+                    lvl.div[i] = self.w.faces.q[i + 1] - self.w.faces.q[i];
                 }
             }
         }

@@ -3,7 +3,7 @@
 //! optional film floor.
 
 use super::newton::MAX_SUBSTEPS;
-use super::{Ctx, H0Mode, Solver};
+use super::{Ctx, H0Mode, Isa, Solver};
 use crate::physics::estimate::{Diagnostics, Estimate, Regime, Status};
 use crate::physics::params::{Method, MAX_ABS_VELOCITY, MAX_LOAD, MAX_STEP_OVER};
 use crate::physics::scheme::StepCoefficients;
@@ -102,7 +102,33 @@ impl Solver {
         }
     }
 
+    /// One step, in the best instruction-set version of the solver this
+    /// CPU runs (see [`Isa`]); every version gives the same numbers.
     fn step_with_gap(&mut self, v: f64, load: f64, gap: H0Mode) -> Estimate {
+        #[cfg(target_arch = "x86_64")]
+        match self.isa {
+            // SAFETY: `Isa::detect` found these features on this CPU.
+            Isa::Avx512 => return unsafe { self.step_avx512(v, load, gap) },
+            Isa::Avx2 => return unsafe { self.step_avx2(v, load, gap) },
+            Isa::Baseline => {}
+        }
+        self.step_body(v, load, gap)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512dq,avx512vl,avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
+    fn step_avx512(&mut self, v: f64, load: f64, gap: H0Mode) -> Estimate {
+        self.step_body(v, load, gap)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
+    fn step_avx2(&mut self, v: f64, load: f64, gap: H0Mode) -> Estimate {
+        self.step_body(v, load, gap)
+    }
+
+    #[inline(always)]
+    fn step_body(&mut self, v: f64, load: f64, gap: H0Mode) -> Estimate {
         let gap_ok = match gap {
             H0Mode::Balance => true,
             H0Mode::Prescribed(h) => h.is_finite() && h > 0.0,
@@ -212,5 +238,76 @@ impl Solver {
         e.diagnostics.substeps = substeps as u32;
         self.last = Some(e);
         e
+    }
+}
+
+#[cfg(test)]
+mod isa_tests {
+    use super::super::Isa;
+    use crate::physics::params::{ModelParams, SolverSettings};
+    use crate::physics::Solver;
+
+    /// Every instruction-set version of the step this CPU runs gives the
+    /// baseline's estimates bit for bit (reciprocating motion through
+    /// reversals, where the film and the cavitation change fastest).
+    #[test]
+    fn every_instruction_set_version_gives_the_baseline_numbers_bit_for_bit() {
+        let settings = SolverSettings {
+            cells: 96,
+            ..Default::default()
+        };
+        let run = |isa: Isa| {
+            let mut s = Solver::new(&ModelParams::default(), &settings).unwrap();
+            assert_eq!(s.set_isa(isa), isa);
+            s.initialize_steady(0.0, 20_000.0);
+            (0..1500)
+                .map(|k| {
+                    let t = k as f64 * settings.dt;
+                    s.step((2.0 * std::f64::consts::PI * t).sin(), 20_000.0)
+                })
+                .collect::<Vec<_>>()
+        };
+        let base = run(Isa::Baseline);
+        let mut versions = vec![Isa::Baseline];
+        match Isa::detect() {
+            Isa::Avx512 => versions.extend([Isa::Avx2, Isa::Avx512]),
+            Isa::Avx2 => versions.push(Isa::Avx2),
+            Isa::Baseline => {}
+        }
+        for isa in versions {
+            let other = run(isa);
+            for (k, (a, b)) in base.iter().zip(&other).enumerate() {
+                assert_eq!(
+                    (
+                        a.friction_force.to_bits(),
+                        a.h0.to_bits(),
+                        a.diagnostics.iterations
+                    ),
+                    (
+                        b.friction_force.to_bits(),
+                        b.h0.to_bits(),
+                        b.diagnostics.iterations
+                    ),
+                    "{isa:?}, step {k}"
+                );
+            }
+        }
+    }
+
+    /// A version the CPU lacks is refused and the baseline runs instead.
+    #[test]
+    fn an_instruction_set_the_cpu_lacks_falls_back_to_the_baseline() {
+        let mut s = Solver::new(&ModelParams::default(), &SolverSettings::default()).unwrap();
+        let best = Isa::detect();
+        assert_eq!(s.isa(), best);
+        let got = s.set_isa(Isa::Avx512);
+        assert_eq!(
+            got,
+            if best == Isa::Avx512 {
+                Isa::Avx512
+            } else {
+                Isa::Baseline
+            }
+        );
     }
 }
