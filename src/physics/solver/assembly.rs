@@ -7,7 +7,7 @@
 
 use super::bordered::Factor;
 use super::{Ctx, Disc, H0Mode, Level};
-use crate::physics::eos::saturated as eos_saturated;
+use crate::physics::eos::{exp_fast, saturated as eos_saturated};
 use crate::physics::scheme::StepCoefficients;
 
 /// Mixture properties of one cell at the current iterate.
@@ -125,8 +125,11 @@ impl RowColumns {
 #[derive(Debug, Clone)]
 pub(crate) struct Work {
     pub cells: CellColumns,
-    /// exp(2β(p − p0)) per cell (0 where the EOS is saturated).
+    /// exp(2β(p − p0)) per cell (any value where the EOS is saturated).
     pub exp2z: Vec<f64>,
+    /// Wide vectors run the step (see [`super::Isa`]): loops that pay off
+    /// only when vectorised are taken.
+    pub wide: bool,
     pub faces: FaceColumns,
     pub rows: RowColumns,
     pub g: f64,
@@ -162,6 +165,7 @@ impl Work {
         Self {
             cells: CellColumns::new(n),
             exp2z: vec![0.0; n],
+            wide: false,
             faces: FaceColumns::new(n + 1),
             rows: RowColumns::new(n),
             g: 0.0,
@@ -362,23 +366,16 @@ fn all_finite(a: &[f64], b: &[f64]) -> bool {
     acc.iter().all(|&v| v == 0.0)
 }
 
-/// Pass 1: mixture properties of every cell. The exponentials first, in a
-/// loop with nothing else live (a libm call clobbers every vector register),
-/// then the rational part, branch-free with the saturated states selected
-/// (bit-identical to [`crate::physics::eos::MixtureEos::cell`]).
+/// Pass 1: mixture properties of every cell, bit-identical to
+/// [`crate::physics::eos::MixtureEos::cell`]. With wide vectors (`w.wide`)
+/// one branch-free loop: the exponential is [`exp_fast`] for every cell and
+/// the saturated states are selected, so it vectorises. Without, the
+/// exponential of the unsaturated cells only (they are a minority), then the
+/// rest: the same numbers, since a saturated cell's exponential is unused.
 #[inline(always)]
 fn cell_pass(d: &Disc, p: &[f64], w: &mut Work) {
     let n = p.len();
     let eos = &d.eos;
-    let e_buf = &mut w.exp2z[..n];
-    for (e, &pi) in e_buf.iter_mut().zip(p) {
-        let z = eos.beta * (pi - eos.p0);
-        *e = if eos_saturated(z) {
-            0.0
-        } else {
-            (2.0 * z).exp()
-        };
-    }
     let c = &mut w.cells;
     let (rho, drho, gr, dgr, mu, dmu) = (
         &mut c.rho[..n],
@@ -388,7 +385,21 @@ fn cell_pass(d: &Disc, p: &[f64], w: &mut Work) {
         &mut c.mu[..n],
         &mut c.dmu[..n],
     );
-    let e_buf = &w.exp2z[..n];
+    let e_buf = &mut w.exp2z[..n];
+    if w.wide {
+        for (e, &pi) in e_buf.iter_mut().zip(p) {
+            *e = exp_fast(2.0 * eos.beta * (pi - eos.p0));
+        }
+    } else {
+        for (e, &pi) in e_buf.iter_mut().zip(p) {
+            let z = eos.beta * (pi - eos.p0);
+            *e = if eos_saturated(z) {
+                0.0
+            } else {
+                exp_fast(2.0 * z)
+            };
+        }
+    }
     let k = eos.constants();
     for i in 0..n {
         let s = k.state(p[i], e_buf[i]);

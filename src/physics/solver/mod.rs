@@ -357,8 +357,9 @@ impl Solver {
             contraction: CONTRACTION_MAX,
             anchor: (0.0, 0.0, 0.0),
             last: None,
-            isa: Isa::detect(),
+            isa: Isa::Baseline,
         };
+        s.set_isa(Isa::detect());
         s.w.p_anchor.copy_from_slice(&s.p);
         Ok(s)
     }
@@ -378,6 +379,7 @@ impl Solver {
             Isa::Avx512 => best == Isa::Avx512,
         };
         self.isa = if ok { isa } else { Isa::Baseline };
+        self.w.wide = self.isa != Isa::Baseline;
         self.isa
     }
 
