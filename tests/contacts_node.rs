@@ -369,19 +369,132 @@ fn bad_contact_settings_for_the_node_are_errors_naming_the_key() {
     );
 }
 
-#[test]
-fn a_one_contact_parameter_update_changes_nothing_in_a_loop_of_several() {
-    use friction_node::node::parameters::ParameterUpdate;
-    let cfg = three();
-    let link = MemoryLink::new(100).with_joints(&joints(&cfg));
+/// Lockstep run of `cfg` for `steps` steps; before step `at`, the
+/// parameter changes `changes` are applied the way the ROS 2 service does
+/// (validated by `apply_set`, prepared, applied between two steps).
+fn lockstep_with_change(
+    cfg: &Config,
+    steps: u64,
+    at: u64,
+    changes: &[(&str, f64)],
+) -> (Vec<Vec<EstimateRecord>>, RunSummary) {
+    use friction_node::msgs::ros_interfaces::{parameter_type, ParameterValue};
+    use friction_node::node::parameters::{apply_set, declare, ParameterUpdate};
+    let mut cfg = cfg.clone();
+    cfg.node.step_mode = friction_node::config::StepMode::Lockstep;
+    let names = joints(&cfg);
+    let link = MemoryLink::new(100_000).with_joints(&names);
+    let mut peer = link.peer();
     let mut l = new_loop(&cfg, &link);
-    let mut next = cfg.clone();
-    next.contact.load_n = 9_000.0;
-    let mut u = ParameterUpdate::prepare(&cfg, next, vec![]).unwrap();
-    l.apply_update(&mut u);
-    assert_eq!(
-        l.summary().parameter_updates,
-        0,
-        "not applied to any contact"
+    let mut per: Vec<Vec<EstimateRecord>> = vec![Vec::new(); names.len()];
+    for i in 0..steps {
+        if i == at && !changes.is_empty() {
+            let changes: Vec<(String, ParameterValue)> = changes
+                .iter()
+                .map(|(k, x)| {
+                    let v = ParameterValue {
+                        r#type: parameter_type::DOUBLE,
+                        double_value: *x,
+                        ..Default::default()
+                    };
+                    (k.to_string(), v)
+                })
+                .collect();
+            let next = apply_set(&cfg, &declare(&cfg), &changes).unwrap();
+            let mut u = ParameterUpdate::prepare(&cfg, next, changes).unwrap();
+            l.apply_update(&mut u);
+        }
+        let velocity: Vec<f64> = (0..names.len()).map(|k| profile(k, i)).collect();
+        let refs: Vec<&str> = names.iter().map(String::as_str).collect();
+        peer.send_joint_state(&js((i + 1) * MS, &refs, &velocity))
+            .unwrap();
+        l.poll_once();
+        while let Some((k, e)) = peer.try_recv_contact().unwrap() {
+            per[k].push(e);
+        }
+    }
+    (per, l.summary())
+}
+
+#[test]
+fn a_runtime_change_of_one_contacts_key_changes_that_contact_alone() {
+    let cfg = three();
+    let (base, s0) = lockstep_with_change(&cfg, 200, 100, &[]);
+    assert_eq!(s0.parameter_updates, 0);
+    let (changed, s1) = lockstep_with_change(
+        &cfg,
+        200,
+        100,
+        &[
+            ("contacts.right.lubricant.viscosity_pa_s", 0.2),
+            ("contacts.wrist.contact.load_n", 3000.0),
+        ],
     );
+    assert_eq!(s1.parameter_updates, 1);
+    let same = |a: &EstimateRecord, b: &EstimateRecord| {
+        a.friction_force_n.to_bits() == b.friction_force_n.to_bits()
+            && a.h0_m.to_bits() == b.h0_m.to_bits()
+    };
+    // `left` is untouched: bit for bit the run without the change.
+    assert!(base[0].iter().zip(&changed[0]).all(|(a, b)| same(a, b)));
+    for k in [1, 2] {
+        assert_eq!(changed[k].len(), 200, "contact {k}");
+        assert!(
+            base[k][..100]
+                .iter()
+                .zip(&changed[k][..100])
+                .all(|(a, b)| same(a, b)),
+            "contact {k} before the change"
+        );
+        assert!(
+            base[k][100..]
+                .iter()
+                .zip(&changed[k][100..])
+                .all(|(a, b)| !same(a, b)),
+            "contact {k} after the change"
+        );
+    }
+    // The wrist now holds its new load; the others keep theirs.
+    assert!(changed[2][100..].iter().all(|e| e.load_n == 3000.0));
+    assert!(changed[0].iter().all(|e| e.load_n == 4000.0));
+}
+
+#[test]
+fn with_several_contacts_each_contacts_model_keys_are_runtime_and_the_defaults_read_only() {
+    use friction_node::node::parameters::declare;
+    let cfg = three();
+    let declared = declare(&cfg);
+    let read_only = |name: &str| {
+        declared
+            .iter()
+            .find(|d| d.name == name)
+            .unwrap_or_else(|| panic!("{name} is declared"))
+            .read_only
+    };
+    for key in [
+        "contacts.right.lubricant.viscosity_pa_s",
+        "contacts.left.contact.load_n",
+        "contacts.wrist.roughness.sigma_m",
+        "drivetrain.viscous_n_s_m",
+    ] {
+        assert!(!read_only(key), "{key} changes at runtime");
+    }
+    for key in [
+        "contacts.right.joint",
+        "contacts.right.gain",
+        "contacts.wrist.solver.cells",
+        "lubricant.viscosity_pa_s",
+        "contact.load_n",
+        "roughness.sigma_m",
+    ] {
+        assert!(read_only(key), "{key} is read-only");
+    }
+    // Without contacts the top-level keys are the model's, and runtime.
+    let one = Config::default();
+    let d1 = declare(&one);
+    let lub = d1
+        .iter()
+        .find(|d| d.name == "lubricant.viscosity_pa_s")
+        .unwrap();
+    assert!(!lub.read_only);
 }

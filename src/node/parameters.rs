@@ -11,7 +11,12 @@
 //! lubricant, roughness and drivetrain key, and the node's command limits,
 //! timeout rule and publication rates. Everything else (geometry, grid,
 //! solver, transports, names, recording) is read-only: changing it needs a
-//! restart.
+//! restart. With several contacts the same keys of each contact,
+//! `contacts.NAME.contact.load_n`, `contacts.NAME.lubricant.…`, … change
+//! that contact alone (its joint, gain and grid are read-only), and the
+//! top-level `contact.`, `lubricant.` and `roughness.` keys, which only gave
+//! the contacts their defaults when the configuration was read, are
+//! read-only.
 
 use super::LoopSettings;
 use crate::config::{key_ranges, Config, ConfigError, KeyRange};
@@ -43,6 +48,19 @@ pub fn is_runtime(key: &str) -> bool {
         || ["lubricant.", "roughness.", "drivetrain."]
             .iter()
             .any(|p| key.starts_with(p))
+}
+
+/// Whether `key` may change while a node with `config` runs: [`is_runtime`]
+/// of the key a per-contact key mirrors; with several contacts the
+/// top-level keys the contacts took their defaults from are read-only.
+pub fn is_runtime_in(config: &Config, key: &str) -> bool {
+    let per_contact = key.starts_with("contacts.");
+    let defaults_only = !config.contacts.0.is_empty()
+        && !per_contact
+        && ["contact.", "lubricant.", "roughness."]
+            .iter()
+            .any(|p| key.starts_with(p));
+    !defaults_only && is_runtime(top_level_key(key))
 }
 
 /// One declared parameter.
@@ -173,7 +191,7 @@ pub fn declare(config: &Config) -> Vec<Declared> {
             });
             Declared {
                 range,
-                read_only: !is_runtime(&name),
+                read_only: !is_runtime_in(config, &name),
                 description,
                 value,
                 r#type,
@@ -268,14 +286,20 @@ pub struct ParameterUpdate {
     /// What changed: (name, new value).
     pub changed: Vec<(String, ParameterValue)>,
     settings: LoopSettings,
+    /// One per contact, in the configuration's order.
+    contacts: Vec<ContactUpdate>,
+    /// Set by the loop: the stamp of the first step that used the change.
+    pub applied_stamp_ns: u64,
+}
+
+/// One contact's part of a [`ParameterUpdate`].
+struct ContactUpdate {
     model: PreparedModel,
     viscosity_model: ViscosityModel,
     mu_ref: f64,
     t_ref_c: f64,
-    /// The new held load, when `contact.load_n` changed.
+    /// The new held load, when the contact's `contact.load_n` changed.
     load: Option<f64>,
-    /// Set by the loop: the stamp of the first step that used the change.
-    pub applied_stamp_ns: u64,
 }
 
 impl ParameterUpdate {
@@ -286,15 +310,26 @@ impl ParameterUpdate {
         new: Config,
         changed: Vec<(String, ParameterValue)>,
     ) -> Result<Box<Self>, SetupError> {
-        let model = Solver::prepare_model(&new.model(), &new.solver_settings())?;
-        let load = (new.contact.load_n != old.contact.load_n).then_some(new.contact.load_n);
+        let before = old.resolved_contacts();
+        let contacts = new
+            .resolved_contacts()
+            .iter()
+            .enumerate()
+            .map(|(i, c)| {
+                let n = &c.config;
+                let load_was = before.get(i).map(|b| b.config.contact.load_n);
+                Ok(ContactUpdate {
+                    model: Solver::prepare_model(&n.model(), &n.solver_settings())?,
+                    viscosity_model: n.viscosity_model(),
+                    mu_ref: n.lubricant.viscosity_pa_s,
+                    t_ref_c: n.lubricant.reference_temperature_c,
+                    load: (load_was != Some(n.contact.load_n)).then_some(n.contact.load_n),
+                })
+            })
+            .collect::<Result<Vec<_>, SetupError>>()?;
         Ok(Box::new(Self {
             settings: LoopSettings::from_config(&new),
-            model,
-            viscosity_model: new.viscosity_model(),
-            mu_ref: new.lubricant.viscosity_pa_s,
-            t_ref_c: new.lubricant.reference_temperature_c,
-            load,
+            contacts,
             changed,
             config: new,
             applied_stamp_ns: 0,
@@ -413,35 +448,34 @@ impl super::Loop {
     /// One change: the model swapped in, the settings replaced, the
     /// viscosity re-derived at the current temperature, the load held.
     pub fn apply_update(&mut self, u: &mut ParameterUpdate) {
-        if self.contacts.len() > 1 {
-            // A prepared update holds one contact's model (the runner
-            // serves parameters only without `contacts`).
-            return;
-        }
-        // The one contact's solver (the runner serves parameters only to a
-        // configuration without `contacts`).
-        if self
-            .contacts
-            .with_solver(0, |s| s.swap_model(&mut u.model))
-            .is_err()
-        {
-            // Geometry and grid are read-only: a mismatch cannot be built
-            // by apply_set. Nothing changes.
+        // Every contact's model must fit its solver (geometry and grid are
+        // read-only, so apply_set cannot build a mismatch; the contact list
+        // itself cannot change): all of them change, or none.
+        let n = self.contacts.len();
+        let fits = u.contacts.len() == n
+            && (0..n).all(|i| {
+                self.contacts
+                    .with_solver(i, |s| s.fits(&u.contacts[i].model))
+            });
+        if !fits {
             return;
         }
         self.s = u.settings.clone();
-        let law = &mut self.viscosity[0];
-        law.model = u.viscosity_model;
-        law.mu_ref = u.mu_ref;
-        law.t_ref_c = u.t_ref_c;
-        if law.model != ViscosityModel::Constant {
-            let mu = law
-                .model
-                .viscosity(law.mu_ref, law.t_ref_c, self.temperature_c);
-            self.contacts.with_solver(0, |s| s.set_liquid_viscosity(mu));
-        }
-        if let Some(l) = u.load {
-            self.cmd[0].load = l;
+        for (i, c) in u.contacts.iter_mut().enumerate() {
+            let _ = self.contacts.with_solver(i, |s| s.swap_model(&mut c.model));
+            let law = &mut self.viscosity[i];
+            law.model = c.viscosity_model;
+            law.mu_ref = c.mu_ref;
+            law.t_ref_c = c.t_ref_c;
+            if law.model != ViscosityModel::Constant {
+                let mu = law
+                    .model
+                    .viscosity(law.mu_ref, law.t_ref_c, self.temperature_c);
+                self.contacts.with_solver(i, |s| s.set_liquid_viscosity(mu));
+            }
+            if let Some(l) = c.load {
+                self.cmd[i].load = l;
+            }
         }
         self.summary.parameter_updates += 1;
     }

@@ -254,17 +254,8 @@ pub fn run_node(
     } else {
         None
     };
-    // Runtime parameter changes serve one contact: with several, a change
-    // would need a model per contact (not built yet), so none is served.
-    let several = config.contacts.0.len() > 1;
-    if several && specs.iter().any(|s| s.serves_parameters()) {
-        report.warnings.push(
-            "several contacts: ROS 2 parameter services are not offered (runtime changes serve one-contact nodes)"
-                .into(),
-        );
-    }
     for s in &specs {
-        let parameters = (!served && !several && s.serves_parameters()).then(|| {
+        let parameters = (!served && s.serves_parameters()).then(|| {
             served = true;
             super::parameters::ParameterIo {
                 config: config.clone(),

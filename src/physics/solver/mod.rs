@@ -319,11 +319,16 @@ impl Solver {
         })
     }
 
+    /// Whether `m` can replace this solver's model (same geometry and grid).
+    pub fn fits(&self, m: &PreparedModel) -> bool {
+        m.cells == self.d.grid.n && m.geometry == self.geometry
+    }
+
     /// Replace the model by a prepared one between two steps, keeping the
     /// state (pressures, h0, history). No allocation: `m` receives the old
     /// model, to be dropped off the loop thread.
     pub fn swap_model(&mut self, m: &mut PreparedModel) -> Result<(), ModelMismatch> {
-        if m.cells != self.d.grid.n || m.geometry != self.geometry {
+        if !self.fits(m) {
             return Err(ModelMismatch);
         }
         std::mem::swap(&mut self.d, &mut m.d);
