@@ -71,7 +71,8 @@
 // Asperities carry at most 5 % of the load.
 #define FN_REGIME_HYDRODYNAMIC 2
 
-// A model: the solver and the configuration it was built from. Opaque to C.
+// A model: one solver per contact and the configuration they were built
+// from. Opaque to C.
 typedef struct FnModel FnModel;
 
 // One step's estimate (the fields of `friction_msgs/FrictionEstimate`).
@@ -145,6 +146,42 @@ int32_t fn_model_step(struct FnModel *model,
                       double dt_s,
                       struct FnEstimate *out);
 
+// Advance every contact by `dt_s`: contact i with velocity
+// `velocities[i]` (m/s) under `loads[i]` (N; `loads` null: each contact's
+// configured `contact.load_n`), in the configuration's contact order, which
+// is the order of its joints. Writes `count` estimates to `out` and, when
+// `efforts` is not null, each contact's feed-forward effort (its `gain` ×
+// `friction_force_n`: N for a linear joint, N·m for a rotary one) to
+// `efforts[i]`. `count` must equal `fn_model_contact_count`. Does not
+// allocate; the contacts are stepped one after the other on the calling
+// thread. Statuses are per estimate, as for `fn_model_step`.
+//
+// # Safety
+// `model` is a handle from this library; `velocities` and `out` (and
+// `loads`, `efforts` when not null) point to `count` values.
+int32_t fn_model_step_contacts(struct FnModel *model,
+                               const double *velocities,
+                               const double *loads,
+                               uint32_t count,
+                               double dt_s,
+                               struct FnEstimate *out,
+                               double *efforts);
+
+// The number of contacts of the model (1 for a configuration without
+// `contacts`; 0 for an invalid handle).
+//
+// # Safety
+// `model` is a handle from this library.
+uint32_t fn_model_contact_count(const struct FnModel *model);
+
+// The index (in `fn_model_step_contacts`'s arrays) of the contact named
+// `name`, or of the contact on the joint named `name`, into `*out`.
+//
+// # Safety
+// `model` is a handle from this library; `name` is a NUL-terminated
+// string; `out` points to writable storage.
+int32_t fn_model_contact_index(const struct FnModel *model, const char *name, uint32_t *out);
+
 // The configured step `solver.dt_s`, s (0 for an invalid handle).
 //
 // # Safety
@@ -152,7 +189,9 @@ int32_t fn_model_step(struct FnModel *model,
 double fn_model_dt(const struct FnModel *model);
 
 // Restart from the steady state at velocity `velocity_m_s` under `load_n`
-// (a new run: the squeeze-film history is forgotten).
+// (a new run: the squeeze-film history is forgotten). `load_n` = 0 takes
+// each contact's configured `contact.load_n`; with several contacts every
+// contact restarts.
 //
 // # Safety
 // `model` is a handle from this library.
@@ -168,8 +207,10 @@ int32_t fn_model_set_temperature(struct FnModel *model, double temperature_c);
 
 // Change one parameter that may change while running (those `ros2 param`
 // can set on the node: load, mass, boundary friction, lubricant,
-// roughness, drivetrain...), `key` dotted (`lubricant.viscosity_pa_s`),
-// `value` in YAML (`0.05`, `vogel`, `[1, 2]`). The film state is kept.
+// roughness, drivetrain...), `key` dotted (`lubricant.viscosity_pa_s`;
+// with several contacts `contacts.NAME.lubricant.viscosity_pa_s`),
+// `value` in YAML (`0.05`, `vogel`, `[1, 2]`). The film state is kept and
+// a temperature set before is re-applied.
 // Allocates (the model's tables are rebuilt): call it between steps, not
 // from the real-time loop. A refused change leaves the model unchanged and
 // the message names the key and value.

@@ -16,10 +16,25 @@
 //! fn_model_free(m);
 //! ```
 //!
+//! **Several contacts in one handle.** A configuration with `contacts` makes
+//! one handle for all of them, in the order they are listed (the joint
+//! order of the node's `Float64MultiArray`): `fn_model_step_contacts` steps
+//! them all in one call, taking arrays of velocities (and optionally loads)
+//! and writing each contact's estimate and its feed-forward effort
+//! (`gain` × friction, the input of `forward_command_controller`);
+//! `fn_model_contact_count` and `fn_model_contact_index` (by contact or joint
+//! name) say which is where. `fn_model_step` steps a one-contact handle only.
+//!
+//! ```c
+//! double v[8], effort[8]; FnEstimate e[8];
+//! /* v[i] = the velocity of joint i, in the configuration's contact order */
+//! fn_model_step_contacts(m, v, NULL, 8, 0.001, e, effort);
+//! ```
+//!
 //! | function | allocates | may be called from the control loop |
 //! |---|---|---|
 //! | `fn_model_new_from_yaml`, `fn_model_new_from_file` | yes (the solver's buffers) | no: at configure time |
-//! | `fn_model_step`, `fn_model_set_temperature`, `fn_model_dt` | **no** | yes |
+//! | `fn_model_step`, `fn_model_step_contacts`, `fn_model_set_temperature`, `fn_model_dt`, `fn_model_contact_count`, `fn_model_contact_index` | **no** | yes |
 //! | `fn_model_reset` | no | yes (it solves a steady state: slower than a step) |
 //! | `fn_model_set_parameter` | yes (rebuilds the model's tables) | no: from a non-real-time thread, between steps |
 //! | `fn_model_free`, `fn_last_error`, `fn_status_name` | frees / no / no | — |
@@ -40,7 +55,7 @@
 //! seen (a wrong pointer, a model already freed while its memory still holds
 //! the freed marker), return `FN_ERROR_INVALID_HANDLE`.
 
-use friction_node::config::{Config, Origin};
+use friction_node::config::{Config, Origin, ResolvedContact};
 use friction_node::msgs::{regime_code, status_code};
 use friction_node::node::parameters::{apply_set, declare, Declared};
 use friction_node::physics::{Estimate, Solver};
@@ -157,12 +172,29 @@ impl From<&Estimate> for FnEstimate {
 const LIVE: u64 = 0x6672_6963_7469_6f6e; // "friction"
 const FREED: u64 = 0x6672_6565_6420_2020; // "freed   "
 
-/// A model: the solver and the configuration it was built from. Opaque to C.
+/// A model: one solver per contact and the configuration they were built
+/// from. Opaque to C.
 pub struct FnModel {
     magic: u64,
-    solver: Solver,
+    /// One per contact, in the configuration's order.
+    solvers: Vec<Solver>,
+    /// Each contact's name, joint, gain and own configuration.
+    contacts: Vec<ResolvedContact>,
     config: Config,
     declared: Vec<Declared>,
+    /// The last temperature set, °C (re-applied after a parameter change).
+    temperature_c: Option<f64>,
+}
+
+impl FnModel {
+    /// Each contact's liquid viscosity at `t` °C (where it follows it).
+    fn apply_temperature(&mut self, t: f64) {
+        for (s, c) in self.solvers.iter_mut().zip(&self.contacts) {
+            if c.config.viscosity_model() != friction_node::physics::ViscosityModel::Constant {
+                s.set_liquid_viscosity(c.config.viscosity_at(t));
+            }
+        }
+    }
 }
 
 thread_local! {
@@ -229,28 +261,25 @@ unsafe fn text<'a>(s: *const c_char, what: &str) -> Result<&'a str, i32> {
 }
 
 fn build(config: Config, out: *mut *mut FnModel) -> i32 {
-    if !config.contacts.is_empty() {
-        return fail(
-            FN_ERROR_CONFIG,
-            format!(
-                "the configuration lists {} contacts (`contacts`): a handle is one contact; \
-                 create one handle per contact from a configuration without `contacts`",
-                config.contacts.0.len()
-            ),
-        );
+    let contacts = config.resolved_contacts();
+    let mut solvers = Vec::with_capacity(contacts.len());
+    for c in &contacts {
+        match Solver::new(&c.config.model(), &c.config.solver_settings()) {
+            Ok(mut s) => {
+                s.initialize_steady(0.0, c.config.contact.load_n);
+                solvers.push(s);
+            }
+            Err(e) => return fail(FN_ERROR_SETUP, format!("contact `{}`: {e}", c.name)),
+        }
     }
-    let solver = match Solver::new(&config.model(), &config.solver_settings()) {
-        Ok(s) => s,
-        Err(e) => return fail(FN_ERROR_SETUP, e.to_string()),
-    };
-    let mut m = Box::new(FnModel {
+    let m = Box::new(FnModel {
         magic: LIVE,
-        solver,
+        solvers,
+        contacts,
         declared: declare(&config),
         config,
+        temperature_c: None,
     });
-    let load = m.config.contact.load_n;
-    m.solver.initialize_steady(0.0, load);
     // SAFETY: checked non-null by the callers.
     unsafe { *out = Box::into_raw(m) };
     FN_OK
@@ -348,14 +377,162 @@ pub unsafe extern "C" fn fn_model_step(
         if out.is_null() {
             return fail(FN_ERROR_NULL_ARGUMENT, "out is null");
         }
-        let e = if dt_s == m.solver.settings().dt {
-            m.solver.step(velocity_m_s, load_n)
-        } else {
-            m.solver.step_over(velocity_m_s, load_n, dt_s)
+        let [solver] = m.solvers.as_mut_slice() else {
+            return fail(
+                FN_ERROR_ARGUMENT,
+                format!(
+                    "the model has {} contacts: step them together with fn_model_step_contacts",
+                    m.solvers.len()
+                ),
+            );
         };
+        let e = step_one(solver, velocity_m_s, load_n, dt_s);
         // SAFETY: checked non-null; the caller provides the storage.
         unsafe { *out = FnEstimate::from(&e) };
         FN_OK
+    })
+}
+
+/// One step of `dt_s` (BDF2 at the configured step, else backward Euler).
+fn step_one(s: &mut Solver, v: f64, load: f64, dt_s: f64) -> Estimate {
+    if dt_s == s.settings().dt {
+        s.step(v, load)
+    } else {
+        s.step_over(v, load, dt_s)
+    }
+}
+
+/// Advance every contact by `dt_s`: contact i with velocity
+/// `velocities[i]` (m/s) under `loads[i]` (N; `loads` null: each contact's
+/// configured `contact.load_n`), in the configuration's contact order, which
+/// is the order of its joints. Writes `count` estimates to `out` and, when
+/// `efforts` is not null, each contact's feed-forward effort (its `gain` ×
+/// `friction_force_n`: N for a linear joint, N·m for a rotary one) to
+/// `efforts[i]`. `count` must equal `fn_model_contact_count`. Does not
+/// allocate; the contacts are stepped one after the other on the calling
+/// thread. Statuses are per estimate, as for `fn_model_step`.
+///
+/// # Safety
+/// `model` is a handle from this library; `velocities` and `out` (and
+/// `loads`, `efforts` when not null) point to `count` values.
+#[no_mangle]
+pub unsafe extern "C" fn fn_model_step_contacts(
+    model: *mut FnModel,
+    velocities: *const f64,
+    loads: *const f64,
+    count: u32,
+    dt_s: f64,
+    out: *mut FnEstimate,
+    efforts: *mut f64,
+) -> i32 {
+    guarded(|| {
+        // SAFETY: forwarded from the caller.
+        let m = match unsafe { self::model(model) } {
+            Ok(m) => m,
+            Err(c) => return c,
+        };
+        if velocities.is_null() || out.is_null() {
+            return fail(FN_ERROR_NULL_ARGUMENT, "velocities or out is null");
+        }
+        let n = m.solvers.len();
+        if count as usize != n {
+            return fail(
+                FN_ERROR_ARGUMENT,
+                format!("count is {count} but the model has {n} contacts"),
+            );
+        }
+        // SAFETY: non-null; the caller provides `count` values each.
+        let (v, out) = unsafe {
+            (
+                std::slice::from_raw_parts(velocities, n),
+                std::slice::from_raw_parts_mut(out, n),
+            )
+        };
+        let loads = (!loads.is_null()).then(|| {
+            // SAFETY: non-null; `count` values.
+            unsafe { std::slice::from_raw_parts(loads, n) }
+        });
+        for (i, (s, c)) in m.solvers.iter_mut().zip(&m.contacts).enumerate() {
+            let load = loads.map_or(c.config.contact.load_n, |l| l[i]);
+            let e = FnEstimate::from(&step_one(s, v[i], load, dt_s));
+            out[i] = e;
+            if !efforts.is_null() {
+                // SAFETY: non-null; `count` values.
+                unsafe { *efforts.add(i) = c.gain * e.friction_force_n };
+            }
+        }
+        FN_OK
+    })
+}
+
+/// The number of contacts of the model (1 for a configuration without
+/// `contacts`; 0 for an invalid handle).
+///
+/// # Safety
+/// `model` is a handle from this library.
+#[no_mangle]
+pub unsafe extern "C" fn fn_model_contact_count(model: *const FnModel) -> u32 {
+    let r = catch_unwind(|| {
+        // SAFETY: forwarded from the caller; only read.
+        unsafe { self::model(model as *mut FnModel) }.map(|m| m.solvers.len() as u32)
+    });
+    match r {
+        Ok(Ok(n)) => n,
+        _ => 0,
+    }
+}
+
+/// The index (in `fn_model_step_contacts`'s arrays) of the contact named
+/// `name`, or of the contact on the joint named `name`, into `*out`.
+///
+/// # Safety
+/// `model` is a handle from this library; `name` is a NUL-terminated
+/// string; `out` points to writable storage.
+#[no_mangle]
+pub unsafe extern "C" fn fn_model_contact_index(
+    model: *const FnModel,
+    name: *const c_char,
+    out: *mut u32,
+) -> i32 {
+    guarded(|| {
+        // SAFETY: forwarded from the caller; only read.
+        let m = match unsafe { self::model(model as *mut FnModel) } {
+            Ok(m) => m,
+            Err(c) => return c,
+        };
+        // SAFETY: forwarded from the caller.
+        let name = match unsafe { text(name, "name") } {
+            Ok(t) => t,
+            Err(c) => return c,
+        };
+        if out.is_null() {
+            return fail(FN_ERROR_NULL_ARGUMENT, "out is null");
+        }
+        match m
+            .contacts
+            .iter()
+            .position(|c| c.name == name || (!c.joint.is_empty() && c.joint == name))
+        {
+            Some(i) => {
+                // SAFETY: checked non-null.
+                unsafe { *out = i as u32 };
+                FN_OK
+            }
+            None => {
+                let known: Vec<String> = m
+                    .contacts
+                    .iter()
+                    .map(|c| format!("{} (joint `{}`)", c.name, c.joint))
+                    .collect();
+                fail(
+                    FN_ERROR_ARGUMENT,
+                    format!(
+                        "no contact or joint named `{name}`; the contacts are {}",
+                        known.join(", ")
+                    ),
+                )
+            }
+        }
     })
 }
 
@@ -367,7 +544,7 @@ pub unsafe extern "C" fn fn_model_step(
 pub unsafe extern "C" fn fn_model_dt(model: *const FnModel) -> f64 {
     let r = catch_unwind(|| {
         // SAFETY: forwarded from the caller; only read.
-        unsafe { self::model(model as *mut FnModel) }.map(|m| m.solver.settings().dt)
+        unsafe { self::model(model as *mut FnModel) }.map(|m| m.solvers[0].settings().dt)
     });
     match r {
         Ok(Ok(dt)) => dt,
@@ -376,7 +553,9 @@ pub unsafe extern "C" fn fn_model_dt(model: *const FnModel) -> f64 {
 }
 
 /// Restart from the steady state at velocity `velocity_m_s` under `load_n`
-/// (a new run: the squeeze-film history is forgotten).
+/// (a new run: the squeeze-film history is forgotten). `load_n` = 0 takes
+/// each contact's configured `contact.load_n`; with several contacts every
+/// contact restarts.
 ///
 /// # Safety
 /// `model` is a handle from this library.
@@ -392,13 +571,20 @@ pub unsafe extern "C" fn fn_model_reset(
             Ok(m) => m,
             Err(c) => return c,
         };
-        if !(velocity_m_s.is_finite() && load_n.is_finite() && load_n > 0.0) {
+        if !(velocity_m_s.is_finite() && load_n.is_finite() && load_n >= 0.0) {
             return fail(
                 FN_ERROR_ARGUMENT,
-                format!("reset: velocity {velocity_m_s} m/s and load {load_n} N must be finite, the load positive"),
+                format!("reset: velocity {velocity_m_s} m/s and load {load_n} N must be finite, the load positive (or 0: each contact's configured load)"),
             );
         }
-        m.solver.initialize_steady(velocity_m_s, load_n);
+        for (s, c) in m.solvers.iter_mut().zip(&m.contacts) {
+            let load = if load_n > 0.0 {
+                load_n
+            } else {
+                c.config.contact.load_n
+            };
+            s.initialize_steady(velocity_m_s, load);
+        }
         FN_OK
     })
 }
@@ -423,18 +609,18 @@ pub unsafe extern "C" fn fn_model_set_temperature(model: *mut FnModel, temperatu
                 format!("temperature {temperature_c} °C is outside [-100, 400]"),
             );
         }
-        if m.config.viscosity_model() != friction_node::physics::ViscosityModel::Constant {
-            m.solver
-                .set_liquid_viscosity(m.config.viscosity_at(temperature_c));
-        }
+        m.temperature_c = Some(temperature_c);
+        m.apply_temperature(temperature_c);
         FN_OK
     })
 }
 
 /// Change one parameter that may change while running (those `ros2 param`
 /// can set on the node: load, mass, boundary friction, lubricant,
-/// roughness, drivetrain...), `key` dotted (`lubricant.viscosity_pa_s`),
-/// `value` in YAML (`0.05`, `vogel`, `[1, 2]`). The film state is kept.
+/// roughness, drivetrain...), `key` dotted (`lubricant.viscosity_pa_s`;
+/// with several contacts `contacts.NAME.lubricant.viscosity_pa_s`),
+/// `value` in YAML (`0.05`, `vogel`, `[1, 2]`). The film state is kept and
+/// a temperature set before is re-applied.
 /// Allocates (the model's tables are rebuilt): call it between steps, not
 /// from the real-time loop. A refused change leaves the model unchanged and
 /// the message names the key and value.
@@ -473,14 +659,33 @@ pub unsafe extern "C" fn fn_model_set_parameter(
             Ok(c) => c,
             Err(e) => return fail(FN_ERROR_PARAMETER, e.to_string()),
         };
-        let mut prepared = match Solver::prepare_model(&new.model(), &new.solver_settings()) {
-            Ok(p) => p,
-            Err(e) => return fail(FN_ERROR_PARAMETER, format!("parameter `{key}`: {e}")),
-        };
-        if let Err(e) = m.solver.swap_model(&mut prepared) {
-            return fail(FN_ERROR_PARAMETER, format!("parameter `{key}`: {e}"));
+        let contacts = new.resolved_contacts();
+        let mut prepared = Vec::with_capacity(contacts.len());
+        for (c, s) in contacts.iter().zip(&m.solvers) {
+            let p = match Solver::prepare_model(&c.config.model(), &c.config.solver_settings()) {
+                Ok(p) => p,
+                Err(e) => return fail(FN_ERROR_PARAMETER, format!("parameter `{key}`: {e}")),
+            };
+            if !s.fits(&p) {
+                return fail(
+                    FN_ERROR_PARAMETER,
+                    format!(
+                        "parameter `{key}`: {}",
+                        friction_node::physics::ModelMismatch
+                    ),
+                );
+            }
+            prepared.push(p);
+        }
+        // Every contact fits: all change together.
+        for (s, p) in m.solvers.iter_mut().zip(prepared.iter_mut()) {
+            let _ = s.swap_model(p);
         }
         m.config = new;
+        m.contacts = contacts;
+        if let Some(t) = m.temperature_c {
+            m.apply_temperature(t);
+        }
         FN_OK
     })
 }

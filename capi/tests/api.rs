@@ -75,14 +75,12 @@ fn a_bad_configuration_is_an_error_code_with_the_key_and_value_named() {
         new_model("/**:\n  ros__parameters:\n    contact:\n      lod_n: 1\n").unwrap_err();
     assert_eq!(code, FN_ERROR_CONFIG);
     assert!(msg.contains("lod_n"), "{msg}");
-    let (code, msg) =
-        new_model("/**:\n  ros__parameters:\n    contacts:\n      left: {}\n      right: {}\n")
-            .unwrap_err();
+    let (code, msg) = new_model(
+        "/**:\n  ros__parameters:\n    contacts:\n      left: {gain: 0}\n      right: {}\n",
+    )
+    .unwrap_err();
     assert_eq!(code, FN_ERROR_CONFIG);
-    assert!(
-        msg.contains("2 contacts") && msg.contains("one handle per contact"),
-        "{msg}"
-    );
+    assert!(msg.contains("contacts.left.gain"), "{msg}");
     let (code, _) = new_model("{{{").unwrap_err();
     assert_eq!(code, FN_ERROR_CONFIG);
     let path = CString::new("/nonexistent/machine.yaml").unwrap();
@@ -237,4 +235,173 @@ fn a_runtime_parameter_changes_the_model_and_a_refused_one_changes_nothing() {
     assert_eq!(unsafe { fn_model_reset(m, 0.0, 20762.0) }, FN_OK);
     unsafe { fn_model_free(m) };
     unsafe { fn_model_free(twin) };
+}
+
+const THREE: &str = "/**:
+  ros__parameters:
+    solver: {cells: 48}
+    contacts:
+      left: {joint: j_left, contact: {load_n: 4000.0}}
+      right: {joint: j_right, gain: 0.05}
+      wrist: {joint: j_wrist, gain: 0.02, solver: {cells: 24}, lubricant: {viscosity_pa_s: 0.1}}
+";
+
+/// The one-contact configuration of contact `name` of THREE.
+fn one_of_three(name: &str) -> String {
+    let cfg = friction_node::config::Config::from_yaml(
+        THREE,
+        &friction_node::config::Origin::Embedded,
+        &[],
+    )
+    .unwrap();
+    let c = cfg
+        .resolved_contacts()
+        .into_iter()
+        .find(|c| c.name == name)
+        .unwrap();
+    format!(
+        "/**:\n  ros__parameters:\n{}",
+        serde_norway::to_string(&c.config)
+            .unwrap()
+            .lines()
+            .filter(|l| !l.starts_with("contacts:"))
+            .map(|l| format!("    {l}\n"))
+            .collect::<String>()
+    )
+}
+
+#[test]
+fn one_handle_steps_several_contacts_each_equal_to_its_own_handle_with_gain_times_friction_efforts()
+{
+    let m = new_model(THREE).unwrap();
+    assert_eq!(unsafe { fn_model_contact_count(m) }, 3);
+    let idx = |name: &str| {
+        let n = CString::new(name).unwrap();
+        let mut i = u32::MAX;
+        let code = unsafe { fn_model_contact_index(m, n.as_ptr(), &mut i) };
+        (code, i)
+    };
+    assert_eq!(idx("right"), (FN_OK, 1));
+    assert_eq!(idx("j_wrist"), (FN_OK, 2), "by joint name");
+    let (code, _) = idx("gripper");
+    assert_eq!(code, FN_ERROR_ARGUMENT);
+    assert!(last_error().contains("gripper") && last_error().contains("j_left"));
+    let singles: Vec<*mut FnModel> = ["left", "right", "wrist"]
+        .iter()
+        .map(|n| new_model(&one_of_three(n)).unwrap())
+        .collect();
+    let gains = [1.0, 0.05, 0.02];
+    let dt = unsafe { fn_model_dt(m) };
+    let mut out = [FnEstimate::default(); 3];
+    let mut efforts = [0.0; 3];
+    let mut allocated = 0;
+    let mut alone = Vec::new();
+    for k in 1..=500 {
+        let t = k as f64 * dt;
+        let v: Vec<f64> = (0..3)
+            .map(|i| {
+                (1.0 + 0.3 * i as f64) * (2.0 * std::f64::consts::PI * (t + 0.1 * i as f64)).sin()
+            })
+            .collect();
+        let before = ALLOCATIONS.with(Cell::get);
+        let code = unsafe {
+            fn_model_step_contacts(
+                m,
+                v.as_ptr(),
+                null(),
+                3,
+                dt,
+                out.as_mut_ptr(),
+                efforts.as_mut_ptr(),
+            )
+        };
+        allocated += ALLOCATIONS.with(Cell::get) - before;
+        assert_eq!(code, FN_OK);
+        alone.clear();
+        for (i, &s) in singles.iter().enumerate() {
+            let load = [4000.0, 20762.0, 20762.0][i];
+            alone.push(step(s, v[i], load, dt));
+        }
+        for i in 0..3 {
+            assert_eq!(out[i], alone[i], "step {k}, contact {i}");
+            assert_eq!(efforts[i], gains[i] * out[i].friction_force_n);
+        }
+    }
+    assert!(out.iter().all(|e| e.status == FN_STATUS_CONVERGED));
+    assert_eq!(allocated, 0, "allocations in 500 steps of three contacts");
+    // Loads given per contact.
+    let v = [0.2, 0.2, 0.2];
+    let loads = [3000.0, 3000.0, 3000.0];
+    assert_eq!(
+        unsafe {
+            fn_model_step_contacts(
+                m,
+                v.as_ptr(),
+                loads.as_ptr(),
+                3,
+                dt,
+                out.as_mut_ptr(),
+                null_mut(),
+            )
+        },
+        FN_OK
+    );
+    assert!(out.iter().all(|e| e.load_n == 3000.0));
+    // Bad calls: a wrong count, null arrays, the one-contact step.
+    let code = unsafe {
+        fn_model_step_contacts(m, v.as_ptr(), null(), 2, dt, out.as_mut_ptr(), null_mut())
+    };
+    assert_eq!(code, FN_ERROR_ARGUMENT);
+    assert!(last_error().contains("count is 2") && last_error().contains("3 contacts"));
+    let code =
+        unsafe { fn_model_step_contacts(m, null(), null(), 3, dt, out.as_mut_ptr(), null_mut()) };
+    assert_eq!(code, FN_ERROR_NULL_ARGUMENT);
+    let mut e = FnEstimate::default();
+    assert_eq!(
+        unsafe { fn_model_step(m, 0.1, 1000.0, dt, &mut e) },
+        FN_ERROR_ARGUMENT
+    );
+    assert!(last_error().contains("fn_model_step_contacts"));
+    // A per-contact parameter changes that contact alone; reset restarts all.
+    let twin = new_model(THREE).unwrap();
+    unsafe {
+        fn_model_step_contacts(
+            twin,
+            v.as_ptr(),
+            loads.as_ptr(),
+            3,
+            dt,
+            out.as_mut_ptr(),
+            null_mut(),
+        )
+    };
+    set(m, "contacts.right.lubricant.viscosity_pa_s", "0.2").unwrap();
+    let (code, msg) = set(m, "contacts.right.joint", "x").unwrap_err();
+    assert_eq!(code, FN_ERROR_PARAMETER);
+    assert!(msg.contains("contacts.right.joint"), "{msg}");
+    assert_eq!(unsafe { fn_model_reset(m, 0.0, 0.0) }, FN_OK);
+    assert_eq!(unsafe { fn_model_reset(twin, 0.0, 0.0) }, FN_OK);
+    let mut a = [FnEstimate::default(); 3];
+    let mut b = [FnEstimate::default(); 3];
+    for _ in 0..50 {
+        unsafe {
+            fn_model_step_contacts(m, v.as_ptr(), null(), 3, dt, a.as_mut_ptr(), null_mut());
+            fn_model_step_contacts(twin, v.as_ptr(), null(), 3, dt, b.as_mut_ptr(), null_mut());
+        }
+    }
+    // (The reset's steady solve is warm-started from each run's own state:
+    // equal to the solver tolerance, not bit for bit.)
+    let rel = |x: f64, y: f64| (x - y).abs() / y.abs();
+    assert!(rel(a[0].friction_force_n, b[0].friction_force_n) < 1e-8);
+    assert!(rel(a[2].friction_force_n, b[2].friction_force_n) < 1e-8);
+    assert!(
+        rel(a[1].friction_force_n, b[1].friction_force_n) > 1e-3,
+        "{} vs {}",
+        a[1].friction_force_n,
+        b[1].friction_force_n
+    );
+    for h in singles.into_iter().chain([m, twin]) {
+        unsafe { fn_model_free(h) };
+    }
+    assert_eq!(unsafe { fn_model_contact_count(null()) }, 0);
 }
