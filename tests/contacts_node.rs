@@ -247,24 +247,7 @@ fn a_contact_left_out_of_the_joint_states_is_held_then_times_out_alone() {
 /// A lockstep loop over `cfg` fed `steps` JointStates; contact k's
 /// velocity at step i is `v(k, i)`.
 fn lockstep(cfg: &Config, steps: u64, v: impl Fn(usize, u64) -> f64) -> Vec<Vec<EstimateRecord>> {
-    let mut cfg = cfg.clone();
-    cfg.node.step_mode = friction_node::config::StepMode::Lockstep;
-    let names = joints(&cfg);
-    let link = MemoryLink::new(100_000).with_joints(&names);
-    let mut peer = link.peer();
-    let mut l = new_loop(&cfg, &link);
-    let mut per: Vec<Vec<EstimateRecord>> = vec![Vec::new(); names.len()];
-    for i in 0..steps {
-        let velocity: Vec<f64> = (0..names.len()).map(|k| v(k, i)).collect();
-        let refs: Vec<&str> = names.iter().map(String::as_str).collect();
-        peer.send_joint_state(&js((i + 1) * MS, &refs, &velocity))
-            .unwrap();
-        l.poll_once();
-        while let Some((k, e)) = peer.try_recv_contact().unwrap() {
-            per[k].push(e);
-        }
-    }
-    per
+    lockstep_with_change(cfg, steps, v, 0, &[]).0
 }
 
 fn profile(k: usize, i: u64) -> f64 {
@@ -375,6 +358,7 @@ fn bad_contact_settings_for_the_node_are_errors_naming_the_key() {
 fn lockstep_with_change(
     cfg: &Config,
     steps: u64,
+    v: impl Fn(usize, u64) -> f64,
     at: u64,
     changes: &[(&str, f64)],
 ) -> (Vec<Vec<EstimateRecord>>, RunSummary) {
@@ -404,7 +388,7 @@ fn lockstep_with_change(
             let mut u = ParameterUpdate::prepare(&cfg, next, changes).unwrap();
             l.apply_update(&mut u);
         }
-        let velocity: Vec<f64> = (0..names.len()).map(|k| profile(k, i)).collect();
+        let velocity: Vec<f64> = (0..names.len()).map(|k| v(k, i)).collect();
         let refs: Vec<&str> = names.iter().map(String::as_str).collect();
         peer.send_joint_state(&js((i + 1) * MS, &refs, &velocity))
             .unwrap();
@@ -419,11 +403,12 @@ fn lockstep_with_change(
 #[test]
 fn a_runtime_change_of_one_contacts_key_changes_that_contact_alone() {
     let cfg = three();
-    let (base, s0) = lockstep_with_change(&cfg, 200, 100, &[]);
+    let (base, s0) = lockstep_with_change(&cfg, 200, profile, 100, &[]);
     assert_eq!(s0.parameter_updates, 0);
     let (changed, s1) = lockstep_with_change(
         &cfg,
         200,
+        profile,
         100,
         &[
             ("contacts.right.lubricant.viscosity_pa_s", 0.2),
