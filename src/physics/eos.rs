@@ -38,17 +38,11 @@ pub(crate) fn exp_fast(x: f64) -> f64 {
     const LIMIT: f64 = 2.0 * SATURATED + 1.0;
     const LOG2E: f64 = std::f64::consts::LOG2_E;
     // ln 2 = LN2_HI + LN2_LO, LN2_HI with 32 trailing zero bits.
-    const LN2_HI: f64 = 6.931_471_803_691_238_2e-1;
+    const LN2_HI: f64 = 6.931_471_803_691_238e-1;
     const LN2_LO: f64 = 1.908_214_929_270_587_7e-10;
     // 1.5·2^52: adding it rounds to an integer held in the low mantissa bits.
     const SHIFT: f64 = 6_755_399_441_055_744.0;
-    let x = if x > LIMIT {
-        LIMIT
-    } else if x < -LIMIT {
-        -LIMIT
-    } else {
-        x
-    };
+    let x = x.clamp(-LIMIT, LIMIT);
     let t = x * LOG2E + SHIFT;
     let kf = t - SHIFT;
     let r = (x - kf * LN2_HI) - kf * LN2_LO;
