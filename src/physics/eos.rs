@@ -128,6 +128,14 @@ impl MixtureEos {
         }
     }
 
+    /// α(p) without a branch (for loops that vectorise): the exponential's
+    /// clamp leaves saturated states within 1e-17 of 0 or 1 instead of
+    /// exactly there; NaN stays NaN.
+    #[inline(always)]
+    pub(crate) fn alpha_branchless(&self, p: f64) -> f64 {
+        1.0 / (1.0 + exp_fast(2.0 * self.beta * (p - self.p0)))
+    }
+
     /// Full state with derivatives.
     #[inline]
     pub fn eval(&self, p: f64) -> MixtureState {

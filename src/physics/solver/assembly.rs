@@ -146,6 +146,10 @@ pub(crate) struct Work {
     pub dp: Vec<f64>,
     pub dbar: Vec<f64>,
     pub p_trial: Vec<f64>,
+    /// The vapour-fraction map of a large Newton update (newton.rs): U(p)
+    /// and U'(p)Δp per cell.
+    pub map_u: Vec<f64>,
+    pub map_du: Vec<f64>,
     pub p_backup: Vec<f64>,
     pub p_anchor: Vec<f64>,
     pub source: Vec<f64>,
@@ -180,6 +184,8 @@ impl Work {
             dp: vec![0.0; n],
             dbar: vec![0.0; n],
             p_trial: vec![0.0; n],
+            map_u: vec![0.0; n],
+            map_du: vec![0.0; n],
             p_backup: vec![0.0; n],
             p_anchor: vec![0.0; n],
             source: vec![0.0; n],

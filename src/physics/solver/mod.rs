@@ -238,6 +238,9 @@ pub struct Solver {
     h0_n3: f64,
     /// Newton contraction constant K (see the module doc).
     contraction: f64,
+    /// h0 of the previous state while a solve starts from the predictor's
+    /// extrapolation (the restart's alternative start; taken by the solve).
+    held_h0: Option<f64>,
     anchor: (f64, f64, f64),
     last: Option<Estimate>,
     /// The instruction-set version of the step.
@@ -360,6 +363,7 @@ impl Solver {
             p_hist: 0,
             h0_n3: 0.0,
             contraction: CONTRACTION_MAX,
+            held_h0: None,
             anchor: (0.0, 0.0, 0.0),
             last: None,
             isa: Isa::Baseline,

@@ -183,6 +183,8 @@ impl Solver {
                 }
             }
         }
+        let predicted = self.p_hist >= 1 && self.hist_len >= 2;
+        self.held_h0 = predicted.then_some(h_backup);
         let mut out = match self.settings.method {
             Method::Newton => self.solve(&ctx),
             Method::Reference => self.reference_solve(&ctx),
