@@ -163,61 +163,70 @@ impl Solver {
                 out.status = Status::Converged;
                 return out;
             }
-            // Trust region on the gap: |Δh0| ≤ 25 % of h0 per iteration.
-            let mut lambda: f64 = 1.0;
-            if dh.abs() > H0_TRUST * self.h0 {
-                lambda = H0_TRUST * self.h0 / dh.abs();
-            }
-            let mut accepted = false;
-            // Deep in the quadratic region the full step is taken untested.
-            let test = norm > SMALL_UPDATE;
-            let mapped = ctx.time.is_some() && norm > MAPPED_UPDATE;
-            if mapped {
-                self.prepare_map();
-            }
-            for _ in 0..12 {
-                let h_trial = self.h0 + lambda * dh;
-                if mapped {
-                    self.mapped_trial(lambda);
-                } else {
-                    for ((pt, p), dp) in self.w.p_trial.iter_mut().zip(&self.p).zip(&self.w.dp) {
-                        *pt = p + lambda * dp;
-                    }
-                }
-                let pt = std::mem::take(&mut self.w.p_trial);
-                let ok = assemble(&self.d, &self.hist, &pt, h_trial, ctx, &mut self.w);
-                self.w.p_trial = pt;
-                if ok && !test && lambda == 1.0 && dh.abs() <= H0_TRUST * self.h0 {
-                    accepted = true;
-                    self.h0 = h_trial;
-                    break;
-                }
-                if ok {
-                    let dhb = direction_with_old_factors(&mut self.w);
-                    let nb = scaled_norm(&self.w.dbar, dhb, scale);
-                    if nb.is_finite() && nb <= (1.0 - 0.25 * lambda) * norm {
-                        accepted = true;
-                        self.h0 = h_trial;
-                        break;
-                    }
-                    if lambda < 1.0 / 256.0 {
-                        // Cannot find descent: take the small step and go on.
-                        accepted = true;
-                        self.h0 = h_trial;
-                        break;
-                    }
-                }
-                lambda *= 0.5;
-                out.backtracks += 1;
-            }
-            if !accepted {
+            let Some(lambda) = self.line_search(ctx, dh, scale, norm, &mut out) else {
                 out.status = Status::NonFinite;
                 return out;
-            }
+            };
             previous = (lambda == 1.0).then_some(norm);
             std::mem::swap(&mut self.p, &mut self.w.p_trial);
         }
         out
+    }
+
+    /// The step length λ of the update (Δp in `w.dp`, `dh`, scaled size
+    /// `norm` on `scale`): the h0 trust region, then halvings until the
+    /// natural monotonicity test passes (untested below [`SMALL_UPDATE`]).
+    /// The accepted trial state is assembled, in `w.p_trial` and `self.h0`;
+    /// None when no finite trial state was found.
+    #[inline(always)]
+    fn line_search(
+        &mut self,
+        ctx: &Ctx,
+        dh: f64,
+        scale: (f64, f64),
+        norm: f64,
+        out: &mut Outcome,
+    ) -> Option<f64> {
+        // Trust region on the gap: |Δh0| ≤ 25 % of h0 per iteration.
+        let mut lambda: f64 = 1.0;
+        if dh.abs() > H0_TRUST * self.h0 {
+            lambda = H0_TRUST * self.h0 / dh.abs();
+        }
+        // Deep in the quadratic region the full step is taken untested.
+        let test = norm > SMALL_UPDATE;
+        let mapped = ctx.time.is_some() && norm > MAPPED_UPDATE;
+        if mapped {
+            self.prepare_map();
+        }
+        for _ in 0..12 {
+            let h_trial = self.h0 + lambda * dh;
+            if mapped {
+                self.mapped_trial(lambda);
+            } else {
+                for ((pt, p), dp) in self.w.p_trial.iter_mut().zip(&self.p).zip(&self.w.dp) {
+                    *pt = p + lambda * dp;
+                }
+            }
+            let pt = std::mem::take(&mut self.w.p_trial);
+            let ok = assemble(&self.d, &self.hist, &pt, h_trial, ctx, &mut self.w);
+            self.w.p_trial = pt;
+            if ok && !test && lambda == 1.0 && dh.abs() <= H0_TRUST * self.h0 {
+                self.h0 = h_trial;
+                return Some(lambda);
+            }
+            if ok {
+                let dhb = direction_with_old_factors(&mut self.w);
+                let nb = scaled_norm(&self.w.dbar, dhb, scale);
+                // Descent, or none to be found: take the small step and go on.
+                if (nb.is_finite() && nb <= (1.0 - 0.25 * lambda) * norm) || lambda < 1.0 / 256.0 {
+                    self.h0 = h_trial;
+                    return Some(lambda);
+                }
+            }
+            lambda *= 0.5;
+            out.backtracks += 1;
+        }
+        None
     }
 
     /// The first Newton direction from the previous state (p in
