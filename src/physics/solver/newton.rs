@@ -244,7 +244,11 @@ impl Solver {
         let h_predicted = self.h0;
         self.w.p_trial.copy_from_slice(&self.p);
         self.p.copy_from_slice(&self.w.p_backup);
-        self.h0 = h_held;
+        // A prescribed gap stays prescribed; only the pressures start over.
+        self.h0 = match ctx.gap {
+            H0Mode::Prescribed(h) => h,
+            H0Mode::Balance => h_held,
+        };
         out.iterations += 1;
         let held = if assemble(&self.d, &self.hist, &self.p, self.h0, ctx, &mut self.w) {
             factor_solve(&mut self.w).map(|dh| {
