@@ -6,7 +6,7 @@
 
 use crate::config::Config;
 use crate::offline::{SimulationError, Timing};
-use crate::physics::{Isa, Method, Solver};
+use crate::physics::{Isa, Method, Solver, StepBreakdown};
 use std::time::Instant;
 
 /// Results for one grid size.
@@ -29,6 +29,9 @@ pub struct BenchCase {
     /// The same steps with the baseline version, when another one ran
     /// (timed right after, same states: the vectorisation's gain).
     pub baseline: Option<Timing>,
+    /// Each part of an iteration timed alone: medians over states spread
+    /// through one cycle (`--breakdown`).
+    pub breakdown: Option<StepBreakdown>,
 }
 
 impl BenchCase {
@@ -45,6 +48,8 @@ pub struct BenchOptions<'a> {
     pub reference_steps: usize,
     /// Reads a global allocation counter, when the binary installs one.
     pub allocation_counter: Option<&'a dyn Fn() -> u64>,
+    /// Also time each part of an iteration alone ([`StepBreakdown`]).
+    pub breakdown: bool,
     pub progress: &'a dyn Fn(&str),
 }
 
@@ -141,9 +146,75 @@ pub fn run(config: &Config, opts: &BenchOptions<'_>) -> Result<Vec<BenchCase>, S
                 .map(|_| allocs as f64 / steps as f64),
             isa,
             baseline,
+            breakdown: opts.breakdown.then(|| {
+                (opts.progress)(&format!("N = {cells}: the parts of an iteration"));
+                breakdown(&cfg, load, &velocity)
+            }),
         });
     }
     Ok(out)
+}
+
+/// States every 25 steps of a cycle after a warm-up cycle, each part timed
+/// 200 times alone; the median per part over the states.
+fn breakdown(cfg: &Config, load: f64, velocity: &dyn Fn(f64) -> f64) -> StepBreakdown {
+    let st = cfg.solver_settings();
+    let per_cycle = (1.0 / st.dt).round() as usize;
+    let mut s = Solver::new(&cfg.model(), &st).expect("validated by the caller");
+    s.initialize_steady(0.0, load);
+    let origin = Instant::now();
+    let mut now = || origin.elapsed().as_nanos() as u64;
+    let mut parts = Vec::new();
+    for k in 1..=2 * per_cycle {
+        let v = velocity(k as f64 * st.dt);
+        if k > per_cycle && k % 25 == 0 {
+            parts.push(s.breakdown(v, load, 200, &mut now));
+        }
+        s.step(v, load);
+    }
+    let median = |f: fn(&StepBreakdown) -> f64| {
+        let mut x: Vec<f64> = parts.iter().map(f).collect();
+        x.sort_by(f64::total_cmp);
+        x.get(x.len() / 2).copied().unwrap_or(f64::NAN)
+    };
+    StepBreakdown {
+        eos_ns: median(|b| b.eos_ns),
+        faces_ns: median(|b| b.faces_ns),
+        rows_ns: median(|b| b.rows_ns),
+        solve_ns: median(|b| b.solve_ns),
+        old_factor_solve_ns: median(|b| b.old_factor_solve_ns),
+        finish_ns: median(|b| b.finish_ns),
+    }
+}
+
+/// The breakdown of each grid as a table (ns per call; empty without one).
+pub fn breakdown_table(cases: &[BenchCase]) -> String {
+    let mut s = String::new();
+    for c in cases {
+        let Some(b) = c.breakdown else { continue };
+        if s.is_empty() {
+            s.push_str("     N | ns per call (median over a cycle's states): EOS  faces  rows+G  factor+solve  finish | sum | old-factor solve (line search)\n");
+        }
+        let sum = b.one_iteration_ns();
+        let pct = |x: f64| 100.0 * x / sum;
+        s.push_str(&format!(
+            "{:>6} | {:>6.0} ({:>2.0} %) {:>5.0} ({:>2.0} %) {:>5.0} ({:>2.0} %) {:>6.0} ({:>2.0} %) {:>5.0} ({:>2.0} %) | {:>5.0} | {:>5.0}\n",
+            c.cells,
+            b.eos_ns,
+            pct(b.eos_ns),
+            b.faces_ns,
+            pct(b.faces_ns),
+            b.rows_ns,
+            pct(b.rows_ns),
+            b.solve_ns,
+            pct(b.solve_ns),
+            b.finish_ns,
+            pct(b.finish_ns),
+            sum,
+            b.old_factor_solve_ns,
+        ));
+    }
+    s
 }
 
 /// Human-readable table.

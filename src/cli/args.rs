@@ -360,6 +360,10 @@ pub enum Command {
         /// Also write the results as CSV.
         #[arg(long, value_name = "FILE")]
         out: Option<PathBuf>,
+        /// Also time each part of a Newton iteration alone (EOS, faces,
+        /// rows, the bordered solve, post-processing).
+        #[arg(long)]
+        breakdown: bool,
     },
 }
 

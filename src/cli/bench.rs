@@ -21,6 +21,7 @@ pub fn step(
     cycles: usize,
     reference_steps: usize,
     out: Option<PathBuf>,
+    breakdown: bool,
     allocations: &dyn Fn() -> u64,
 ) -> Result<()> {
     warn_debug("bench");
@@ -34,10 +35,12 @@ pub fn step(
             cycles,
             reference_steps,
             allocation_counter: Some(allocations),
+            breakdown,
             progress: &progress,
         },
     )?;
     print!("{}", friction_node::bench::table(&cases));
+    print!("{}", friction_node::bench::breakdown_table(&cases));
     if let Some(mut f) = file {
         f.line(format_args!(
             "{}",

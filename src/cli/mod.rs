@@ -144,7 +144,16 @@ pub fn dispatch(
             cycles,
             reference_steps,
             out,
+            breakdown,
             ..
-        } => bench::step(&config, cells, cycles, reference_steps, out, allocations),
+        } => bench::step(
+            &config,
+            cells,
+            cycles,
+            reference_steps,
+            out,
+            breakdown,
+            allocations,
+        ),
     }
 }

@@ -48,5 +48,5 @@ pub use params::{
     Contact, Geometry, Lubricant, Method, ModelParams, Pocket, Profile, ReferenceSettings,
     Roughness, SolverSettings, TimeScheme,
 };
-pub use solver::{FieldPoint, Isa, ModelMismatch, PreparedModel, Solver};
+pub use solver::{FieldPoint, Isa, ModelMismatch, PreparedModel, Solver, StepBreakdown};
 pub use viscosity::{ViscosityModel, VogelModel};

@@ -6,6 +6,7 @@
 //! G. See the parent module for the discrete equations.
 
 use super::bordered::Factor;
+use super::lanes::{all_finite, lane_sum};
 use super::{Ctx, Disc, H0Mode, Level};
 use crate::physics::eos::{exp_fast, saturated as eos_saturated};
 use crate::physics::scheme::StepCoefficients;
@@ -270,7 +271,22 @@ pub(crate) fn assemble(
     let p = &p[..n];
     cell_pass(d, p, w);
     face_pass(d, p, h0, ctx, w);
-    let finite = row_pass(d, hist, h0, ctx, w);
+    let rows_finite = row_pass(d, hist, h0, ctx, w);
+    let g_finite = balance_row(d, hist, p, h0, ctx, w);
+    rows_finite && g_finite
+}
+
+/// The load-balance row: G, ∂G/∂h0 and the uniform ∂G/∂p (`w.c_row`), with
+/// the net force. Returns false when G is not finite.
+#[inline(always)]
+pub(super) fn balance_row(
+    d: &Disc,
+    hist: &[Level; 2],
+    p: &[f64],
+    h0: f64,
+    ctx: &Ctx,
+    w: &mut Work,
+) -> bool {
     let sum_p = lane_sum(p, d.p_amb);
     let (sum_asp, sum_dasp) = d.contact.pressure_sum(h0);
     let bdx = d.grid.width * d.grid.dx;
@@ -292,84 +308,7 @@ pub(crate) fn assemble(
         }
     }
     w.balance = ctx.gap == H0Mode::Balance;
-    finite && w.g.is_finite()
-}
-
-/// Σ (x − offset) over `xs`, in eight interleaved partial sums (the serial
-/// sum is latency-bound; these vectorise). Not the serial sum's rounding.
-#[inline(always)]
-pub(crate) fn lane_sum(xs: &[f64], offset: f64) -> f64 {
-    const L: usize = 8;
-    let mut acc = [0.0f64; L];
-    let chunks = xs.chunks_exact(L);
-    let rest = chunks.remainder();
-    for c in chunks {
-        for k in 0..L {
-            acc[k] += c[k] - offset;
-        }
-    }
-    for (k, x) in rest.iter().enumerate() {
-        acc[k] += x - offset;
-    }
-    ((acc[0] + acc[4]) + (acc[1] + acc[5])) + ((acc[2] + acc[6]) + (acc[3] + acc[7]))
-}
-
-/// The largest of `xs` (−∞ when empty), lane-wise so it vectorises; NaN
-/// entries are ignored like [`f64::max`] does.
-#[inline(always)]
-pub(crate) fn lane_max(xs: &[f64]) -> f64 {
-    const L: usize = 8;
-    let mut acc = [f64::NEG_INFINITY; L];
-    let chunks = xs.chunks_exact(L);
-    let rest = chunks.remainder();
-    for c in chunks {
-        for k in 0..L {
-            acc[k] = if c[k] > acc[k] { c[k] } else { acc[k] };
-        }
-    }
-    for (k, &x) in rest.iter().enumerate() {
-        acc[k] = acc[k].max(x);
-    }
-    acc.iter().fold(f64::NEG_INFINITY, |m, &x| m.max(x))
-}
-
-/// max(floor, max |x_i|), lane-wise so it vectorises; NaN entries are
-/// ignored like [`f64::max`] does.
-#[inline(always)]
-pub(crate) fn lane_max_abs(xs: &[f64], floor: f64) -> f64 {
-    const L: usize = 8;
-    let mut acc = [floor; L];
-    let chunks = xs.chunks_exact(L);
-    let rest = chunks.remainder();
-    for c in chunks {
-        for k in 0..L {
-            let a = c[k].abs();
-            acc[k] = if a > acc[k] { a } else { acc[k] };
-        }
-    }
-    for (k, &x) in rest.iter().enumerate() {
-        acc[k] = acc[k].max(x.abs());
-    }
-    acc.iter().fold(floor, |m, &x| m.max(x))
-}
-
-/// Whether every a_i + b_i is finite (lane-wise, so it vectorises).
-#[inline(always)]
-fn all_finite(a: &[f64], b: &[f64]) -> bool {
-    const L: usize = 8;
-    let mut acc = [0.0f64; L];
-    let (ca, cb) = (a.chunks_exact(L), b.chunks_exact(L));
-    let (ra, rb) = (ca.remainder(), cb.remainder());
-    for (x, y) in ca.zip(cb) {
-        for k in 0..L {
-            // Zero for finite values, NaN otherwise (inf − inf or NaN).
-            acc[k] += (x[k] + y[k]) * 0.0;
-        }
-    }
-    for (k, (x, y)) in ra.iter().zip(rb).enumerate() {
-        acc[k] += (x + y) * 0.0;
-    }
-    acc.iter().all(|&v| v == 0.0)
+    w.g.is_finite()
 }
 
 /// Pass 1: mixture properties of every cell, bit-identical to
@@ -379,7 +318,7 @@ fn all_finite(a: &[f64], b: &[f64]) -> bool {
 /// exponential of the unsaturated cells only (they are a minority), then the
 /// rest: the same numbers, since a saturated cell's exponential is unused.
 #[inline(always)]
-fn cell_pass(d: &Disc, p: &[f64], w: &mut Work) {
+pub(super) fn cell_pass(d: &Disc, p: &[f64], w: &mut Work) {
     let n = p.len();
     let eos = &d.eos;
     let c = &mut w.cells;
@@ -421,7 +360,7 @@ fn cell_pass(d: &Disc, p: &[f64], w: &mut Work) {
 /// Pass 2: the mass flux through every face. Without flow factors the
 /// interior faces run a specialised loop (no per-face branch; vectorises).
 #[inline(always)]
-fn face_pass(d: &Disc, p: &[f64], h0: f64, ctx: &Ctx, w: &mut Work) {
+pub(super) fn face_pass(d: &Disc, p: &[f64], h0: f64, ctx: &Ctx, w: &mut Work) {
     let n = p.len();
     let inv_dx = 1.0 / d.grid.dx;
     let boundary = CellProps {
@@ -530,7 +469,7 @@ fn smooth_faces<const UPWIND_LEFT: bool>(
 /// Pass 3: the rows of the bordered system (mass balance of every cell).
 /// Returns false when a row is not finite.
 #[inline(always)]
-fn row_pass(d: &Disc, hist: &[Level; 2], h0: f64, ctx: &Ctx, w: &mut Work) -> bool {
+pub(super) fn row_pass(d: &Disc, hist: &[Level; 2], h0: f64, ctx: &Ctx, w: &mut Work) -> bool {
     let n = d.grid.n;
     let dx = d.grid.dx;
     let w0 = ctx.w0();

@@ -47,17 +47,22 @@
 //! | `newton.rs` | Newton iteration, line search, sub-stepping |
 //! | `assembly.rs` | residual and Jacobian of one iterate |
 //! | `bordered.rs` | the tridiagonal-plus-border linear solve |
+//! | `lanes.rs` | lane-wise sums and maxima that vectorise |
 //! | `postprocess.rs` | forces, friction and diagnostics of a solved state |
+//! | `breakdown.rs` | the cost of each part of an iteration (a benchmark aid) |
 
 mod assembly;
 mod bordered;
+mod breakdown;
 mod history;
+mod lanes;
 mod newton;
 mod postprocess;
 mod steady;
 mod step;
 
 pub(crate) use assembly::Work;
+pub use breakdown::StepBreakdown;
 
 use super::eos::MixtureEos;
 use super::error::SetupError;

@@ -56,8 +56,9 @@
 //! | U, K | mapped variable, its vapour weight | Pa |
 //! | λ | step length of the line search | – |
 
-use super::assembly::{assemble, lane_max_abs};
+use super::assembly::assemble;
 use super::bordered::{direction_with_old_factors, factor_solve};
+use super::lanes::lane_max_abs;
 use super::{Ctx, H0Mode, Outcome, Solver};
 use crate::physics::estimate::Status;
 use crate::physics::scheme::StepCoefficients;

@@ -1,7 +1,8 @@
 //! From a solved state to an [`Estimate`]: forces, friction, COF, inertia,
 //! diagnostics; and, when the step advances time, the new history level.
 
-use super::assembly::{assemble, lane_max, lane_sum};
+use super::assembly::assemble;
+use super::lanes::{lane_max, lane_sum};
 use super::{Ctx, H0Mode, Outcome, Solver};
 use crate::physics::estimate::{Diagnostics, Estimate, Regime};
 use crate::physics::scheme::StepCoefficients;
