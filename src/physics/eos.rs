@@ -237,6 +237,25 @@ pub struct CellConstants {
 }
 
 impl CellConstants {
+    /// The pure liquid's state (β(p − p0) beyond saturation).
+    #[inline(always)]
+    pub fn liquid(&self) -> CellState {
+        CellState {
+            rho: self.eos.rho_l,
+            drho: 0.0,
+            gr: self.gr_liquid,
+            dgr: 0.0,
+            mu: self.eos.mu_l,
+            dmu: 0.0,
+        }
+    }
+
+    /// Whether `p` is pure liquid to double precision (false for NaN).
+    #[inline(always)]
+    pub fn is_liquid(&self, p: f64) -> bool {
+        self.eos.beta * (p - self.eos.p0) > SATURATED
+    }
+
     /// [`MixtureEos::cell`] at `p` given e = exp(2β(p − p0)) (any value
     /// where saturated). Branch-free: the saturated states are selected, so a
     /// loop over cells vectorises.
@@ -270,7 +289,7 @@ impl CellConstants {
             dmu: 0.0,
         };
         if z > SATURATED {
-            pure(k.rho_l, self.gr_liquid, k.mu_l)
+            self.liquid()
         } else if z < -SATURATED {
             pure(k.rho_g, self.gr_gas, k.mu_g)
         } else {

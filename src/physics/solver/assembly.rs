@@ -8,7 +8,7 @@
 use super::bordered::Factor;
 use super::lanes::{all_finite, lane_sum};
 use super::{Ctx, Disc, H0Mode, Level};
-use crate::physics::eos::{exp_fast, saturated as eos_saturated};
+use crate::physics::eos::{exp_fast, CellConstants, MixtureEos};
 use crate::physics::scheme::StepCoefficients;
 
 /// Mixture properties of one cell at the current iterate.
@@ -126,11 +126,8 @@ impl RowColumns {
 #[derive(Debug, Clone)]
 pub(crate) struct Work {
     pub cells: CellColumns,
-    /// exp(2β(p − p0)) per cell (any value where the EOS is saturated).
+    /// exp(2β(p − p0)) of the cells of a mixture run (cell pass scratch).
     pub exp2z: Vec<f64>,
-    /// Wide vectors run the step (see [`super::Isa`]): loops that pay off
-    /// only when vectorised are taken.
-    pub wide: bool,
     pub faces: FaceColumns,
     pub rows: RowColumns,
     pub g: f64,
@@ -170,7 +167,6 @@ impl Work {
         Self {
             cells: CellColumns::new(n),
             exp2z: vec![0.0; n],
-            wide: false,
             faces: FaceColumns::new(n + 1),
             rows: RowColumns::new(n),
             g: 0.0,
@@ -312,50 +308,85 @@ pub(super) fn balance_row(
 }
 
 /// Pass 1: mixture properties of every cell, bit-identical to
-/// [`crate::physics::eos::MixtureEos::cell`]. With wide vectors (`w.wide`)
-/// one branch-free loop: the exponential is [`exp_fast`] for every cell and
-/// the saturated states are selected, so it vectorises. Without, the
-/// exponential of the unsaturated cells only (they are a minority), then the
-/// rest: the same numbers, since a saturated cell's exponential is unused.
+/// [`crate::physics::eos::MixtureEos::cell`], in chunks of [`CHUNK`] cells.
+/// A chunk whose cells are all pure liquid (|β(p − p0)| beyond saturation,
+/// about 40 % of the cells of a loaded contact) takes the liquid's
+/// constants; any other chunk is one branch-free loop (the exponential is
+/// [`exp_fast`] for every cell, the saturated states selected), so it
+/// vectorises.
 #[inline(always)]
 pub(super) fn cell_pass(d: &Disc, p: &[f64], w: &mut Work) {
     let n = p.len();
-    let eos = &d.eos;
+    let k = d.eos.constants();
+    let liquid = k.liquid();
     let c = &mut w.cells;
-    let (rho, drho, gr, dgr, mu, dmu) = (
-        &mut c.rho[..n],
-        &mut c.drho[..n],
-        &mut c.gr[..n],
-        &mut c.dgr[..n],
-        &mut c.mu[..n],
-        &mut c.dmu[..n],
-    );
-    let e_buf = &mut w.exp2z[..n];
-    if w.wide {
-        for (e, &pi) in e_buf.iter_mut().zip(p) {
-            *e = exp_fast(2.0 * eos.beta * (pi - eos.p0));
+    // Whether the chunk at i0 is whole and all liquid.
+    let liquid_chunk = |i0: usize| {
+        i0 + CHUNK <= n
+            && p[i0..i0 + CHUNK]
+                .iter()
+                .fold(true, |all, &x| all & k.is_liquid(x))
+    };
+    let mut i0 = 0;
+    while i0 < n {
+        // A run of chunks of one kind: [i0, i1).
+        let kind = liquid_chunk(i0);
+        let mut i1 = i0 + CHUNK;
+        while i1 < n && liquid_chunk(i1) == kind {
+            i1 += CHUNK;
         }
-    } else {
-        for (e, &pi) in e_buf.iter_mut().zip(p) {
-            let z = eos.beta * (pi - eos.p0);
-            *e = if eos_saturated(z) {
-                0.0
-            } else {
-                exp_fast(2.0 * z)
-            };
+        let i1 = i1.min(n);
+        if kind {
+            c.rho[i0..i1].fill(liquid.rho);
+            c.drho[i0..i1].fill(liquid.drho);
+            c.gr[i0..i1].fill(liquid.gr);
+            c.dgr[i0..i1].fill(liquid.dgr);
+            c.mu[i0..i1].fill(liquid.mu);
+            c.dmu[i0..i1].fill(liquid.dmu);
+        } else {
+            mixture_run(&d.eos, &k, &p[i0..i1], &mut w.exp2z[i0..i1], c, i0);
         }
-    }
-    let k = eos.constants();
-    for i in 0..n {
-        let s = k.state(p[i], e_buf[i]);
-        rho[i] = s.rho;
-        drho[i] = s.drho;
-        gr[i] = s.gr;
-        dgr[i] = s.dgr;
-        mu[i] = s.mu;
-        dmu[i] = s.dmu;
+        i0 = i1;
     }
 }
+
+/// The cells of `p` (starting at cell `i0`) one by one, branch-free so
+/// that both loops vectorise: the exponentials into `e`, then the states.
+#[inline(always)]
+fn mixture_run(
+    eos: &MixtureEos,
+    k: &CellConstants,
+    p: &[f64],
+    e: &mut [f64],
+    c: &mut CellColumns,
+    i0: usize,
+) {
+    let m = p.len();
+    let e = &mut e[..m];
+    for (ei, &pi) in e.iter_mut().zip(p) {
+        *ei = exp_fast(2.0 * eos.beta * (pi - eos.p0));
+    }
+    let (rho, drho, gr, dgr, mu, dmu) = (
+        &mut c.rho[i0..i0 + m],
+        &mut c.drho[i0..i0 + m],
+        &mut c.gr[i0..i0 + m],
+        &mut c.dgr[i0..i0 + m],
+        &mut c.mu[i0..i0 + m],
+        &mut c.dmu[i0..i0 + m],
+    );
+    for j in 0..m {
+        let s = k.state(p[j], e[j]);
+        rho[j] = s.rho;
+        drho[j] = s.drho;
+        gr[j] = s.gr;
+        dgr[j] = s.dgr;
+        mu[j] = s.mu;
+        dmu[j] = s.dmu;
+    }
+}
+
+/// Cells per chunk of the cell pass (one AVX-512 vector).
+const CHUNK: usize = 8;
 
 /// Pass 2: the mass flux through every face. Without flow factors the
 /// interior faces run a specialised loop (no per-face branch; vectorises).
@@ -689,6 +720,58 @@ mod jacobian_tests {
             // Stay inside one branch of Table A1's φs (it jumps at H = 5).
             let (sigma, h0) = if thick { (1e-6, 6e-6 + 20e-6 * h0f) } else { (5e-6, 3e-6 + 20e-6 * h0f * 0.05) };
             check(Profile::Flat, false, true, sigma, p, h0, v, false);
+        }
+    }
+}
+
+#[cfg(test)]
+mod cell_pass_tests {
+    //! The chunked cell pass equals the EOS evaluated cell by cell.
+    use super::super::Solver;
+    use super::*;
+    use crate::physics::params::{ModelParams, SolverSettings};
+    use proptest::prelude::*;
+
+    fn bits(x: f64) -> u64 {
+        x.to_bits()
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+
+        /// Runs of liquid, mixture and vapour cells (and NaN), chunks
+        /// partly liquid and a partial chunk at the end: every column is
+        /// `MixtureEos::cell` bit for bit.
+        #[test]
+        fn the_chunked_cell_pass_equals_the_eos_cell_by_cell(
+            runs in prop::collection::vec(
+                (
+                    prop_oneof![
+                        // Pure liquid, mixture near p0, vapour, NaN.
+                        4 => 1e6..4e6f64,
+                        2 => 0.0..2e5f64,
+                        1 => -1e3..0.0f64,
+                        1 => Just(f64::NAN),
+                    ],
+                    1..24usize,
+                ),
+                1..8,
+            ),
+        ) {
+            let mut p: Vec<f64> = runs.iter().flat_map(|&(x, len)| vec![x; len]).collect();
+            p.resize(p.len().max(8), 2e6);
+            let st = SolverSettings { cells: p.len(), ..Default::default() };
+            let mut s = Solver::new(&ModelParams::default(), &st).unwrap();
+            cell_pass(&s.d, &p, &mut s.w);
+            let c = &s.w.cells;
+            for (i, &pi) in p.iter().enumerate() {
+                let e = s.d.eos.cell(pi);
+                let got = [c.rho[i], c.drho[i], c.gr[i], c.dgr[i], c.mu[i], c.dmu[i]];
+                let want = [e.rho, e.drho, e.gr, e.dgr, e.mu, e.dmu];
+                for (g, w) in got.iter().zip(&want) {
+                    prop_assert_eq!(bits(*g), bits(*w), "cell {} at p = {}", i, pi);
+                }
+            }
         }
     }
 }

@@ -393,7 +393,6 @@ impl Solver {
             Isa::Avx512 => best == Isa::Avx512,
         };
         self.isa = if ok { isa } else { Isa::Baseline };
-        self.w.wide = self.isa != Isa::Baseline;
         self.isa
     }
 
