@@ -6,7 +6,10 @@
 //! cargo run --release --example bench_contacts -- [CONTACTS [CELLS [SECONDS [MAX_WORKERS [CPU...]]]]]
 //! ```
 //! Defaults: 8 contacts, 256 cells, 10 s per worker count, workers 0 and 1.
-//! CPU...: the loop's CPU then each worker's (pinned when given). Every
+//! CPU...: the loop's CPU then each worker's (pinned when given).
+//! `SPIN_US=N` in the environment busy-waits the last N µs before each
+//! deadline, as the node's `node.timer_spin_us` does (≥ 1000: never sleep).
+//! Every
 //! contact follows v = sin 2π(t + i/8) m/s under its own load. Run
 //! `../shared/tools/timer-baseline SECONDS` in the same minute to read the
 //! misses.
@@ -45,6 +48,11 @@ fn main() {
         arg(3, 1.0) as usize,
     );
     let cpus: Vec<usize> = a.iter().skip(4).filter_map(|s| s.parse().ok()).collect();
+    let spin_ns: u64 = std::env::var("SPIN_US")
+        .ok()
+        .and_then(|s| s.parse::<u64>().ok())
+        .unwrap_or(0)
+        .saturating_mul(1000);
     let mut yaml =
         format!("/**:\n  ros__parameters:\n    solver: {{cells: {cells}}}\n    contacts:\n");
     for i in 0..n {
@@ -56,7 +64,10 @@ fn main() {
     let config = Config::from_yaml(&yaml, &Origin::Embedded, &[]).expect("config");
     let clock: Arc<dyn Clock> = Arc::new(SystemClock::new());
     pin(cpus.first().copied());
-    println!("{n} contacts, N = {cells}, 1 kHz, {seconds} s per run");
+    println!(
+        "{n} contacts, N = {cells}, 1 kHz, {seconds} s per run, spin {} µs",
+        spin_ns / 1000
+    );
     for workers in 0..=max_workers.min(n.saturating_sub(1)) {
         let worker_cpus = cpus.clone();
         let mut set = ContactSet::new(
@@ -75,7 +86,8 @@ fn main() {
         let (t0, mut misses) = (clock.now_ns() + 1_000_000, 0u64);
         for k in 0..periods {
             let deadline = t0 + k * 1_000_000;
-            clock.sleep_until_ns(deadline);
+            clock.sleep_until_ns(deadline.saturating_sub(spin_ns));
+            clock.spin_until_ns(deadline);
             let t = k as f64 * 1e-3;
             for (i, x) in v.iter_mut().enumerate() {
                 *x = (2.0 * std::f64::consts::PI * (t + i as f64 / 8.0)).sin();

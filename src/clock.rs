@@ -20,6 +20,11 @@ pub trait Clock: Send + Sync {
     fn now_ns(&self) -> u64;
     /// Return at monotonic time `deadline_ns` or later (at once if past).
     fn sleep_until_ns(&self, deadline_ns: u64);
+    /// Return at monotonic time `deadline_ns` or later, busy-waiting where
+    /// the clock can (a clock that others drive sleeps instead).
+    fn spin_until_ns(&self, deadline_ns: u64) {
+        self.sleep_until_ns(deadline_ns)
+    }
     /// Wall-clock (ROS) time, ns since the Unix epoch. May jump (NTP).
     fn wall_ns(&self) -> u64;
 }
@@ -68,6 +73,12 @@ impl Clock for SystemClock {
         if left > SPIN_NS {
             std::thread::sleep(Duration::from_nanos(left - SPIN_NS));
         }
+        while self.now_ns() < deadline_ns {
+            std::hint::spin_loop();
+        }
+    }
+
+    fn spin_until_ns(&self, deadline_ns: u64) {
         while self.now_ns() < deadline_ns {
             std::hint::spin_loop();
         }
@@ -327,6 +338,18 @@ impl WallStamps {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_system_spin_returns_at_or_after_its_deadline_and_a_simulated_one_moves_time() {
+        let c = SystemClock::new();
+        let due = c.now_ns() + 200_000;
+        c.spin_until_ns(due);
+        assert!(c.now_ns() >= due);
+        // A driven clock cannot be spun on: the default waits like a sleep.
+        let s = SimClock::new(0);
+        s.spin_until_ns(3_000_000);
+        assert_eq!(s.now_ns(), 3_000_000);
+    }
 
     #[test]
     fn a_simulated_sleep_moves_time_to_the_deadline_at_once() {

@@ -220,6 +220,77 @@ fn a_stall_beyond_the_catch_up_bound_is_advanced_in_one_long_step() {
     assert_eq!(est.last().unwrap().stamp_ns, WALL0 + 1000 * MS);
 }
 
+/// A simulated clock that logs how the loop waits: ("sleep" | "spin", deadline).
+struct WaitLog {
+    inner: SimClock,
+    waits: std::sync::Mutex<Vec<(&'static str, u64)>>,
+}
+
+impl Clock for WaitLog {
+    fn now_ns(&self) -> u64 {
+        self.inner.now_ns()
+    }
+    fn sleep_until_ns(&self, deadline_ns: u64) {
+        self.waits.lock().unwrap().push(("sleep", deadline_ns));
+        self.inner.sleep_until_ns(deadline_ns)
+    }
+    fn spin_until_ns(&self, deadline_ns: u64) {
+        self.waits.lock().unwrap().push(("spin", deadline_ns));
+        self.inner.sleep_until_ns(deadline_ns)
+    }
+    fn wall_ns(&self) -> u64 {
+        self.inner.wall_ns()
+    }
+}
+
+#[test]
+fn timer_spin_busy_waits_the_last_microseconds_of_each_period_and_changes_no_estimate() {
+    let run = |spin_us: u64| {
+        let mut cfg = timer_config();
+        cfg.node.timer_spin_us = spin_us;
+        let link = MemoryLink::new(1000);
+        let mut peer = link.peer();
+        peer.send(&velocity(0.3, 1)).unwrap();
+        let clock = Arc::new(WaitLog {
+            inner: SimClock::new(WALL0),
+            waits: Default::default(),
+        });
+        let mut l = Loop::new(
+            &cfg,
+            vec![Box::new(link.node())],
+            None,
+            None,
+            Default::default(),
+        )
+        .unwrap()
+        .with_clock(clock.clone());
+        let s = l.run(&AtomicBool::new(false), Some(Duration::from_millis(50)));
+        let waits = clock.waits.lock().unwrap().clone();
+        (s, drain(&mut peer), waits)
+    };
+    let (slept, est_slept, waits_slept) = run(0);
+    assert_eq!(slept.steps, 50);
+    assert!(waits_slept.iter().all(|w| w.0 == "sleep"));
+    for spin_us in [300, 5_000] {
+        let (spun, est_spun, waits) = run(spin_us);
+        assert_eq!(spun.steps, 50, "spin {spin_us} µs");
+        assert_eq!(spun.deadline_misses, 0);
+        // Each period: sleep to the deadline less the spin, then spin to it.
+        let steps: Vec<_> = waits.chunks(2).collect();
+        assert_eq!(steps.len(), 50);
+        for (k, w) in steps.iter().enumerate() {
+            let due = (k as u64 + 1) * MS;
+            assert_eq!(w[0], ("sleep", due.saturating_sub(spin_us * 1000)));
+            assert_eq!(w[1], ("spin", due));
+        }
+        assert_eq!(est_spun.len(), est_slept.len());
+        for (a, b) in est_spun.iter().zip(&est_slept) {
+            assert_eq!(a.stamp_ns, b.stamp_ns);
+            assert_eq!(a.friction_force_n.to_bits(), b.friction_force_n.to_bits());
+        }
+    }
+}
+
 #[test]
 fn a_wall_clock_set_back_changes_no_deadline_and_stamps_stay_monotonic() {
     let cfg = timer_config();

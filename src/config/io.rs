@@ -94,6 +94,12 @@ pub struct NodeConfig {
     /// transport's wake-up, µs (0 = always block; a spin trades one core for
     /// a lower wake-up latency).
     pub lockstep_spin_us: u64,
+    /// Timer mode: busy-wait this long before each deadline instead of
+    /// sleeping, µs (0 = sleep; the period or more = the loop never sleeps).
+    /// A spinning loop keeps its core, caches and branch predictors to
+    /// itself, so a step after the wait costs what a step in a tight loop
+    /// does; it costs one busy core.
+    pub timer_spin_us: u64,
     /// Timer mode: a loop that wakes up late catches up the lost steps one
     /// by one (model time = wall time) when it is at most this far behind,
     /// s; further behind, it advances the lost time in one backward-Euler
@@ -124,6 +130,7 @@ impl Default for NodeConfig {
             queue_capacity: 4096,
             frame_id: "slider".into(),
             lockstep_spin_us: 0,
+            timer_spin_us: 0,
             max_catch_up_s: 0.1,
             contact_workers: 0,
             realtime: RealtimeConfig::default(),

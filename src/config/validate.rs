@@ -353,6 +353,7 @@ impl Config {
         oc("node.statistics_rate_hz", n.statistics_rate_hz, 0.0, 1000.0)?;
         cc("node.queue_capacity", n.queue_capacity as f64, 16.0, 1e7)?;
         cc("node.lockstep_spin_us", n.lockstep_spin_us as f64, 0.0, 1e6)?;
+        cc("node.timer_spin_us", n.timer_spin_us as f64, 0.0, 1e6)?;
         cc("node.max_catch_up_s", n.max_catch_up_s, 0.0, 60.0)?;
         cc(
             "node.realtime.priority",

@@ -142,6 +142,8 @@ pub struct LoopSettings {
     pub profile_every: u64,
     pub statistics_every: u64,
     pub lockstep_spin_ns: u64,
+    /// Timer mode: busy-wait before each deadline, ns.
+    pub timer_spin_ns: u64,
     /// Lost steps caught up one by one before a long step is taken.
     pub max_catch_up_steps: u64,
 }
@@ -182,6 +184,7 @@ impl LoopSettings {
             profile_every: every(c.node.profile_rate_hz),
             statistics_every: every(c.node.statistics_rate_hz),
             lockstep_spin_ns: c.node.lockstep_spin_us.saturating_mul(1000),
+            timer_spin_ns: c.node.timer_spin_us.saturating_mul(1000),
             max_catch_up_steps: secs_to_ns(c.node.max_catch_up_s) / dt_ns,
         }
     }

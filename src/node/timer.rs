@@ -19,7 +19,13 @@ impl Loop {
             if end.is_some_and(|e| due > e) || stop.load(Ordering::Relaxed) {
                 break;
             }
-            self.clock.sleep_until_ns(due);
+            if self.s.timer_spin_ns > 0 {
+                self.clock
+                    .sleep_until_ns(due.saturating_sub(self.s.timer_spin_ns));
+                self.clock.spin_until_ns(due);
+            } else {
+                self.clock.sleep_until_ns(due);
+            }
             let woke = self.clock.now_ns();
             let late = woke.saturating_sub(due);
             if k == self.first_step {
