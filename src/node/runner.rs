@@ -154,6 +154,24 @@ fn status_thread(
     })
 }
 
+/// A timer loop that spins (nearly) the whole period under SCHED_FIFO
+/// exceeds the kernel's real-time budget (`sched_rt_runtime_us`, 95 % by
+/// default): the kernel then stalls it for the rest of each second.
+fn spin_under_fifo(config: &Config) -> Option<String> {
+    let n = &config.node;
+    let period_us = config.solver.dt_s * 1e6;
+    (n.realtime.fifo
+        && n.step_mode == crate::config::StepMode::Timer
+        && n.timer_spin_us as f64 >= 0.9 * period_us)
+        .then(|| {
+            format!(
+                "node.timer_spin_us = {} with node.realtime.fifo: a loop that spins {:.0} % of its {period_us:.0} µs period under SCHED_FIFO runs into the kernel's real-time throttling (sched_rt_runtime_us) and stalls; spin without fifo on a core of its own, or spin less",
+                n.timer_spin_us,
+                (100.0 * n.timer_spin_us as f64 / period_us).min(100.0)
+            )
+        })
+}
+
 /// Run the node until `stop`, the duration or the demo ends.
 pub fn run_node(
     config: &Config,
@@ -177,6 +195,7 @@ pub fn run_node(
             }
         }
     }
+    report.warnings.extend(spin_under_fifo(config));
     let profile =
         (config.node.profile_rate_hz > 0.0).then(|| ProfileSlot::new(config.solver.cells));
     // Recording: checked and created before anything runs; a path that
@@ -383,4 +402,24 @@ pub fn stop_on_signals() -> Arc<AtomicBool> {
         }
     }
     stop
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_whole_period_spin_under_fifo_is_warned_about_and_a_short_one_is_not() {
+        let mut c = Config::default();
+        c.node.timer_spin_us = 1000;
+        assert_eq!(spin_under_fifo(&c), None, "no fifo: no throttling");
+        c.node.realtime.fifo = true;
+        let w = spin_under_fifo(&c).expect("warned");
+        assert!(w.contains("node.timer_spin_us = 1000"), "{w}");
+        c.node.timer_spin_us = 200;
+        assert_eq!(spin_under_fifo(&c), None, "20 % of the period");
+        c.node.timer_spin_us = 1000;
+        c.node.step_mode = crate::config::StepMode::Lockstep;
+        assert_eq!(spin_under_fifo(&c), None, "lockstep ignores timer_spin_us");
+    }
 }
