@@ -7,8 +7,9 @@
 //! to back on the same inputs, so the figures are warm-cache costs; their
 //! sum is close to a one-iteration step.
 
-use super::assembly::{balance_row, cell_pass, face_pass, row_pass};
+use super::assembly::{balance_row, face_pass, row_pass};
 use super::bordered::{direction_with_old_factors, factor_solve};
+use super::cell_pass::cell_pass;
 use super::{Ctx, H0Mode, Isa, Outcome, Solver};
 use crate::physics::estimate::Status;
 use crate::physics::scheme::StepCoefficients;

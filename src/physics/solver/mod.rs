@@ -54,6 +54,7 @@
 mod assembly;
 mod bordered;
 mod breakdown;
+mod cell_pass;
 mod history;
 mod lanes;
 mod newton;
