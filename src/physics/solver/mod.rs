@@ -94,6 +94,7 @@ pub(crate) struct Disc {
     pub v_reg: f64,
     pub min_film: f64,
     pub drivetrain: crate::physics::drivetrain::Drivetrain,
+    pub guard: step::PredictionGuard,
 }
 
 /// Which instruction-set version of the step runs (detected once, in
@@ -313,6 +314,7 @@ impl Solver {
             v_reg: model.contact.sign_regularization,
             min_film: model.contact.min_film,
             drivetrain: model.drivetrain,
+            guard: step::PredictionGuard::new(&eos, model.lubricant.saturation_pressure),
         })
     }
 

@@ -1,9 +1,40 @@
 //! One time step: input checks, the quadratic predictor, Newton and its
 //! fallbacks (retry from the last state, then backward-Euler sub-steps), the
 //! optional film floor.
+//!
+//! ## The predictor's guard
+//!
+//! Extrapolation in time is exact to O(Δt³) while the film evolves smoothly,
+//! but not where a cell's pressure falls fast and then levels off, as in the
+//! vapour-pocket collapse after a reversal: at 10 kN a liquid cell at
+//! 1.58 bar falling 0.75 bar a step was predicted at 0.09 bar, deep in the
+//! vapour (α ≈ 0.9), and settled at 1.3 bar. Newton then has to cross the
+//! EOS's steep transition twice (the crawl that the vapour-fraction map of
+//! `newton.rs` eases). So a cell on the liquid side whose extrapolation
+//! crosses into the mixture starts in the liquid instead:
+//!
+//! ```text
+//! p_start = p_s + ¾ (p_n − p_s)   if p_n > p_s and p_extrapolated < p_s − 0.3/β
+//!         = p_extrapolated        otherwise
+//! ```
+//!
+//! The start changes, not the equations: the converged state is the same
+//! within the tolerance. On the reciprocating case (N = 128, 256, 512; 5,
+//! 10 and 20.8 kN; 0.5, 1 and 2 Hz) the worst step of a cycle takes 5–6
+//! Newton iterations instead of 5–10 (8 at 10 kN, 1 Hz, N = 256), and steps
+//! that converge in one iteration never trigger it. ¾ and 0.3/β were picked
+//! among ½…1 and 0…1/β on those cases; clamping at p_s itself (share 0)
+//! left 6 iterations.
+//!
+//! | symbol | meaning | unit |
+//! |---|---|---|
+//! | p_n | the cell's pressure at the last step | Pa |
+//! | p_s | saturation pressure (α = α_s) | Pa |
+//! | β | steepness of the EOS transition (`eos.rs`) | 1/Pa |
 
 use super::newton::MAX_SUBSTEPS;
 use super::{Ctx, H0Mode, Isa, Solver};
+use crate::physics::eos::MixtureEos;
 use crate::physics::estimate::{Diagnostics, Estimate, Regime, Status};
 use crate::physics::params::{Method, MAX_ABS_VELOCITY, MAX_LOAD, MAX_STEP_OVER};
 use crate::physics::scheme::StepCoefficients;
@@ -156,15 +187,18 @@ impl Solver {
         let h_backup = self.h0;
         // Warm start: pressure and h0 extrapolated in time, quadratically
         // once three levels exist (error O(Δt³): within the tolerance for
-        // smooth motion, so such steps take one Newton iteration).
+        // smooth motion, so such steps take one Newton iteration), with a
+        // liquid cell kept out of the vapour ([`PredictionGuard`]).
         let quadratic = self.p_hist == 2 && self.hist_len >= 2;
         if quadratic {
+            let guard = self.d.guard;
             for ((p, o), o2) in self.p.iter_mut().zip(&self.p_old).zip(&self.p_old2) {
-                *p = 3.0 * (*p - o) + o2;
+                *p = guard.apply(*p, 3.0 * (*p - o) + o2);
             }
         } else if self.p_hist >= 1 && self.hist_len >= 2 {
+            let guard = self.d.guard;
             for (p, o) in self.p.iter_mut().zip(&self.p_old) {
-                *p = 2.0 * *p - o;
+                *p = guard.apply(*p, 2.0 * *p - o);
             }
         }
         match gap {
@@ -240,6 +274,82 @@ impl Solver {
         e.diagnostics.substeps = substeps as u32;
         self.last = Some(e);
         e
+    }
+}
+
+/// The predictor's guard (module doc): the thresholds for one lubricant.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct PredictionGuard {
+    /// p_s: a cell above it is on the liquid side (Pa).
+    pub liquid_above: f64,
+    /// p_s − [`GUARD_MARGIN`]/β: an extrapolation below it has crossed
+    /// into the mixture (Pa).
+    pub vapour_below: f64,
+}
+
+/// How far below p_s, in units of 1/β, an extrapolation must land for the
+/// guard to act: 0.3/β ≈ 6.5 kPa by default (α ≈ 1.8 % there against
+/// α_s = 1 %), so that a smooth dip just below p_s is left alone.
+const GUARD_MARGIN: f64 = 0.3;
+
+/// The share of its height above p_s that a guarded cell keeps.
+const GUARD_KEEP: f64 = 0.75;
+
+impl PredictionGuard {
+    pub(crate) fn new(eos: &MixtureEos, saturation_pressure: f64) -> Self {
+        Self {
+            liquid_above: saturation_pressure,
+            vapour_below: saturation_pressure - GUARD_MARGIN / eos.beta,
+        }
+    }
+
+    /// The start of a cell at `p` (Pa) whose extrapolation is `predicted`
+    /// (branch-free: the predictor's loop vectorises).
+    #[inline(always)]
+    pub(crate) fn apply(&self, p: f64, predicted: f64) -> f64 {
+        if p > self.liquid_above && predicted < self.vapour_below {
+            self.liquid_above + GUARD_KEEP * (p - self.liquid_above)
+        } else {
+            predicted
+        }
+    }
+}
+
+#[cfg(test)]
+mod guard_tests {
+    use super::PredictionGuard;
+    use crate::physics::eos::MixtureEos;
+    use crate::physics::params::Lubricant;
+
+    fn guard() -> (PredictionGuard, MixtureEos) {
+        let l = Lubricant::default();
+        let eos = MixtureEos::new(&l);
+        (PredictionGuard::new(&eos, l.saturation_pressure), eos)
+    }
+
+    #[test]
+    fn a_liquid_cell_extrapolated_into_the_vapour_starts_at_the_saturation_pressure() {
+        let (g, eos) = guard();
+        // The case from the reciprocating run at 10 kN: 1.58 bar, predicted
+        // at 0.09 bar (α ≈ 0.9); it starts at 1 + 0.75 · 0.58 bar.
+        assert!(eos.alpha(9.0e3) > 0.8);
+        approx::assert_relative_eq!(g.apply(1.58e5, 9.0e3), 1.435e5, max_relative = 1e-12);
+        approx::assert_relative_eq!(g.apply(1.58e5, -2.0e4), 1.435e5, max_relative = 1e-12);
+        // The threshold sits 0.3/β below p_s, at α ≈ 1.8 %.
+        approx::assert_relative_eq!(eos.alpha(g.vapour_below), 0.0182, epsilon = 2e-4);
+    }
+
+    #[test]
+    fn smooth_extrapolations_and_cells_already_in_the_mixture_are_left_alone() {
+        let (g, _) = guard();
+        // Liquid staying liquid, or dipping just below p_s.
+        assert_eq!(g.apply(3.0e5, 2.5e5), 2.5e5);
+        assert_eq!(g.apply(1.02e5, 9.6e4), 9.6e4);
+        // A cell already in the mixture follows its extrapolation, down or up.
+        assert_eq!(g.apply(8.0e4, 2.0e4), 2.0e4);
+        assert_eq!(g.apply(8.0e4, 3.0e5), 3.0e5);
+        // NaN is not hidden.
+        assert!(g.apply(1.5e5, f64::NAN).is_nan());
     }
 }
 
