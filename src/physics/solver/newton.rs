@@ -47,6 +47,8 @@
 //! step (absolute pressures below zero). When the first update from the
 //! prediction exceeds [`PREDICTION_RESTART`], the step also tries the
 //! previous state as the start and keeps the one with the smaller update.
+//! (Before Newton starts, the predictor's guard in `step.rs` already keeps a
+//! falling liquid cell from being extrapolated into the vapour.)
 //!
 //! | symbol | meaning | unit |
 //! |---|---|---|
