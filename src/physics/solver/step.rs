@@ -190,13 +190,12 @@ impl Solver {
         // smooth motion, so such steps take one Newton iteration), with a
         // liquid cell kept out of the vapour ([`PredictionGuard`]).
         let quadratic = self.p_hist == 2 && self.hist_len >= 2;
+        let guard = self.d.guard;
         if quadratic {
-            let guard = self.d.guard;
             for ((p, o), o2) in self.p.iter_mut().zip(&self.p_old).zip(&self.p_old2) {
                 *p = guard.apply(*p, 3.0 * (*p - o) + o2);
             }
         } else if self.p_hist >= 1 && self.hist_len >= 2 {
-            let guard = self.d.guard;
             for (p, o) in self.p.iter_mut().zip(&self.p_old) {
                 *p = guard.apply(*p, 2.0 * *p - o);
             }
@@ -328,7 +327,8 @@ mod guard_tests {
     }
 
     #[test]
-    fn a_liquid_cell_extrapolated_into_the_vapour_starts_at_the_saturation_pressure() {
+    fn a_liquid_cell_extrapolated_into_the_vapour_starts_in_the_liquid_above_the_saturation_pressure(
+    ) {
         let (g, eos) = guard();
         // The case from the reciprocating run at 10 kN: 1.58 bar, predicted
         // at 0.09 bar (α ≈ 0.9); it starts at 1 + 0.75 · 0.58 bar.
