@@ -24,6 +24,8 @@ pub enum SimulationError {
     Signal(#[from] SignalError),
     #[error(transparent)]
     Output(#[from] OutputError),
+    #[error(transparent)]
+    Interrupted(#[from] crate::interrupt::Interrupted),
     #[error("invalid argument `{name}` = {value}: {message}")]
     Argument {
         name: &'static str,
@@ -167,31 +169,59 @@ pub fn check_signals(
     velocity: &Signal,
     load: &Signal,
 ) -> Result<(), SimulationError> {
-    let vmax = config.node.max_abs_velocity_m_s;
-    if velocity.max_abs().is_nan() || velocity.max_abs() > vmax {
-        return Err(arg_err(
+    let limits = crate::config::InputLimits::of(config);
+    let v = velocity.max_abs();
+    limits.check_velocity(v).map_err(|e| {
+        arg_err(
             "--velocity",
             velocity,
-            format!(
-                "reaches |v| = {} m/s, beyond node.max_abs_velocity_m_s = {vmax} m/s",
-                Num(velocity.max_abs())
-            ),
-        ));
-    }
-    let (lo, hi) = (config.node.min_load_n, config.node.max_load_n);
+            format!("reaches |v| = {}: {e}", Num(v)),
+        )
+    })?;
     let (fmin, fmax) = load.range();
-    if fmin.is_nan() || fmax.is_nan() || fmin < lo || fmax > hi {
-        return Err(arg_err(
-            "--load",
-            load,
-            format!(
-                "spans [{}, {}] N; a load must lie in [node.min_load_n, node.max_load_n] = [{lo}, {hi}] N",
-                Num(fmin),
-                Num(fmax)
-            ),
-        ));
+    for f in [fmin, fmax] {
+        limits.check_load(f).map_err(|e| {
+            arg_err(
+                "--load",
+                load,
+                format!("spans [{}, {}] N: {e}", Num(fmin), Num(fmax)),
+            )
+        })?;
     }
     Ok(())
+}
+
+/// The number of steps of a run of `duration_s`, checked: in (0, 1e7] s
+/// and at least one step of `solver.dt_s`.
+pub fn check_duration(config: &Config, duration_s: f64) -> Result<u64, SimulationError> {
+    if !(duration_s.is_finite() && duration_s > 0.0 && duration_s <= 1e7) {
+        return Err(arg_err(
+            "--duration",
+            duration_s,
+            "must be a number of seconds in (0, 1e7]",
+        ));
+    }
+    let dt = config.solver.dt_s;
+    let steps = (duration_s / dt).round();
+    if steps < 1.0 {
+        return Err(arg_err(
+            "--duration",
+            duration_s,
+            format!("is shorter than one step ({dt} s)"),
+        ));
+    }
+    Ok(steps as u64)
+}
+
+/// The steady state at the start of a run (one solve): what a run's
+/// first row looks like, e.g. to estimate the size of its output.
+pub fn sample_estimate(
+    config: &Config,
+    velocity: &Signal,
+    load: &Signal,
+) -> Result<Estimate, SimulationError> {
+    let mut solver = Solver::new(&config.model(), &config.solver_settings())?;
+    Ok(solver.initialize_steady(velocity.at(0.0), load.at(0.0)))
 }
 
 /// The inputs of a transient run: velocity (m/s), load (N) and lubricant
@@ -203,25 +233,19 @@ pub struct Inputs<'a> {
     pub temperature: Option<&'a Signal>,
 }
 
-/// Check a temperature signal: within [-60, 300] °C and above Vogel's C.
+/// Check a temperature signal against the configuration's viscosity law
+/// ([`crate::config::ViscosityLaw::check_span`], the rule every entry point uses).
 pub fn check_temperature(config: &Config, t: &Signal) -> Result<(), SimulationError> {
     let (lo, hi) = t.range();
-    let floor = match config.viscosity_model() {
-        crate::physics::ViscosityModel::Vogel(v) => v.c_c.max(-60.0),
-        crate::physics::ViscosityModel::Constant => -60.0,
-    };
-    if lo.is_nan() || hi.is_nan() || lo <= floor || lo < -60.0 || hi > 300.0 {
-        return Err(arg_err(
-            "--temperature",
-            t,
-            format!(
-                "spans [{}, {}] °C; a temperature must lie in [-60, 300] °C and above lubricant.vogel_c_c",
-                Num(lo),
-                Num(hi)
-            ),
-        ));
-    }
-    Ok(())
+    crate::config::ViscosityLaw::of(config)
+        .check_span(lo, hi)
+        .map_err(|e| {
+            arg_err(
+                "--temperature",
+                t,
+                format!("spans [{}, {}] °C: {e}", Num(lo), Num(hi)),
+            )
+        })
 }
 
 /// Run the transient model over `duration_s` and stream every estimate to
@@ -257,33 +281,21 @@ pub fn simulate_inputs(
     mut on_step: impl FnMut(&Estimate, u64, f64) -> Result<(), SimulationError>,
 ) -> Result<SimulateReport, SimulationError> {
     let (velocity, load) = (inputs.velocity, inputs.load);
-    if !(duration_s.is_finite() && duration_s > 0.0 && duration_s <= 1e7) {
-        return Err(arg_err(
-            "--duration",
-            duration_s,
-            "must be a number of seconds in (0, 1e7]",
-        ));
-    }
+    let steps = check_duration(config, duration_s)?;
     check_signals(config, velocity, load)?;
     if let Some(t) = inputs.temperature {
         check_temperature(config, t)?;
     }
     let t_ref = config.lubricant.reference_temperature_c;
     let temperature_at = |t: f64| inputs.temperature.map_or(t_ref, |s| s.at(t));
-    let follows = inputs.temperature.is_some()
-        && config.viscosity_model() != crate::physics::ViscosityModel::Constant;
+    let law = crate::config::ViscosityLaw::of(config);
+    let follows = inputs.temperature.is_some() && law.follows_temperature();
+    // Checked over the signal's whole range above: every value passes.
+    let viscosity_at = |t_c: f64| law.viscosity_at(t_c).unwrap_or(law.mu_ref);
     let settings = config.solver_settings();
-    let steps = (duration_s / settings.dt).round() as u64;
-    if steps == 0 {
-        return Err(arg_err(
-            "--duration",
-            duration_s,
-            format!("is shorter than one step ({} s)", settings.dt),
-        ));
-    }
     let mut solver = Solver::new(&config.model(), &settings)?;
     if follows {
-        solver.set_liquid_viscosity(config.viscosity_at(temperature_at(0.0)));
+        solver.set_liquid_viscosity(viscosity_at(temperature_at(0.0)));
     }
     solver.initialize_steady(velocity.at(0.0), load.at(0.0));
     let period = velocity.period();
@@ -296,7 +308,7 @@ pub fn simulate_inputs(
         let (v, f) = (velocity.at(t), load.at(t));
         let temperature = temperature_at(t);
         if follows {
-            solver.set_liquid_viscosity(config.viscosity_at(temperature));
+            solver.set_liquid_viscosity(viscosity_at(temperature));
         }
         let start = Instant::now();
         let e = solver.step(v, f);

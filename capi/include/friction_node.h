@@ -135,8 +135,10 @@ int32_t fn_model_new_from_file(const char *path, struct FnModel **out);
 // `load_n`; write the estimate to `*out`. Does not allocate. `dt_s` equal
 // to the configured step (see `fn_model_dt`) continues BDF2; another
 // length in (0, 3600] s takes one backward-Euler step. Inputs outside the
-// physical envelope are not errors: the estimate's status says so and
-// holds the last good values.
+// configuration's envelope (`node.max_abs_velocity_m_s`,
+// `node.min_load_n`…`node.max_load_n`: the commands the node rejects) are
+// not errors: the estimate's status is `input_out_of_range` and it holds
+// the last good values.
 //
 // # Safety
 // `model` is a handle from this library; `out` points to writable storage.

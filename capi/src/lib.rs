@@ -55,7 +55,7 @@
 //! seen (a wrong pointer, a model already freed while its memory still holds
 //! the freed marker), return `FN_ERROR_INVALID_HANDLE`.
 
-use friction_node::config::{Config, Origin, ResolvedContact};
+use friction_node::config::{Config, Origin, ResolvedContact, ViscosityLaw};
 use friction_node::msgs::{regime_code, status_code};
 use friction_node::node::parameters::{apply_set, declare, Declared};
 use friction_node::physics::{Estimate, Solver};
@@ -187,13 +187,28 @@ pub struct FnModel {
 }
 
 impl FnModel {
-    /// Each contact's liquid viscosity at `t` °C (where it follows it).
-    fn apply_temperature(&mut self, t: f64) {
-        for (s, c) in self.solvers.iter_mut().zip(&self.contacts) {
-            if c.config.viscosity_model() != friction_node::physics::ViscosityModel::Constant {
-                s.set_liquid_viscosity(c.config.viscosity_at(t));
+    /// Each contact's liquid viscosity at `t` °C (where it follows it), or,
+    /// changing nothing, why a contact's law refuses `t` (the envelope every
+    /// entry point checks: [`friction_node::config::ViscosityLaw`]).
+    fn apply_temperature(&mut self, t: f64) -> Result<(), String> {
+        let laws = self.contacts.iter().map(|c| ViscosityLaw::of(&c.config));
+        let several = self.contacts.len() > 1;
+        let mut viscosities = [0.0; friction_node::config::MAX_CONTACTS];
+        for (k, (law, c)) in laws.zip(&self.contacts).enumerate() {
+            viscosities[k] = law.viscosity_at(t).map_err(|e| {
+                if several {
+                    format!("contact `{}`: {e}", c.name)
+                } else {
+                    e.to_string()
+                }
+            })?;
+        }
+        for ((s, c), mu) in self.solvers.iter_mut().zip(&self.contacts).zip(viscosities) {
+            if ViscosityLaw::of(&c.config).follows_temperature() {
+                s.set_liquid_viscosity(mu);
             }
         }
+        Ok(())
     }
 }
 
@@ -317,7 +332,7 @@ pub unsafe extern "C" fn fn_model_new_from_yaml(
         let config = if text.trim().is_empty() {
             Config::load(None, &[])
         } else {
-            Config::from_yaml(text, &Origin::Embedded, &[])
+            Config::from_yaml(text, &Origin::Text("passed to fn_model_new_from_yaml"), &[])
         };
         match config {
             Ok(c) => build(c, out),
@@ -355,8 +370,10 @@ pub unsafe extern "C" fn fn_model_new_from_file(
 /// `load_n`; write the estimate to `*out`. Does not allocate. `dt_s` equal
 /// to the configured step (see `fn_model_dt`) continues BDF2; another
 /// length in (0, 3600] s takes one backward-Euler step. Inputs outside the
-/// physical envelope are not errors: the estimate's status says so and
-/// holds the last good values.
+/// configuration's envelope (`node.max_abs_velocity_m_s`,
+/// `node.min_load_n`…`node.max_load_n`: the commands the node rejects) are
+/// not errors: the estimate's status is `input_out_of_range` and it holds
+/// the last good values.
 ///
 /// # Safety
 /// `model` is a handle from this library; `out` points to writable storage.
@@ -386,15 +403,25 @@ pub unsafe extern "C" fn fn_model_step(
                 ),
             );
         };
-        let e = step_one(solver, velocity_m_s, load_n, dt_s);
+        let e = step_one(solver, &m.contacts[0].config, velocity_m_s, load_n, dt_s);
         // SAFETY: checked non-null; the caller provides the storage.
         unsafe { *out = FnEstimate::from(&e) };
         FN_OK
     })
 }
 
-/// One step of `dt_s` (BDF2 at the configured step, else backward Euler).
-fn step_one(s: &mut Solver, v: f64, load: f64, dt_s: f64) -> Estimate {
+/// One contact's step of `dt_s` (BDF2 at the configured step, else
+/// backward Euler); inputs outside the configuration's envelope
+/// (`node.max_abs_velocity_m_s`, `node.min_load_n`…`node.max_load_n`, the
+/// rule every entry point checks) are refused with the status
+/// `input_out_of_range`, as the node rejects such commands.
+fn step_one(s: &mut Solver, config: &Config, v: f64, load: f64, dt_s: f64) -> Estimate {
+    let limits = friction_node::config::InputLimits::of(config);
+    // Non-finite inputs go on to the solver, whose status names them.
+    let finite = v.is_finite() && load.is_finite();
+    if finite && (limits.check_velocity(v).is_err() || limits.check_load(load).is_err()) {
+        return s.refuse_step();
+    }
     if dt_s == s.settings().dt {
         s.step(v, load)
     } else {
@@ -454,7 +481,7 @@ pub unsafe extern "C" fn fn_model_step_contacts(
         });
         for (i, (s, c)) in m.solvers.iter_mut().zip(&m.contacts).enumerate() {
             let load = loads.map_or(c.config.contact.load_n, |l| l[i]);
-            let e = FnEstimate::from(&step_one(s, v[i], load, dt_s));
+            let e = FnEstimate::from(&step_one(s, &c.config, v[i], load, dt_s));
             out[i] = e;
             if !efforts.is_null() {
                 // SAFETY: non-null; `count` values.
@@ -603,14 +630,10 @@ pub unsafe extern "C" fn fn_model_set_temperature(model: *mut FnModel, temperatu
             Ok(m) => m,
             Err(c) => return c,
         };
-        if !(temperature_c.is_finite() && (-100.0..=400.0).contains(&temperature_c)) {
-            return fail(
-                FN_ERROR_ARGUMENT,
-                format!("temperature {temperature_c} °C is outside [-100, 400]"),
-            );
+        if let Err(e) = m.apply_temperature(temperature_c) {
+            return fail(FN_ERROR_ARGUMENT, e);
         }
         m.temperature_c = Some(temperature_c);
-        m.apply_temperature(temperature_c);
         FN_OK
     })
 }
@@ -660,6 +683,19 @@ pub unsafe extern "C" fn fn_model_set_parameter(
             Err(e) => return fail(FN_ERROR_PARAMETER, e.to_string()),
         };
         let contacts = new.resolved_contacts();
+        if let Some(t) = m.temperature_c {
+            // The temperature set before must stay valid under the new law.
+            for c in &contacts {
+                if let Err(e) = ViscosityLaw::of(&c.config).viscosity_at(t) {
+                    return fail(
+                        FN_ERROR_PARAMETER,
+                        format!(
+                            "parameter `{key}`: the temperature set before no longer holds: {e}"
+                        ),
+                    );
+                }
+            }
+        }
         let mut prepared = Vec::with_capacity(contacts.len());
         for (c, s) in contacts.iter().zip(&m.solvers) {
             let p = match Solver::prepare_model(&c.config.model(), &c.config.solver_settings()) {
@@ -684,7 +720,8 @@ pub unsafe extern "C" fn fn_model_set_parameter(
         m.config = new;
         m.contacts = contacts;
         if let Some(t) = m.temperature_c {
-            m.apply_temperature(t);
+            // Checked above: every contact's law accepts it.
+            let _ = m.apply_temperature(t);
         }
         FN_OK
     })

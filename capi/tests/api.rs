@@ -105,6 +105,21 @@ fn a_bad_configuration_is_an_error_code_with_the_key_and_value_named() {
         unsafe { fn_model_new_from_yaml(y.as_ptr(), null_mut()) },
         FN_ERROR_NULL_ARGUMENT
     );
+    // The caller's own YAML is named as such, never as the built-in file.
+    let (code, msg) = new_model("not: [valid").unwrap_err();
+    assert_eq!(code, FN_ERROR_CONFIG);
+    assert!(
+        msg.contains("YAML text passed to fn_model_new_from_yaml") && !msg.contains("built-in"),
+        "{msg}"
+    );
+    // A directory given as the file: the reason is kept.
+    let dir = CString::new(std::env::temp_dir().to_str().unwrap()).unwrap();
+    assert_eq!(
+        unsafe { fn_model_new_from_file(dir.as_ptr(), &mut m) },
+        FN_ERROR_IO
+    );
+    let msg = last_error();
+    assert!(msg.contains("directory"), "{msg}");
 }
 
 #[test]
@@ -404,4 +419,93 @@ fn one_handle_steps_several_contacts_each_equal_to_its_own_handle_with_gain_time
         unsafe { fn_model_free(h) };
     }
     assert_eq!(unsafe { fn_model_contact_count(null()) }, 0);
+}
+
+/// One case every entry point refuses: (quantity, value, overrides,
+/// expected message part).
+type EnvelopeCase = (String, f64, Vec<(String, String)>, String);
+
+/// `tests/fixtures/envelope_cases.csv`.
+fn envelope_cases() -> Vec<EnvelopeCase> {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../tests/fixtures/envelope_cases.csv"
+    );
+    let text = std::fs::read_to_string(path).expect("the cases file");
+    text.lines()
+        .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
+        .skip(1)
+        .map(|l| {
+            let mut f = l.splitn(4, ',');
+            let (q, v, o, e) = (
+                f.next().unwrap(),
+                f.next().unwrap(),
+                f.next().unwrap(),
+                f.next().unwrap(),
+            );
+            let overrides = o
+                .split(';')
+                .filter(|s| !s.is_empty())
+                .map(|kv| {
+                    let (k, v) = kv.split_once('=').unwrap();
+                    (k.to_string(), v.to_string())
+                })
+                .collect();
+            (
+                q.into(),
+                v.parse().unwrap(),
+                overrides,
+                e.trim_matches('"').into(),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn the_c_api_refuses_every_envelope_case_with_the_rule_of_every_entry_point() {
+    let cases = envelope_cases();
+    assert!(cases.len() >= 10);
+    for (quantity, value, overrides, expect) in cases {
+        let m = new_model("").unwrap();
+        for (k, v) in &overrides {
+            set(m, k, v).unwrap();
+        }
+        let before = step(m, 0.1, 20762.0, 1e-3);
+        match quantity.as_str() {
+            "temperature" => {
+                assert_eq!(
+                    unsafe { fn_model_set_temperature(m, value) },
+                    FN_ERROR_ARGUMENT,
+                    "{value}"
+                );
+                let msg = last_error();
+                assert!(msg.contains(&expect), "{value}: {msg}");
+                // Nothing changed: the next step is the one a model that
+                // never saw the temperature takes.
+                let twin = new_model("").unwrap();
+                for (k, v) in &overrides {
+                    set(twin, k, v).unwrap();
+                }
+                step(twin, 0.1, 20762.0, 1e-3);
+                let (a, b) = (step(m, 0.2, 20762.0, 1e-3), step(twin, 0.2, 20762.0, 1e-3));
+                assert_eq!(a.friction_force_n, b.friction_force_n, "{value}");
+                unsafe { fn_model_free(twin) };
+            }
+            "velocity" | "load" => {
+                let (v, f) = if quantity == "velocity" {
+                    (value, 20762.0)
+                } else {
+                    (0.1, value)
+                };
+                let e = step(m, v, f, 1e-3);
+                assert_eq!(e.status, FN_STATUS_INPUT_OUT_OF_RANGE, "{quantity} {value}");
+                assert_eq!(
+                    e.friction_force_n, before.friction_force_n,
+                    "the last good estimate"
+                );
+            }
+            q => panic!("unknown quantity {q}"),
+        }
+        unsafe { fn_model_free(m) };
+    }
 }

@@ -167,8 +167,11 @@ class Model:
     def step(self, velocity: float, load: Optional[float] = None, dt: Optional[float] = None) -> Estimate:
         """Advance one step (``dt``: default ``solver.dt_s``, BDF2; another
         length is one backward-Euler step) at ``velocity`` m/s under ``load``
-        N (default ``contact.load_n``). A numerical outcome is not an error:
-        the estimate's ``status`` says what the solver did."""
+        N (default ``contact.load_n``). A velocity or load outside the
+        configuration's envelope (``node.max_abs_velocity_m_s``,
+        ``node.min_load_n``..``node.max_load_n``: the rule ``run``, the command
+        line and the node apply) raises ``ValueError``. A numerical outcome is
+        not an error: the estimate's ``status`` says what the solver did."""
         return self._core.step(float(velocity), None if load is None else float(load), None if dt is None else float(dt))
 
     def reset(self, velocity: float = 0.0, load: Optional[float] = None) -> Estimate:
@@ -177,7 +180,10 @@ class Model:
 
     def set_temperature(self, temperature_c: float) -> None:
         """The lubricant temperature, degC (with ``lubricant.viscosity_model:
-        vogel`` the viscosity follows it)."""
+        vogel`` the viscosity follows it). A temperature outside [-60, 300]
+        degC, at or below Vogel's C, or giving a viscosity outside the
+        model's (1e-5, 100] Pa s raises ``ValueError`` (the rule of every
+        entry point)."""
         self._core.set_temperature(float(temperature_c))
 
     def run(self, t: Any, velocity: Any, load: Any = None, temperature: Any = None, as_frame: bool = False):
@@ -188,7 +194,8 @@ class Model:
 
         Returns a dict of numpy arrays, one per ``simulate`` column (row 0 is
         the initial steady state), or a pandas DataFrame with
-        ``as_frame=True``. The GIL is released while the model runs."""
+        ``as_frame=True``. The GIL is released while the model runs; Ctrl-C
+        (``KeyboardInterrupt``) stops it within about 10 000 steps."""
         t = _array(t, "t")
         n = t.shape[0]
         v = _array(velocity, "velocity", n)
@@ -384,7 +391,7 @@ def fit(
     """Calibrate configuration keys (and input-map coefficients) to
     recorded friction, as ``friction-node fit`` does (same arguments, same
     defaults, same messages): ``data`` CSV files or bags, ``fit`` the keys
-    (e.g. ``["roughness.sigma_m", "contact.mu_boundary"]``), ``bounds``
+    (e.g. ``["roughness.sigma_m", "contact.boundary_friction"]``), ``bounds``
     ``{key: (lo, hi)}``, ``start`` ``{key: value}``. ``out`` writes the
     fitted parameter file, ``report`` the summary, tables and plots."""
     if isinstance(data, (str, os.PathLike)):

@@ -3,8 +3,8 @@
 
 use crate::columns::Columns;
 use crate::errors;
-use friction_node::config::{Config, Origin};
-use friction_node::physics::{Estimate as CoreEstimate, Solver, ViscosityModel};
+use friction_node::config::{Config, InputLimits, Origin, OutOfEnvelope, ViscosityLaw};
+use friction_node::physics::{Estimate as CoreEstimate, Solver};
 use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -22,7 +22,9 @@ pub fn load_config(
                 "give the configuration as text or as a file, not both",
             ))
         }
-        (Some(text), None) => Config::from_yaml(text, &Origin::Embedded, overrides),
+        (Some(text), None) => {
+            Config::from_yaml(text, &Origin::Text("given to friction_node"), overrides)
+        }
         (None, Some(p)) => Config::load(Some(std::path::Path::new(p)), overrides),
         (None, None) => Config::load(None, overrides),
     }
@@ -122,19 +124,25 @@ fn series<'a>(
     Ok(Some(s))
 }
 
-fn check_range(name: &str, x: &[f64], lo: f64, hi: f64, what: &str) -> PyResult<()> {
-    if let Some(k) = x
-        .iter()
-        .position(|v| !(v.is_finite() && *v >= lo && *v <= hi))
-    {
-        return Err(errors::value(format!("{name}[{k}] = {}: {what}", x[k])));
+/// The first sample of `x` the envelope refuses, as a ValueError naming
+/// the array and the index (the rule every entry point checks:
+/// [`friction_node::config::Envelope`]).
+fn check_each(
+    name: &str,
+    x: &[f64],
+    check: impl Fn(f64) -> Result<(), OutOfEnvelope>,
+) -> PyResult<()> {
+    for (k, v) in x.iter().enumerate() {
+        if let Err(e) = check(*v) {
+            return Err(errors::value(format!("{name}[{k}]: {e}")));
+        }
     }
     Ok(())
 }
 
 impl Model {
-    fn viscosity_follows(&self) -> bool {
-        self.config.viscosity_model() != ViscosityModel::Constant
+    fn law(&self) -> ViscosityLaw {
+        ViscosityLaw::of(&self.config)
     }
 }
 
@@ -179,15 +187,20 @@ impl Model {
     }
 
     #[pyo3(signature = (velocity, load=None, dt=None))]
-    fn step(&mut self, velocity: f64, load: Option<f64>, dt: Option<f64>) -> Estimate {
+    fn step(&mut self, velocity: f64, load: Option<f64>, dt: Option<f64>) -> PyResult<Estimate> {
         let load = load.unwrap_or(self.config.contact.load_n);
+        let limits = InputLimits::of(&self.config);
+        limits
+            .check_velocity(velocity)
+            .and_then(|_| limits.check_load(load))
+            .map_err(|e| errors::value(e.to_string()))?;
         let e = match dt {
             Some(dt) if dt != self.solver.settings().dt => {
                 self.solver.step_over(velocity, load, dt)
             }
             _ => self.solver.step(velocity, load),
         };
-        Estimate::from(&e)
+        Ok(Estimate::from(&e))
     }
 
     #[pyo3(signature = (velocity=0.0, load=None))]
@@ -204,15 +217,13 @@ impl Model {
     }
 
     fn set_temperature(&mut self, temperature_c: f64) -> PyResult<()> {
-        if !(temperature_c.is_finite() && (-60.0..=300.0).contains(&temperature_c)) {
-            return Err(errors::value(format!(
-                "temperature_c = {temperature_c}: must lie in [-60, 300] °C"
-            )));
-        }
+        let law = self.law();
+        let mu = law
+            .viscosity_at(temperature_c)
+            .map_err(|e| errors::value(e.to_string()))?;
         self.temperature_c = temperature_c;
-        if self.viscosity_follows() {
-            self.solver
-                .set_liquid_viscosity(self.config.viscosity_at(temperature_c));
+        if law.follows_temperature() {
+            self.solver.set_liquid_viscosity(mu);
         }
         Ok(())
     }
@@ -237,7 +248,12 @@ impl Model {
         let v = series(&velocity, "velocity", n)?.expect("given");
         let load = series(&load, "load", n)?;
         let temperature = series(&temperature, "temperature", n)?;
-        check_range("t", t, f64::MIN, f64::MAX, "not a finite time")?;
+        if let Some(k) = t.iter().position(|x| !x.is_finite()) {
+            return Err(errors::value(format!(
+                "t[{k}] = {}: not a finite time",
+                t[k]
+            )));
+        }
         if let Some(k) = (1..n).find(|&k| t[k] <= t[k - 1]) {
             return Err(errors::value(format!(
                 "t[{k}] = {} is not after t[{}] = {}: t must increase strictly",
@@ -246,69 +262,54 @@ impl Model {
                 t[k - 1]
             )));
         }
-        let node = &self.config.node;
-        let vmax = node.max_abs_velocity_m_s;
-        check_range(
-            "velocity",
-            v,
-            -vmax,
-            vmax,
-            &format!("a velocity must be finite with |v| ≤ node.max_abs_velocity_m_s = {vmax} m/s"),
-        )?;
+        // The envelope `step`, the command line and the node check.
+        let limits = InputLimits::of(&self.config);
+        let law = self.law();
+        check_each("velocity", v, |x| limits.check_velocity(x))?;
         if let Some(l) = load {
-            let (lo, hi) = (node.min_load_n, node.max_load_n);
-            check_range(
-                "load",
-                l,
-                lo,
-                hi,
-                &format!("a load must lie in [node.min_load_n, node.max_load_n] = [{lo}, {hi}] N"),
-            )?;
+            check_each("load", l, |x| limits.check_load(x))?;
         }
         if let Some(tc) = temperature {
-            let floor = match self.config.viscosity_model() {
-                ViscosityModel::Vogel(v) => v.c_c.max(-60.0),
-                ViscosityModel::Constant => -60.0,
-            };
-            if let Some(k) = tc
-                .iter()
-                .position(|x| !(x.is_finite() && *x > floor && *x <= 300.0))
-            {
-                return Err(errors::value(format!(
-                    "temperature[{k}] = {}: a temperature must lie in [-60, 300] °C and above lubricant.vogel_c_c",
-                    tc[k]
-                )));
-            }
+            check_each("temperature", tc, |x| law.viscosity_at(x).map(|_| ()))?;
         }
         let default_load = self.config.contact.load_n;
-        let follows = temperature.is_some() && self.viscosity_follows();
+        let follows = temperature.is_some() && law.follows_temperature();
         let dt = self.solver.settings().dt;
-        let config = &self.config;
         let solver = &mut self.solver;
         let t_ref = self.temperature_c;
-        let (columns, last_t) = py.detach(|| {
-            let mut c = Columns::with_capacity(n);
-            let temp = |k: usize| temperature.map_or(t_ref, |s| s[k]);
-            let f = |k: usize| load.map_or(default_load, |s| s[k]);
-            if follows {
-                solver.set_liquid_viscosity(config.viscosity_at(temp(0)));
-            }
-            let e = solver.initialize_steady(v[0], f(0));
-            c.push(&e, t[0], e.status.as_str(), temp(0));
-            for k in 1..n {
-                if follows {
-                    solver.set_liquid_viscosity(config.viscosity_at(temp(k)));
+        let temp = |k: usize| temperature.map_or(t_ref, |s| s[k]);
+        let f = |k: usize| load.map_or(default_load, |s| s[k]);
+        // Checked above: every temperature has its viscosity.
+        let mu = |k: usize| law.viscosity_at(temp(k)).unwrap_or(law.mu_ref);
+        let mut c = Columns::with_capacity(n);
+        // In chunks without the GIL, Python's signals checked between them:
+        // Ctrl-C stops a long run within a chunk (~10-50 ms).
+        const CHUNK: usize = 10_000;
+        let mut k = 0;
+        while k < n {
+            let end = (k + CHUNK).min(n);
+            py.detach(|| {
+                for k in k..end {
+                    if follows {
+                        solver.set_liquid_viscosity(mu(k));
+                    }
+                    let e = if k == 0 {
+                        solver.initialize_steady(v[0], f(0))
+                    } else {
+                        let h = t[k] - t[k - 1];
+                        if (h - dt).abs() <= 1e-9 * dt {
+                            solver.step(v[k], f(k))
+                        } else {
+                            solver.step_over(v[k], f(k), h)
+                        }
+                    };
+                    c.push(&e, t[k], e.status.as_str(), temp(k));
                 }
-                let h = t[k] - t[k - 1];
-                let e = if (h - dt).abs() <= 1e-9 * dt {
-                    solver.step(v[k], f(k))
-                } else {
-                    solver.step_over(v[k], f(k), h)
-                };
-                c.push(&e, t[k], e.status.as_str(), temp(k));
-            }
-            (c, temp(n - 1))
-        });
+            });
+            py.check_signals()?;
+            k = end;
+        }
+        let (columns, last_t) = (c, temp(n - 1));
         self.temperature_c = last_t;
         columns.into_dict(py)
     }

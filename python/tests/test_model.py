@@ -3,6 +3,7 @@ command line for the same inputs, Python exceptions for bad input."""
 
 import csv
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -109,6 +110,11 @@ def test_fit_recovers_boundary_friction_and_equals_the_cli(cli, tmp_path):
         (lambda: fn.Model(**{"contact.nope": 1}), ValueError, "contact.nope"),
         (lambda: fn.Model(**{"contact.load_n": -1}), ValueError, "contact.load_n"),
         (lambda: fn.Model("/no/such/config.yaml"), FileNotFoundError, "/no/such/config.yaml"),
+        (lambda: fn.Model("not: [valid\n"), ValueError, "YAML text given to friction_node"),
+        (lambda: fn.Model("/tmp"), OSError, "directory"),
+        (lambda: fn.Model().step(50.0), ValueError, "node.max_abs_velocity_m_s"),
+        (lambda: fn.fit("/no/such/data.csv", ["contact.boundary_friction"], holdout=2.0), ValueError,
+         "holdout: 2 is out of range"),
         (lambda: fn.Model().run([0, 0.001, 0.002], [0, math.nan, 1]), ValueError, "velocity[1]"),
         (lambda: fn.Model().run([0, 0.001], [0, 1, 2]), ValueError, "same length"),
         (lambda: fn.Model().run([0, 0.002, 0.001], [0, 0, 0]), ValueError, "t[2]"),
@@ -169,3 +175,44 @@ def test_replay_of_a_recording_of_several_contacts_checks_each_contact(cli, tmp_
     assert counts.nunique() == 1 and counts.iloc[0] > 500
     cli("replay", bag, "--out", tmp_path / "cli.csv")
     assert (tmp_path / "py.csv").read_bytes() == (tmp_path / "cli.csv").read_bytes()
+
+
+def _envelope_cases():
+    """tests/fixtures/envelope_cases.csv: the inputs every entry point refuses."""
+    path = Path(__file__).resolve().parents[2] / "tests" / "fixtures" / "envelope_cases.csv"
+    rows = [l for l in path.read_text().splitlines() if l.strip() and not l.startswith("#")]
+    out = []
+    for row in csv.DictReader(rows):
+        overrides = dict(kv.split("=", 1) for kv in row["overrides"].split(";") if kv)
+        out.append((row["quantity"], float(row["value"]), overrides, row["expect"]))
+    return out
+
+
+@pytest.mark.parametrize("quantity, value, overrides, expect", _envelope_cases())
+def test_step_run_and_set_temperature_refuse_every_envelope_case_with_one_rule(quantity, value, overrides, expect):
+    m = fn.Model(overrides=overrides)
+    before = m.step(0.1)
+    t = [0.0, m.dt]
+    with pytest.raises(ValueError) as e:
+        if quantity == "temperature":
+            m.set_temperature(value)
+        elif quantity == "velocity":
+            m.step(value)
+        else:
+            m.step(0.1, load=value)
+    assert expect in str(e.value)
+    with pytest.raises(ValueError) as e:
+        if quantity == "temperature":
+            fn.Model(overrides=overrides).run(t, [0.1, 0.1], temperature=[40.0, value])
+        elif quantity == "velocity":
+            fn.Model(overrides=overrides).run(t, [0.1, value])
+        else:
+            fn.Model(overrides=overrides).run(t, [0.1, 0.1], load=[20762.0, value])
+    # A non-finite sample is refused by the array check before the envelope.
+    assert f"{quantity}[1]" in str(e.value)
+    assert (expect if math.isfinite(value) else "not a finite number") in str(e.value)
+    # The refused call changed nothing.
+    twin = fn.Model(overrides=overrides)
+    twin.step(0.1)
+    assert m.step(0.2).friction_force_n == twin.step(0.2).friction_force_n
+    assert before.status == "converged"

@@ -71,9 +71,9 @@ impl Db3File {
         let mut head = [0u8; 16];
         {
             use std::io::Read;
-            let mut f = std::fs::File::open(path).map_err(|source| BagError::Io {
+            let mut f = std::fs::File::open(path).map_err(|cause| BagError::Io {
                 path: path.to_path_buf(),
-                source,
+                cause,
             })?;
             if f.read_exact(&mut head).is_err() || !is_sqlite(&head) {
                 return Err(not_bag("it is not an SQLite database".into()));

@@ -60,9 +60,9 @@ fn channel_info(c: &mcap::Channel<'_>, messages: u64) -> ChannelInfo {
 
 impl McapFile {
     pub fn open(path: &Path) -> Result<Self, BagError> {
-        let io = |source| BagError::Io {
+        let io = |cause| BagError::Io {
             path: path.to_path_buf(),
-            source,
+            cause,
         };
         let file = std::fs::File::open(path).map_err(io)?;
         if !file.metadata().map_err(io)?.is_file() {

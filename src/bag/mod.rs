@@ -35,11 +35,10 @@ use std::path::{Path, PathBuf};
 /// Errors of the bag layer.
 #[derive(Debug, thiserror::Error)]
 pub enum BagError {
-    #[error("cannot read bag {}: {source}", path.display())]
+    #[error("cannot read bag {}: {cause}", path.display())]
     Io {
         path: PathBuf,
-        #[source]
-        source: std::io::Error,
+        cause: std::io::Error,
     },
     #[error("{} is not a bag: {message}", path.display())]
     NotABag { path: PathBuf, message: String },
@@ -203,9 +202,9 @@ impl BagFile {
         let mut head = [0u8; 16];
         let n = {
             use std::io::Read;
-            let mut f = std::fs::File::open(path).map_err(|source| BagError::Io {
+            let mut f = std::fs::File::open(path).map_err(|cause| BagError::Io {
                 path: path.to_path_buf(),
-                source,
+                cause,
             })?;
             f.read(&mut head).unwrap_or(0)
         };
@@ -243,9 +242,9 @@ impl Bag {
     /// Open an MCAP file, an SQLite (`.db3`) file or a rosbag2 directory;
     /// nothing is decoded yet.
     pub fn open(path: &Path) -> Result<Self, BagError> {
-        let io = |source| BagError::Io {
+        let io = |cause| BagError::Io {
             path: path.to_path_buf(),
-            source,
+            cause,
         };
         let meta = std::fs::metadata(path).map_err(io)?;
         if meta.is_dir() {

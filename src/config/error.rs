@@ -5,11 +5,10 @@ use std::path::PathBuf;
 /// Errors of the configuration layer.
 #[derive(Debug, thiserror::Error)]
 pub enum ConfigError {
-    #[error("cannot read config file {}", path.display())]
+    #[error("cannot read config file {}: {cause}", path.display())]
     Io {
         path: PathBuf,
-        #[source]
-        source: std::io::Error,
+        cause: std::io::Error,
     },
     #[error("config {origin} is not valid YAML: {message}")]
     Syntax { origin: String, message: String },
@@ -34,8 +33,12 @@ pub enum ConfigError {
 /// Where a configuration came from (for messages).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Origin {
+    /// The built-in `launch-config/default.yaml`.
     Embedded,
     File(PathBuf),
+    /// Text handed over by a caller, described (e.g. "passed to
+    /// fn_model_new_from_yaml", "recorded in the bag").
+    Text(&'static str),
 }
 
 impl std::fmt::Display for Origin {
@@ -43,6 +46,7 @@ impl std::fmt::Display for Origin {
         match self {
             Origin::Embedded => write!(f, "(built-in launch-config/default.yaml)"),
             Origin::File(p) => write!(f, "{}", p.display()),
+            Origin::Text(what) => write!(f, "(YAML text {what})"),
         }
     }
 }

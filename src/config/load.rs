@@ -12,9 +12,9 @@ impl Config {
     pub fn load(path: Option<&Path>, overrides: &[String]) -> Result<Config, ConfigError> {
         let (text, origin) = match path {
             Some(p) => (
-                std::fs::read_to_string(p).map_err(|source| ConfigError::Io {
+                std::fs::read_to_string(p).map_err(|cause| ConfigError::Io {
                     path: p.to_path_buf(),
-                    source,
+                    cause,
                 })?,
                 Origin::File(p.to_path_buf()),
             ),
@@ -35,9 +35,9 @@ impl Config {
     ) -> Result<Config, ConfigError> {
         let (text, origin) = match path {
             Some(p) => (
-                std::fs::read_to_string(p).map_err(|source| ConfigError::Io {
+                std::fs::read_to_string(p).map_err(|cause| ConfigError::Io {
                     path: p.to_path_buf(),
-                    source,
+                    cause,
                 })?,
                 Origin::File(p.to_path_buf()),
             ),

@@ -27,8 +27,10 @@
 //! | `validate.rs` | physical ranges and ROS 2 names, one function per section |
 //! | `contacts.rs` | `contacts.*`: several contacts, each overriding the top-level sections |
 //! | `error.rs` | [`ConfigError`] and the [`Origin`] of a configuration |
+//! | `envelope.rs` | the inputs every entry point accepts: velocity, load, temperature ([`Envelope`]) |
 
 mod contacts;
+mod envelope;
 mod error;
 mod io;
 mod load;
@@ -39,6 +41,9 @@ mod validate;
 pub use contacts::{
     ContactEntry, ContactList, ContactSolverConfig, ResolvedContact, CONTACT_SECTIONS,
     MAX_CONTACTS, MAX_JOINT_NAME_BYTES, SINGLE_CONTACT_NAME,
+};
+pub use envelope::{
+    Envelope, InputLimits, OutOfEnvelope, ViscosityLaw, TEMPERATURE_RANGE_C, VISCOSITY_RANGE_PA_S,
 };
 pub use error::{ConfigError, Origin};
 pub use io::*;
@@ -155,15 +160,6 @@ impl Config {
                 })
             }
         }
-    }
-
-    /// The liquid's viscosity at `t_c` °C, Pa·s.
-    pub fn viscosity_at(&self, t_c: f64) -> f64 {
-        self.viscosity_model().viscosity(
-            self.lubricant.viscosity_pa_s,
-            self.lubricant.reference_temperature_c,
-            t_c,
-        )
     }
 
     /// The solver's settings.

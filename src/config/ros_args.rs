@@ -300,9 +300,9 @@ pub fn merge(base: &mut Value, over: Value) {
 /// The `ros__parameters` of every entry of a parameter file that matches
 /// `fqn`, in file order (nested namespace mappings are joined).
 pub fn matching_parameters(path: &Path, fqn: &str) -> Result<Vec<Value>, ConfigError> {
-    let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Io {
+    let text = std::fs::read_to_string(path).map_err(|cause| ConfigError::Io {
         path: path.to_path_buf(),
-        source,
+        cause,
     })?;
     let doc: Value = serde_norway::from_str(&text).map_err(|e| ConfigError::Syntax {
         origin: path.display().to_string(),

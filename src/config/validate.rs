@@ -182,12 +182,14 @@ impl Config {
 
     pub(super) fn validate_lubricant(&self) -> Result<(), ConfigError> {
         let l = &self.lubricant;
-        oc("lubricant.viscosity_pa_s", l.viscosity_pa_s, 1e-5, 100.0)?;
+        let (mu_lo, mu_hi) = super::envelope::VISCOSITY_RANGE_PA_S;
+        oc("lubricant.viscosity_pa_s", l.viscosity_pa_s, mu_lo, mu_hi)?;
+        let (t_lo, t_hi) = super::envelope::TEMPERATURE_RANGE_C;
         cc(
             "lubricant.reference_temperature_c",
             l.reference_temperature_c,
-            -60.0,
-            300.0,
+            t_lo,
+            t_hi,
         )?;
         oc("lubricant.vogel_b_c", l.vogel_b_c, 0.0, 1e5)?;
         cc(

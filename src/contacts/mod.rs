@@ -31,16 +31,12 @@ use std::sync::Arc;
 /// Errors building a contact set.
 #[derive(Debug, thiserror::Error)]
 pub enum ContactSetError {
-    #[error("contact `{name}`: {source}")]
-    Setup {
-        name: String,
-        #[source]
-        source: SetupError,
-    },
+    #[error("contact `{name}`: {cause}")]
+    Setup { name: String, cause: SetupError },
     #[error("node.contact_workers = {workers}: at most one worker per contact beyond the first ({contacts} contacts)")]
     TooManyWorkers { workers: usize, contacts: usize },
     #[error("cannot start contact worker threads: {0}")]
-    Spawn(#[source] std::io::Error),
+    Spawn(std::io::Error),
 }
 
 /// The outcome of one step of every contact.
@@ -210,10 +206,10 @@ impl ContactSet {
 }
 
 fn build(c: &ResolvedContact) -> Result<Solver, ContactSetError> {
-    Solver::new(&c.config.model(), &c.config.solver_settings()).map_err(|source| {
+    Solver::new(&c.config.model(), &c.config.solver_settings()).map_err(|cause| {
         ContactSetError::Setup {
             name: c.name.clone(),
-            source,
+            cause,
         }
     })
 }

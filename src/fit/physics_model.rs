@@ -14,7 +14,7 @@ use super::params::{ConfigKeys, DataScale, ParamSpec, Parameter};
 use super::problem::Model;
 use super::series::Series;
 use super::FitError;
-use crate::config::Config;
+use crate::config::{Config, ViscosityLaw};
 use crate::physics::{Solver, Status, ViscosityModel};
 
 /// The physics model with some configuration keys fitted.
@@ -97,6 +97,12 @@ fn follows_temperature(config: &Config, s: &Series) -> bool {
     s.temperature.is_some() && config.viscosity_model() != ViscosityModel::Constant
 }
 
+/// The liquid viscosity at `t_c` °C by the configuration's law, or why
+/// these parameters give none there (the rule of every entry point).
+fn viscosity(law: &ViscosityLaw, t_c: f64) -> Result<f64, String> {
+    law.viscosity_at(t_c).map_err(|e| e.to_string())
+}
+
 fn transient(config: &Config, s: &Series) -> Result<Vec<f64>, String> {
     let settings = config.solver_settings();
     let dt = settings.dt;
@@ -107,12 +113,13 @@ fn transient(config: &Config, s: &Series) -> Result<Vec<f64>, String> {
     let default_load = vec![config.contact.load_n; n];
     let load = s.load.as_deref().unwrap_or(&default_load);
     let follows = follows_temperature(config, s);
+    let law = ViscosityLaw::of(config);
     let mut v_at = Cursor::new(&s.t, &s.velocity);
     let mut f_at = Cursor::new(&s.t, load);
     let mut temp_at = s.temperature.as_deref().map(|y| Cursor::new(&s.t, y));
     if follows {
         let temp = temp_at.as_mut().expect("follows").at(t0);
-        solver.set_liquid_viscosity(config.viscosity_at(temp));
+        solver.set_liquid_viscosity(viscosity(&law, temp)?);
     }
     let first = solver.initialize_steady(v_at.at(t0), f_at.at(t0));
     let mut out = vec![f64::NAN; n];
@@ -128,7 +135,7 @@ fn transient(config: &Config, s: &Series) -> Result<Vec<f64>, String> {
         let t = t0 + step as f64 * dt;
         if follows {
             let temp = temp_at.as_mut().expect("follows").at(t);
-            solver.set_liquid_viscosity(config.viscosity_at(temp));
+            solver.set_liquid_viscosity(viscosity(&law, temp)?);
         }
         let e = solver.step(v_at.at(t), f_at.at(t));
         if !e.friction_force.is_finite()
@@ -167,11 +174,12 @@ fn steady(config: &Config, s: &Series) -> Result<Vec<f64>, String> {
     let mut solver =
         Solver::new(&config.model(), &config.solver_settings()).map_err(|e| e.to_string())?;
     let follows = follows_temperature(config, s);
+    let law = ViscosityLaw::of(config);
     (0..s.len())
         .map(|k| {
             if follows {
                 let temp = s.temperature.as_ref().expect("follows")[k];
-                solver.set_liquid_viscosity(config.viscosity_at(temp));
+                solver.set_liquid_viscosity(viscosity(&law, temp)?);
             }
             let e = solver.steady(s.velocity[k], s.load_at(k, config.contact.load_n));
             if e.status.is_converged() && e.friction_force.is_finite() {

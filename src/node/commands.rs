@@ -9,9 +9,8 @@
 //! own lubricant's law.
 
 use super::Loop;
-use crate::config::{Config, TimeoutBehaviour};
+use crate::config::TimeoutBehaviour;
 use crate::msgs::{estimate_constants as codes, Command, CommandKind};
-use crate::physics::ViscosityModel;
 use std::sync::atomic::Ordering;
 
 /// One contact's command state.
@@ -46,35 +45,6 @@ impl ContactCommand {
     }
 }
 
-/// How one contact's liquid viscosity follows the temperature.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) struct ViscosityLaw {
-    pub model: ViscosityModel,
-    /// μ at `t_ref_c`, Pa·s.
-    pub mu_ref: f64,
-    pub t_ref_c: f64,
-}
-
-impl ViscosityLaw {
-    pub fn of(c: &Config) -> Self {
-        Self {
-            model: c.viscosity_model(),
-            mu_ref: c.lubricant.viscosity_pa_s,
-            t_ref_c: c.lubricant.reference_temperature_c,
-        }
-    }
-
-    /// μ at `t_c`, if the temperature is valid for this law.
-    fn at(&self, t_c: f64) -> Option<f64> {
-        let mu = self.model.viscosity(self.mu_ref, self.t_ref_c, t_c);
-        let vogel_ok = match self.model {
-            ViscosityModel::Vogel(v) => t_c > v.c_c,
-            ViscosityModel::Constant => true,
-        };
-        (t_c.is_finite() && (-60.0..=300.0).contains(&t_c) && vogel_ok && mu > 0.0).then_some(mu)
-    }
-}
-
 impl Loop {
     pub(super) fn poll(&mut self, i: usize) -> Option<Command> {
         match self.ports[i].poll_command() {
@@ -105,11 +75,11 @@ impl Loop {
     }
 
     pub(super) fn velocity_ok(&self, v: f64) -> bool {
-        v.is_finite() && v.abs() <= self.s.max_abs_velocity
+        self.s.limits.check_velocity(v).is_ok()
     }
 
     pub(super) fn load_ok(&self, f: f64) -> bool {
-        f.is_finite() && f >= self.s.min_load && f <= self.s.max_load
+        self.s.limits.check_load(f).is_ok()
     }
 
     /// The contact a velocity command is for (None: not a velocity, or a
@@ -150,16 +120,21 @@ impl Loop {
     }
 
     /// A temperature command: each contact's viscosity follows it (Vogel),
-    /// else it is only reported. Outside [-60, 300] °C (or at or below a
-    /// contact's Vogel C) it is rejected.
+    /// else it is only reported. A temperature any contact's law refuses
+    /// ([`crate::config::ViscosityLaw::viscosity_at`]) is rejected.
     pub(super) fn temperature_command(&mut self, t_c: f64) {
-        if self.viscosity.iter().any(|law| law.at(t_c).is_none()) {
+        if self
+            .viscosity
+            .iter()
+            .any(|law| law.viscosity_at(t_c).is_err())
+        {
             self.reject(None);
             return;
         }
         self.temperature_c = t_c;
         for k in 0..self.viscosity.len() {
-            if let Some(mu) = self.viscosity[k].at(t_c) {
+            let law = self.viscosity[k];
+            if let (true, Ok(mu)) = (law.follows_temperature(), law.viscosity_at(t_c)) {
                 self.contacts.with_solver(k, |s| s.set_liquid_viscosity(mu));
             }
         }

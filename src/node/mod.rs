@@ -135,9 +135,8 @@ pub struct LoopSettings {
     pub command_timeout_ns: u64,
     pub timeout_behaviour: TimeoutBehaviour,
     pub deceleration: f64,
-    pub max_abs_velocity: f64,
-    pub min_load: f64,
-    pub max_load: f64,
+    /// The velocity and load commands accepted.
+    pub limits: crate::config::InputLimits,
     /// Steps between profile and statistics publications (0 = never).
     pub profile_every: u64,
     pub statistics_every: u64,
@@ -178,9 +177,7 @@ impl LoopSettings {
             command_timeout_ns: secs_to_ns(c.node.command_timeout_s),
             timeout_behaviour: c.node.timeout_behaviour,
             deceleration: c.node.timeout_deceleration_m_s2,
-            max_abs_velocity: c.node.max_abs_velocity_m_s,
-            min_load: c.node.min_load_n,
-            max_load: c.node.max_load_n,
+            limits: crate::config::InputLimits::of(c),
             profile_every: every(c.node.profile_rate_hz),
             statistics_every: every(c.node.statistics_rate_hz),
             lockstep_spin_ns: c.node.lockstep_spin_us.saturating_mul(1000),
@@ -219,7 +216,7 @@ pub struct Loop {
     stamps: WallStamps,
     temperature_c: f64,
     /// How each contact's viscosity follows the temperature: μ_ref at T_ref.
-    viscosity: Vec<commands::ViscosityLaw>,
+    viscosity: Vec<crate::config::ViscosityLaw>,
     last_stamp: Option<u64>,
     // statistics
     summary: RunSummary,
@@ -276,7 +273,7 @@ impl Loop {
             .collect();
         let viscosity = resolved
             .iter()
-            .map(|c| commands::ViscosityLaw::of(&c.config))
+            .map(|c| crate::config::ViscosityLaw::of(&c.config))
             .collect();
         let n = contacts.len();
         let window = (s.statistics_every as usize).clamp(16, 1 << 16);

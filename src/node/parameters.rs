@@ -21,7 +21,7 @@
 use super::LoopSettings;
 use crate::config::{key_ranges, Config, ConfigError, KeyRange};
 use crate::msgs::ros_interfaces::{parameter_type as ty, ParameterValue};
-use crate::physics::{PreparedModel, SetupError, Solver, ViscosityModel};
+use crate::physics::{PreparedModel, SetupError, Solver};
 use crossbeam_queue::ArrayQueue;
 use serde_norway::Value;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -295,9 +295,7 @@ pub struct ParameterUpdate {
 /// One contact's part of a [`ParameterUpdate`].
 struct ContactUpdate {
     model: PreparedModel,
-    viscosity_model: ViscosityModel,
-    mu_ref: f64,
-    t_ref_c: f64,
+    viscosity: crate::config::ViscosityLaw,
     /// The new held load, when the contact's `contact.load_n` changed.
     load: Option<f64>,
 }
@@ -320,9 +318,7 @@ impl ParameterUpdate {
                 let load_was = before.get(i).map(|b| b.config.contact.load_n);
                 Ok(ContactUpdate {
                     model: Solver::prepare_model(&n.model(), &n.solver_settings())?,
-                    viscosity_model: n.viscosity_model(),
-                    mu_ref: n.lubricant.viscosity_pa_s,
-                    t_ref_c: n.lubricant.reference_temperature_c,
+                    viscosity: crate::config::ViscosityLaw::of(n),
                     load: (load_was != Some(n.contact.load_n)).then_some(n.contact.load_n),
                 })
             })
@@ -463,14 +459,14 @@ impl super::Loop {
         self.s = u.settings.clone();
         for (i, c) in u.contacts.iter_mut().enumerate() {
             let _ = self.contacts.with_solver(i, |s| s.swap_model(&mut c.model));
-            let law = &mut self.viscosity[i];
-            law.model = c.viscosity_model;
-            law.mu_ref = c.mu_ref;
-            law.t_ref_c = c.t_ref_c;
-            if law.model != ViscosityModel::Constant {
-                let mu = law
-                    .model
-                    .viscosity(law.mu_ref, law.t_ref_c, self.temperature_c);
+            self.viscosity[i] = c.viscosity;
+            if c.viscosity.follows_temperature() {
+                // A temperature the new law refuses (its C moved above it)
+                // gives the law's reference viscosity.
+                let mu = c
+                    .viscosity
+                    .viscosity_at(self.temperature_c)
+                    .unwrap_or(c.viscosity.mu_ref);
                 self.contacts.with_solver(i, |s| s.set_liquid_viscosity(mu));
             }
             if let Some(l) = c.load {

@@ -165,9 +165,9 @@ impl BagWriter {
         extra: BTreeMap<String, String>,
         started_ns: u64,
     ) -> Result<Self, RecorderError> {
-        let create = |source| RecorderError::Create {
+        let create = |cause| RecorderError::Create {
             path: path.to_path_buf(),
-            source,
+            cause,
         };
         if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir).map_err(create)?;

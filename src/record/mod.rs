@@ -58,11 +58,10 @@ use std::time::{Duration, Instant};
 /// Errors of the recorder layer.
 #[derive(Debug, thiserror::Error)]
 pub enum RecorderError {
-    #[error("cannot create recording {}: {source}", path.display())]
+    #[error("cannot create recording {}: {cause}", path.display())]
     Create {
         path: PathBuf,
-        #[source]
-        source: std::io::Error,
+        cause: std::io::Error,
     },
     #[error("recording {}: {message}", path.display())]
     Mcap { path: PathBuf, message: String },
@@ -186,9 +185,9 @@ impl Recorder {
         let thread = std::thread::Builder::new()
             .name("mcap-recorder".into())
             .spawn(move || w.run(q, s, snap, profile))
-            .map_err(|source| RecorderError::Create {
+            .map_err(|cause| RecorderError::Create {
                 path: plan.path.clone().unwrap_or_default(),
-                source,
+                cause,
             })?;
         Ok(Self {
             queue,

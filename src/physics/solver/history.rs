@@ -11,7 +11,7 @@ impl Solver {
         self.p.fill(self.d.p_amb);
         self.h0 = h0;
         self.velocity = 0.0;
-        self.time = 0.0;
+        self.set_time(0.0);
         self.hist_len = 0;
         // Both levels at rest (so h0'' starts at 0), but only one counts:
         // the first step is backward Euler.

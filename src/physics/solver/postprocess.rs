@@ -111,7 +111,9 @@ impl Solver {
             H0Mode::Prescribed(_) => f64::NAN,
         };
         if advance {
-            self.time += ctx.time.map_or(0.0, |(_, dt)| dt);
+            if ctx.time.is_some() {
+                self.advance_time();
+            }
             // The θ scheme needs this level's flux divergence.
             let needs_div = ctx.time.is_some_and(|(c, _)| c.uses_force_history())
                 || StepCoefficients::for_scheme(self.settings.scheme).uses_force_history();

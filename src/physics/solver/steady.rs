@@ -44,7 +44,7 @@ impl Solver {
     pub fn initialize_steady(&mut self, v: f64, load: f64) -> Estimate {
         let e = self.steady(v, load);
         self.fill_history_with_current();
-        self.time = 0.0;
+        self.set_time(0.0);
         Estimate { time: 0.0, ..e }
     }
 

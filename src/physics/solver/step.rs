@@ -66,10 +66,21 @@ impl Solver {
         self.restart_history();
         let fixed = self.settings.dt;
         self.settings.dt = dt;
+        self.set_time(self.time);
         let e = self.step(v, load);
         self.settings.dt = fixed;
+        self.set_time(self.time);
         self.restart_history();
         e
+    }
+
+    /// A step whose inputs the caller refused by a rule of its own (a
+    /// configured envelope narrower than the physical one): nothing is
+    /// computed, the state is kept, time advances, and the estimate is the
+    /// last good one under [`Status::InputOutOfRange`], as for inputs
+    /// outside the physical envelope.
+    pub fn refuse_step(&mut self) -> Estimate {
+        self.rejected_input(f64::NAN, f64::NAN, Status::InputOutOfRange, true)
     }
 
     /// Advance one step with a prescribed gap h0 (no load balance). `load`
@@ -99,7 +110,7 @@ impl Solver {
         advance: bool,
     ) -> Estimate {
         if advance {
-            self.time += self.settings.dt;
+            self.advance_time();
         }
         let mut e = self.last.unwrap_or_else(|| self.blank_estimate());
         e.time = self.time;
