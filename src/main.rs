@@ -8,6 +8,8 @@
 //! | 2 | bad arguments, configuration or input; an output that could not be written |
 //! | 3 | `replay --expect-identical`: the re-simulation differs |
 //! | 4 | `fit`: the fit did not converge (the best point found is written) |
+//! | 5 | `replay --expect-identical`: the bag holds no recorded estimates to compare with |
+//! | 130, 143 | stopped by SIGINT, SIGTERM (`simulate`, `study`, `replay`, `fit`): nothing half-written is left |
 
 mod cli;
 
@@ -88,6 +90,12 @@ fn main() {
     };
     let allocations = || ALLOCATIONS.with(Cell::get);
     if let Err(e) = cli::dispatch(cli, ros, &allocations) {
+        // Whatever error the stop surfaced as, an interrupted command exits
+        // as the signal asked.
+        if let Err(i) = friction_node::interrupt::Stop::process().check() {
+            eprintln!("{i}");
+            std::process::exit(i.exit_code());
+        }
         eprintln!("error: {e:#}");
         std::process::exit(2);
     }

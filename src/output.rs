@@ -182,6 +182,78 @@ pub fn write_file(path: &Path, data: &[u8]) -> Result<PathBuf, OutputError> {
     f.commit()
 }
 
+/// Bytes free for an unprivileged writer on the filesystem that holds
+/// `path` (its directory when `path` does not exist yet); None when it
+/// cannot be asked (not Unix, or the path has no existing ancestor).
+pub fn free_bytes(path: &Path) -> Option<u64> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::ffi::OsStrExt;
+        let mut at = path;
+        while !at.exists() {
+            at = match at.parent() {
+                Some(p) if p.as_os_str().is_empty() => Path::new("."),
+                p => p?,
+            };
+        }
+        let c = std::ffi::CString::new(at.as_os_str().as_bytes()).ok()?;
+        // SAFETY: a valid NUL-terminated path and a zeroed struct to fill.
+        let mut st: libc::statvfs = unsafe { std::mem::zeroed() };
+        if unsafe { libc::statvfs(c.as_ptr(), &mut st) } != 0 {
+            return None;
+        }
+        Some((st.f_bavail as u64).saturating_mul(st.f_frsize as u64))
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = path;
+        None
+    }
+}
+
+/// A size in bytes as people read it (kB, MB, GB, TB, PB; powers of 1000).
+pub fn human_bytes(b: f64) -> String {
+    let units = ["B", "kB", "MB", "GB", "TB", "PB", "EB"];
+    let mut v = b;
+    let mut k = 0;
+    while v >= 1000.0 && k + 1 < units.len() {
+        v /= 1000.0;
+        k += 1;
+    }
+    if k == 0 {
+        format!("{v:.0} B")
+    } else {
+        format!("{v:.1} {}", units[k])
+    }
+}
+
+/// Above this an output is worth a warning with its estimated size.
+pub const LARGE_OUTPUT_BYTES: f64 = 1e9;
+
+/// Check that an output of about `estimated` bytes fits on the filesystem
+/// of `path` before anything is computed: an error naming both sizes when
+/// it does not (a device such as `/dev/null` always fits); `Ok(Some(..))`
+/// with a warning to print when it is large ([`LARGE_OUTPUT_BYTES`]).
+pub fn check_room(path: &Path, estimated: f64, what: &str) -> Result<Option<String>, OutputError> {
+    if is_special(path) {
+        return Ok(None);
+    }
+    if let Some(free) = free_bytes(path) {
+        if estimated > free as f64 {
+            return Err(OutputError::other(
+                path,
+                format!(
+                    "{what} would take about {}, and {} are free there",
+                    human_bytes(estimated),
+                    human_bytes(free as f64)
+                ),
+            ));
+        }
+    }
+    Ok((estimated > LARGE_OUTPUT_BYTES)
+        .then(|| format!("{what} will take about {}", human_bytes(estimated))))
+}
+
 /// Make sure `dir` exists and is writable (before any computation).
 pub fn prepare_dir(dir: &Path) -> Result<(), OutputError> {
     let err = |source| OutputError::new(dir, source);
@@ -243,6 +315,27 @@ mod tests {
             write_file(Path::new("/dev/null"), b"x").unwrap();
             assert!(is_special(Path::new("/dev/null")), "still a device");
         }
+    }
+
+    #[test]
+    fn an_output_larger_than_the_free_space_is_refused_with_both_sizes() {
+        let d = dir("room");
+        let p = d.join("big.csv");
+        let free = free_bytes(&p).expect("statvfs works here") as f64;
+        let e = check_room(&p, 2.0 * free + 1e15, "the CSV")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("would take about") && e.contains("are free"),
+            "{e}"
+        );
+        assert_eq!(check_room(&p, 10.0, "the CSV").unwrap(), None);
+        if free > 2e9 {
+            let w = check_room(&p, 1.5e9, "the CSV").unwrap().unwrap();
+            assert!(w.contains("1.5 GB"), "{w}");
+        }
+        assert_eq!(human_bytes(3.2e15), "3.2 PB");
+        assert_eq!(human_bytes(512.0), "512 B");
     }
 
     #[test]

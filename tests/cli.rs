@@ -295,3 +295,54 @@ fn a_study_writes_case_csvs_a_summary_plots_and_the_claims() {
         assert!(svg.starts_with("<svg") && svg.contains("Hersey"));
     }
 }
+
+#[test]
+#[cfg(feature = "iceoryx2")]
+fn log_lines_on_a_redirected_stderr_carry_no_colour_codes() {
+    let svc = format!("fn-cli-colour-{}", std::process::id());
+    let mut c = bin();
+    c.args(["run", "--demo", "0.2", "--transport", "iceoryx2", "--quiet"]);
+    for (key, suffix) in [
+        ("cmd_velocity_service", "v"),
+        ("normal_load_service", "l"),
+        ("temperature_service", "t"),
+        ("friction_service", "f"),
+        ("loop_statistics_service", "s"),
+        ("cmd_event_service", "e"),
+    ] {
+        c.arg("--set").arg(format!("iceoryx2.{key}={svc}/{suffix}"));
+    }
+    let o = c.output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("INFO"), "a tracing line was logged: {err}");
+    assert!(!err.contains('\u{1b}'), "no escape codes: {err:?}");
+}
+
+#[test]
+fn simulate_times_are_whole_steps_without_accumulated_rounding() {
+    let d = dir("times");
+    let out = d.join("run.csv");
+    let (ok, _, stderr) = run(&[
+        "simulate",
+        "--velocity",
+        "sine:0,1,1",
+        "--duration",
+        "4",
+        "--set",
+        "solver.cells=32",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    let text = std::fs::read_to_string(&out).unwrap();
+    for (k, line) in text.lines().skip(1).enumerate() {
+        let t = line.split(',').next().unwrap();
+        // Row k is step k + 1, at (k + 1) dt exactly.
+        assert_eq!(
+            t,
+            friction_node::text::Num((k + 1) as f64 * 1e-3).to_string(),
+            "row {k}"
+        );
+    }
+}

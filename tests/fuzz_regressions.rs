@@ -34,7 +34,7 @@ fn replay_inputs_the_fuzzer_found_are_refused_or_replayed_without_a_crash() {
         if let Ok(mut p) = replay::prepare(&bag, &opts) {
             p.commands.truncate(200);
             p.recorded.truncate(200);
-            let _ = replay::run(&p, &mut |_, _| {}, &mut |_, _, _| {});
+            let _ = replay::run(&p, &mut |_, _| Ok(()), &mut |_, _, _| {});
         }
     }
 }

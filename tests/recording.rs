@@ -193,7 +193,7 @@ fn a_60_s_run_split_every_5_s_loses_and_repeats_no_message_and_replays_as_one_ba
     let b = Bag::open(&bag).unwrap();
     assert_eq!(b.files().len(), 12);
     let p = replay::prepare(&b, &ReplayOptions::default()).unwrap();
-    let r = replay::run(&p, &mut |_, _| {}, &mut |_, _, _| {}).unwrap();
+    let r = replay::run(&p, &mut |_, _| Ok(()), &mut |_, _, _| {}).unwrap();
     let o = r.oracle.unwrap();
     assert!(o.identical, "{:?}", o.deviations);
     assert_eq!(o.compared, 60_000);
@@ -389,13 +389,13 @@ fn a_run_whose_parameters_changed_midway_replays_bit_identically() {
     let b = Bag::open(&bag).unwrap();
     let prepared = replay::prepare(&b, &ReplayOptions::default()).unwrap();
     assert_eq!(prepared.parameter_changes.len(), 3);
-    let r = replay::run(&prepared, &mut |_, _| {}, &mut |_, _, _| {}).unwrap();
+    let r = replay::run(&prepared, &mut |_, _| Ok(()), &mut |_, _, _| {}).unwrap();
     let oracle = r.oracle.expect("a friction-node bag");
     assert!(oracle.identical, "{:?}", oracle.deviations);
     assert_eq!(oracle.compared, 1200);
     // Without the changes the replay differs: they are what made it match.
     let mut without = prepared.clone();
     without.parameter_changes.clear();
-    let r = replay::run(&without, &mut |_, _| {}, &mut |_, _, _| {}).unwrap();
+    let r = replay::run(&without, &mut |_, _| Ok(()), &mut |_, _, _| {}).unwrap();
     assert!(!r.oracle.unwrap().identical);
 }

@@ -131,7 +131,7 @@ fn a_foreign_joint_state_bag_replays_the_named_joint_on_the_model_time_grid() {
     );
     assert!(p.gaps.is_empty());
 
-    let r = replay::run(&p, &mut |_, _| {}, &mut |_, _, _| {}).unwrap();
+    let r = replay::run(&p, &mut |_, _| Ok(()), &mut |_, _, _| {}).unwrap();
     assert_eq!(r.estimates.len(), 2001);
     assert!(
         r.oracle.is_none(),
@@ -223,7 +223,7 @@ fn the_node_fixture_replays_within_one_part_per_million_of_its_recording() {
         p.mode
     );
     assert_eq!(p.recorded.len(), 2000);
-    let r = replay::run(&p, &mut |_, _| {}, &mut |_, _, _| {}).unwrap();
+    let r = replay::run(&p, &mut |_, _| Ok(()), &mut |_, _, _| {}).unwrap();
     let o = r.oracle.expect("a friction-node bag is compared");
     assert_eq!(o.compared, 2000);
     assert_eq!(o.count_mismatch, None);
@@ -417,7 +417,7 @@ fn a_truncated_bag_replays_up_to_the_damage_and_says_where() {
         steps > 500 && steps < 2000,
         "{steps} steps before the damage"
     );
-    let r = replay::run(&p, &mut |_, _| {}, &mut |_, _, _| {}).unwrap();
+    let r = replay::run(&p, &mut |_, _| Ok(()), &mut |_, _, _| {}).unwrap();
     assert_eq!(r.estimates.len(), steps);
     let out = d.join("out.csv");
     let (code, stdout, err) = run(&[
@@ -781,4 +781,33 @@ fn velocity_and_load_maps_transform_the_topics_and_bad_maps_are_named() {
         assert!(stderr.contains(needle), "{map}: {stderr}");
         assert!(!out.exists(), "{map}: nothing written");
     }
+}
+
+#[test]
+fn expect_identical_on_a_bag_without_recorded_estimates_exits_5_before_writing() {
+    let d = dir("nothing-to-compare");
+    let out = d.join("r.csv");
+    let (code, _, err) = run(&[
+        "replay",
+        FOREIGN_BAG,
+        "--topic",
+        "/joint_states",
+        "--joint",
+        "slider",
+        "--out",
+        out.to_str().unwrap(),
+        "--expect-identical",
+    ]);
+    assert_eq!(code, 5, "{err}");
+    assert!(err.contains("nothing to compare"), "{err}");
+    assert_eq!(std::fs::read_dir(&d).unwrap().count(), 0, "nothing written");
+    // A recorded bag still compares (and exits 0 when identical).
+    let (code, _, err) = run(&[
+        "replay",
+        NODE_BAG,
+        "--out",
+        out.to_str().unwrap(),
+        "--expect-identical",
+    ]);
+    assert_eq!(code, 0, "{err}");
 }

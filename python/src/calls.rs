@@ -125,8 +125,8 @@ pub fn replay<'py>(
             errors::value(message)
         }
     };
-    let (prepared, result, written, wall, model_wall) = py
-        .detach(|| -> PyResult<_> {
+    let (prepared, result, written, wall, model_wall) =
+        crate::interrupts::interruptible(py, |stop| -> PyResult<_> {
             let b = Bag::open(&bag).map_err(errors::bag)?;
             let prepared = rp::prepare(&b, &opts).map_err(errors::replay)?;
             if let Some(r) = &report_dir {
@@ -139,7 +139,7 @@ pub fn replay<'py>(
                 _ => None,
             };
             let model_started = Instant::now();
-            let result = rp::run(&prepared, &mut |_, _| {}, &mut |e, rec, k| {
+            let result = rp::run(&prepared, &mut |_, _| stop.check(), &mut |e, rec, k| {
                 if let Some(s) = stream.as_mut() {
                     s.push(e, rec, k)
                 }
@@ -156,7 +156,7 @@ pub fn replay<'py>(
                     .map_err(|e| errors::os(e.to_string()))?;
             }
             Ok((prepared, result, written, wall, model_wall))
-        })
+        })?
         .map_err(in_bag)?;
     // Columns as the CSV output has them: t_s from the first stamp; with
     // several contacts every contact's rows, named in a `contact` column.
@@ -413,27 +413,33 @@ pub fn fit<'py>(
         progress: progress.then(|| {
             Arc::new(|label: &str, l: &str| eprintln!("fit [{label}]: {l}")) as LabelledProgress
         }),
+        stop: friction_node::interrupt::Stop::new(),
     };
-    let (p, ours, classic, skipped) = py.detach(|| -> PyResult<_> {
-        let p = prepare(&config, &req).map_err(errors::fit)?;
-        // Outputs are checked before any computation.
-        if let Some(o) = &out {
-            drop(
-                friction_node::output::AtomicFile::create(o)
-                    .map_err(|e| errors::os(e.to_string()))?,
-            );
-        }
-        if let Some(r) = &report_dir {
-            friction_node::output::prepare_dir(r).map_err(|e| errors::os(e.to_string()))?;
-        }
-        let ours = fit_ours(&p, &req).map_err(errors::fit)?;
-        let (classic, skipped) = if baselines {
-            fit_baselines(&p, &req).map_err(errors::fit)?
-        } else {
-            (Vec::new(), Vec::new())
-        };
-        Ok((p, ours, classic, skipped))
-    })?;
+    let (p, ours, classic, skipped) =
+        crate::interrupts::interruptible(py, |stop| -> PyResult<_> {
+            let req = FitRequest {
+                stop: stop.clone(),
+                ..req.clone()
+            };
+            let p = prepare(&config, &req).map_err(errors::fit)?;
+            // Outputs are checked before any computation.
+            if let Some(o) = &out {
+                drop(
+                    friction_node::output::AtomicFile::create(o)
+                        .map_err(|e| errors::os(e.to_string()))?,
+                );
+            }
+            if let Some(r) = &report_dir {
+                friction_node::output::prepare_dir(r).map_err(|e| errors::os(e.to_string()))?;
+            }
+            let ours = fit_ours(&p, &req).map_err(errors::fit)?;
+            let (classic, skipped) = if baselines {
+                fit_baselines(&p, &req).map_err(errors::fit)?
+            } else {
+                (Vec::new(), Vec::new())
+            };
+            Ok((p, ours, classic, skipped))
+        })??;
     let yaml = report::fitted_yaml(&ours.config, &ours.outcome, &p.names, &ours.map);
     let mut extra = String::new();
     let d = outcome_dict(py, &ours.outcome)?;

@@ -12,6 +12,7 @@
 mod calls;
 mod columns;
 mod errors;
+mod interrupts;
 mod model;
 
 use pyo3::prelude::*;

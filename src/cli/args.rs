@@ -385,6 +385,21 @@ impl Command {
             | Command::Fit { common, .. } => common,
         }
     }
+
+    /// Offline work that SIGINT/SIGTERM stop cleanly (the node and its
+    /// benches handle signals themselves, or are short).
+    pub fn is_offline_work(&self) -> bool {
+        matches!(
+            self,
+            Command::Simulate { .. }
+                | Command::Stribeck { .. }
+                | Command::Study { .. }
+                | Command::Replay { .. }
+                | Command::Fit { .. }
+                | Command::BenchFit { .. }
+                | Command::BenchAccuracy { .. }
+        )
+    }
 }
 
 /// `replay`'s arguments.

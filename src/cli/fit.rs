@@ -269,6 +269,7 @@ impl FitArgs {
             progress: Some(Arc::new(|label: &str, l: &str| {
                 eprintln!("fit [{label}]: {l}")
             })),
+            stop: friction_node::interrupt::Stop::process().clone(),
         })
     }
 }

@@ -1,7 +1,8 @@
 //! Logging for the binary: `tracing` events to the terminal (stderr), at
 //! the level `RUST_LOG` or `--ros-args --log-level` gives (default: the
 //! node's own lines from info up, other crates' from warn; RustDDS's
-//! teardown chatter is silenced). The ROS 2 transport also sends
+//! teardown chatter is silenced), in colour only on a terminal without
+//! `NO_COLOR`. The ROS 2 transport also sends
 //! them to `/rosout` (see `friction_node::transport::rosout`).
 
 use friction_node::config::RosArgs;
@@ -31,7 +32,15 @@ pub fn init(ros: Option<&RosArgs>) {
             .unwrap_or_else(|_| EnvFilter::new(format!("warn,friction_node=info{quiet}"))),
     };
     let stdout = !ros.is_some_and(|r| r.stdout_disabled);
-    let terminal = stdout.then(|| tracing_subscriber::fmt::layer().with_writer(std::io::stderr));
+    // Colour only on a terminal, and never with NO_COLOR set (no-color.org):
+    // a redirected log holds plain text.
+    let colour = std::io::IsTerminal::is_terminal(&std::io::stderr())
+        && std::env::var_os("NO_COLOR").is_none_or(|v| v.is_empty());
+    let terminal = stdout.then(|| {
+        tracing_subscriber::fmt::layer()
+            .with_writer(std::io::stderr)
+            .with_ansi(colour)
+    });
     let rosout_enabled = !ros.is_some_and(|r| r.rosout_disabled);
     tracing_subscriber::registry()
         .with(filter)

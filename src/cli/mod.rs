@@ -7,6 +7,7 @@ pub mod fit;
 pub mod logging;
 pub mod node;
 pub mod offline;
+pub mod progress;
 #[cfg(feature = "mcap")]
 pub mod replay;
 pub mod study;
@@ -22,6 +23,11 @@ pub fn dispatch(
     ros: Option<friction_node::config::RosArgs>,
     allocations: &dyn Fn() -> u64,
 ) -> Result<()> {
+    if cli.command.is_offline_work() {
+        // SIGINT/SIGTERM stop the work and remove what is half-written
+        // (the node's `run` has handlers of its own).
+        friction_node::interrupt::Stop::process().install_signal_handlers()?;
+    }
     let sub = cli.command.common().clone();
     if cli.common.config.is_some() && sub.config.is_some() {
         anyhow::bail!("--config given twice (before and after the subcommand)");

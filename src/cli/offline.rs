@@ -28,6 +28,28 @@ pub fn simulate(
     if let Some(t) = &temperature {
         offline::check_temperature(config, t)?;
     }
+    let steps = offline::check_duration(config, duration)?;
+    for (what, s) in [
+        ("velocity", Some(&velocity)),
+        ("load", Some(&load)),
+        ("temperature", temperature.as_ref()),
+    ] {
+        if let Some(w) = s
+            .map(|s| s.check_coverage(what, duration))
+            .transpose()?
+            .flatten()
+        {
+            eprintln!("warning: {w}");
+        }
+    }
+    // The size of the whole CSV, from the header and a row of this run.
+    let row = offline::simulate_row(&offline::sample_estimate(config, &velocity, &load)?, 20.0);
+    let estimate =
+        (offline::SIMULATE_COLUMNS.len() + 1) as f64 + (steps as f64) * (row.len() + 1) as f64;
+    let what = format!("the CSV ({steps} rows)");
+    if let Some(w) = friction_node::output::check_room(out, estimate, &what)? {
+        eprintln!("warning: {w}");
+    }
     let mut file = AtomicFile::create(out)?;
     file.line(format_args!("{}", offline::SIMULATE_COLUMNS))?;
     eprintln!(
@@ -39,9 +61,14 @@ pub fn simulate(
         load: &load,
         temperature: temperature.as_ref(),
     };
+    let stop = friction_node::interrupt::Stop::process();
+    let bar = super::progress::bar(steps, "steps");
     let report = offline::simulate_inputs(config, &inputs, duration, |e, _, t_c| {
+        stop.check()?;
+        bar.inc(1);
         Ok(file.line(format_args!("{}", offline::simulate_row(e, t_c)))?)
     })?;
+    bar.finish_and_clear();
     let path = file.commit()?;
     print!("{report}");
     println!("wrote {} ({} rows)", path.display(), report.steps);

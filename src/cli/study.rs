@@ -58,14 +58,16 @@ pub fn run(
         .iter()
         .filter(|j| matches!(j, Job::Case(_)))
         .count();
+    let n_steady = jobs_list.len() - n_cases;
     eprintln!(
-        "study {}: {} cases on {} threads, N = {}, dt = {} s, {} cycles per case",
+        "study {}: {} cases and {} steady curves on {} threads, N = {}, dt = {} s, {} cycles per case",
         kinds
             .iter()
             .map(|k| k.name())
             .collect::<Vec<_>>()
             .join(", "),
         n_cases,
+        n_steady,
         rayon::current_num_threads(),
         config.solver.cells,
         config.solver.dt_s,
@@ -84,6 +86,7 @@ pub fn run(
         ),
         Case(Box<studies::CaseResult>),
     }
+    let stop = friction_node::interrupt::Stop::process();
     let done: Vec<Done> = jobs_list
         .into_par_iter()
         .map(|j| match j {
@@ -94,11 +97,16 @@ pub fn run(
             }
             Job::Case(c) => {
                 bar.set_message(format!("{} {}", c.study.name(), c.id));
-                Done::Case(Box::new(studies::run_case(&c, &|n| bar.inc(n as u64))))
+                Done::Case(Box::new(studies::run_case(&c, &|n| {
+                    bar.inc(n as u64);
+                    !stop.requested()
+                })))
             }
         })
         .collect();
     bar.finish_and_clear();
+    // Nothing is written after a stop.
+    stop.check()?;
     let mut results: claims::Results = kinds
         .iter()
         .map(|&k| {
@@ -131,10 +139,20 @@ pub fn run(
             .iter()
             .filter_map(|c| c.failure.as_ref().map(|f| format!("{} ({f})", c.case.id)))
             .collect();
+        // A study is transient cases, steady curves, or both.
+        let count =
+            |n: usize, one: &str, many: &str| format!("{n:>3} {}", if n == 1 { one } else { many });
+        let mut parts = Vec::new();
+        if !r.cases.is_empty() {
+            parts.push(count(r.cases.len(), "case", "cases"));
+        }
+        if !r.steady.is_empty() {
+            parts.push(count(r.steady.len(), "steady curve", "steady curves"));
+        }
         println!(
-            "{:<20} {:>3} cases, {} files in {}{}",
+            "{:<20} {}, {} files in {}{}",
             r.study.name(),
-            r.cases.len(),
+            parts.join(", "),
             files.len(),
             out.join(r.study.name()).display(),
             if bad.is_empty() {

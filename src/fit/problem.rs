@@ -50,6 +50,9 @@ pub struct Options {
     pub max_evaluations: usize,
     /// Progress lines (the command prints them).
     pub progress: Option<Progress>,
+    /// Requested from outside (SIGINT, Ctrl-C): the search ends at its next
+    /// evaluation and the fit is [`super::FitError::Interrupted`].
+    pub stop: crate::interrupt::Stop,
 }
 
 impl Default for Options {
@@ -60,6 +63,7 @@ impl Default for Options {
             seed: 1,
             max_evaluations: 200,
             progress: None,
+            stop: crate::interrupt::Stop::new(),
         }
     }
 }
@@ -123,6 +127,8 @@ pub struct Problem<'a> {
     /// validation): a Jacobian column that moves only a model parameter
     /// reuses them instead of evaluating the column expressions again.
     recent: Mutex<Vec<SeriesEntry>>,
+    /// A stop requested from outside ends the local runs at once.
+    pub stop: crate::interrupt::Stop,
     pub simulations: AtomicUsize,
     pub simulation_ns: AtomicU64,
 }
@@ -183,6 +189,7 @@ impl<'a> Problem<'a> {
             friction_scale: scale,
             fixed,
             recent: Mutex::new(Vec::new()),
+            stop: crate::interrupt::Stop::new(),
             simulations: AtomicUsize::new(0),
             simulation_ns: AtomicU64::new(0),
         })
@@ -356,10 +363,14 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Lm<'_, '_> {
     }
 
     fn residuals(&self) -> Option<DVector<f64>> {
-        Some(self.r.clone())
+        // None ends the run (TerminationReason::User) when a stop is asked.
+        (!self.problem.stop.requested()).then(|| self.r.clone())
     }
 
     fn jacobian(&self) -> Option<DMatrix<f64>> {
+        if self.problem.stop.requested() {
+            return None;
+        }
         let n = self.u.len();
         let columns: Vec<Vec<f64>> = (0..n)
             .into_par_iter()
@@ -486,8 +497,10 @@ pub fn fit(
     options: &Options,
 ) -> Result<FitOutcome, super::FitError> {
     let wall = Instant::now();
-    let problem = Problem::new(model, data, map_fit)?;
+    let mut problem = Problem::new(model, data, map_fit)?;
+    problem.stop = options.stop.clone();
     let optima = super::search::search(&problem, options);
+    options.stop.check()?;
     let best = optima[0].clone();
     let statistics = super::stats::at_optimum(&problem, &best.x);
     let collect = |v: Vec<Result<SeriesFit, String>>| -> Result<Vec<SeriesFit>, super::FitError> {

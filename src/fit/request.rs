@@ -56,6 +56,9 @@ pub struct FitRequest {
     pub baselines: bool,
     /// Progress lines, with the model's label.
     pub progress: Option<LabelledProgress>,
+    /// Requested from outside (SIGINT, Ctrl-C): the fit ends with
+    /// [`FitError::Interrupted`].
+    pub stop: crate::interrupt::Stop,
 }
 
 impl Default for FitRequest {
@@ -77,6 +80,7 @@ impl Default for FitRequest {
             max_evaluations: 200,
             baselines: false,
             progress: None,
+            stop: crate::interrupt::Stop::new(),
         }
     }
 }
@@ -153,6 +157,7 @@ impl FitRequest {
             seed: self.seed,
             max_evaluations: self.max_evaluations,
             progress,
+            stop: self.stop.clone(),
         }
     }
 

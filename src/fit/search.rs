@@ -52,6 +52,9 @@ pub fn search(problem: &Problem<'_>, options: &Options) -> Vec<LocalRun> {
         let mut scored: Vec<(f64, Vec<f64>)> = cube
             .par_iter()
             .map(|f| {
+                if problem.stop.requested() {
+                    return (f64::INFINITY, Vec::new());
+                }
                 let x: Vec<f64> = problem
                     .params
                     .iter()
@@ -69,7 +72,7 @@ pub fn search(problem: &Problem<'_>, options: &Options) -> Vec<LocalRun> {
             scored[0].0
         ));
         for (_, x) in scored {
-            if starts.len() >= options.starts {
+            if starts.len() >= options.starts || x.is_empty() {
                 break;
             }
             if starts
@@ -84,6 +87,7 @@ pub fn search(problem: &Problem<'_>, options: &Options) -> Vec<LocalRun> {
     let mut runs: Vec<LocalRun> = starts
         .iter()
         .enumerate()
+        .take_while(|_| !problem.stop.requested())
         .map(|(k, x)| {
             let run = local_run(problem, x, options.max_evaluations);
             options.say(&format!(
@@ -110,6 +114,17 @@ pub fn search(problem: &Problem<'_>, options: &Options) -> Vec<LocalRun> {
         {
             distinct.push(r);
         }
+    }
+    if distinct.is_empty() {
+        // Stopped before any local run: the start, unrefined.
+        let cost = problem.cost(&x0);
+        distinct.push(LocalRun {
+            x: x0,
+            cost,
+            converged: false,
+            termination: "stopped before any local run".into(),
+            evaluations: 1,
+        });
     }
     distinct
 }

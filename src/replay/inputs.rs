@@ -18,6 +18,7 @@ fn map_samples(
         expr: expr.to_string(),
         message,
     };
+    crate::expression::check_size(expr).map_err(err)?;
     let node = evalexpr::build_operator_tree::<DefaultNumericTypes>(expr)
         .map_err(|e| err(e.to_string()))?;
     if let Some(id) = node.iter_variable_identifiers().find(|id| *id != "x") {

@@ -54,6 +54,8 @@ use std::sync::Arc;
 pub enum ReplayError {
     #[error(transparent)]
     Bag(#[from] BagError),
+    #[error(transparent)]
+    Interrupted(#[from] crate::interrupt::Interrupted),
     #[error("no usable velocity topic ({VELOCITY_TYPES}); the bag has:\n{}", bag::listing(.available))]
     NoVelocityTopic {
         available: Vec<(String, String, u64)>,
@@ -139,6 +141,15 @@ pub enum InputMode {
 }
 
 impl InputMode {
+    /// Whether the replay has recorded estimates to compare with (the
+    /// determinism oracle).
+    pub fn has_recorded_estimates(&self) -> bool {
+        matches!(
+            self,
+            InputMode::RecordedEstimates { .. } | InputMode::RecordedContacts { .. }
+        )
+    }
+
     /// One line for logs and reports.
     pub fn describe(&self) -> String {
         match self {
@@ -254,7 +265,7 @@ fn choose_config(scan: &BagScan, opts: &ReplayOptions) -> Result<(Config, String
         ));
     }
     if let Some(text) = &scan.recorded_config {
-        let c = Config::from_yaml(text, &Origin::Embedded, &opts.overrides)
+        let c = Config::from_yaml(text, &Origin::Text("recorded in the bag"), &opts.overrides)
             .map_err(ReplayError::RecordedConfig)?;
         return Ok((c, "recorded in the bag".into()));
     }
@@ -507,7 +518,7 @@ pub struct ContactReplay {
 /// index; e.g. [`OutputStream::push`]).
 pub fn run(
     p: &PreparedReplay,
-    progress: &mut dyn FnMut(usize, usize),
+    progress: &mut dyn FnMut(usize, usize) -> Result<(), crate::interrupt::Interrupted>,
     on_step: &mut dyn FnMut(&Estimate, &EstimateRecord, u16),
 ) -> Result<ReplayResult, ReplayError> {
     let mut cfg = p.config.clone();
@@ -573,10 +584,10 @@ pub fn run(
             out.push((e, rec));
         }
         if k % 4096 == 0 {
-            progress(k, total);
+            progress(k, total)?;
         }
     }
-    progress(total, total);
+    progress(total, total)?;
     let contacts: Vec<ContactReplay> = cfg
         .contacts
         .0

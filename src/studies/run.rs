@@ -26,8 +26,9 @@ impl CaseResult {
 }
 
 /// Run one case; `progress(n)` is called with the number of steps done since
-/// the last call.
-pub fn run_case(case: &Case, progress: &dyn Fn(usize)) -> CaseResult {
+/// the last call, and returns whether to go on (false: the case ends with
+/// the failure "interrupted").
+pub fn run_case(case: &Case, progress: &dyn Fn(usize) -> bool) -> CaseResult {
     let mut result = CaseResult {
         case: case.clone(),
         steps: 0,
@@ -73,7 +74,10 @@ pub fn run_case(case: &Case, progress: &dyn Fn(usize)) -> CaseResult {
         }
         pending += 1;
         if pending == 500 {
-            progress(pending);
+            if !progress(pending) {
+                result.failure = Some("interrupted".into());
+                return result;
+            }
             pending = 0;
         }
     }
@@ -207,7 +211,7 @@ pub fn run_study(
         .iter()
         .map(steady_curve)
         .collect::<Result<Vec<_>, _>>()?;
-    let cases = cs.iter().map(|c| run_case(c, &|_| {})).collect();
+    let cases = cs.iter().map(|c| run_case(c, &|_| true)).collect();
     Ok(StudyResult {
         study,
         cases,

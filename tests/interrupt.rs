@@ -1,0 +1,175 @@
+//! SIGINT and SIGTERM during long offline work (`simulate`, `study`,
+//! `replay`, `fit`): the command stops, exits 128 + the signal and leaves no
+//! temporary (half-written) file. Each test signals the process once it
+//! has printed the line it prints just before the long part (an event, not
+//! a delay), with work sized to take far longer than that.
+
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+
+fn bin() -> &'static str {
+    env!("CARGO_BIN_EXE_friction-node")
+}
+
+fn dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("fn-interrupt-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Every file under `d`, recursively.
+fn files(d: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    for e in std::fs::read_dir(d).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_dir() {
+            out.extend(files(&p));
+        } else {
+            out.push(p);
+        }
+    }
+    out
+}
+
+/// Start `args`, send `signal` once a stderr line contains `ready`, and
+/// return the exit code and the whole stderr.
+fn interrupt(args: &[&str], ready: &str, signal: i32) -> (Option<i32>, String) {
+    let mut child = Command::new(bin())
+        .args(args)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut lines = BufReader::new(child.stderr.take().unwrap()).lines();
+    let mut seen = String::new();
+    loop {
+        let line = lines
+            .next()
+            .unwrap_or_else(|| panic!("{args:?} ended before printing `{ready}`:\n{seen}"))
+            .unwrap();
+        seen.push_str(&line);
+        seen.push('\n');
+        if line.contains(ready) {
+            break;
+        }
+    }
+    // SAFETY: signalling our own child process.
+    assert_eq!(unsafe { libc::kill(child.id() as i32, signal) }, 0);
+    for l in lines {
+        seen.push_str(&l.unwrap());
+        seen.push('\n');
+    }
+    (child.wait().unwrap().code(), seen)
+}
+
+#[test]
+fn sigint_and_sigterm_stop_simulate_and_remove_its_temporary_file() {
+    for (signal, code) in [(libc::SIGINT, 130), (libc::SIGTERM, 143)] {
+        let d = dir(&format!("simulate-{signal}"));
+        let out = d.join("run.csv");
+        let (rc, err) = interrupt(
+            &[
+                "simulate",
+                "--velocity",
+                "const:0.1",
+                "--duration",
+                "300",
+                "--set",
+                "solver.cells=8192",
+                "--out",
+                out.to_str().unwrap(),
+            ],
+            "simulate: velocity",
+            signal,
+        );
+        assert_eq!(rc, Some(code), "{err}");
+        assert!(err.contains("interrupted by SIG"), "{err}");
+        assert_eq!(files(&d), Vec::<PathBuf>::new(), "nothing left behind");
+    }
+}
+
+#[test]
+fn sigint_stops_a_study_before_anything_is_written() {
+    let d = dir("study");
+    let (rc, err) = interrupt(
+        &[
+            "study",
+            "all",
+            "--out",
+            d.to_str().unwrap(),
+            "--set",
+            "solver.cells=4096",
+        ],
+        "cases and",
+        libc::SIGINT,
+    );
+    assert_eq!(rc, Some(130), "{err}");
+    assert_eq!(files(&d), Vec::<PathBuf>::new(), "nothing written");
+}
+
+#[test]
+#[cfg(feature = "mcap")]
+fn sigterm_stops_a_replay_and_removes_its_temporary_output() {
+    let d = dir("replay");
+    let bag = concat!(env!("CARGO_MANIFEST_DIR"), "/bags/node_lockstep.mcap");
+    let out = d.join("replay.csv");
+    // 2 s of bag at 10 µs steps on 8192 cells: far longer than the signal.
+    let (rc, err) = interrupt(
+        &[
+            "replay",
+            bag,
+            "--out",
+            out.to_str().unwrap(),
+            "--set",
+            "solver.cells=8192",
+            "--set",
+            "solver.dt_s=1e-5",
+        ],
+        "replay ",
+        libc::SIGTERM,
+    );
+    assert_eq!(rc, Some(143), "{err}");
+    assert_eq!(files(&d), Vec::<PathBuf>::new(), "nothing left behind");
+}
+
+#[test]
+fn sigint_stops_a_fit_before_it_writes_anything() {
+    let d = dir("fit");
+    let data = d.join("data.csv");
+    let sim = Command::new(bin())
+        .args([
+            "simulate",
+            "--velocity",
+            "sine:0,0.5,1",
+            "--duration",
+            "4",
+            "--set",
+            "solver.cells=64",
+        ])
+        .arg("--out")
+        .arg(&data)
+        .output()
+        .unwrap();
+    assert!(sim.status.success());
+    let out = d.join("fitted.yaml");
+    let (rc, err) = interrupt(
+        &[
+            "fit",
+            data.to_str().unwrap(),
+            "--fit",
+            "contact.boundary_friction,roughness.sigma_m,lubricant.viscosity_pa_s",
+            "--global-points",
+            "10000",
+            "--out",
+            out.to_str().unwrap(),
+            "--set",
+            "solver.cells=2048",
+        ],
+        "parameter(s) on",
+        libc::SIGINT,
+    );
+    assert_eq!(rc, Some(130), "{err}");
+    assert_eq!(files(&d), vec![data], "only the data is there");
+}
