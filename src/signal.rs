@@ -8,9 +8,12 @@
 //! | `csv:FILE` | time in the first column (s), value in the second; linear interpolation, held constant outside the table |
 //! | `csv:FILE@NAME` | the same, value from the column whose header is NAME |
 //!
-//! A CSV may start with a header line; `#` starts a comment; times must
-//! increase strictly. A malformed line is reported with its line number.
+//! A table is read as [`crate::table::Table`] reads one: comma, semicolon,
+//! tab or whitespace separated, an optional header line, `#` comments;
+//! times must increase strictly. A malformed line is reported with its
+//! line number.
 
+use crate::table::{Delimiter, Table, TableError};
 use crate::text::Num;
 use std::path::{Path, PathBuf};
 
@@ -40,12 +43,17 @@ pub enum SignalError {
         spec: String,
         message: String,
     },
-    #[error("cannot read {what} table {}", path.display())]
+    #[error("cannot read {what} table {}: {cause}", path.display())]
     Io {
         what: String,
         path: PathBuf,
-        #[source]
-        source: std::io::Error,
+        cause: std::io::Error,
+    },
+    #[error("{what} table {}: {message}", path.display())]
+    Coverage {
+        what: String,
+        path: PathBuf,
+        message: String,
     },
     #[error("{}:{line}: {message}", path.display())]
     Csv {
@@ -153,6 +161,56 @@ impl Signal {
         }
     }
 
+    /// How a `csv:` table covers a run over [0, `duration_s`] s (other
+    /// signals cover any run): `Ok(None)` when its times span the run;
+    /// a warning when part of the run lies outside them, where the table's
+    /// first or last value is held; an error when no part of the run lies
+    /// within them (the whole run would be a held value).
+    pub fn check_coverage(
+        &self,
+        what: &str,
+        duration_s: f64,
+    ) -> Result<Option<String>, SignalError> {
+        let Signal::Table { source, t, .. } = self else {
+            return Ok(None);
+        };
+        if t.len() == 1 {
+            // One row: a constant, whatever its time.
+            return Ok(None);
+        }
+        let (first, last) = (t[0], t[t.len() - 1]);
+        let spans = format!(
+            "its times span [{}, {}] s and the run [0, {}] s",
+            Num(first),
+            Num(last),
+            Num(duration_s)
+        );
+        if last < 0.0 || first > duration_s {
+            return Err(SignalError::Coverage {
+                what: what.into(),
+                path: source.clone(),
+                message: format!(
+                    "{spans}: the table does not cover the run at all (the whole run would hold its {} value)",
+                    if last <= 0.0 { "last" } else { "first" }
+                ),
+            });
+        }
+        let mut held = Vec::new();
+        if first > 0.0 {
+            held.push(format!("its first value before {} s", Num(first)));
+        }
+        if last < duration_s {
+            held.push(format!("its last value after {} s", Num(last)));
+        }
+        Ok((!held.is_empty()).then(|| {
+            format!(
+                "{what} table {}: {spans}; held at {}",
+                source.display(),
+                held.join(" and ")
+            )
+        }))
+    }
+
     /// The period of a periodic signal (a sine with non-zero amplitude and frequency).
     pub fn period(&self) -> Option<f64> {
         match self {
@@ -222,16 +280,38 @@ impl std::fmt::Display for Signal {
 }
 
 fn read_table(path: &Path, column: Option<&str>, what: &str) -> Result<Signal, SignalError> {
-    let text = std::fs::read_to_string(path).map_err(|source| SignalError::Io {
+    let text = std::fs::read_to_string(path).map_err(|cause| SignalError::Io {
         what: what.to_string(),
         path: path.to_path_buf(),
-        source,
+        cause,
     })?;
     parse_table(&text, path, column, what)
 }
 
-/// Parse the text of a `csv:` table (see the module documentation); `path`
-/// names it in messages.
+impl From<TableError> for SignalError {
+    fn from(e: TableError) -> Self {
+        match e {
+            TableError::Io { path, cause } => SignalError::Io {
+                what: "signal".into(),
+                path,
+                cause,
+            },
+            TableError::Cell {
+                path,
+                line,
+                message,
+            } => SignalError::Csv {
+                path,
+                line,
+                message,
+            },
+        }
+    }
+}
+
+/// Parse the text of a `csv:` table (see the module documentation; read
+/// as [`crate::table::Table`] reads it: any separator, a header or none);
+/// `path` names it in messages.
 pub fn parse_table(
     text: &str,
     path: &Path,
@@ -244,75 +324,46 @@ pub fn parse_table(
         line,
         message,
     };
-    let mut col = 1usize;
-    let mut saw_data = false;
-    let mut header_seen = false;
-    let (mut ts, mut ys) = (Vec::new(), Vec::new());
-    // A byte-order mark (spreadsheet exports) is not part of the first line.
-    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    for (k, raw) in text.lines().enumerate() {
-        let lineno = k + 1;
-        let line = raw.split('#').next().unwrap_or("").trim();
-        if line.is_empty() {
-            continue;
-        }
-        let fields: Vec<&str> = line.split(',').map(str::trim).collect();
-        let first_is_number = fields[0].parse::<f64>().is_ok();
-        if !saw_data && !first_is_number {
-            // Header line.
-            header_seen = true;
-            if let Some(name) = column {
-                col = fields.iter().position(|f| *f == name).ok_or_else(|| {
-                    err(
-                        lineno,
-                        format!("no column named `{name}` in header {fields:?}"),
-                    )
-                })?;
-                if col == 0 {
-                    return Err(err(lineno, format!("column `{name}` is the time column")));
-                }
-            }
-            continue;
-        }
-        if let (Some(name), false) = (column, header_seen) {
-            return Err(err(
-                lineno,
-                format!("a column name (@{name}) needs a header line"),
-            ));
-        }
-        saw_data = true;
-        if fields.len() <= col {
-            return Err(err(
-                lineno,
-                format!(
-                    "expected at least {} columns, found {}",
-                    col + 1,
-                    fields.len()
-                ),
-            ));
-        }
-        let t: f64 = fields[0]
-            .parse()
-            .map_err(|_| err(lineno, format!("time `{}` is not a number", fields[0])))?;
-        let y: f64 = fields[col]
-            .parse()
-            .map_err(|_| err(lineno, format!("value `{}` is not a number", fields[col])))?;
-        if !t.is_finite() || !y.is_finite() {
-            return Err(err(lineno, "time and value must be finite".into()));
-        }
-        if let Some(&prev) = ts.last() {
-            if t <= prev {
-                return Err(err(
-                    lineno,
-                    format!("time {t} s does not increase (previous {prev} s)"),
-                ));
-            }
-        }
-        ts.push(t);
-        ys.push(y);
+    let table = Table::parse(text, path, Delimiter::Auto, None, 0)?;
+    if table.names.len() < 2 {
+        return Err(err(
+            table.lines[0],
+            format!(
+                "expected at least 2 columns (time, value), found {}",
+                table.names.len()
+            ),
+        ));
     }
-    if ts.is_empty() {
-        return Err(err(0, "no data rows".into()));
+    let col = match column {
+        None => 1,
+        Some(name) if !table.has_header => {
+            return Err(err(
+                table.lines[0],
+                format!("a column name (@{name}) needs a header line"),
+            ))
+        }
+        Some(name) => match table.index(name) {
+            Some(0) => return Err(err(1, format!("column `{name}` is the time column"))),
+            Some(k) => k,
+            None => return Err(table.column_error(name).into()),
+        },
+    };
+    let numeric = |k: usize| -> Result<Vec<f64>, SignalError> {
+        match table.text[k] {
+            None => Ok(table.columns[k].clone()),
+            Some(_) => Err(table.column_error(&table.names[k]).into()),
+        }
+    };
+    let (ts, ys) = (numeric(0)?, numeric(col)?);
+    if let Some(k) = (1..ts.len()).find(|&k| ts[k] <= ts[k - 1]) {
+        return Err(err(
+            table.lines[k],
+            format!(
+                "time {} s does not increase (previous {} s)",
+                ts[k],
+                ts[k - 1]
+            ),
+        ));
     }
     Ok(Signal::Table {
         source: path.to_path_buf(),
@@ -372,9 +423,44 @@ mod tests {
         assert_relative_eq!(s.at(0.5), 1.0);
         assert_relative_eq!(s.at(2.0), 1.0);
         assert_eq!(s.at(10.0), 0.0);
+        // Any separator a spreadsheet writes, as `fit` reads it.
+        for (name, text) in [
+            ("semi.csv", "t_s;v\n0;0\n1;2\n"),
+            ("tab.csv", "t_s\tv\n0\t0\n1\t2\n"),
+            ("space.csv", "t_s v\n0 0\n1 2\n"),
+        ] {
+            let p = tmp(name, text);
+            let s = Signal::parse(&format!("csv:{}", p.display()), "velocity").unwrap();
+            assert_relative_eq!(s.at(0.5), 1.0);
+        }
         let p = tmp("cols.csv", "t_s,velocity_m_s,load_n\n0,1,100\n1,1,300\n");
         let s = Signal::parse(&format!("csv:{}@load_n", p.display()), "load").unwrap();
         assert_relative_eq!(s.at(0.5), 200.0);
+    }
+
+    #[test]
+    fn a_table_outside_the_run_is_an_error_and_a_partial_one_a_warning() {
+        let p = tmp("late.csv", "t_s,v\n5,0.1\n6,0.1\n");
+        let s = Signal::parse(&format!("csv:{}", p.display()), "velocity").unwrap();
+        let e = s.check_coverage("velocity", 1.0).unwrap_err().to_string();
+        assert!(
+            e.contains("late.csv")
+                && e.contains("[5, 6] s")
+                && e.contains("does not cover the run at all"),
+            "{e}"
+        );
+        let w = s.check_coverage("velocity", 10.0).unwrap().unwrap();
+        assert!(
+            w.contains("first value before 5 s") && w.contains("last value after 6 s"),
+            "{w}"
+        );
+        let p = tmp("full.csv", "t_s,v\n0,0.1\n2,0.1\n");
+        let s = Signal::parse(&format!("csv:{}", p.display()), "velocity").unwrap();
+        assert_eq!(s.check_coverage("velocity", 2.0).unwrap(), None);
+        assert_eq!(
+            Signal::Const(1.0).check_coverage("load", 1e6).unwrap(),
+            None
+        );
     }
 
     #[test]

@@ -407,6 +407,97 @@ fn bad_data_keys_and_bounds_get_a_clear_message_and_nothing_is_written() {
         ],
         "drivetrain.coulomb_n",
     );
+    expect_error(
+        good,
+        &[
+            "--fit",
+            "k",
+            "--map",
+            "k=1",
+            "--velocity",
+            "k * velocity_m_s + ddt(ddt(k))",
+        ],
+        "ddt(k): ",
+    );
+}
+
+#[test]
+fn a_missing_validation_file_is_named_once_with_its_reason() {
+    let d = dir("validate-missing");
+    let data = small_data(&d);
+    let nope = d.join("nope.csv");
+    let out = d.join("fitted.yaml");
+    let (code, _, stderr) = run(&[
+        "fit",
+        data.to_str().unwrap(),
+        "--fit",
+        "contact.boundary_friction",
+        "--validate",
+        nope.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{stderr}");
+    assert_eq!(
+        stderr.matches("No such file or directory").count(),
+        1,
+        "{stderr}"
+    );
+    assert!(stderr.contains("nope.csv"), "{stderr}");
+}
+
+#[test]
+fn a_simulate_run_is_fit_data_as_written_its_text_columns_skipped() {
+    let d = dir("from-simulate");
+    let data = d.join("run.csv");
+    let (code, _, stderr) = run(&[
+        "simulate",
+        "--velocity",
+        "sine:0,0.5,1",
+        "--duration",
+        "1",
+        "--set",
+        "solver.cells=32",
+        "--out",
+        data.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let out = d.join("fitted.yaml");
+    let (code, _, stderr) = run(&[
+        "fit",
+        data.to_str().unwrap(),
+        "--fit",
+        "contact.boundary_friction",
+        "--start",
+        "contact.boundary_friction=0.2",
+        "--global-points",
+        "0",
+        "--starts",
+        "1",
+        "--set",
+        "solver.cells=32",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let fitted = friction_node::config::Config::load(Some(&out), &[]).unwrap();
+    approx::assert_relative_eq!(fitted.contact.boundary_friction, 0.3, max_relative = 1e-4);
+    // Reading a text column is refused by name, with the cell.
+    let (code, _, stderr) = run(&[
+        "fit",
+        data.to_str().unwrap(),
+        "--fit",
+        "contact.boundary_friction",
+        "--friction",
+        "status",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains("`converged` in column `status`"),
+        "{stderr}"
+    );
 }
 
 #[test]

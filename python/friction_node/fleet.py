@@ -76,11 +76,11 @@ def expand(bags: Union[str, os.PathLike, Iterable[Union[str, os.PathLike]]]) -> 
             head, chain = (b.split("::", 1) + [""])[:2]
             proto = head.split("://", 1)[0]
             suffix = f"::{chain}" if chain else ""
+            # A rosbag2 directory's split files are one bag: the directory.
+            paths = _rosbag2_dirs_for_their_files(paths, lambda p: fs.isfile(p), lambda p: fs.isdir(p))
             hits = sorted(f"{proto}://{p.lstrip('/') if chain else p}{suffix}" for p in paths)
         else:
-            hits = sorted(_glob.glob(b, recursive=True))
-            # A rosbag2 directory's split files are one bag: keep the directory.
-            hits = [h for h in hits if not _inside_rosbag2_dir(h)]
+            hits = _rosbag2_dirs_for_their_files(_glob.glob(b, recursive=True), os.path.isfile, os.path.isdir)
         if not hits:
             raise FileNotFoundError(f"no bags match {b!r}")
         out.extend(hits)
@@ -89,9 +89,20 @@ def expand(bags: Union[str, os.PathLike, Iterable[Union[str, os.PathLike]]]) -> 
     return [b for b in out if not (b in seen or seen.add(b))]
 
 
-def _inside_rosbag2_dir(path: str) -> bool:
-    parent = os.path.dirname(path)
-    return os.path.isfile(path) and os.path.isfile(os.path.join(parent, "metadata.yaml"))
+def _rosbag2_dirs_for_their_files(hits: Iterable[str], isfile, isdir) -> List[str]:
+    """Glob hits with every file of a rosbag2 directory (a directory holding
+    ``metadata.yaml``: the node's split recordings, rosbag2's own bags)
+    replaced by the directory itself, once: a rosbag2 directory is one bag.
+    A hit that is such a directory stays one bag too. Sorted."""
+    out = set()
+    for h in hits:
+        h = h.rstrip("/")
+        parent = h.rsplit("/", 1)[0] if "/" in h else "."
+        if isfile(h) and isfile(f"{parent}/metadata.yaml"):
+            out.add(parent)
+        elif isfile(h) or (isdir(h) and isfile(f"{h}/metadata.yaml")):
+            out.add(h)
+    return sorted(out)
 
 
 def _output_names(bags: Sequence[str]) -> List[str]:
@@ -260,14 +271,25 @@ def _client(client: Any, workers: Optional[int]):
     if client is not None:
         raise TypeError(f"client: expected a distributed.Client, a scheduler address or None, got {client!r}")
     n = workers or os.cpu_count() or 1
-    cluster = distributed.LocalCluster(
-        n_workers=n,
-        threads_per_worker=1,
-        processes=True,
-        host="127.0.0.1",
-        dashboard_address=None,
-        silence_logs=40,
-    )
+    try:
+        cluster = distributed.LocalCluster(
+            n_workers=n,
+            threads_per_worker=1,
+            processes=True,
+            host="127.0.0.1",
+            dashboard_address=None,
+            silence_logs=40,
+        )
+    except RuntimeError as e:
+        main = sys.modules.get("__main__")
+        if getattr(main, "__file__", None):
+            raise RuntimeError(
+                f"the local Dask cluster could not start its workers ({e}). Dask starts each worker "
+                "as a new Python process that imports your script again: call fleet functions in a "
+                "script under `if __name__ == \"__main__\":` (see the README's fleet example), or "
+                "pass client= an existing distributed.Client"
+            ) from e
+        raise
     c = distributed.Client(cluster)
     try:
         yield c
@@ -382,6 +404,15 @@ def _fit_one(bag: str, keys: Sequence[str], fixed: Mapping[str, float], options:
     return row
 
 
+def _raise_if_every_bag_failed(rows: Sequence[Mapping[str, Any]]) -> None:
+    """A fleet fit in which no bag could be fitted has no result: raise,
+    naming each bag's error (at most five)."""
+    if rows and not any(r.get("ok") for r in rows):
+        errors = "; ".join(f"{r['bag']}: {r.get('error')}" for r in rows[:5])
+        more = f" (and {len(rows) - 5} more)" if len(rows) > 5 else ""
+        raise RuntimeError(f"every bag failed to fit ({len(rows)} bags): {errors}{more}")
+
+
 def _consensus(rows: Sequence[Mapping[str, Any]], key: str) -> Tuple[float, float, int]:
     """The precision-weighted mean of the bags' estimates of a shared
     parameter, its standard error and the number of bags used."""
@@ -484,11 +515,13 @@ def fit(
             # estimate of the shared ones with their marginal standard errors
             # (the correlation with its own parameters accounted for).
             rows = wave(c, shared + per_bag, lambda k: ({}, {**own_start, **current}))
+            _raise_if_every_bag_failed(rows)
             combined = {key: _consensus(rows, key) for key in shared}
             current = {key: v for key, (v, _, n) in combined.items() if n > 0}
             history.append(dict(current))
         # (2) Each bag's own parameters at the fleet's shared values.
         final = wave(c, per_bag, lambda k: (dict(current), own_start)) if per_bag else rows
+        _raise_if_every_bag_failed(final)
         n_workers = _workers(c)
     shared_rows = [
         {"name": key, "value": v, "std_error": se, "bags_used": n} for key, (v, se, n) in combined.items()

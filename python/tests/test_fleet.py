@@ -60,6 +60,26 @@ def test_a_glob_that_matches_nothing_is_an_error_naming_it(tmp_path):
         fleet.replay(str(tmp_path / "nothing-here/*.mcap"), progress=False)
 
 
+def test_a_glob_keeps_rosbag2_directories_as_one_bag_each(repo, tmp_path):
+    # The shipped bags: two MCAP files and a rosbag2 directory of MCAP files.
+    got = fleet.expand(str(repo / "bags" / "**" / "*.mcap"))
+    assert got == sorted(
+        [str(repo / "bags" / "foreign_joint_states.mcap"), str(repo / "bags" / "node_lockstep.mcap"),
+         str(repo / "bags" / "rosbags_mcap")]
+    )
+    # A tree holding only split recordings: each directory once, however
+    # many files it holds; a directory without metadata.yaml is no bag.
+    for d, files in (("day1", 3), ("day2", 2)):
+        (tmp_path / "fleet" / d).mkdir(parents=True)
+        (tmp_path / "fleet" / d / "metadata.yaml").write_text("rosbag2_bagfile_information: {}\n")
+        for k in range(files):
+            (tmp_path / "fleet" / d / f"{d}_{k}.mcap").write_bytes(b"")
+    (tmp_path / "fleet" / "notes").mkdir()
+    want = [str(tmp_path / "fleet" / "day1"), str(tmp_path / "fleet" / "day2")]
+    assert fleet.expand(str(tmp_path / "fleet" / "**" / "*.mcap")) == want
+    assert fleet.expand(str(tmp_path / "fleet" / "*")) == want
+
+
 def test_an_unreachable_scheduler_is_a_clear_error(bag_dir):
     with pytest.raises(ConnectionError, match="tcp://127.0.0.1:9"):
         fleet.replay([str(bag_dir / "node_a.mcap")], client="tcp://127.0.0.1:9", progress=False)
@@ -104,6 +124,24 @@ def test_fleet_fit_recovers_the_shared_boundary_friction_and_each_machines_visco
         assert got[name] == pytest.approx(mu, rel=0.01), name
     assert len(r.history) == 1
     assert r.bags["contact.boundary_friction:bag_estimate"].between(0.21, 0.23).all()
+
+
+def test_a_fleet_fit_in_which_every_bag_fails_raises_naming_the_errors(bag_dir, cluster_client):
+    with pytest.raises(RuntimeError, match="every bag failed to fit") as e:
+        fleet.fit([str(bag_dir / "node_a.mcap")], shared=["contact.boundary_friction"],
+                  client=cluster_client, velocity_topic="/nope", friction_topic="/nope", progress=False)
+    assert "node_a.mcap" in str(e.value)
+
+
+def test_a_script_that_starts_a_local_cluster_outside_a_main_guard_is_told_why(tmp_path):
+    script = tmp_path / "unguarded.py"
+    script.write_text(
+        "from friction_node import fleet\n"
+        f"fleet.replay({str(tmp_path / 'none.mcap')!r}, workers=1, progress=False)\n"
+    )
+    r = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, cwd=tmp_path)
+    assert r.returncode != 0
+    assert "__main__" in r.stderr, r.stderr[-2000:]
 
 
 def test_the_fleet_command_line_replays_and_exits_1_when_a_bag_failed(bag_dir, tmp_path):

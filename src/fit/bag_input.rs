@@ -7,9 +7,9 @@
 //! Columns: `t_s` (from the first friction sample), `velocity_m_s`,
 //! `friction_n`, and `load_n`, `temperature_c` when their topics are given.
 
-use super::table::Table;
 use super::FitError;
 use crate::bag::{read_topics, Bag, BagError, SampleKind, TopicDecoder};
+use crate::table::Table;
 use std::path::Path;
 
 /// Which topics hold what.
@@ -174,11 +174,7 @@ pub fn read(
         .damage
         .map(|d| format!("{}: reading stopped {d}", path.display()));
     Ok((
-        Table {
-            source: path.to_path_buf(),
-            names,
-            columns,
-        },
+        Table::from_columns(path, names, columns),
         note,
         topics.clone(),
     ))

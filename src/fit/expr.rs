@@ -3,8 +3,8 @@
 //! from a base column and slopes; `ddt(COLUMN)`'s smoothed derivative.
 
 use super::series::Source;
-use super::table::Table;
 use super::FitError;
+use crate::table::Table;
 use evalexpr::{
     build_operator_tree, Context, DefaultNumericTypes, EvalexprError, EvalexprResult, Node, Value,
 };
@@ -113,9 +113,16 @@ pub(super) fn compile(
     derived: &mut Vec<(String, String)>,
     coefficients: &[(String, f64)],
 ) -> Result<Expr, FitError> {
-    // ddt(NAME) → ddt__NAME, a derived column.
+    crate::expression::check_size(text).map_err(|message| FitError::Expression {
+        what: what.into(),
+        text: crate::expression::shorten(text),
+        message,
+    })?;
+    // ddt(NAME) → ddt__NAME, a derived column; innermost first, so that
+    // ddt(ddt(x)) (an acceleration) is ddt__ddt__x, the derivative of
+    // ddt__x, smoothed the same way.
     let mut t = text.to_string();
-    while let Some(i) = t.find("ddt(") {
+    while let Some(i) = t.rfind("ddt(") {
         let rest = &t[i + 4..];
         let Some(j) = rest.find(')') else {
             return Err(FitError::Expression {
@@ -125,14 +132,17 @@ pub(super) fn compile(
             });
         };
         let col = rest[..j].trim().to_string();
-        if table.column(&col).is_none() {
+        let is_derived = derived.iter().any(|(d, _)| *d == col);
+        if !is_derived && (!is_name(&col) || table.column(&col).is_none()) {
+            let why = if is_name(&col) {
+                table.column_error(&col).to_string()
+            } else {
+                "ddt() takes a column name (or ddt(COLUMN) for a second derivative)".into()
+            };
             return Err(FitError::Expression {
                 what: what.into(),
                 text: text.into(),
-                message: format!(
-                    "ddt({col}): no column `{col}` (columns: {})",
-                    table.names.join(", ")
-                ),
+                message: format!("ddt({col}): {why}"),
             });
         }
         let id = format!("ddt__{col}");
@@ -148,6 +158,13 @@ pub(super) fn compile(
             message: e.to_string(),
         })?;
     for id in node.iter_variable_identifiers() {
+        if table.index(id).is_some() && table.column(id).is_none() {
+            return Err(FitError::Expression {
+                what: what.into(),
+                text: text.into(),
+                message: format!("column `{id}` holds text: {}", table.column_error(id)),
+            });
+        }
         let known = table.column(id).is_some()
             || derived.iter().any(|(d, _)| d == id)
             || coefficients.iter().any(|(c, _)| c == id);
@@ -171,16 +188,24 @@ pub(super) fn compile(
     })
 }
 
+fn is_name(s: &str) -> bool {
+    !s.is_empty() && s.chars().all(|c| c.is_alphanumeric() || c == '_')
+}
+
 /// d/dt of `y` by a local linear fit over ±`half` s (at least ±1 sample).
 pub(super) fn derivative(t: &[f64], y: &[f64], half: f64) -> Vec<f64> {
     let n = t.len();
+    let reach = half * (1.0 + 1e-9);
     let (mut lo, mut hi) = (0usize, 0usize);
     (0..n)
         .map(|k| {
-            while t[k] - t[lo] > half && lo + 1 < k {
+            // Samples exactly `half` away count on both sides (up to
+            // rounding): on a uniform grid the window is symmetric, and the
+            // fit's slope is exact for a quadratic.
+            while t[k] - t[lo] > reach && lo + 1 < k {
                 lo += 1;
             }
-            while hi + 1 < n && (t[hi + 1] - t[k] <= half || hi < k + 1) {
+            while hi + 1 < n && (t[hi + 1] - t[k] <= reach || hi < k + 1) {
                 hi += 1;
             }
             let a = lo.min(k.saturating_sub(1));

@@ -20,7 +20,6 @@
 //!
 //! | file | content |
 //! |---|---|
-//! | `table.rs` | CSV tables (header or `--columns`, any separator) |
 //! | `series.rs` | a table and its mapping → the model's inputs |
 //! | `expr.rs` | column expressions: compiling, affine fast path, `ddt` |
 //! | `bag_input.rs` | topics of a bag → a table |
@@ -47,14 +46,13 @@ pub mod search;
 pub mod series;
 pub mod stats;
 pub mod synthetic;
-pub mod table;
 
+pub use crate::table::{Delimiter, Table, TableError};
 pub use baselines::{Baseline, BaselineKind, LoadForm};
 pub use params::{ParamSpec, Parameter};
 pub use physics_model::PhysicsModel;
 pub use problem::{Data, FitOutcome, Model, Options};
 pub use series::{Mapping, Series, Source};
-pub use table::{Delimiter, Table};
 
 use std::path::PathBuf;
 
@@ -62,13 +60,12 @@ use std::path::PathBuf;
 /// not converge is not an error (it is an outcome with a status).
 #[derive(Debug, thiserror::Error)]
 pub enum FitError {
-    #[error("cannot read {}: {source}", path.display())]
+    #[error("cannot read {}: {cause}", path.display())]
     Io {
         path: PathBuf,
-        #[source]
-        source: std::io::Error,
+        cause: std::io::Error,
     },
-    #[error("{}, line {line}: {message}", path.display())]
+    #[error("{}:{line}: {message}", path.display())]
     Table {
         path: PathBuf,
         line: usize,
@@ -88,7 +85,26 @@ pub enum FitError {
     Bounds { key: String, message: String },
     #[error(transparent)]
     Config(#[from] crate::config::ConfigError),
+    #[error(transparent)]
+    Interrupted(#[from] crate::interrupt::Interrupted),
     #[cfg(feature = "mcap")]
     #[error(transparent)]
     Bag(#[from] crate::bag::BagError),
+}
+
+impl From<TableError> for FitError {
+    fn from(e: TableError) -> Self {
+        match e {
+            TableError::Io { path, cause } => FitError::Io { path, cause },
+            TableError::Cell {
+                path,
+                line,
+                message,
+            } => FitError::Table {
+                path,
+                line,
+                message,
+            },
+        }
+    }
 }

@@ -83,9 +83,12 @@ impl Parameter {
     }
 
     /// The unbounded variable of `p` (a start at a bound is moved inside).
+    /// It is shifted by a whole period of the sine: MINPACK sizes its first
+    /// step by the norm of the variables, so a start in the middle of every
+    /// range (all u = 0) would take steps of 1e-16 and stop at once.
     pub fn to_internal(&self, p: f64) -> f64 {
         let f = self.fraction(p).clamp(START_MARGIN, 1.0 - START_MARGIN);
-        (2.0 * f - 1.0).asin()
+        (2.0 * f - 1.0).asin() + std::f64::consts::TAU
     }
 
     pub fn from_internal(&self, u: f64) -> f64 {

@@ -12,8 +12,8 @@
 //! row a steady operating point.
 
 use super::expr::{compile, derivative, Expr, Var};
-use super::table::Table;
 use super::FitError;
+use crate::table::Table;
 use std::path::PathBuf;
 
 /// How the model's inputs come from a table's columns.
@@ -195,8 +195,17 @@ impl Source {
                     ),
                 });
             }
+            // In order: a nested ddt reads a derived column made before it.
             for (id, col) in derived_cols {
-                let y = s.table.column(&col).expect("checked").to_vec();
+                let y = match s.table.column(&col) {
+                    Some(y) => y.to_vec(),
+                    None => s
+                        .derived
+                        .iter()
+                        .find(|(d, _)| *d == col)
+                        .map(|(_, y)| y.clone())
+                        .expect("checked when compiled"),
+                };
                 s.derived.push((id, derivative(&t, &y, mapping.smooth_s)));
             }
         }
@@ -382,7 +391,7 @@ pub fn source_path(p: &std::path::Path) -> PathBuf {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fit::table::Delimiter;
+    use crate::table::Delimiter;
     use std::path::Path;
 
     fn table(text: &str) -> Table {
@@ -418,6 +427,74 @@ mod tests {
         assert_eq!(se.load.as_ref().unwrap()[0], 100.0);
         let se = s.series(&[-1.0, 1.0]);
         assert!(se.unwrap_err().to_string().contains("must be positive"));
+    }
+
+    #[test]
+    fn a_nested_ddt_is_the_second_derivative_an_acceleration() {
+        // x = 3 t² mm: ẍ = 6 mm/s² everywhere (a local linear fit of a
+        // linear velocity is exact away from the ends).
+        let mut text = String::from("t_s,x_mm,force\n");
+        for k in 0..300 {
+            let t = k as f64 * 0.01;
+            text += &format!("{t},{},{}\n", 3.0 * t * t, 1.0);
+        }
+        let m = Mapping {
+            velocity: "ddt(x_mm) / 1000".into(),
+            friction: "force - m * ddt(ddt(x_mm)) / 1000".into(),
+            coefficients: vec![("m".into(), 2.0)],
+            ..Default::default()
+        };
+        let s = Source::new(table(&text), &m).unwrap();
+        let se = s.series(&[2.0]).unwrap();
+        for k in 20..280 {
+            approx::assert_relative_eq!(se.friction[k], 1.0 - 2.0 * 6e-3, epsilon = 1e-9);
+            approx::assert_relative_eq!(se.velocity[k], 6.0 * se.t[k] / 1000.0, epsilon = 1e-9);
+        }
+        // Anything but a column (or a ddt of one) is refused by name.
+        let e = Source::new(
+            table(&text),
+            &Mapping {
+                velocity: "ddt(x_mm * 2)".into(),
+                friction: "force".into(),
+                ..Default::default()
+            },
+        )
+        .err()
+        .unwrap()
+        .to_string();
+        assert!(e.contains("ddt() takes a column name"), "{e}");
+    }
+
+    #[test]
+    fn an_absurdly_long_or_deep_expression_is_refused_before_it_is_parsed() {
+        let t = table("t_s,v,f\n0,1,2\n1,1,2\n");
+        let m = |v: String| Mapping {
+            velocity: v,
+            friction: "f".into(),
+            ..Default::default()
+        };
+        let e = Source::new(t.clone(), &m(format!("{}v", "-".repeat(100_000))))
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(
+            e.contains("100001 characters") && e.contains("at most 1000"),
+            "{e}"
+        );
+        let e = Source::new(t.clone(), &m(format!("{}v", "-".repeat(40))))
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(e.contains("nested 40 deep"), "{e}");
+        let e = Source::new(
+            t.clone(),
+            &m(format!("{}v{}", "(".repeat(33), ")".repeat(33))),
+        )
+        .err()
+        .unwrap()
+        .to_string();
+        assert!(e.contains("nested 33 deep"), "{e}");
+        assert!(Source::new(t, &m("-(-v) - -1e-3 * 2".into())).is_ok());
     }
 
     #[test]
