@@ -277,7 +277,23 @@ fn a_study_writes_case_csvs_a_summary_plots_and_the_claims() {
     ]);
     assert!(ok, "{stderr}");
     assert!(
-        stdout.contains("hersey") && stdout.contains("8 cases"),
+        stdout.contains("hersey")
+            && stdout.contains("8 cases")
+            && stdout.contains("6 steady curves"),
+        "{stdout}"
+    );
+    // A study of steady curves alone counts its curves, not "0 cases".
+    let (ok, stdout, stderr) = run(&[
+        "study",
+        "stribeck",
+        "--out",
+        d.to_str().unwrap(),
+        "--set",
+        "solver.cells=32",
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(
+        stdout.contains("6 steady curves") && !stdout.contains("0 cases"),
         "{stdout}"
     );
     let s = d.join("hersey");

@@ -216,3 +216,30 @@ def test_step_run_and_set_temperature_refuse_every_envelope_case_with_one_rule(q
     twin.step(0.1)
     assert m.step(0.2).friction_force_n == twin.step(0.2).friction_force_n
     assert before.status == "converged"
+
+
+def test_ctrl_c_stops_a_long_model_run_with_keyboard_interrupt(tmp_path):
+    """Model.run checks Python's signals between chunks: SIGINT during a
+    run of millions of steps raises KeyboardInterrupt instead of finishing."""
+    import signal
+    import subprocess
+    import sys
+
+    script = tmp_path / "long_run.py"
+    script.write_text(
+        "import sys, numpy as np, friction_node as fn\n"
+        "m = fn.Model(**{'solver.cells': 256})\n"
+        "t = np.arange(0, 600, m.dt)\n"
+        "try:\n"
+        "    print('running', flush=True)\n"
+        "    m.run(t, 0.2 * np.sin(t))\n"
+        "except KeyboardInterrupt:\n"
+        "    print('interrupted', flush=True)\n"
+        "    sys.exit(7)\n"
+        "print('finished', flush=True)\n"
+    )
+    p = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE, text=True)
+    assert p.stdout.readline().strip() == "running"
+    p.send_signal(signal.SIGINT)
+    out, _ = p.communicate()
+    assert p.returncode == 7 and "interrupted" in out, out
