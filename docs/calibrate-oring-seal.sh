@@ -15,6 +15,11 @@
 #   load      the O-ring's normal load: its preload F0 (fitted) plus the
 #             pressure on the contact band (1.5 mm x 80.7 mm = 12.1 N/bar)
 #
+# The model (launch-config/oring-seal.yaml): a soft contact whose area
+# grows in proportion to the load, a grease film, and the ring's pre-sliding
+# stiffness; fitted are the boundary friction, the roughness, the grease's
+# viscosity, the pre-sliding stiffness and the three maps.
+#
 # Usage: docs/calibrate-oring-seal.sh [OUT_DIR]      (default: out/oring-seal)
 # Prints the models table; OUT_DIR gets the fitted parameter file and the
 # report with plots (summary.md, fit.csv, SVGs per model).
@@ -36,8 +41,9 @@ time target/release/friction-node fit \
     --load '12.1 * p_bar + f0' \
     --map a_eff=5.1875e-4 --map f_off=0 --map f0=90 \
     --bounds a_eff=4.8e-4:5.6e-4 --bounds f_off=-5:5 --bounds f0=10:400 \
-    --fit contact.boundary_friction,roughness.sigma_m,lubricant.viscosity_pa_s,drivetrain.viscous_n_s_m,a_eff,f_off,f0 \
-    --bounds drivetrain.viscous_n_s_m=0:500 \
+    --fit contact.boundary_friction,roughness.sigma_m,lubricant.viscosity_pa_s,contact.presliding_stiffness_n_m,a_eff,f_off,f0 \
+    --bounds roughness.sigma_m=1e-6:1e-4 --bounds lubricant.viscosity_pa_s=0.1:100 \
+    --bounds contact.presliding_stiffness_n_m=1e3:1e6 \
     --baselines \
     --out "$OUT/fitted.yaml" --report "$OUT/report"
 echo

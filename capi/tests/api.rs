@@ -509,3 +509,29 @@ fn the_c_api_refuses_every_envelope_case_with_the_rule_of_every_entry_point() {
         unsafe { fn_model_free(m) };
     }
 }
+
+#[test]
+fn the_real_drive_terms_are_in_the_c_api_bit_for_bit() {
+    // Pre-sliding, a soft width, a quadratic loss and an asymmetry: the C
+    // API's steps equal the solver's own.
+    let yaml = "/**:\n  ros__parameters:\n    solver: {cells: 32}\n    contact: {presliding_stiffness_n_m: 1.0e+8, width_load_exponent: 0.5}\n    drivetrain: {quadratic_n_s2_m2: 300.0, coulomb_asymmetry_n: 40.0}\n";
+    let m = new_model(yaml).unwrap();
+    let c = friction_node::config::Config::from_yaml(
+        yaml,
+        &friction_node::config::Origin::Embedded,
+        &[],
+    )
+    .unwrap();
+    let mut s = friction_node::physics::Solver::new(&c.model(), &c.solver_settings()).unwrap();
+    s.initialize_steady(0.0, c.contact.load_n);
+    for k in 1..=500 {
+        let v = 0.3 * (k as f64 * 1e-3 * std::f64::consts::TAU).sin();
+        let e = step(m, v, 15_000.0, 1e-3);
+        assert_eq!(
+            e.friction_force_n,
+            s.step(v, 15_000.0).friction_force,
+            "step {k}"
+        );
+    }
+    unsafe { fn_model_free(m) };
+}

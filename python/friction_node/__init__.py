@@ -335,6 +335,8 @@ class FitResult:
             row = {
                 "model": m["label"],
                 "converged": m["converged"],
+                "termination": m["termination"],
+                "cost_n2": m["cost_n2"],
                 "train_rms_n": m["train_rms_n"],
                 "held_out_rms_n": m["held_out_rms_n"],
             }

@@ -270,6 +270,31 @@ fn outcome_dict<'py>(py: Python<'py>, o: &FitOutcome) -> PyResult<Bound<'py, PyD
     let d = PyDict::new(py);
     d.set_item("label", &o.label)?;
     d.set_item("converged", o.converged)?;
+    let best = o.optima.first();
+    d.set_item("termination", best.map(|r| r.termination.clone()))?;
+    d.set_item("cost_n2", best.map_or(f64::NAN, |r| r.cost))?;
+    // The data as the model saw them at the optimum (maps applied), with
+    // its prediction: for plots, and for checking the fit independently.
+    let series = |fits: &[friction_node::fit::problem::SeriesFit]| -> PyResult<Bound<'py, PyList>> {
+        let out = PyList::empty(py);
+        for f in fits {
+            let s = &f.series;
+            let e = PyDict::new(py);
+            e.set_item("name", &s.name)?;
+            e.set_item("steady", s.steady)?;
+            e.set_item("t_s", PyArray1::from_slice(py, &s.t))?;
+            e.set_item("velocity_m_s", PyArray1::from_slice(py, &s.velocity))?;
+            e.set_item("friction_n", PyArray1::from_slice(py, &s.friction))?;
+            let load: Vec<f64> = (0..s.len()).map(|k| s.load_at(k, f64::NAN)).collect();
+            e.set_item("load_n", PyArray1::from_vec(py, load))?;
+            e.set_item("fit", PyArray1::from_vec(py, s.fit.clone()))?;
+            e.set_item("predicted_n", PyArray1::from_slice(py, &f.predicted))?;
+            out.append(e)?;
+        }
+        Ok(out)
+    };
+    d.set_item("series", series(&o.train)?)?;
+    d.set_item("validate_series", series(&o.validate)?)?;
     d.set_item("train_rms_n", o.train_rms)?;
     d.set_item("train_max_n", o.train_max)?;
     d.set_item("holdout_rms_n", o.holdout_rms)?;
@@ -477,12 +502,6 @@ fn write_fit_report(
     classic: &[FitOutcome],
     extra: &str,
 ) -> PyResult<()> {
-    let os = |e: friction_node::output::OutputError| errors::os(e.to_string());
-    for b in classic {
-        let dir = r.join(report::slug(&b.label));
-        friction_node::output::prepare_dir(&dir).map_err(os)?;
-        report::write_report(&dir, b, "").map_err(os)?;
-    }
-    report::write_report(r, ours, extra).map_err(os)?;
+    report::write_models_report(r, ours, classic, extra).map_err(|e| errors::os(e.to_string()))?;
     Ok(())
 }

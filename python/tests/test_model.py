@@ -21,13 +21,24 @@ def floats(col):
     return np.array([float(x) for x in col])
 
 
-def test_run_is_bit_identical_to_the_cli_simulate(cli, tmp_path):
+REAL_DRIVE_TERMS = {
+    "contact.presliding_stiffness_n_m": 1e8,
+    "contact.presliding_damping_n_s_m": 50.0,
+    "contact.width_load_exponent": 0.5,
+    "drivetrain.quadratic_n_s2_m2": 300.0,
+    "drivetrain.coulomb_asymmetry_n": 40.0,
+}
+
+
+@pytest.mark.parametrize("terms", [{}, REAL_DRIVE_TERMS], ids=["default", "pre-sliding, soft width, losses"])
+def test_run_is_bit_identical_to_the_cli_simulate(cli, tmp_path, terms):
     out = tmp_path / "run.csv"
-    cli("--set", "solver.cells=64", "simulate", "--velocity", "sine:0,1,1", "--duration", "2", "--out", out)
+    sets = [a for k, v in terms.items() for a in ("--set", f"{k}={v}")]
+    cli("--set", "solver.cells=64", *sets, "simulate", "--velocity", "sine:0,1,1", "--duration", "2", "--out", out)
     ref = read_csv(out)
     t = np.concatenate([[0.0], floats(ref["t_s"])])
     v = np.concatenate([[0.0], floats(ref["velocity_m_s"])])
-    m = fn.Model(**{"solver.cells": 64})
+    m = fn.Model(**{"solver.cells": 64, **terms})
     got = m.run(t, v)
     assert len(got["friction_n"]) == len(t)
     for col in ("friction_n", "h0_m", "h_min_m", "f_hyd_n", "f_asp_n", "cof", "contact_friction_n"):

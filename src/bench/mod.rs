@@ -3,6 +3,14 @@
 //! (V1 = 1 m/s, f = 1 Hz, F = 20 762 N, μ = 0.0564 Pa·s), Newton against the
 //! reference algorithm, and allocations per step. A benchmark, not a test:
 //! release build, medians and ratios measured side by side in one run.
+//!
+//! | file | job |
+//! |---|---|
+//! | `mod.rs` | `bench`: one model step, Newton against the reference, allocations per step |
+//! | `latency.rs` | `bench-latency`: command → estimate through a transport, beside an empty timer loop |
+//! | `recorder.rs` | `bench-recorder`: the recorder over simulated days |
+//! | `accuracy.rs` | `bench-accuracy`: the accuracy guide, answers against N and Δt |
+//! | `fit.rs` | `bench-fit`: calibration targets on synthetic data (recovery, drivetrain, pre-sliding, transfer) |
 
 use crate::config::Config;
 use crate::offline::{SimulationError, Timing};
@@ -276,6 +284,7 @@ pub fn csv(cases: &[BenchCase]) -> String {
 }
 
 pub mod accuracy;
+pub mod fit;
 mod latency;
 #[cfg(feature = "mcap")]
 pub mod recorder;

@@ -306,6 +306,7 @@ pub fn run(config: &Config, args: &FitArgs) -> Result<()> {
     friction_node::output::write_file(&args.out, yaml.as_bytes())?;
     println!("{}", report::summary(&ours, ""));
     let mut extra = String::new();
+    let mut classic = Vec::new();
     if args.baselines {
         let (baselines, skipped) = fit_baselines(&p, &req)?;
         for s in skipped {
@@ -316,16 +317,10 @@ pub fn run(config: &Config, args: &FitArgs) -> Result<()> {
         let table = report::models_table(&rows, held_out_scale(&ours));
         println!("## Models on the same data, same optimiser\n\n{table}");
         extra = format!("## Models on the same data, same optimiser\n\n{table}");
-        if let Some(r) = &args.report {
-            for b in &baselines {
-                let dir = r.join(report::slug(&b.label));
-                friction_node::output::prepare_dir(&dir)?;
-                report::write_report(&dir, b, "")?;
-            }
-        }
+        classic = baselines;
     }
     if let Some(r) = &args.report {
-        let files = report::write_report(r, &ours, &extra)?;
+        let files = report::write_models_report(r, &ours, &classic, &extra)?;
         eprintln!("fit: report in {} ({} files)", r.display(), files.len());
     }
     eprintln!("fit: wrote {}", args.out.display());

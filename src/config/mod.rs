@@ -28,6 +28,8 @@
 //! | `contacts.rs` | `contacts.*`: several contacts, each overriding the top-level sections |
 //! | `error.rs` | [`ConfigError`] and the [`Origin`] of a configuration |
 //! | `envelope.rs` | the inputs every entry point accepts: velocity, load, temperature ([`Envelope`]) |
+//! | `ros_args.rs` | `--ros-args` as rcl parses them (a `launch_ros` Node action) |
+//! | `tests.rs` | unit tests of loading, overrides and validation |
 
 mod contacts;
 mod envelope;
@@ -139,12 +141,22 @@ impl Config {
                 coulomb: self.drivetrain.coulomb_n,
                 viscous: self.drivetrain.viscous_n_s_m,
                 load_coefficient: self.drivetrain.load_coefficient,
+                quadratic: self.drivetrain.quadratic_n_s2_m2,
+                coulomb_asymmetry: self.drivetrain.coulomb_asymmetry_n,
             },
             contact: Contact {
                 mass: c.mass_kg,
                 boundary_friction: c.boundary_friction,
                 sign_regularization: c.sign_regularization_m_s,
                 min_film: c.min_film_m,
+                presliding: crate::physics::Presliding {
+                    stiffness: c.presliding_stiffness_n_m,
+                    damping: c.presliding_damping_n_s_m,
+                },
+                width_law: crate::physics::WidthLaw {
+                    exponent: c.width_load_exponent,
+                    reference_load: c.width_reference_load_n,
+                },
             },
         }
     }

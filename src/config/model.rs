@@ -20,6 +20,14 @@ pub struct ContactConfig {
     pub boundary_friction: f64,
     pub sign_regularization_m_s: f64,
     pub min_film_m: f64,
+    /// Pre-sliding (tangential) stiffness σ0 of the contact, N/m; 0: rigid.
+    pub presliding_stiffness_n_m: f64,
+    /// Damping σ1 of the pre-sliding displacement, N·s/m.
+    pub presliding_damping_n_s_m: f64,
+    /// Soft contact: the width follows (F/F_ref)^κ; 0 = rigid.
+    pub width_load_exponent: f64,
+    /// F_ref, the load at which the width is `width_m`, N.
+    pub width_reference_load_n: f64,
 }
 
 /// Shape of the global profile.
@@ -54,6 +62,10 @@ impl Default for ContactConfig {
             boundary_friction: c.boundary_friction,
             sign_regularization_m_s: c.sign_regularization,
             min_film_m: c.min_film,
+            presliding_stiffness_n_m: c.presliding.stiffness,
+            presliding_damping_n_s_m: c.presliding.damping,
+            width_load_exponent: c.width_law.exponent,
+            width_reference_load_n: c.width_law.reference_load,
         }
     }
 }
@@ -135,6 +147,11 @@ pub struct DrivetrainConfig {
     pub viscous_n_s_m: f64,
     /// Friction proportional to the normal load (rolling elements).
     pub load_coefficient: f64,
+    /// Loss growing with the square of the speed, N·s²/m².
+    pub quadratic_n_s2_m2: f64,
+    /// Half the difference between the forward and backward constant
+    /// levels, N (forward F_c + this, backward F_c − this).
+    pub coulomb_asymmetry_n: f64,
 }
 
 /// `roughness.*`: GW contact and flow factors.

@@ -149,7 +149,31 @@ impl Config {
             1e-9,
             1.0,
         )?;
-        cc("contact.min_film_m", c.min_film_m, 0.0, 1e-3)
+        cc("contact.min_film_m", c.min_film_m, 0.0, 1e-3)?;
+        cc(
+            "contact.presliding_stiffness_n_m",
+            c.presliding_stiffness_n_m,
+            0.0,
+            1e15,
+        )?;
+        cc(
+            "contact.presliding_damping_n_s_m",
+            c.presliding_damping_n_s_m,
+            0.0,
+            1e9,
+        )?;
+        cc(
+            "contact.width_load_exponent",
+            c.width_load_exponent,
+            0.0,
+            1.0,
+        )?;
+        oc(
+            "contact.width_reference_load_n",
+            c.width_reference_load_n,
+            0.0,
+            1e9,
+        )
     }
 
     pub(super) fn validate_texture(&self) -> Result<(), ConfigError> {
@@ -247,7 +271,19 @@ impl Config {
         let d = &self.drivetrain;
         cc("drivetrain.coulomb_n", d.coulomb_n, 0.0, 1e9)?;
         cc("drivetrain.viscous_n_s_m", d.viscous_n_s_m, 0.0, 1e9)?;
-        cc("drivetrain.load_coefficient", d.load_coefficient, 0.0, 10.0)
+        cc("drivetrain.load_coefficient", d.load_coefficient, 0.0, 10.0)?;
+        cc(
+            "drivetrain.quadratic_n_s2_m2",
+            d.quadratic_n_s2_m2,
+            0.0,
+            1e9,
+        )?;
+        cc(
+            "drivetrain.coulomb_asymmetry_n",
+            d.coulomb_asymmetry_n,
+            -1e9,
+            1e9,
+        )
     }
 
     pub(super) fn validate_roughness(&self) -> Result<(), ConfigError> {

@@ -27,6 +27,7 @@
 use super::params::{DataScale, Parameter};
 use super::problem::Model;
 use super::series::Series;
+use nalgebra::{DMatrix, DVector};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum BaselineKind {
@@ -95,63 +96,215 @@ struct Levels {
     sigma1: f64,
 }
 
+/// The fitted samples of the training data: velocity, friction, load.
+struct Samples {
+    v: Vec<f64>,
+    f: Vec<f64>,
+    n: Vec<f64>,
+}
+
+impl Samples {
+    fn of(series: &[Series]) -> Self {
+        let (mut v, mut f, mut n) = (Vec::new(), Vec::new(), Vec::new());
+        for s in series {
+            for k in (0..s.len()).filter(|&k| s.fit[k]) {
+                v.push(s.velocity[k]);
+                f.push(s.friction[k]);
+                n.push(s.load_at(k, 1.0));
+            }
+        }
+        Self { v, f, n }
+    }
+}
+
+/// The level columns of a regression: one per level coefficient of the
+/// load form, each times `shape` (a level multiplies sgn v, or sgn v · E).
+fn level_columns(form: LoadForm, shape: f64, load: f64) -> Vec<f64> {
+    match form {
+        LoadForm::Constant => vec![shape],
+        LoadForm::Proportional => vec![shape * load],
+        LoadForm::Linear => vec![shape, shape * load],
+    }
+}
+
+/// Least squares of `rows` (each a row of the design matrix) against `y`:
+/// the coefficients and the residual sum of squares (None: degenerate).
+fn least_squares(rows: &[Vec<f64>], y: &[f64]) -> Option<(Vec<f64>, f64)> {
+    let m = rows.len();
+    let n = rows.first()?.len();
+    if m <= n {
+        return None;
+    }
+    let a = DMatrix::from_fn(m, n, |i, j| rows[i][j]);
+    let b = DVector::from_column_slice(y);
+    let x = a.clone().svd(true, true).solve(&b, 1e-12).ok()?;
+    let ss = (a * &x - b).norm_squared();
+    (x.iter().all(|c| c.is_finite()) && ss.is_finite()).then(|| (x.iter().copied().collect(), ss))
+}
+
 impl Baseline {
-    /// Bounds and starts from the data's scales (`mean_abs_n`: mean |F|).
+    /// The model with wide bounds from the data's scales and starts from
+    /// the data themselves (see [`Baseline::from_data`]); without data
+    /// (`series` empty) the starts are generic.
     pub fn new(
         kind: BaselineKind,
         load_form: LoadForm,
         scale: &DataScale,
         mean_abs_n: f64,
     ) -> Self {
+        Self::from_data(kind, load_form, scale, mean_abs_n, &[])
+    }
+
+    /// Bounds wide enough for any answer the data's scales allow, and
+    /// starts from the data (so that a local run begins at the obvious
+    /// answer, not at a bound):
+    ///
+    /// - the levels and the viscous slope by linear least squares (exact
+    ///   for Coulomb + viscous; for Stribeck, at the best Stribeck velocity
+    ///   of a log grid over the data's speeds: variable projection);
+    /// - LuGre's steady curve from that Stribeck fit and σ0 from the
+    ///   stiffness through the data's reversals
+    ///   ([`super::reversals::stiffness`]).
+    pub fn from_data(
+        kind: BaselineKind,
+        load_form: LoadForm,
+        scale: &DataScale,
+        mean_abs_n: f64,
+        series: &[Series],
+    ) -> Self {
         let f = scale.friction_n.max(1e-12);
         let v = scale.velocity_m_s.max(1e-9);
+        let load_min = scale.load_min_n.max(1e-9);
+        let samples = Samples::of(series);
+        let fit = starts(kind, load_form, &samples, v);
         let fc0 = mean_abs_n.clamp(1e-3 * f, f);
+        let generic = |name: &str| -> f64 {
+            match name {
+                "fs" => (1.5 * fc0).min(f),
+                _ => fc0,
+            }
+        };
         let mut params = Vec::new();
-        let level = |params: &mut Vec<Parameter>, name: &str, start: f64, top: f64| {
-            let mu_hi = 2.0 * top / scale.load_min_n.max(1e-9);
-            let mu = |share: f64| (share * start / scale.load_min_n.max(1e-9)).min(0.5 * mu_hi);
+        let mut next = 0;
+        let mut take = |default: f64| -> f64 {
+            let x = fit
+                .as_ref()
+                .and_then(|x| x.get(next).copied())
+                .unwrap_or(default);
+            next += 1;
+            x
+        };
+        // A start outside the default bounds widens them: a bound never
+        // excludes the least-squares answer.
+        let push = |params: &mut Vec<Parameter>, name: &str, start: f64, lo: f64, hi: f64| {
+            let (lo, hi) = (
+                if start < lo {
+                    start - (lo - start).abs().max(lo.abs())
+                } else {
+                    lo
+                },
+                if start > hi { 2.0 * start } else { hi },
+            );
+            params.push(Parameter::new(name, start.clamp(lo, hi), lo, hi));
+        };
+        let top = 4.0 * f;
+        let mu_hi = top / load_min;
+        let level = |params: &mut Vec<Parameter>, name: &str, take: &mut dyn FnMut(f64) -> f64| {
+            let start = generic(name);
+            let suffix = &name[1..];
             match load_form {
                 LoadForm::Linear => {
-                    params.push(Parameter::new(
-                        &format!("{name}0_n"),
-                        0.0,
-                        -2.0 * top,
-                        2.0 * top,
-                    ));
-                    params.push(Parameter::new(
-                        &format!("mu_{}", &name[1..]),
-                        mu(0.5),
-                        0.0,
-                        mu_hi,
-                    ));
+                    let a = take(0.0);
+                    push(params, &format!("{name}0_n"), a, -top, top);
+                    let m = take(0.5 * start / load_min);
+                    push(params, &format!("mu_{suffix}"), m.max(0.0), 0.0, mu_hi);
                 }
                 LoadForm::Proportional => {
-                    params.push(Parameter::new(
-                        &format!("mu_{}", &name[1..]),
-                        mu(1.0),
-                        0.0,
-                        mu_hi,
-                    ));
+                    let m = take(start / load_min);
+                    push(params, &format!("mu_{suffix}"), m.max(0.0), 0.0, mu_hi);
                 }
                 LoadForm::Constant => {
-                    params.push(Parameter::new(&format!("{name}_n"), start, 0.0, top));
+                    let c = take(start);
+                    push(params, &format!("{name}_n"), c.max(0.0), 0.0, top);
                 }
             }
         };
-        level(&mut params, "fc", fc0, 2.0 * f);
+        level(&mut params, "fc", &mut take);
         if kind != BaselineKind::CoulombViscous {
-            level(&mut params, "fs", (1.5 * fc0).min(f), 4.0 * f);
-            params.push(Parameter::new("vs_m_s", 0.01 * v, 1e-4 * v, v));
+            level(&mut params, "fs", &mut take);
+            let vs = take(0.01 * v);
+            push(&mut params, "vs_m_s", vs, 1e-4 * v, 10.0 * v);
         }
-        params.push(Parameter::new("b_n_s_m", 0.0, 0.0, 2.0 * f / v));
+        let b = take(0.0);
+        push(&mut params, "b_n_s_m", b.max(0.0), 0.0, 10.0 * f / v);
         if kind == BaselineKind::LuGre {
-            params.push(Parameter::new("sigma0_n_m", 1e5 * f, 1e2 * f, 1e8 * f));
-            params.push(Parameter::new("sigma1_n_s_m", 0.0, 0.0, 10.0 * f / v));
+            let stiffness = super::reversals::stiffness(series)
+                .stiffness_n_m
+                .unwrap_or(1e3 * f / v);
+            push(
+                &mut params,
+                "sigma0_n_m",
+                stiffness,
+                stiffness * 1e-4,
+                stiffness * 1e4,
+            );
+            // Damping from a small share of critical-like damping; a start
+            // inside its range (0 is its bound).
+            push(
+                &mut params,
+                "sigma1_n_s_m",
+                0.01 * f / v,
+                0.0,
+                100.0 * f / v,
+            );
         }
         Self {
             kind,
             load_form,
             params,
+        }
+    }
+
+    /// Starts that reproduce `inner` (the simpler model this one contains:
+    /// Coulomb + viscous in Stribeck, Stribeck in LuGre) at its values
+    /// `inner_x` (its parameters, then `maps` fitted map coefficients):
+    /// Stribeck with F_s = F_c is Coulomb + viscous whatever v_s; LuGre is
+    /// Stribeck as σ0 grows, started at the data's reversal stiffness and
+    /// a hundred times it.
+    pub fn nested_starts(&self, inner: &Baseline, inner_x: &[f64], maps: usize) -> Vec<Vec<f64>> {
+        let n_inner = inner.params.len();
+        if inner_x.len() != n_inner + maps {
+            return Vec::new();
+        }
+        let value = |name: &str| -> Option<f64> {
+            inner
+                .params
+                .iter()
+                .position(|p| p.name == name)
+                .map(|i| inner_x[i])
+        };
+        let base: Vec<f64> = self
+            .params
+            .iter()
+            .map(|p| {
+                value(&p.name)
+                    // Stribeck from Coulomb + viscous: the static level equal
+                    // to the Coulomb one.
+                    .or_else(|| value(&p.name.replace("fs", "fc").replace("_s", "_c")))
+                    .unwrap_or(p.start)
+            })
+            .chain(inner_x[n_inner..].iter().copied())
+            .collect();
+        match self.params.iter().position(|p| p.name == "sigma0_n_m") {
+            Some(i) => [1.0, 100.0]
+                .iter()
+                .map(|k| {
+                    let mut x = base.clone();
+                    x[i] = (self.params[i].start * k).min(self.params[i].hi);
+                    x
+                })
+                .collect(),
+            None => vec![base],
         }
     }
 
@@ -189,6 +342,74 @@ impl Baseline {
             b,
             sigma0,
             sigma1,
+        }
+    }
+}
+
+/// Starts of every parameter but LuGre's σ0, σ1, in the model's order,
+/// from linear least squares on the samples (None: too few samples).
+/// Coulomb + viscous is linear in its parameters: this is its optimum.
+/// Stribeck is linear once the Stribeck velocity is fixed: the best of a
+/// log grid of 49 velocities over the data's speeds.
+fn starts(kind: BaselineKind, form: LoadForm, s: &Samples, v_scale: f64) -> Option<Vec<f64>> {
+    let rows = |vs: Option<f64>| -> Vec<Vec<f64>> {
+        (0..s.v.len())
+            .map(|k| {
+                let (v, n) = (s.v[k], s.n[k]);
+                let sg = sgn(v);
+                let mut row = Vec::with_capacity(5);
+                match vs {
+                    None => row.extend(level_columns(form, sg, n)),
+                    Some(vs) => {
+                        let e = (-(v / vs).powi(2)).exp();
+                        row.extend(level_columns(form, sg * (1.0 - e), n));
+                        row.extend(level_columns(form, sg * e, n));
+                    }
+                }
+                row.push(v);
+                row
+            })
+            .collect()
+    };
+    match kind {
+        BaselineKind::CoulombViscous => least_squares(&rows(None), &s.f).map(|(x, _)| x),
+        BaselineKind::Stribeck | BaselineKind::LuGre => {
+            let (lo, hi) = (1e-3 * v_scale, v_scale);
+            let best = (0..49)
+                .map(|k| lo * (hi / lo).powf(k as f64 / 48.0))
+                .filter_map(|vs| least_squares(&rows(Some(vs)), &s.f).map(|(x, ss)| (vs, x, ss)))
+                .min_by(|a, b| a.2.total_cmp(&b.2))?;
+            let (vs, x, _) = best;
+            let per_level = level_columns(form, 0.0, 0.0).len();
+            let (mut fc, mut fs) = (
+                x[..per_level].to_vec(),
+                x[per_level..2 * per_level].to_vec(),
+            );
+            if kind == BaselineKind::LuGre {
+                // LuGre divides by g(v): both levels must stay positive at
+                // every load of the data. If the unconstrained optimum
+                // leaves that, start from Coulomb + viscous's level with a
+                // static level half of it.
+                let at = |c: &[f64], n: f64| match form {
+                    LoadForm::Linear => c[0] + c[1] * n,
+                    LoadForm::Proportional => c[0] * n,
+                    LoadForm::Constant => c[0],
+                };
+                let positive = |c: &[f64]| s.n.iter().all(|&n| at(c, n) > 0.0);
+                if !(positive(&fc) && positive(&fs)) {
+                    let cv = least_squares(&rows(None), &s.f)?.0;
+                    fc = cv[..per_level].to_vec();
+                    if !positive(&fc) {
+                        return None;
+                    }
+                    fs = fc.iter().map(|c| 0.5 * c).collect();
+                }
+            }
+            let mut out = fc;
+            out.extend(fs);
+            out.push(vs);
+            out.push(x[2 * per_level]);
+            Some(out)
         }
     }
 }
@@ -269,6 +490,7 @@ mod tests {
             friction_n: 10.0,
             velocity_m_s: 0.1,
             load_min_n: 100.0,
+            reversal_stiffness_n_m: None,
         }
     }
 

@@ -32,6 +32,7 @@
 //! | `stats.rs` | standard errors, correlations, flags |
 //! | `report.rs` | the summary, the tables, plots, the fitted YAML |
 //! | `synthetic.rs` | synthetic data: the model along a motion, with noise |
+//! | `reversals.rs` | velocity reversals in the data and the stiffness through them (pre-sliding starts) |
 
 #[cfg(feature = "mcap")]
 pub mod bag_input;
@@ -42,6 +43,7 @@ pub mod physics_model;
 pub mod problem;
 pub mod report;
 pub mod request;
+pub mod reversals;
 pub mod search;
 pub mod series;
 pub mod stats;

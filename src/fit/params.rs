@@ -111,6 +111,9 @@ pub struct DataScale {
     pub velocity_m_s: f64,
     /// Smallest load, N.
     pub load_min_n: f64,
+    /// The contact's stiffness through the data's reversals, N/m (None:
+    /// no reversal; see [`super::reversals`]).
+    pub reversal_stiffness_n_m: Option<f64>,
 }
 
 /// The configuration as a tree of keys, to read and set numeric keys by
@@ -190,7 +193,14 @@ impl ConfigKeys {
     pub fn parameter(&self, spec: &ParamSpec, scale: &DataScale) -> Result<Parameter, FitError> {
         let key = spec.name.as_str();
         let current = self.value(key)?;
-        let start = spec.start.unwrap_or(current);
+        // A pre-sliding stiffness that is off (0) starts at the data's
+        // stiffness through its reversals.
+        let data_start = if key.ends_with("presliding_stiffness_n_m") && current == 0.0 {
+            scale.reversal_stiffness_n_m
+        } else {
+            None
+        };
+        let start = spec.start.or(data_start).unwrap_or(current);
         let (lo, hi) = match spec.bounds {
             Some((lo, hi)) => {
                 check_bounds(key, lo, hi)?;
@@ -244,12 +254,18 @@ impl ConfigKeys {
         }
         // Terms that are off by default: bounds from the data's scales.
         let s = scale;
+        let v = s.velocity_m_s.max(1e-9);
+        if key == "drivetrain.coulomb_asymmetry_n" {
+            return Ok((-s.friction_n, s.friction_n));
+        }
         let hi = match key {
             "drivetrain.coulomb_n" => Some(2.0 * s.friction_n),
-            "drivetrain.viscous_n_s_m" => Some(2.0 * s.friction_n / s.velocity_m_s.max(1e-9)),
+            "drivetrain.viscous_n_s_m" => Some(2.0 * s.friction_n / v),
+            "drivetrain.quadratic_n_s2_m2" => Some(2.0 * s.friction_n / (v * v)),
             "drivetrain.load_coefficient" => {
                 Some((2.0 * s.friction_n / s.load_min_n.max(1e-9)).min(10.0))
             }
+            k if k.ends_with("presliding_damping_n_s_m") => Some(100.0 * s.friction_n / v),
             _ => None,
         };
         match hi {
@@ -317,6 +333,7 @@ mod tests {
         friction_n: 100.0,
         velocity_m_s: 0.5,
         load_min_n: 1000.0,
+        reversal_stiffness_n_m: None,
     };
 
     fn spec(name: &str) -> ParamSpec {

@@ -53,6 +53,10 @@ pub struct Options {
     /// Requested from outside (SIGINT, Ctrl-C): the search ends at its next
     /// evaluation and the fit is [`super::FitError::Interrupted`].
     pub stop: crate::interrupt::Stop,
+    /// More starts, each a whole point (the model's parameters, then the
+    /// fitted map coefficients), run besides the given start and the global
+    /// points: e.g. a nested model's optimum.
+    pub extra_starts: Vec<Vec<f64>>,
 }
 
 impl Default for Options {
@@ -64,6 +68,7 @@ impl Default for Options {
             max_evaluations: 200,
             progress: None,
             stop: crate::interrupt::Stop::new(),
+            extra_starts: Vec::new(),
         }
     }
 }
@@ -345,6 +350,9 @@ struct Lm<'p, 'a> {
     problem: &'p Problem<'a>,
     u: DVector<f64>,
     r: DVector<f64>,
+    /// Every point evaluated: (cost, u), for what was still moving when a
+    /// run stops on its budget.
+    trail: Vec<(f64, Vec<f64>)>,
 }
 
 impl LeastSquaresProblem<f64, Dyn, Dyn> for Lm<'_, '_> {
@@ -356,6 +364,8 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Lm<'_, '_> {
         self.u.copy_from(u);
         let x = self.problem.from_internal(u.as_slice());
         self.r = DVector::from_vec(self.problem.residuals(&x));
+        self.trail
+            .push((0.5 * self.r.norm_squared(), u.as_slice().to_vec()));
     }
 
     fn params(&self) -> DVector<f64> {
@@ -399,6 +409,7 @@ pub fn local_run(problem: &Problem<'_>, x0: &[f64], max_evaluations: usize) -> L
         problem,
         u: u0.clone(),
         r: DVector::zeros(0),
+        trail: Vec::new(),
     };
     lm.set_params(&u0);
     let patience = max_evaluations.div_ceil(n + 1).max(1);
@@ -415,13 +426,43 @@ pub fn local_run(problem: &Problem<'_>, x0: &[f64], max_evaluations: usize) -> L
         );
     let x = problem.from_internal(lm.u.as_slice());
     let cost = 0.5 * lm.r.norm_squared();
+    let mut termination = termination_text(&report.termination);
+    if matches!(report.termination, TerminationReason::LostPatience) {
+        let moving = still_moving(problem, &lm.trail);
+        if !moving.is_empty() {
+            termination.push_str(&format!("; still moving: {}", moving.join(", ")));
+        }
+    }
     LocalRun {
         x,
         cost,
         converged,
-        termination: termination_text(&report.termination),
+        termination,
         evaluations: report.number_of_evaluations,
     }
+}
+
+/// The parameters that moved by more than 0.1 % of their scaled range
+/// between the best point of the first three quarters of a run and the
+/// best point of all of it: what a larger budget would still change.
+fn still_moving(problem: &Problem<'_>, trail: &[(f64, Vec<f64>)]) -> Vec<String> {
+    let best = |t: &[(f64, Vec<f64>)]| {
+        t.iter()
+            .filter(|(c, _)| c.is_finite())
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+            .map(|(_, u)| problem.from_internal(u))
+    };
+    let early = trail.len() * 3 / 4;
+    let (Some(a), Some(b)) = (best(&trail[..early.max(1).min(trail.len())]), best(trail)) else {
+        return Vec::new();
+    };
+    problem
+        .params
+        .iter()
+        .zip(a.iter().zip(&b))
+        .filter(|(p, (x, y))| (p.fraction(**x) - p.fraction(**y)).abs() > 1e-3)
+        .map(|(p, _)| p.name.clone())
+        .collect()
 }
 
 fn termination_text(t: &TerminationReason) -> String {

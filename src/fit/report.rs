@@ -140,6 +140,10 @@ pub struct ModelRow {
     /// Why there is no held-out prediction, when there is none.
     pub held_out_failure: Option<String>,
     pub converged: bool,
+    /// How the best local run ended.
+    pub termination: String,
+    /// ½ Σ r² on the fitted samples, N².
+    pub cost: f64,
 }
 
 impl From<&FitOutcome> for ModelRow {
@@ -156,6 +160,11 @@ impl From<&FitOutcome> for ModelRow {
             held_out_rms: o.held_out_rms(),
             held_out_failure: o.validate_failure.clone(),
             converged: o.converged,
+            termination: o
+                .optima
+                .first()
+                .map_or(String::new(), |r| r.termination.clone()),
+            cost: o.optima.first().map_or(f64::NAN, |r| r.cost),
         }
     }
 }
@@ -164,7 +173,7 @@ impl From<&FitOutcome> for ModelRow {
 /// when given).
 pub fn models_table(rows: &[ModelRow], scale_n: f64) -> String {
     let mut s = String::from(
-        "| model | n | parameters | training RMS (N) | held-out RMS (N) | held-out / friction scale |\n|---|---|---|---|---|---|\n",
+        "| model | n | parameters | fit | training RMS (N) | held-out RMS (N) | held-out / friction scale |\n|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         let params: Vec<String> = r
@@ -174,11 +183,15 @@ pub fn models_table(rows: &[ModelRow], scale_n: f64) -> String {
             .collect();
         let _ = writeln!(
             s,
-            "| {}{} | {} | {} | {:.4} | {} | {} |",
+            "| {} | {} | {} | {} | {:.4} | {} | {} |",
             r.label,
-            if r.converged { "" } else { " (not converged)" },
             r.parameters.len(),
             params.join(", "),
+            if r.converged {
+                "converged".to_string()
+            } else {
+                format!("NOT converged: {}", r.termination.replace('|', "/"))
+            },
             r.train_rms,
             match (&r.held_out_rms, &r.held_out_failure) {
                 (Some(h), _) => format!("{h:.4}"),
@@ -304,6 +317,62 @@ pub fn write_report(dir: &Path, o: &FitOutcome, extra: &str) -> Result<Vec<PathB
     Ok(files)
 }
 
+/// The report of a fit and of the classic models fitted beside it: ours
+/// in `dir` (with `extra` appended to its summary), each classic model in
+/// a folder named for it, and, with classic models, the residual of every
+/// model against velocity on the held-out data in one figure. Returns the
+/// files written.
+pub fn write_models_report(
+    dir: &Path,
+    ours: &FitOutcome,
+    classic: &[FitOutcome],
+    extra: &str,
+) -> Result<Vec<PathBuf>, OutputError> {
+    let mut files = Vec::new();
+    for b in classic {
+        let sub = dir.join(slug(&b.label));
+        crate::output::prepare_dir(&sub)?;
+        files.extend(write_report(&sub, b, "")?);
+    }
+    files.extend(write_report(dir, ours, extra)?);
+    #[cfg(feature = "plots")]
+    if !classic.is_empty() {
+        let all: Vec<&FitOutcome> = std::iter::once(ours).chain(classic).collect();
+        files.extend(plots::residual_by_velocity(dir, &all)?);
+    }
+    Ok(files)
+}
+
+/// The mean residual (model − measured, N) in `bins` equal bins of
+/// velocity over the samples of `fit`: (bin centre, mean) for bins that
+/// hold samples.
+pub fn binned_residual(fit: &SeriesFit, bins: usize) -> Vec<(f64, f64)> {
+    let v = &fit.series.velocity;
+    let (lo, hi) = v
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+            (a.min(*x), b.max(*x))
+        });
+    if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
+        return Vec::new();
+    }
+    let w = (hi - lo) / bins as f64;
+    let mut sum = vec![(0.0, 0usize); bins];
+    for (k, vk) in v.iter().enumerate() {
+        let r = fit.predicted[k] - fit.series.friction[k];
+        if r.is_finite() {
+            let b = (((vk - lo) / w) as usize).min(bins - 1);
+            sum[b].0 += r;
+            sum[b].1 += 1;
+        }
+    }
+    sum.iter()
+        .enumerate()
+        .filter(|(_, (_, n))| *n > 0)
+        .map(|(b, (s, n))| (lo + (b as f64 + 0.5) * w, s / *n as f64))
+        .collect()
+}
+
 #[cfg(feature = "plots")]
 mod plots {
     use super::*;
@@ -351,6 +420,62 @@ mod plots {
                 }
             })
             .collect()
+    }
+
+    /// One panel per held-out source (validation data, else the training
+    /// data), one line per model: its residual against velocity, averaged
+    /// in 40 bins of velocity.
+    pub fn residual_by_velocity(
+        dir: &Path,
+        models: &[&FitOutcome],
+    ) -> Result<Vec<PathBuf>, OutputError> {
+        let held_out = !models[0].validate.is_empty();
+        let sources = if held_out {
+            &models[0].validate
+        } else {
+            &models[0].train
+        };
+        let panels: Vec<Panel> = (0..sources.len())
+            .map(|j| {
+                let name = Path::new(&sources[j].series.name)
+                    .file_name()
+                    .map_or(sources[j].series.name.clone(), |s| {
+                        s.to_string_lossy().into_owned()
+                    });
+                Panel {
+                    title: format!(
+                        "{name} ({})",
+                        if held_out { "held out" } else { "training" }
+                    ),
+                    lines: models
+                        .iter()
+                        .enumerate()
+                        .filter_map(|(m, o)| {
+                            let fits = if held_out { &o.validate } else { &o.train };
+                            fits.get(j)
+                                .map(|f| line(&o.label, m, binned_residual(f, 40), m > 0))
+                        })
+                        .collect(),
+                }
+            })
+            .collect();
+        if panels.is_empty() {
+            return Ok(Vec::new());
+        }
+        let ax = Axes {
+            x: "velocity (m/s)",
+            y: "mean residual, model − measured (N)",
+            log_x: false,
+            log_y: false,
+            legend: SeriesLabelPosition::UpperLeft,
+            legend_everywhere: false,
+        };
+        Ok(vec![figure(
+            &dir.join("residual_velocity.svg"),
+            "residual against velocity, every model",
+            &panels,
+            &ax,
+        )?])
     }
 
     pub fn write(dir: &Path, o: &FitOutcome) -> Result<Vec<PathBuf>, OutputError> {

@@ -5,7 +5,7 @@
 //! caller; nothing here prints.
 
 use super::params::{map_parameter, DataScale};
-use super::problem::{fit, FitOutcome, Options, Progress};
+use super::problem::{fit, FitOutcome, Model, Options, Progress};
 use super::{
     Baseline, BaselineKind, Data, Delimiter, FitError, LoadForm, Mapping, ParamSpec, Parameter,
     PhysicsModel, Source, Table,
@@ -158,6 +158,7 @@ impl FitRequest {
             max_evaluations: self.max_evaluations,
             progress,
             stop: self.stop.clone(),
+            extra_starts: Vec::new(),
         }
     }
 
@@ -281,6 +282,7 @@ pub fn data_scale(
 ) -> Result<(DataScale, f64, bool), FitError> {
     let (mut f, mut v, mut lmin, mut lmax) = (0.0f64, 0.0f64, f64::INFINITY, 0.0f64);
     let (mut sum_abs, mut n) = (0.0, 0usize);
+    let mut all = Vec::with_capacity(sources.len());
     for s in sources {
         let se = s.series(map)?;
         for k in 0..se.len() {
@@ -292,6 +294,7 @@ pub fn data_scale(
             sum_abs += se.friction[k].abs();
             n += 1;
         }
+        all.push(se);
     }
     if v == 0.0 {
         return Err(FitError::Data {
@@ -303,6 +306,7 @@ pub fn data_scale(
         friction_n: f,
         velocity_m_s: v,
         load_min_n: lmin,
+        reversal_stiffness_n_m: super::reversals::stiffness(&all).stiffness_n_m,
     };
     Ok((scale, sum_abs / n.max(1) as f64, lmax > 1.01 * lmin))
 }
@@ -382,6 +386,14 @@ pub fn prepare(config: &Config, req: &FitRequest) -> Result<Prepared, FitError> 
                     "neither a configuration key (dotted, e.g. roughness.sigma_m) nor a --map coefficient"
                         .into(),
             });
+        }
+    }
+    if scale.reversal_stiffness_n_m.is_none() {
+        for s in key_specs.iter().filter(|s| s.name.contains("presliding_")) {
+            notes.push(format!(
+                "warning: {} is fitted, but the training data hold no usable velocity reversal: pre-sliding shows only through a reversal, so these data cannot identify it (its estimate will follow its start and bounds)",
+                s.name
+            ));
         }
     }
     let model = PhysicsModel::new(config, &key_specs, &scale)?;
@@ -483,24 +495,62 @@ pub fn fit_baselines(
         .cloned()
         .collect();
     let all_steady = p.data.train.iter().all(Source::is_steady);
+    // The training data at the maps' starts: the classic models' starts.
+    let series = p
+        .data
+        .train
+        .iter()
+        .map(|s| {
+            let mut se = s.series(&p.data.map_values)?;
+            se.hold_out(p.data.holdout);
+            Ok(se)
+        })
+        .collect::<Result<Vec<_>, FitError>>()?;
     let (mut out, mut skipped) = (Vec::new(), Vec::new());
+    let mut previous: Option<(Baseline, FitOutcome)> = None;
     for kind in BaselineKind::ALL {
         if kind == BaselineKind::LuGre && all_steady {
             skipped.push("LuGre skipped: on steady curves it is Stribeck".to_string());
             continue;
         }
-        let model = Baseline::new(
+        let model = Baseline::from_data(
             kind,
             LoadForm::for_data(p.loads_vary, p.other_loads),
             &p.scale,
             p.mean_abs_n,
+            &series,
         );
         // A classic model costs microseconds per evaluation: give it ten
         // times the budget, so that a non-converged baseline is never the
         // budget's fault.
         let mut opts = req.options(kind.label());
         opts.max_evaluations = req.max_evaluations.saturating_mul(10);
-        out.push(fit(&model, &p.data, map_fit.clone(), &opts)?);
+        // Each model contains the one before it: it also starts from that
+        // one's optimum, so it never ends worse than the simpler model; and
+        // from generic starts that ignore the data (mean level, static
+        // level half as high again), in case the data's starts sit in
+        // another basin.
+        if let Some((inner, o)) = &previous {
+            opts.extra_starts = model.nested_starts(inner, &o.best, map_fit.len());
+        }
+        let generic = Baseline::from_data(
+            kind,
+            LoadForm::for_data(p.loads_vary, p.other_loads),
+            &p.scale,
+            p.mean_abs_n,
+            &[],
+        );
+        opts.extra_starts.push(
+            generic
+                .parameters()
+                .iter()
+                .map(|q| q.start)
+                .chain(map_fit.iter().map(|(i, _)| p.data.map_values[*i]))
+                .collect(),
+        );
+        let o = fit(&model, &p.data, map_fit.clone(), &opts)?;
+        out.push(o.clone());
+        previous = Some((model, o));
     }
     Ok((out, skipped))
 }

@@ -47,6 +47,23 @@ const DISTINCT_OPTIMUM: f64 = 0.02;
 pub fn search(problem: &Problem<'_>, options: &Options) -> Vec<LocalRun> {
     let x0 = problem.start();
     let mut starts = vec![x0.clone()];
+    // Extra starts (a nested model's optimum) run whatever the count.
+    let clamp = |x: &[f64]| -> Vec<f64> {
+        problem
+            .params
+            .iter()
+            .zip(x)
+            .map(|(p, v)| v.clamp(p.lo, p.hi))
+            .collect()
+    };
+    let extra: Vec<Vec<f64>> = options
+        .extra_starts
+        .iter()
+        .filter(|x| x.len() == problem.params.len())
+        .map(|x| clamp(x))
+        .collect();
+    let wanted = options.starts + extra.len();
+    starts.extend(extra);
     if options.global_points > 0 && options.starts > 1 {
         let cube = latin_hypercube(options.global_points, problem.params.len(), options.seed);
         let mut scored: Vec<(f64, Vec<f64>)> = cube
@@ -72,7 +89,7 @@ pub fn search(problem: &Problem<'_>, options: &Options) -> Vec<LocalRun> {
             scored[0].0
         ));
         for (_, x) in scored {
-            if starts.len() >= options.starts || x.is_empty() {
+            if starts.len() >= wanted || x.is_empty() {
                 break;
             }
             if starts

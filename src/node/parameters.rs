@@ -28,12 +28,16 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Whether `key` may change while the node runs.
 pub fn is_runtime(key: &str) -> bool {
-    const EXACT: [&str; 13] = [
+    const EXACT: [&str; 17] = [
         "contact.load_n",
         "contact.mass_kg",
         "contact.boundary_friction",
         "contact.sign_regularization_m_s",
         "contact.min_film_m",
+        "contact.presliding_stiffness_n_m",
+        "contact.presliding_damping_n_s_m",
+        "contact.width_load_exponent",
+        "contact.width_reference_load_n",
         "node.command_timeout_s",
         "node.timeout_behaviour",
         "node.timeout_deceleration_m_s2",

@@ -16,7 +16,9 @@
 //! | [`solver`] | discretised Reynolds + load balance, Newton, steady mode |
 //! | [`reference`] | the paper's Algorithm 1 (Picard + secant) |
 //! | [`estimate`] | per-step output, status and diagnostics |
+//! | [`error`] | the core's setup errors ([`SetupError`]) |
 //! | [`drivetrain`] | losses beside the contact (bearings, seals, gears) |
+//! | [`presliding`] | the contact's elastic displacement before gross sliding |
 //! | [`viscosity`] | the liquid's viscosity against temperature (Vogel) |
 //!
 //! ```
@@ -36,6 +38,7 @@ pub mod flow_factors;
 pub mod geometry;
 pub mod gw;
 pub mod params;
+pub mod presliding;
 pub mod reference;
 pub mod scheme;
 pub mod solver;
@@ -46,7 +49,8 @@ pub use error::SetupError;
 pub use estimate::{Diagnostics, Estimate, Regime, Status};
 pub use params::{
     Contact, Geometry, Lubricant, Method, ModelParams, Pocket, Profile, ReferenceSettings,
-    Roughness, SolverSettings, TimeScheme,
+    Roughness, SolverSettings, TimeScheme, WidthLaw,
 };
+pub use presliding::Presliding;
 pub use solver::{FieldPoint, Isa, ModelMismatch, PreparedModel, Solver, StepBreakdown};
 pub use viscosity::{ViscosityModel, VogelModel};

@@ -23,6 +23,8 @@
 //! | μ_bl | `boundary_friction` | boundary friction coefficient | – |
 //! | v_reg | `sign_regularization` | velocity scale of tanh(v/v_reg) | m/s |
 //! | h_floor | `min_film` | optional floor on h0 (0 = off) | m |
+//! | σ0, σ1 | `presliding` | pre-sliding stiffness and damping (0 = rigid; see [`super::presliding`]) | N/m, N·s/m |
+//! | κ, F_ref | `width_law` | soft contact: width B(F) = B (F/F_ref)^κ (κ = 0: rigid) | –, N |
 
 use super::error::SetupError;
 
@@ -137,6 +139,56 @@ pub struct Contact {
     pub sign_regularization: f64,
     /// Floor on h0; 0 disables it (the default: with GW it should not bind).
     pub min_film: f64,
+    /// Pre-sliding compliance (off by default).
+    pub presliding: super::presliding::Presliding,
+    /// How the contact's width follows the load (constant by default).
+    pub width_law: WidthLaw,
+}
+
+/// A soft contact's width against the normal load:
+///
+/// ```text
+/// B(F) = B (F / F_ref)^κ
+/// ```
+///
+/// | symbol | meaning | unit |
+/// |---|---|---|
+/// | B | `Geometry::width`, the width at the reference load | m |
+/// | F, F_ref | normal load, the load at which the width is B | N |
+/// | κ | `exponent`: 0 a rigid contact of constant width; 1 a contact whose nominal area grows in proportion to the load (an elastomer conforming at constant mean pressure); ½ Hertz's line contact | – |
+///
+/// The model is one-dimensional: the film problem is per unit width, so a
+/// wider contact carries the same film at the load per unit width
+/// F / B(F), and every force scales with B(F). The solver solves the film
+/// for the load F (B/B(F)) on the width B and scales the forces by
+/// B(F)/B; the squeeze film's history is per unit width and unaffected.
+/// The slider's mass is taken per the reference width (its inertia is a
+/// millionth of the load at the paper's conditions).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WidthLaw {
+    pub exponent: f64,
+    pub reference_load: f64,
+}
+
+impl Default for WidthLaw {
+    fn default() -> Self {
+        Self {
+            exponent: 0.0,
+            reference_load: 20_762.0,
+        }
+    }
+}
+
+impl WidthLaw {
+    /// B(F)/B at load `load` (1 for a rigid contact, or a load that is not
+    /// a positive number: the step's input check reports it).
+    pub fn scale(&self, load: f64) -> f64 {
+        if self.exponent == 0.0 || !(load.is_finite() && load > 0.0) {
+            1.0
+        } else {
+            (load / self.reference_load).powf(self.exponent)
+        }
+    }
 }
 
 impl Default for Contact {
@@ -146,6 +198,8 @@ impl Default for Contact {
             boundary_friction: 0.3,
             sign_regularization: 1e-4,
             min_film: 0.0,
+            presliding: super::presliding::Presliding::default(),
+            width_law: WidthLaw::default(),
         }
     }
 }
@@ -332,10 +386,25 @@ impl ModelParams {
         non_negative("contact.boundary_friction", c.boundary_friction)?;
         positive("contact.sign_regularization", c.sign_regularization)?;
         non_negative("contact.min_film", c.min_film)?;
+        non_negative("contact.presliding.stiffness", c.presliding.stiffness)?;
+        non_negative("contact.presliding.damping", c.presliding.damping)?;
+        non_negative("contact.width_law.exponent", c.width_law.exponent)?;
+        positive(
+            "contact.width_law.reference_load",
+            c.width_law.reference_load,
+        )?;
         let d = &self.drivetrain;
         non_negative("drivetrain.coulomb", d.coulomb)?;
         non_negative("drivetrain.viscous", d.viscous)?;
         non_negative("drivetrain.load_coefficient", d.load_coefficient)?;
+        non_negative("drivetrain.quadratic", d.quadratic)?;
+        if !d.coulomb_asymmetry.is_finite() {
+            return Err(SetupError::invalid(
+                "drivetrain.coulomb_asymmetry",
+                d.coulomb_asymmetry,
+                "must be finite",
+            ));
+        }
         Ok(())
     }
 }

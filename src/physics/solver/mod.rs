@@ -46,6 +46,7 @@
 //! | `steady.rs` | steady states (Stribeck points) and continuation |
 //! | `newton.rs` | Newton iteration, line search, sub-stepping |
 //! | `assembly.rs` | residual and Jacobian of one iterate |
+//! | `cell_pass.rs` | pass 1 of the assembly: per-cell density, viscosity ratio and their derivatives |
 //! | `bordered.rs` | the tridiagonal-plus-border linear solve |
 //! | `lanes.rs` | lane-wise sums and maxima that vectorise |
 //! | `postprocess.rs` | forces, friction and diagnostics of a solved state |
@@ -94,6 +95,8 @@ pub(crate) struct Disc {
     pub v_reg: f64,
     pub min_film: f64,
     pub drivetrain: crate::physics::drivetrain::Drivetrain,
+    pub presliding: crate::physics::presliding::Presliding,
+    pub width_law: crate::physics::params::WidthLaw,
     pub guard: step::PredictionGuard,
 }
 
@@ -255,6 +258,12 @@ pub struct Solver {
     held_h0: Option<f64>,
     anchor: (f64, f64, f64),
     last: Option<Estimate>,
+    /// The contact's pre-sliding displacement z, m (see
+    /// [`crate::physics::presliding`]; 0 while it is off).
+    pub(crate) bristle: f64,
+    /// B(F)/B of the solve in progress (see [`crate::physics::WidthLaw`]);
+    /// the solver works on the load per reference width, F/this.
+    pub(crate) width_scale: f64,
     /// The instruction-set version of the step.
     isa: Isa,
 }
@@ -319,6 +328,8 @@ impl Solver {
             v_reg: model.contact.sign_regularization,
             min_film: model.contact.min_film,
             drivetrain: model.drivetrain,
+            presliding: model.contact.presliding,
+            width_law: model.contact.width_law,
             guard: step::PredictionGuard::new(&eos, model.lubricant.saturation_pressure),
         })
     }
@@ -347,7 +358,17 @@ impl Solver {
         if !self.fits(m) {
             return Err(ModelMismatch);
         }
+        let was_rigid = !self.d.presliding.is_on();
         std::mem::swap(&mut self.d, &mut m.d);
+        if was_rigid && self.d.presliding.is_on() {
+            // Compliance switched on: as if it had always been, the
+            // displacement of the last state's level.
+            self.bristle = self.last.map_or(0.0, |e| {
+                self.d
+                    .presliding
+                    .steady_displacement(e.contact_friction_force)
+            });
+        }
         Ok(())
     }
 
@@ -381,6 +402,8 @@ impl Solver {
             held_h0: None,
             anchor: (0.0, 0.0, 0.0),
             last: None,
+            bristle: 0.0,
+            width_scale: 1.0,
             isa: Isa::Baseline,
         };
         s.set_isa(Isa::detect());
@@ -453,6 +476,13 @@ impl Solver {
     /// The liquid's dynamic viscosity μl now, Pa·s.
     pub fn liquid_viscosity(&self) -> f64 {
         self.d.eos.mu_l
+    }
+
+    /// The load per reference width of a solve at `load` (N), after
+    /// setting the width scale the solve's forces are reported with.
+    pub(crate) fn per_reference_width(&mut self, load: f64) -> f64 {
+        self.width_scale = self.d.width_law.scale(load);
+        load / self.width_scale
     }
 
     /// Restart the time count at `t`, s.

@@ -76,6 +76,8 @@ impl Solver {
         let visc = lane_sum(mu, 0.0);
         let sum_p = lane_sum(p, d.p_amb);
         let p_max = lane_max(p);
+        // The film's forces on the reference width (its load is the load
+        // per reference width: f_net and the history stay in its terms).
         let f_hyd = b * dx * sum_p;
         let f_asp = b * dx * sum_asp;
         let f_visc = b * visc;
@@ -97,12 +99,39 @@ impl Solver {
             }
             _ => (0.0, f_net.abs() / load),
         };
-        let contact_friction = f_visc + d.mu_bl * f_asp * (v / d.v_reg).tanh();
+        // A soft contact's forces on its width at this load (w = 1: rigid,
+        // and every force below is the film's, bit for bit).
+        let w = self.width_scale;
+        let (f_hyd, f_asp, f_visc, inertia) = (w * f_hyd, w * f_asp, w * f_visc, w * inertia);
+        let contact_friction = if d.presliding.is_on() {
+            // Gross sliding's level, through the contact's compliance.
+            let level = f_visc + d.mu_bl * f_asp * sgn(v);
+            let p = d.presliding;
+            match (advance, ctx.time) {
+                (true, Some((_, dt))) => {
+                    let (z, f) = p.advance(self.bristle, level, v, dt);
+                    self.bristle = z;
+                    f
+                }
+                // A steady state (or a solve that does not advance time):
+                // the displacement of steady sliding.
+                _ => {
+                    if ctx.time.is_none() {
+                        self.bristle = p.steady_displacement(level);
+                    }
+                    level
+                }
+            }
+        } else {
+            f_visc + d.mu_bl * f_asp * (v / d.v_reg).tanh()
+        };
         // Zero drivetrain terms leave the contact's force untouched (bit for bit).
+        // The load itself (the film's load is per reference width).
+        let load = w * load;
         let friction = if d.drivetrain.is_zero() {
             contact_friction
         } else {
-            contact_friction + d.drivetrain.force(v, ctx.load, d.v_reg)
+            contact_friction + d.drivetrain.force(v, load, d.v_reg)
         };
         let cof = (f_visc.abs() + d.mu_bl * f_asp) / load;
         let share = f_asp / load;
@@ -173,5 +202,16 @@ impl Solver {
                 substeps: 0,
             },
         }
+    }
+}
+
+/// sgn(v): ±1, and 0 at rest.
+fn sgn(v: f64) -> f64 {
+    if v > 0.0 {
+        1.0
+    } else if v < 0.0 {
+        -1.0
+    } else {
+        0.0
     }
 }

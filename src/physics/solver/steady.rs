@@ -55,6 +55,8 @@ impl Solver {
         if let Some(status) = Self::input_status(v, load) {
             return self.rejected_input(v, load, status, false);
         }
+        // A soft contact: the film per reference width (1 when rigid).
+        let load = self.per_reference_width(load);
         if self.anchor.2 == 0.0 {
             self.set_static_anchor(load);
         }
@@ -90,6 +92,7 @@ impl Solver {
         if v.abs() > crate::physics::params::MAX_ABS_VELOCITY {
             return self.rejected_input(v, load, Status::InputOutOfRange, false);
         }
+        let load = self.per_reference_width(load);
         let ctx = Ctx {
             v,
             load,

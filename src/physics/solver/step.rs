@@ -147,6 +147,8 @@ impl Solver {
     /// One step, in the best instruction-set version of the solver this
     /// CPU runs (see [`Isa`]); every version gives the same numbers.
     fn step_with_gap(&mut self, v: f64, load: f64, gap: H0Mode) -> Estimate {
+        // A soft contact: the film per reference width (1 when rigid).
+        let load = self.per_reference_width(load);
         #[cfg(target_arch = "x86_64")]
         match self.isa {
             // SAFETY: `Isa::detect` found these features on this CPU.
@@ -181,7 +183,9 @@ impl Solver {
         }
         if self.hist_len == 0 {
             // Never initialised: start from the steady state at this input.
-            self.initialize_steady(v, load);
+            // (`load` is per reference width; the steady solve takes the
+            // load itself.)
+            self.initialize_steady(v, load * self.width_scale);
         }
         let coeffs = if self.hist_len >= 2 {
             StepCoefficients::for_scheme(self.settings.scheme)
