@@ -1,8 +1,36 @@
 //! friction-node: a physics-based, real-time estimate of sliding friction.
 //!
-//! The [`physics`] module is the model core (no I/O, no clock, no logging).
-//! [`analysis`] computes loop metrics from runs. [`config`] reads the ROS 2
-//! parameter files; [`signal`] the velocity and load inputs.
+//! The [`physics`] module is the model core (no I/O, no clock, no logging);
+//! everything else carries it to and from the world. Layers, lowest first:
+//! the core; configuration, inputs and tables; messages and transports;
+//! the loop (node, contacts) and recording; offline work (simulate, replay,
+//! fit, studies, benches) on top.
+//!
+//! | module | job |
+//! |---|---|
+//! | [`physics`] | the model and its solvers: Reynolds + cavitation + GW + load balance |
+//! | [`config`] | the YAML parameter files: schema, defaults, overrides, validation, input envelope |
+//! | [`signal`] | velocity, load and temperature inputs of offline runs |
+//! | [`table`] | numeric tables from text (the csv crate): delimiters, columns, line numbers |
+//! | [`expression`] | size and depth limits on the column expressions people write |
+//! | [`clock`] | monotonic and wall time, system or simulated |
+//! | [`stats`] | fixed-memory statistics, the recorder's counters |
+//! | [`text`] | text formatting shared by the output layers |
+//! | [`output`] | atomic, checked output files; free-space checks |
+//! | [`interrupt`] | SIGINT/SIGTERM as a stop request for long offline work |
+//! | [`analysis`] | hysteresis-loop metrics of a run |
+//! | [`msgs`] | wire structs mirroring `msg/*.msg`, the loop's records, CDR |
+//! | [`transport`] | in-memory, iceoryx2 and ROS 2 backends behind small traits |
+//! | [`contacts`] | several contacts stepped together, the worker pool |
+//! | [`node`] | the fixed-step real-time loop, its runner and live parameters |
+//! | [`record`] | MCAP recording: one file, split directories, snapshots |
+//! | [`bag`] | reading bags: MCAP, rosbag2 SQLite and directories |
+//! | [`replay`] | the model over a recorded motion, the determinism oracle, reports |
+//! | [`offline`] | `simulate`, `stribeck` and `profile` to CSV |
+//! | [`fit`] | calibration: least squares on any key, classic baselines, reports |
+//! | [`studies`] | the paper's parametric studies and their claims |
+//! | [`plot`] | SVG figures shared by studies, replay and fit |
+//! | [`bench`] | step, latency, recorder, accuracy and fit benchmarks |
 
 pub mod analysis;
 #[cfg(feature = "mcap")]

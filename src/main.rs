@@ -10,6 +10,11 @@
 //! | 4 | `fit`: the fit did not converge (the best point found is written) |
 //! | 5 | `replay --expect-identical`: the bag holds no recorded estimates to compare with |
 //! | 130, 143 | stopped by SIGINT, SIGTERM (`simulate`, `study`, `replay`, `fit`): nothing half-written is left |
+//!
+//! | file | job |
+//! |---|---|
+//! | `main.rs` | the counting allocator, parsing, dispatch, exit codes |
+//! | `cli/` | argument types and one file per group of subcommands |
 
 mod cli;
 

@@ -8,6 +8,15 @@
 //! for files. A panic in the library becomes PyO3's `PanicException`, never
 //! a crash of the interpreter. Long calls (`Model.run`, `replay`, `fit`,
 //! `stribeck`) release the GIL.
+//!
+//! | file | job |
+//! |---|---|
+//! | `lib.rs` | the module `friction_node._core` and what it exports |
+//! | `model.rs` | `Model`: one contact stepped from Python, `Model.run` over arrays |
+//! | `calls.rs` | `stribeck`, `replay` and `fit`: the command line's jobs returning arrays |
+//! | `columns.rs` | estimates → named numpy columns |
+//! | `errors.rs` | library errors → Python exceptions, CLI flags → keywords |
+//! | `interrupts.rs` | Ctrl-C during long calls (checked between chunks) |
 
 mod calls;
 mod columns;

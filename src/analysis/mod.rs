@@ -1,4 +1,8 @@
 //! Analysis of runs: hysteresis-loop metrics. Pure computation (no I/O).
+//!
+//! | file | job |
+//! |---|---|
+//! | `metrics.rs` | hysteresis-loop metrics per motion cycle (MODEL.md §8) |
 
 pub mod metrics;
 

@@ -17,6 +17,7 @@
 //! | `rosbag2.rs` | rosbag2 directories: `metadata.yaml` and its files |
 //! | `decode.rs` | schema checks and the known message types as samples |
 //! | `resample.rs` | sampled inputs onto the model's step grid, silences |
+//! | `structure.rs` | a structural check of an MCAP file before the `mcap` reader sees it |
 
 mod db3_file;
 pub mod decode;

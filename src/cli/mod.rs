@@ -1,5 +1,18 @@
 //! The command line: argument types (`args.rs`) and one file per group of
 //! subcommands. `main.rs` parses, dispatches and maps errors to exit codes.
+//!
+//! | file | job |
+//! |---|---|
+//! | `mod.rs` | the subcommand enum and its dispatch |
+//! | `args.rs` | argument types shared by the subcommands (signals, overrides, paths) |
+//! | `node.rs` | `run` (the real-time node) and `soak` |
+//! | `offline.rs` | `simulate`, `stribeck`, `profile` |
+//! | `study.rs` | `study`: the paper's studies, every case in parallel |
+//! | `replay.rs` | `replay`: the model over a recorded motion |
+//! | `fit.rs` | `fit`: calibration and its report |
+//! | `bench.rs` | `bench`, `bench-latency`, `bench-recorder`, `bench-accuracy`, `bench-fit` |
+//! | `progress.rs` | progress bars on a terminal's stderr |
+//! | `logging.rs` | `tracing` to the terminal |
 
 pub mod args;
 pub mod bench;

@@ -18,6 +18,12 @@
 //! | F_f,i | friction force of contact i ([`Estimate::friction_force`]) | N |
 //! | g_i | gain of contact i | 1 or m |
 //! | τ_i = g_i F_f,i | effort of contact i on its joint | N or N·m |
+//!
+//! | file | job |
+//! |---|---|
+//! | `mod.rs` | [`ContactSet`]: the contacts, their joints and gains, one step of all |
+//! | `pool.rs` | a fixed pool of worker threads stepping their share of the contacts |
+//! | `tests.rs` | unit tests: one contact equals the single solver, the pool equals serial |
 
 mod pool;
 

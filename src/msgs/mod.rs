@@ -14,6 +14,7 @@
 //! | `records.rs` | heap-free records of the loop and their conversions |
 //! | `cdr.rs` | CDR with its encapsulation header |
 //! | `ros_interfaces.rs` | standard interfaces: parameters, `/rosout`, diagnostics, `/clock`, Trigger |
+//! | `tests.rs` | round trips of every message through CDR and the records |
 
 mod cdr;
 mod records;

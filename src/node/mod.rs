@@ -36,6 +36,7 @@
 //! | `parameters.rs` | declared parameters, sets validated and prepared off the loop, applied between steps |
 //! | `runner.rs` | the `run` command around the loop |
 //! | `rt.rs` | real-time settings |
+//! | `driver.rs` | the demo and soak driver: a peer commanding the node on its own topics |
 
 mod commands;
 pub mod driver;

@@ -14,6 +14,13 @@
 //! reach full film; the roughness study runs at V0 = 1 m/s (where MODEL.md
 //! says the σ = 2.5 µm fluid-share claim holds) and also at V0 = 0.25 m/s;
 //! the Hersey study is two groups of four loops with equal μ·V1/F.
+//!
+//! | file | job |
+//! |---|---|
+//! | `cases.rs` | the cases of each study (MODEL.md §8), one function per study |
+//! | `run.rs` | steady curves, one case's transient run and its analysed cycle |
+//! | `report.rs` | per-case CSVs, steady curves, figures and the claims' report |
+//! | `claims/` | the paper's claims 1–9 evaluated on the results |
 
 mod cases;
 pub mod claims;

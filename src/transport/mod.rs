@@ -8,6 +8,16 @@
 //!
 //! Backends are opened from a [`BackendSpec`] on the thread that uses them
 //! (iceoryx2 ports are not `Send`).
+//!
+//! | file | job |
+//! |---|---|
+//! | `mod.rs` | the backend-neutral traits, the loop's ports, profile slots |
+//! | `memory.rs` | in-memory: bounded lock-free queues between threads of one process |
+//! | `iceoryx/` | iceoryx2: zero-copy shared memory on one host |
+//! | `ros2/` | ROS 2 through ros2-client (pure-Rust DDS) |
+//! | `names.rs` | the node's ROS 2 topic names, resolved from the configuration |
+//! | `rosout.rs` | log lines for `/rosout` (a `tracing` layer) |
+//! | `diagnostics.rs` | `/diagnostics`: the loop's health as a DiagnosticArray |
 
 pub mod diagnostics;
 pub mod memory;

@@ -5,6 +5,12 @@
 //! expects our model to differ from the paper, the paper's statement is still
 //! a check (and is allowed to fail); the difference is explained in
 //! `docs/paper-reproduction.md`.
+//!
+//! | file | job |
+//! |---|---|
+//! | `stribeck.rs` | claim 1: the Stribeck curves |
+//! | `loops.rs` | claims about the loops' shape (amplitude, frequency, branches) |
+//! | `parameters.rs` | claims about the operating parameters (load, viscosity, roughness, texture) |
 
 use super::{CaseResult, StudyKind, StudyResult, LOW_SPEED};
 use std::collections::BTreeMap;

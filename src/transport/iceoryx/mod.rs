@@ -13,6 +13,12 @@
 //! port opens. Publishing never blocks (safe overflow: a full subscriber
 //! buffer loses its oldest sample); the node polls and publishes inline on the
 //! loop thread (lock-free shared-memory operations, no system call).
+//!
+//! | file | job |
+//! |---|---|
+//! | `mod.rs` | the single-contact services: commands in, estimates and profiles out |
+//! | `payloads.rs` | the `#[repr(C)]` payloads and their conversions |
+//! | `joints.rs` | several contacts: JointState velocities in, per-contact estimates out |
 
 mod joints;
 pub mod payloads;

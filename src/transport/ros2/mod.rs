@@ -18,6 +18,16 @@
 //! and CI use) builds the participant on the loopback interface only, so no
 //! traffic leaves the host; discovery between processes then uses RustDDS's
 //! same-host unicast announcements.
+//!
+//! | file | job |
+//! |---|---|
+//! | `mod.rs` | the transport: participant, topics, QoS, the loop's side |
+//! | `io.rs` | the I/O thread: commands in, estimates and statistics out |
+//! | `raw.rs` | command samples as raw CDR bytes, decoded off the loop |
+//! | `joints.rs` | several contacts: JointState in, per-contact estimates out |
+//! | `params.rs` | the node's services: parameters, reset, on their own thread |
+//! | `service.rs` | one service served in both DDS layouts ROS 2 uses |
+//! | `peer.rs` | a peer's side (tests, demo driver): its own participant on loopback |
 
 mod io;
 mod joints;

@@ -1,0 +1,118 @@
+//! The maps of the source tree stay true: every module that declares child
+//! modules (`lib.rs`, `main.rs`, each `mod.rs`) lists every one of them in
+//! its doc comment's file table, one row per file (`| \`name.rs\` | job |`),
+//! folder (`| \`name/\` | job |`) or module link (`| [\`name\`] | job |`), and the table lists nothing that is not
+//! there. A new file without its line in the parent's table fails here.
+
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+
+/// The roots whose module trees are checked.
+const ROOTS: [&str; 3] = ["src", "python/src", "capi/src"];
+
+/// Every `lib.rs`, `main.rs` and `mod.rs` under `dir`.
+fn parents(dir: &Path, out: &mut Vec<PathBuf>) {
+    let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .map(|e| e.unwrap().path())
+        .collect();
+    entries.sort();
+    for p in entries {
+        if p.is_dir() {
+            parents(&p, out);
+        } else if matches!(
+            p.file_name().and_then(|n| n.to_str()),
+            Some("lib.rs" | "main.rs" | "mod.rs")
+        ) {
+            out.push(p);
+        }
+    }
+}
+
+/// The child modules a file declares (`mod x;`, `pub mod x;`,
+/// `pub(crate) mod x;`), each checked to have its file (`x.rs` or `x/mod.rs`).
+fn declared(text: &str, dir: &Path) -> BTreeSet<String> {
+    let mut out = BTreeSet::new();
+    for line in text.lines() {
+        let l = line.trim();
+        let rest = l
+            .strip_prefix("pub(crate) mod ")
+            .or_else(|| l.strip_prefix("pub(super) mod "))
+            .or_else(|| l.strip_prefix("pub mod "))
+            .or_else(|| l.strip_prefix("mod "));
+        let Some(rest) = rest else { continue };
+        let Some(name) = rest.strip_suffix(';') else {
+            continue; // an inline module `mod x { ... }` has no file
+        };
+        let name = name.trim();
+        assert!(
+            dir.join(format!("{name}.rs")).is_file() || dir.join(name).join("mod.rs").is_file(),
+            "{}: `mod {name};` has no file",
+            dir.display()
+        );
+        out.insert(name.to_string());
+    }
+    out
+}
+
+/// The modules named in the doc comment's table rows, by the first cell:
+/// a file (`` `x.rs` ``), a folder (`` `x/` ``) or a link (``[`x`]``).
+fn listed(text: &str) -> BTreeSet<String> {
+    let mut out = BTreeSet::new();
+    for line in text.lines() {
+        let Some(row) = line.trim_start().strip_prefix("//! | ") else {
+            continue;
+        };
+        let cell = row.split('|').next().unwrap_or("").trim();
+        if !(cell.starts_with('`') || cell.starts_with("[`")) {
+            continue; // a header, a rule or a table of symbols
+        }
+        let name = cell
+            .trim_start_matches('[')
+            .trim_end_matches(']')
+            .trim_matches('`');
+        let name = name
+            .strip_suffix(".rs")
+            .or_else(|| name.strip_suffix('/'))
+            .unwrap_or(name);
+        if !name.is_empty() && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+            out.insert(name.to_string());
+        }
+    }
+    out
+}
+
+#[test]
+fn every_module_file_has_its_line_in_its_parents_file_table() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut problems = Vec::new();
+    let mut checked = 0;
+    for r in ROOTS {
+        let mut files = Vec::new();
+        parents(&root.join(r), &mut files);
+        for f in files {
+            let text = std::fs::read_to_string(&f).unwrap();
+            let dir = f.parent().unwrap();
+            let children = declared(&text, dir);
+            if children.is_empty() {
+                continue;
+            }
+            checked += 1;
+            let rows = listed(&text);
+            let rel = f.strip_prefix(root).unwrap().display().to_string();
+            for c in children.difference(&rows) {
+                problems.push(format!("{rel}: `{c}` is missing from the file table"));
+            }
+            let this = f.file_stem().unwrap().to_str().unwrap().to_string();
+            for c in rows.difference(&children) {
+                if *c != this {
+                    problems.push(format!(
+                        "{rel}: the file table lists `{c}`, which is no module"
+                    ));
+                }
+            }
+        }
+    }
+    assert!(checked >= 20, "only {checked} parent modules found");
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
