@@ -72,12 +72,11 @@ pub(super) const MAX_SUBSTEPS: usize = 16;
 const H0_TRUST: f64 = 0.25;
 
 /// Updates below this (scaled) are taken without the monotonicity test
-/// (with the h0 trust region and a consistent merit scale, measured safe on
-/// every study case; it saves a solve per iteration in the slow phase of a
-/// vapour-pocket collapse), except right after a damped update: there an
-/// untested full step of a cell at the cavitation edge could throw it back
-/// (measured at μ = 0.143 Pa·s, 4 Hz: a cycle 0.08 → 0.35 → 0.17 → 0.08 of
-/// update sizes, three times over, 18 iterations; tested, 11).
+/// (with the h0 trust region and a consistent merit scale they are safe; it
+/// saves a solve per iteration in the slow phase of a vapour-pocket
+/// collapse), except right after a damped update: there an untested full
+/// step of a cell at the cavitation edge can throw it back into a cycle of
+/// update sizes (the measured case: `docs/solver-tuning.md`).
 const SMALL_UPDATE: f64 = 1e-1;
 
 /// Bounds of the Newton contraction constant K (‖e_(k+1)‖ ≈ K‖e_k‖², scaled
@@ -92,8 +91,8 @@ const MAPPED_UPDATE: f64 = 1e-2;
 
 /// The map's vapour weight K in units of 1/β: U is mostly p below a vapour
 /// fraction of 1/(2 · MAP_STIFFNESS) = 1 % (α at the saturation pressure by
-/// default), mostly −Kα above. 10…1000 all help; 50 took the fewest
-/// iterations on the reciprocating case at 5, 10 and 20.8 kN.
+/// default), mostly −Kα above. Any K from 10 to 1000 removes the crawl; the
+/// value is the measured best (`docs/solver-tuning.md`).
 const MAP_STIFFNESS: f64 = 50.0;
 
 /// A first update from the predictor above this (scaled) sends the step
