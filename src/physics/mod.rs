@@ -13,8 +13,7 @@
 //! | [`gw`] | Greenwood–Williamson contact, exact F_n tables |
 //! | [`flow_factors`] | Patir–Cheng flow factors (optional) |
 //! | [`scheme`] | three-level θ / BDF2 time discretisation |
-//! | [`solver`] | discretised Reynolds + load balance, Newton, steady mode |
-//! | [`reference`] | the paper's Algorithm 1 (Picard + secant) |
+//! | [`solver`] | discretised Reynolds + load balance, Newton, steady mode, the paper's Algorithm 1 |
 //! | [`estimate`] | per-step output, status and diagnostics |
 //! | [`error`] | the core's setup errors ([`SetupError`]) |
 //! | [`drivetrain`] | losses beside the contact (bearings, seals, gears) |
@@ -39,7 +38,6 @@ pub mod geometry;
 pub mod gw;
 pub mod params;
 pub mod presliding;
-pub mod reference;
 pub mod scheme;
 pub mod solver;
 pub mod viscosity;

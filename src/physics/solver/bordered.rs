@@ -25,20 +25,7 @@
 //! stability is the Thomas algorithm's (diagonally dominant rows: the
 //! spikes are below one in size and 1 − v_last u_first stays away from 0).
 
-use super::assembly::{RowColumns, Work};
-
-/// Factors of one row, the block's spike and z = A⁻¹ col. `fa` is the
-/// coupling to the already-eliminated neighbour (a above the block's meeting
-/// row, c below it) and `cp` the multiplier of the other neighbour.
-#[derive(Debug, Clone, Copy, Default)]
-pub(crate) struct Factor {
-    pub fa: f64,
-    pub cp: f64,
-    pub inv_m: f64,
-    pub z: f64,
-    /// The block's spike (v in the first block, u in the second).
-    pub s: f64,
-}
+use super::work::{Factor, RowColumns, Work};
 
 /// The partition of N rows into two twisted blocks.
 #[derive(Debug, Clone, Copy)]

@@ -2,7 +2,7 @@
 //! current iterate (density, ρ/μ, viscosity and their derivatives in p),
 //! from the mixture EOS (`crate::physics::eos`, MODEL.md §2).
 
-use super::assembly::{CellColumns, Work};
+use super::work::{CellColumns, Work};
 use super::Disc;
 use crate::physics::eos::{exp_fast, CellConstants, MixtureEos};
 

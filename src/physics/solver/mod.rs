@@ -46,10 +46,12 @@
 //! | `steady.rs` | steady states (Stribeck points) and continuation |
 //! | `newton.rs` | Newton iteration, line search, sub-stepping |
 //! | `assembly.rs` | residual and Jacobian of one iterate |
+//! | `work.rs` | the scratch memory: cell, face and row columns, factors, buffers |
 //! | `cell_pass.rs` | pass 1 of the assembly: per-cell density, viscosity ratio and their derivatives |
 //! | `bordered.rs` | the tridiagonal-plus-border linear solve |
 //! | `lanes.rs` | lane-wise sums and maxima that vectorise |
 //! | `postprocess.rs` | forces, friction and diagnostics of a solved state |
+//! | `reference.rs` | the paper's Algorithm 1 (Picard + secant), the verification reference |
 //! | `breakdown.rs` | the cost of each part of an iteration (a benchmark aid) |
 
 mod assembly;
@@ -60,11 +62,13 @@ mod history;
 mod lanes;
 mod newton;
 mod postprocess;
+mod reference;
 mod steady;
 mod step;
+mod work;
 
-pub(crate) use assembly::Work;
 pub use breakdown::StepBreakdown;
+pub(crate) use work::Work;
 
 use super::eos::MixtureEos;
 use super::error::SetupError;

@@ -23,8 +23,8 @@
 //! coefficients as the Newton solver. It is kept as a cross-check and as the
 //! benchmark baseline; it is slow by construction.
 
-use super::estimate::Status;
-use super::solver::{Ctx, H0Mode, Outcome, Solver};
+use super::{Ctx, H0Mode, Outcome, Solver};
+use crate::physics::estimate::Status;
 
 impl Solver {
     pub(crate) fn reference_solve(&mut self, ctx: &Ctx) -> Outcome {
