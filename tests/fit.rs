@@ -5,8 +5,10 @@
 //! data, read from ../shared/data) fit too; bad input gets a clear message.
 
 use friction_node::config::Config;
+use friction_node::fit::driver::{fit, FitOutcome};
+use friction_node::fit::options::Options;
 use friction_node::fit::params::DataScale;
-use friction_node::fit::problem::{fit, FitOutcome, Model, Options};
+use friction_node::fit::problem::Model;
 use friction_node::fit::synthetic::{
     gaussian, model_friction, noisy_csv, two_amplitudes_two_loads,
 };

@@ -20,6 +20,7 @@ fn files_in(folder: &str) -> Vec<PathBuf> {
 }
 
 /// The inputs the fuzzer found for `target` (crashes, out-of-memory, timeouts).
+#[cfg(feature = "mcap")]
 fn inputs(target: &str) -> Vec<PathBuf> {
     files_in(&format!("tests/fuzz_regressions/{target}"))
 }

@@ -9,7 +9,8 @@
 //! | transfer | fitted at one load, amplitude and frequency, validated at another: ours and the classic models, with the new terms off and on in the data |
 
 use crate::config::Config;
-use crate::fit::problem::{fit, FitOutcome, Options};
+use crate::fit::driver::{fit, FitOutcome};
+use crate::fit::options::Options;
 use crate::fit::report::{models_table, ModelRow};
 use crate::fit::request::data_scale;
 use crate::fit::synthetic::{

@@ -2,7 +2,6 @@
 //! source, evaluated row by row or, when affine in the map coefficients,
 //! from a base column and slopes; `ddt(COLUMN)`'s smoothed derivative.
 
-use super::series::Source;
 use super::FitError;
 use crate::table::Table;
 use evalexpr::{
@@ -227,7 +226,19 @@ pub(super) fn derivative(t: &[f64], y: &[f64], half: f64) -> Vec<f64> {
         .collect()
 }
 
-impl Source {
+/// The columns an expression reads: a source's table and its derived
+/// (`ddt`) columns, under the source's name (for messages).
+pub(super) struct Columns<'a> {
+    pub(super) name: &'a str,
+    pub(super) table: &'a Table,
+    pub(super) derived: &'a [(String, Vec<f64>)],
+}
+
+impl Columns<'_> {
+    fn name(&self) -> &str {
+        self.name
+    }
+
     /// `e` as an affine function of its coefficients about `c0`, if it is
     /// one: slopes from unit steps, then checked at two other points (to
     /// 1e-9 of the values' scale). None for a non-affine expression, one

@@ -26,7 +26,10 @@
 //! | `params.rs` | fitted parameters: bounds, scales, configuration keys |
 //! | `physics_model.rs` | our model as a predictor (transient and steady) |
 //! | `baselines.rs` | Coulomb + viscous, Stribeck, LuGre |
-//! | `problem.rs` | residuals, the parallel Jacobian, the LM run |
+//! | `problem.rs` | the problem: model, data, map coefficients, residuals, predictions |
+//! | `options.rs` | how a fit searches: starts, global points, budget, progress, stop |
+//! | `local_run.rs` | one Levenberg–Marquardt run, the parallel Jacobian, what was still moving |
+//! | `driver.rs` | the whole fit: global phase, local runs, statistics, predictions |
 //! | `request.rs` | a calibration as data (the command line's and Python's) and its steps |
 //! | `search.rs` | the global phase and the distinct optima |
 //! | `stats.rs` | standard errors, correlations, flags |
@@ -37,7 +40,10 @@
 #[cfg(feature = "mcap")]
 pub mod bag_input;
 pub mod baselines;
+pub mod driver;
 mod expr;
+pub mod local_run;
+pub mod options;
 pub mod params;
 pub mod physics_model;
 pub mod problem;
@@ -51,9 +57,11 @@ pub mod synthetic;
 
 pub use crate::table::{Delimiter, Table, TableError};
 pub use baselines::{Baseline, BaselineKind, LoadForm};
+pub use driver::FitOutcome;
+pub use options::Options;
 pub use params::{ParamSpec, Parameter};
 pub use physics_model::PhysicsModel;
-pub use problem::{Data, FitOutcome, Model, Options};
+pub use problem::{Data, Model};
 pub use series::{Mapping, Series, Source};
 
 use std::path::PathBuf;

@@ -3,7 +3,8 @@
 //! the baselines table; `summary.md`, `fit.csv` and plots in a report
 //! directory; the fitted parameter file.
 
-use super::problem::{FitOutcome, SeriesFit};
+use super::driver::FitOutcome;
+use super::problem::SeriesFit;
 use super::stats::CORRELATION_FLAG;
 use crate::config::Config;
 use crate::output::{AtomicFile, OutputError};

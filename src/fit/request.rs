@@ -4,8 +4,10 @@
 //! the same data). Writing the fitted file and the report stays with the
 //! caller; nothing here prints.
 
+use super::driver::{fit, FitOutcome};
+use super::options::{Options, Progress};
 use super::params::{map_parameter, DataScale};
-use super::problem::{fit, FitOutcome, Model, Options, Progress};
+use super::problem::Model;
 use super::{
     Baseline, BaselineKind, Data, Delimiter, FitError, LoadForm, Mapping, ParamSpec, Parameter,
     PhysicsModel, Source, Table,

@@ -7,7 +7,9 @@
 //! start already taken; their end points, sorted by cost and with
 //! near-duplicates merged, are the distinct optima.
 
-use super::problem::{local_run, LocalRun, Options, Problem};
+use super::local_run::{local_run, LocalRun};
+use super::options::Options;
+use super::problem::Problem;
 use rand::rngs::StdRng;
 use rand::seq::SliceRandom;
 use rand::{RngExt, SeedableRng};

@@ -11,7 +11,7 @@
 //! A table without a time column (and no `--time`) is a steady curve: each
 //! row a steady operating point.
 
-use super::expr::{compile, derivative, Expr, Var};
+use super::expr::{compile, derivative, Affine, Columns, Expr, Var};
 use super::FitError;
 use crate::table::Table;
 use std::path::PathBuf;
@@ -283,6 +283,25 @@ impl Source {
 
     pub fn name(&self) -> &str {
         &self.name
+    }
+
+    /// The columns its expressions read.
+    fn columns(&self) -> Columns<'_> {
+        Columns {
+            name: &self.name,
+            table: &self.table,
+            derived: &self.derived,
+        }
+    }
+
+    /// `e` as an affine function of the coefficients about `c0`, if it is one.
+    fn affine(&self, e: &Expr, c0: &[f64]) -> Option<Affine> {
+        self.columns().affine(e, c0)
+    }
+
+    /// `e` at every row, for map coefficients `coeffs`.
+    fn eval_column(&self, e: &Expr, what: &str, coeffs: &[f64]) -> Result<Vec<f64>, FitError> {
+        self.columns().eval_column(e, what, coeffs)
     }
 
     pub fn is_steady(&self) -> bool {

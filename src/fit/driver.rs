@@ -1,0 +1,113 @@
+//! The fit's driver: global phase (`search.rs`), local runs
+//! (`local_run.rs`), statistics at the optimum (`stats.rs`), and the
+//! predictions and errors on the training and validation data. The problem
+//! it solves is `problem.rs`.
+
+use super::local_run::LocalRun;
+use super::options::Options;
+use super::params::Parameter;
+use super::problem::{Data, Model, Problem, SeriesFit};
+use std::sync::atomic::Ordering;
+use std::time::Instant;
+
+/// The whole outcome of a fit.
+#[derive(Debug, Clone)]
+pub struct FitOutcome {
+    pub label: String,
+    pub params: Vec<Parameter>,
+    pub best: Vec<f64>,
+    /// Distinct optima, best first.
+    pub optima: Vec<LocalRun>,
+    pub converged: bool,
+    pub statistics: super::stats::Statistics,
+    pub train: Vec<SeriesFit>,
+    pub validate: Vec<SeriesFit>,
+    /// RMS and max |residual| on the fitted samples, N.
+    pub train_rms: f64,
+    pub train_max: f64,
+    /// RMS on held-out samples of the training sources, N.
+    pub holdout_rms: Option<f64>,
+    /// RMS on the validation sources, N.
+    pub validate_rms: Option<f64>,
+    /// Why the fitted model gives no prediction on the validation sources
+    /// (e.g. LuGre's g(v) ≤ 0 beyond the training velocities): an outcome
+    /// to report, not an error.
+    pub validate_failure: Option<String>,
+    pub simulations: usize,
+    pub simulation_mean_s: f64,
+    pub wall_s: f64,
+}
+
+impl FitOutcome {
+    /// Held-out RMS: validation sources when given, else the held-out part.
+    pub fn held_out_rms(&self) -> Option<f64> {
+        self.validate_rms.or(self.holdout_rms)
+    }
+}
+
+fn pooled(fits: &[SeriesFit], select: impl Fn(&SeriesFit, usize) -> bool) -> Option<(f64, f64)> {
+    let (mut ss, mut max, mut n) = (0.0, 0.0f64, 0usize);
+    for f in fits {
+        if let Some((rms, m, k)) = f.residual_stats(|i| select(f, i)) {
+            ss += rms * rms * k as f64;
+            max = max.max(m);
+            n += k;
+        }
+    }
+    (n > 0).then(|| ((ss / n as f64).sqrt(), max))
+}
+
+/// Fit `model` to `data`: global phase, local runs, statistics, the
+/// predictions on training and validation data.
+pub fn fit(
+    model: &dyn Model,
+    data: &Data,
+    map_fit: Vec<(usize, Parameter)>,
+    options: &Options,
+) -> Result<FitOutcome, super::FitError> {
+    let wall = Instant::now();
+    let mut problem = Problem::new(model, data, map_fit)?;
+    problem.stop = options.stop.clone();
+    let optima = super::search::search(&problem, options);
+    options.stop.check()?;
+    let best = optima[0].clone();
+    let statistics = super::stats::at_optimum(&problem, &best.x);
+    let collect = |v: Vec<Result<SeriesFit, String>>| -> Result<Vec<SeriesFit>, super::FitError> {
+        v.into_iter()
+            .map(|r| {
+                r.map_err(|message| super::FitError::Data {
+                    what: model.label(),
+                    message: format!("no prediction at the optimum: {message}"),
+                })
+            })
+            .collect()
+    };
+    let train = collect(problem.predict_sources(&best.x, true))?;
+    let (validate, validate_failure) = match collect(problem.predict_sources(&best.x, false)) {
+        Ok(v) => (v, None),
+        Err(e) => (Vec::new(), Some(e.to_string())),
+    };
+    let (train_rms, train_max) = pooled(&train, |f, i| f.series.fit[i]).unwrap_or((f64::NAN, 0.0));
+    let holdout_rms = pooled(&train, |f, i| !f.series.fit[i]).map(|p| p.0);
+    let validate_rms = pooled(&validate, |_, _| true).map(|p| p.0);
+    let simulations = problem.simulations.load(Ordering::Relaxed);
+    let ns = problem.simulation_ns.load(Ordering::Relaxed);
+    Ok(FitOutcome {
+        label: model.label(),
+        params: problem.params.clone(),
+        best: best.x.clone(),
+        converged: best.converged,
+        optima,
+        statistics,
+        train,
+        validate,
+        train_rms,
+        train_max,
+        holdout_rms,
+        validate_rms,
+        validate_failure,
+        simulations,
+        simulation_mean_s: ns as f64 / 1e9 / simulations.max(1) as f64,
+        wall_s: wall.elapsed().as_secs_f64(),
+    })
+}

@@ -1,0 +1,48 @@
+//! How a fit searches: the number of starts and global points, the
+//! evaluation budget, progress lines and the stop request.
+
+/// Where progress lines go.
+pub type Progress = Box<dyn Fn(&str) + Sync>;
+
+/// How a fit searches.
+pub struct Options {
+    /// Local (LM) runs: the start and the best distinct points of the
+    /// global phase.
+    pub starts: usize,
+    /// Points of the global phase (0: none).
+    pub global_points: usize,
+    pub seed: u64,
+    /// Residual evaluations per LM run (the Jacobian's are extra).
+    pub max_evaluations: usize,
+    /// Progress lines (the command prints them).
+    pub progress: Option<Progress>,
+    /// Requested from outside (SIGINT, Ctrl-C): the search ends at its next
+    /// evaluation and the fit is [`super::FitError::Interrupted`].
+    pub stop: crate::interrupt::Stop,
+    /// More starts, each a whole point (the model's parameters, then the
+    /// fitted map coefficients), run besides the given start and the global
+    /// points: e.g. a nested model's optimum.
+    pub extra_starts: Vec<Vec<f64>>,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Self {
+            starts: 3,
+            global_points: 16,
+            seed: 1,
+            max_evaluations: 200,
+            progress: None,
+            stop: crate::interrupt::Stop::new(),
+            extra_starts: Vec::new(),
+        }
+    }
+}
+
+impl Options {
+    pub fn say(&self, line: &str) {
+        if let Some(p) = &self.progress {
+            p(line);
+        }
+    }
+}
