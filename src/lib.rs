@@ -20,6 +20,7 @@
 //! | [`interrupt`] | SIGINT/SIGTERM as a stop request for long offline work |
 //! | [`analysis`] | hysteresis-loop metrics of a run |
 //! | [`msgs`] | wire structs mirroring `msg/*.msg`, the loop's records, CDR |
+//! | [`link`] | what the loop shares with its threads: loop settings, the parameter hand-over |
 //! | [`transport`] | in-memory, iceoryx2 and ROS 2 backends behind small traits |
 //! | [`contacts`] | several contacts stepped together, the worker pool |
 //! | [`node`] | the fixed-step real-time loop, its runner and live parameters |
@@ -42,6 +43,7 @@ pub mod contacts;
 pub mod expression;
 pub mod fit;
 pub mod interrupt;
+pub mod link;
 pub mod msgs;
 pub mod node;
 pub mod offline;

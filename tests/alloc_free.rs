@@ -213,10 +213,11 @@ fn a_prepared_model_swaps_in_between_two_steps_without_allocating() {
 
 #[test]
 fn a_parameter_change_is_applied_by_the_loop_between_two_steps_without_allocating() {
+    use friction_node::config::parameters::{apply_set, declare};
     use friction_node::config::{Config, StepMode};
+    use friction_node::link::{ParameterChannel, ParameterUpdate};
     use friction_node::msgs::ros_interfaces::{parameter_type, ParameterValue};
     use friction_node::msgs::{Command, CommandKind};
-    use friction_node::node::parameters::{apply_set, declare, ParameterChannel, ParameterUpdate};
     use friction_node::node::{LiveStatus, Loop};
     use friction_node::transport::memory::MemoryLink;
     use friction_node::transport::PeerPort;

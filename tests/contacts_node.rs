@@ -362,8 +362,9 @@ fn lockstep_with_change(
     at: u64,
     changes: &[(&str, f64)],
 ) -> (Vec<Vec<EstimateRecord>>, RunSummary) {
+    use friction_node::config::parameters::{apply_set, declare};
+    use friction_node::link::ParameterUpdate;
     use friction_node::msgs::ros_interfaces::{parameter_type, ParameterValue};
-    use friction_node::node::parameters::{apply_set, declare, ParameterUpdate};
     let mut cfg = cfg.clone();
     cfg.node.step_mode = friction_node::config::StepMode::Lockstep;
     let names = joints(&cfg);
@@ -446,7 +447,7 @@ fn a_runtime_change_of_one_contacts_key_changes_that_contact_alone() {
 
 #[test]
 fn with_several_contacts_each_contacts_model_keys_are_runtime_and_the_defaults_read_only() {
-    use friction_node::node::parameters::declare;
+    use friction_node::config::parameters::declare;
     let cfg = three();
     let declared = declare(&cfg);
     let read_only = |name: &str| {

@@ -307,12 +307,14 @@ fn a_split_recording_refuses_a_directory_that_is_not_empty() {
     assert!(e.contains("not empty") && e.contains("nonempty"), "{e}");
 }
 
+/// (Live parameter changes arrive through the ROS 2 parameter services.)
+#[cfg(feature = "ros2")]
 #[test]
 fn a_run_whose_parameters_changed_midway_replays_bit_identically() {
+    use friction_node::config::parameters::{apply_set, declare};
+    use friction_node::link::{ParameterChannel, ParameterUpdate};
     use friction_node::msgs::ros_interfaces::{parameter_type, ParameterValue};
-    use friction_node::node::parameters::{
-        apply_set, declare, record_applied, ParameterChannel, ParameterUpdate,
-    };
+    use friction_node::transport::ros2::params::record_applied;
     let d = dir("params");
     let bag = d.join("params.mcap");
     let mut cfg = config();

@@ -55,9 +55,9 @@
 //! seen (a wrong pointer, a model already freed while its memory still holds
 //! the freed marker), return `FN_ERROR_INVALID_HANDLE`.
 
+use friction_node::config::parameters::{apply_set, declare, Declared};
 use friction_node::config::{Config, Origin, ResolvedContact, ViscosityLaw};
 use friction_node::msgs::{regime_code, status_code};
-use friction_node::node::parameters::{apply_set, declare, Declared};
 use friction_node::physics::{Estimate, Solver};
 use std::cell::RefCell;
 use std::ffi::{c_char, CStr};

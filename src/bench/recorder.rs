@@ -42,7 +42,7 @@ pub fn run(
         clock.clone(),
     )?;
     let q = rec.queue();
-    let dt_ns = crate::node::secs_to_ns(config.solver.dt_s).max(1);
+    let dt_ns = crate::link::secs_to_ns(config.solver.dt_s).max(1);
     let per_hour = 3_600_000_000_000 / dt_ns;
     let stats_every = (1.0 / config.node.statistics_rate_hz / config.solver.dt_s).round() as u64;
     let started = std::time::Instant::now();

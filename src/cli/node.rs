@@ -34,7 +34,7 @@ pub fn run(
 /// applied) and every parameter that differs from the built-in default.
 /// The configuration was already loaded and validated by the caller.
 pub fn check(config: &Config, transport: Option<TransportArg>) {
-    use friction_node::node::parameters::flatten;
+    use friction_node::config::parameters::flatten;
     use friction_node::transport::names::TopicNames;
     let r = &config.ros;
     let fqn = if r.namespace.trim_end_matches('/').is_empty() {

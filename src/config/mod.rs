@@ -28,6 +28,7 @@
 //! | `contacts.rs` | `contacts.*`: several contacts, each overriding the top-level sections |
 //! | `error.rs` | [`ConfigError`] and the [`Origin`] of a configuration |
 //! | `envelope.rs` | the inputs every entry point accepts: velocity, load, temperature ([`Envelope`]) |
+//! | `parameters.rs` | the live-parameter catalogue (declared keys, types, ranges, writability) and [`parameters::apply_set`] |
 //! | `ros_args.rs` | `--ros-args` as rcl parses them (a `launch_ros` Node action) |
 //! | `tests.rs` | unit tests of loading, overrides and validation |
 
@@ -37,6 +38,7 @@ mod error;
 mod io;
 mod load;
 mod model;
+pub mod parameters;
 pub mod ros_args;
 mod validate;
 

@@ -33,7 +33,7 @@
 //! | `lockstep.rs` | lockstep mode and [`Loop::feed`] (replay) |
 //! | `commands.rs` | command validation, timeouts, command status |
 //! | `outputs.rs` | one step and its outputs: estimates, profiles, statistics |
-//! | `parameters.rs` | declared parameters, sets validated and prepared off the loop, applied between steps |
+//! | `parameters.rs` | the loop's side of live parameters: changes applied between steps |
 //! | `runner.rs` | the `run` command around the loop |
 //! | `rt.rs` | real-time settings |
 //! | `driver.rs` | the demo and soak driver: a peer commanding the node on its own topics |
@@ -48,8 +48,9 @@ pub mod runner;
 mod timer;
 
 use crate::clock::{Clock, SystemClock, WallStamps};
-use crate::config::{Config, StepMode, TimeoutBehaviour};
+use crate::config::{Config, StepMode};
 use crate::contacts::ContactSet;
+use crate::link::LoopSettings;
 use crate::msgs::RecordItem;
 use crate::physics::SetupError;
 use crate::stats::{Histogram, Window};
@@ -126,68 +127,6 @@ pub struct RunSummary {
     pub window_slowest: (usize, u64),
 }
 
-/// Settings the loop reads every step (from the configuration).
-#[derive(Debug, Clone, PartialEq)]
-pub struct LoopSettings {
-    pub mode: StepMode,
-    pub dt: f64,
-    /// The step in integer nanoseconds (validated to be whole).
-    pub dt_ns: u64,
-    pub command_timeout_ns: u64,
-    pub timeout_behaviour: TimeoutBehaviour,
-    pub deceleration: f64,
-    /// The velocity and load commands accepted.
-    pub limits: crate::config::InputLimits,
-    /// Steps between profile and statistics publications (0 = never).
-    pub profile_every: u64,
-    pub statistics_every: u64,
-    pub lockstep_spin_ns: u64,
-    /// Timer mode: busy-wait before each deadline, ns.
-    pub timer_spin_ns: u64,
-    /// Lost steps caught up one by one before a long step is taken.
-    pub max_catch_up_steps: u64,
-}
-
-/// Seconds to whole nanoseconds (saturating; config values are validated).
-pub(crate) fn secs_to_ns(s: f64) -> u64 {
-    let ns = (s * 1e9).round();
-    if ns <= 0.0 {
-        0
-    } else if ns >= u64::MAX as f64 {
-        u64::MAX
-    } else {
-        ns as u64
-    }
-}
-
-impl LoopSettings {
-    pub fn from_config(c: &Config) -> Self {
-        let dt = c.solver.dt_s;
-        let dt_ns = secs_to_ns(dt).max(1);
-        let every = |hz: f64| {
-            if hz > 0.0 {
-                ((1.0 / hz) / dt).round().max(1.0) as u64
-            } else {
-                0
-            }
-        };
-        Self {
-            mode: c.node.step_mode,
-            dt,
-            dt_ns,
-            command_timeout_ns: secs_to_ns(c.node.command_timeout_s),
-            timeout_behaviour: c.node.timeout_behaviour,
-            deceleration: c.node.timeout_deceleration_m_s2,
-            limits: crate::config::InputLimits::of(c),
-            profile_every: every(c.node.profile_rate_hz),
-            statistics_every: every(c.node.statistics_rate_hz),
-            lockstep_spin_ns: c.node.lockstep_spin_us.saturating_mul(1000),
-            timer_spin_ns: c.node.timer_spin_us.saturating_mul(1000),
-            max_catch_up_steps: secs_to_ns(c.node.max_catch_up_s) / dt_ns,
-        }
-    }
-}
-
 /// Errors of the node layer (setup only: a running loop never fails).
 #[derive(Debug, thiserror::Error)]
 pub enum NodeError {
@@ -230,7 +169,7 @@ pub struct Loop {
     first_step: u64,
     recorder: Option<Arc<crate::stats::RecorderCounters>>,
     /// Parameter changes while running (see [`parameters`]).
-    parameters: Option<Arc<parameters::ParameterChannel>>,
+    parameters: Option<Arc<crate::link::ParameterChannel>>,
 }
 
 impl Loop {

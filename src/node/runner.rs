@@ -260,7 +260,7 @@ pub fn run_node(
     #[cfg(not(feature = "mcap"))]
     let snapshot_flag = None;
     let mut ports: Vec<Box<dyn NodePort>> = Vec::new();
-    let channel = Arc::new(super::parameters::ParameterChannel::default());
+    let channel = Arc::new(crate::link::ParameterChannel::default());
     let mut served = false;
     // use_sim_time: timer mode follows ROS 2 /clock.
     let sim_time = if config.use_sim_time {
@@ -276,7 +276,7 @@ pub fn run_node(
     for s in &specs {
         let parameters = (!served && s.serves_parameters()).then(|| {
             served = true;
-            super::parameters::ParameterIo {
+            crate::link::ParameterIo {
                 config: config.clone(),
                 channel: channel.clone(),
             }

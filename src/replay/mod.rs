@@ -547,17 +547,17 @@ pub fn run(
     let total = p.commands.len();
     // Recorded parameter changes, re-applied before the step that used them.
     let mut current = p.config.clone();
-    let declared = crate::node::parameters::declare(&current);
+    let declared = crate::config::parameters::declare(&current);
     let mut changes = p.parameter_changes.iter().peekable();
     for (k, c) in p.commands.iter().enumerate() {
         if c.kind == CommandKind::Velocity {
             while let Some(ch) = changes.next_if(|ch| ch.stamp_ns <= c.stamp_ns) {
-                let next = crate::node::parameters::apply_set(&current, &declared, &ch.changed)
+                let next = crate::config::parameters::apply_set(&current, &declared, &ch.changed)
                     .map_err(|e| ReplayError::Parameters {
-                        stamp_ns: ch.stamp_ns,
-                        message: e.to_string(),
-                    })?;
-                let mut u = crate::node::parameters::ParameterUpdate::prepare(
+                    stamp_ns: ch.stamp_ns,
+                    message: e.to_string(),
+                })?;
+                let mut u = crate::link::ParameterUpdate::prepare(
                     &current,
                     next.clone(),
                     ch.changed.clone(),

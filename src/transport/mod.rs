@@ -136,7 +136,7 @@ pub struct PortIo {
     /// Set when a peer asks for a snapshot (ROS 2 `~/snapshot`).
     pub snapshot: Option<Arc<std::sync::atomic::AtomicBool>>,
     /// Parameters while running (ROS 2 serves them; others ignore it).
-    pub parameters: Option<crate::node::parameters::ParameterIo>,
+    pub parameters: Option<crate::link::ParameterIo>,
     /// `use_sim_time`: the clock that ROS 2 `/clock` drives.
     pub sim_time: Option<Arc<crate::clock::ExternalClock>>,
 }

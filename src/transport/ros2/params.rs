@@ -4,7 +4,7 @@
 //! `set_parameters_atomically`) and `~/snapshot` (`std_srvs/srv/Trigger`),
 //! each in both DDS layouts ([`super::service`]); `/parameter_events`.
 //!
-//! A set is validated and prepared here ([`crate::node::parameters`]) and
+//! A set is validated ([`crate::config::parameters`]) and prepared ([`crate::link`]) here and
 //! handed to the loop, which applies it between two steps and hands it
 //! back stamped with the first step that used it; this thread then
 //! publishes the `ParameterEvent` (stamped so) and gives it to the
@@ -12,17 +12,15 @@
 
 use super::service::{DualServer, Request};
 use super::{err, TransportError};
+use crate::config::parameters::{apply_set, declare, Declared, SetRefusal};
 use crate::config::Config;
+use crate::link::{ParameterChannel, ParameterIo, ParameterUpdate};
 use crate::msgs::ros_interfaces::{
     parameter_type as ty, DescribeParametersResponse, FloatingPointRange,
     GetParameterTypesResponse, GetParametersResponse, IntegerRange, ListParametersRequest,
     ListParametersResponse, ListParametersResult, NamesRequest, ParameterDescriptor,
     ParameterEvent, ParameterValue, SetParametersAtomicallyResponse, SetParametersRequest,
     SetParametersResponse, SetParametersResult, TriggerRequest, TriggerResponse,
-};
-use crate::node::parameters::{
-    apply_set, declare, event, record_applied, Declared, ParameterChannel, ParameterIo,
-    ParameterUpdate, SetRefusal,
 };
 use crate::transport::RecordQueue;
 use ros2_client::dds::rustdds::mio1::{Events, Interest, Poll, Token};
@@ -383,6 +381,43 @@ fn serve(e: &mut Entities, state: &mut ParamState, snapshot: Option<&AtomicBool>
             );
         }
     }
+}
+
+/// The `rcl_interfaces/msg/ParameterEvent` of an applied update, stamped
+/// with the first step that used it.
+pub fn event(node_fqn: &str, u: &ParameterUpdate) -> crate::msgs::ros_interfaces::ParameterEvent {
+    use crate::msgs::ros_interfaces::{Parameter, ParameterEvent};
+    ParameterEvent {
+        stamp: crate::msgs::Time::from_ns(u.applied_stamp_ns),
+        node: node_fqn.to_string(),
+        changed_parameters: u
+            .changed
+            .iter()
+            .map(|(name, value)| Parameter {
+                name: name.clone(),
+                value: value.clone(),
+            })
+            .collect(),
+        ..Default::default()
+    }
+}
+
+/// Hand an applied update's event to the recorder (replay re-applies it at
+/// the same step); `logged_ns` is the wall time now.
+pub fn record_applied(
+    queue: &crossbeam_queue::ArrayQueue<crate::msgs::RecordItem>,
+    node_fqn: &str,
+    u: &ParameterUpdate,
+    logged_ns: u64,
+) -> Result<(), String> {
+    let cdr = crate::msgs::to_cdr(&event(node_fqn, u))?;
+    queue
+        .push(crate::msgs::RecordItem::ParameterEvent {
+            cdr,
+            stamp_ns: u.applied_stamp_ns,
+            logged_ns,
+        })
+        .map_err(|_| "the recorder queue is full".to_string())
 }
 
 #[cfg(test)]

@@ -1,0 +1,204 @@
+//! What the loop shares with the threads around it, below `node/`,
+//! `transport/` and `record/`: the settings the loop reads every step
+//! ([`LoopSettings`], a pure function of the configuration) and the
+//! hand-over of live parameter changes ([`ParameterUpdate`] prepared off the
+//! loop, [`ParameterChannel`] to the loop and back, [`ParameterIo`] for a
+//! transport that serves parameters). The loop applies an update between two
+//! steps without blocking or allocating and hands it back stamped with the
+//! first step that used it (for `/parameter_events`, the recording and
+//! replay).
+
+use crate::config::parameters::SetRefusal;
+use crate::config::{Config, StepMode, TimeoutBehaviour};
+use crate::msgs::ros_interfaces::ParameterValue;
+use crate::physics::{PreparedModel, SetupError, Solver};
+use crossbeam_queue::ArrayQueue;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// Settings the loop reads every step (from the configuration).
+#[derive(Debug, Clone, PartialEq)]
+pub struct LoopSettings {
+    pub mode: StepMode,
+    pub dt: f64,
+    /// The step in integer nanoseconds (validated to be whole).
+    pub dt_ns: u64,
+    pub command_timeout_ns: u64,
+    pub timeout_behaviour: TimeoutBehaviour,
+    pub deceleration: f64,
+    /// The velocity and load commands accepted.
+    pub limits: crate::config::InputLimits,
+    /// Steps between profile and statistics publications (0 = never).
+    pub profile_every: u64,
+    pub statistics_every: u64,
+    pub lockstep_spin_ns: u64,
+    /// Timer mode: busy-wait before each deadline, ns.
+    pub timer_spin_ns: u64,
+    /// Lost steps caught up one by one before a long step is taken.
+    pub max_catch_up_steps: u64,
+}
+
+/// Seconds to whole nanoseconds (saturating; config values are validated).
+pub(crate) fn secs_to_ns(s: f64) -> u64 {
+    let ns = (s * 1e9).round();
+    if ns <= 0.0 {
+        0
+    } else if ns >= u64::MAX as f64 {
+        u64::MAX
+    } else {
+        ns as u64
+    }
+}
+
+impl LoopSettings {
+    pub fn from_config(c: &Config) -> Self {
+        let dt = c.solver.dt_s;
+        let dt_ns = secs_to_ns(dt).max(1);
+        let every = |hz: f64| {
+            if hz > 0.0 {
+                ((1.0 / hz) / dt).round().max(1.0) as u64
+            } else {
+                0
+            }
+        };
+        Self {
+            mode: c.node.step_mode,
+            dt,
+            dt_ns,
+            command_timeout_ns: secs_to_ns(c.node.command_timeout_s),
+            timeout_behaviour: c.node.timeout_behaviour,
+            deceleration: c.node.timeout_deceleration_m_s2,
+            limits: crate::config::InputLimits::of(c),
+            profile_every: every(c.node.profile_rate_hz),
+            statistics_every: every(c.node.statistics_rate_hz),
+            lockstep_spin_ns: c.node.lockstep_spin_us.saturating_mul(1000),
+            timer_spin_ns: c.node.timer_spin_us.saturating_mul(1000),
+            max_catch_up_steps: secs_to_ns(c.node.max_catch_up_s) / dt_ns,
+        }
+    }
+}
+
+/// A validated change, prepared for the loop.
+pub struct ParameterUpdate {
+    /// The whole configuration after the change.
+    pub config: Config,
+    /// What changed: (name, new value).
+    pub changed: Vec<(String, ParameterValue)>,
+    pub(crate) settings: LoopSettings,
+    /// One per contact, in the configuration's order.
+    pub(crate) contacts: Vec<ContactUpdate>,
+    /// Set by the loop: the stamp of the first step that used the change.
+    pub applied_stamp_ns: u64,
+}
+
+/// One contact's part of a [`ParameterUpdate`].
+pub(crate) struct ContactUpdate {
+    pub(crate) model: PreparedModel,
+    pub(crate) viscosity: crate::config::ViscosityLaw,
+    /// The new held load, when the contact's `contact.load_n` changed.
+    pub(crate) load: Option<f64>,
+}
+
+impl ParameterUpdate {
+    /// Prepare `new` (the result of [`apply_set`] on `old`) for the loop:
+    /// the model's tables are built here.
+    pub fn prepare(
+        old: &Config,
+        new: Config,
+        changed: Vec<(String, ParameterValue)>,
+    ) -> Result<Box<Self>, SetupError> {
+        let before = old.resolved_contacts();
+        let contacts = new
+            .resolved_contacts()
+            .iter()
+            .enumerate()
+            .map(|(i, c)| {
+                let n = &c.config;
+                let load_was = before.get(i).map(|b| b.config.contact.load_n);
+                Ok(ContactUpdate {
+                    model: Solver::prepare_model(&n.model(), &n.solver_settings())?,
+                    viscosity: crate::config::ViscosityLaw::of(n),
+                    load: (load_was != Some(n.contact.load_n)).then_some(n.contact.load_n),
+                })
+            })
+            .collect::<Result<Vec<_>, SetupError>>()?;
+        Ok(Box::new(Self {
+            settings: LoopSettings::from_config(&new),
+            contacts,
+            changed,
+            config: new,
+            applied_stamp_ns: 0,
+        }))
+    }
+}
+
+/// What a transport that serves parameters needs from the node.
+#[derive(Clone)]
+pub struct ParameterIo {
+    /// The configuration the node runs with.
+    pub config: Config,
+    pub channel: std::sync::Arc<ParameterChannel>,
+}
+
+/// Capacity of the channel: changes in flight (submitted, not yet taken
+/// back after the loop applied them).
+pub const IN_FLIGHT: usize = 8;
+
+/// Between the parameter service and the loop.
+pub struct ParameterChannel {
+    pub(crate) pending: ArrayQueue<Box<ParameterUpdate>>,
+    pub(crate) applied: ArrayQueue<Box<ParameterUpdate>>,
+    in_flight: AtomicUsize,
+}
+
+impl Default for ParameterChannel {
+    fn default() -> Self {
+        Self {
+            pending: ArrayQueue::new(IN_FLIGHT),
+            applied: ArrayQueue::new(IN_FLIGHT),
+            in_flight: AtomicUsize::new(0),
+        }
+    }
+}
+
+impl ParameterChannel {
+    /// Hand a prepared change to the loop; refused when [`IN_FLIGHT`]
+    /// changes wait (the loop is not stepping, or nobody takes them back).
+    pub fn submit(&self, u: Box<ParameterUpdate>) -> Result<(), SetRefusal> {
+        if self.in_flight.fetch_add(1, Ordering::AcqRel) >= IN_FLIGHT {
+            self.in_flight.fetch_sub(1, Ordering::AcqRel);
+            return Err(SetRefusal::Busy);
+        }
+        self.pending.push(u).map_err(|_| {
+            self.in_flight.fetch_sub(1, Ordering::AcqRel);
+            SetRefusal::Busy
+        })
+    }
+
+    /// A change the loop has applied (stamped), if any.
+    pub fn take_applied(&self) -> Option<Box<ParameterUpdate>> {
+        let u = self.applied.pop()?;
+        self.in_flight.fetch_sub(1, Ordering::AcqRel);
+        Some(u)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::parameters::SetRefusal;
+
+    #[test]
+    fn the_channel_bounds_changes_in_flight_and_hands_them_back() {
+        let c = Config::default();
+        let ch = ParameterChannel::default();
+        let mut small = c.clone();
+        small.solver.cells = 16;
+        for _ in 0..IN_FLIGHT {
+            let u = ParameterUpdate::prepare(&small, small.clone(), vec![]).unwrap();
+            ch.submit(u).unwrap();
+        }
+        let u = ParameterUpdate::prepare(&small, small.clone(), vec![]).unwrap();
+        assert_eq!(ch.submit(u).unwrap_err(), SetRefusal::Busy);
+        assert!(ch.take_applied().is_none(), "nothing applied yet");
+    }
+}
