@@ -1,6 +1,7 @@
 //! What the loop shares with the threads around it, below `node/`,
 //! `transport/` and `record/`: the settings the loop reads every step
-//! ([`LoopSettings`], a pure function of the configuration) and the
+//! ([`LoopSettings`], a pure function of the configuration), the latest
+//! film profile ([`ProfileSlot`], written by the loop without allocating) and the
 //! hand-over of live parameter changes ([`ParameterUpdate`] prepared off the
 //! loop, [`ParameterChannel`] to the loop and back, [`ParameterIo`] for a
 //! transport that serves parameters). The loop applies an update between two
@@ -13,7 +14,8 @@ use crate::config::{Config, StepMode, TimeoutBehaviour};
 use crate::msgs::ros_interfaces::ParameterValue;
 use crate::physics::{PreparedModel, SetupError, Solver};
 use crossbeam_queue::ArrayQueue;
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
 
 /// Settings the loop reads every step (from the configuration).
 #[derive(Debug, Clone, PartialEq)]
@@ -179,6 +181,61 @@ impl ParameterChannel {
         let u = self.applied.pop()?;
         self.in_flight.fetch_sub(1, Ordering::AcqRel);
         Some(u)
+    }
+}
+
+/// The latest film profile, shared between the loop (writer) and the I/O
+/// threads (readers) without allocation on the loop: the loop copies into a
+/// preallocated buffer under a `try_lock` and bumps the sequence number.
+#[derive(Debug)]
+pub struct ProfileSlot {
+    seq: AtomicU64,
+    data: Mutex<ProfileData>,
+}
+
+/// Contents of a [`ProfileSlot`].
+#[derive(Debug, Clone, Default)]
+pub struct ProfileData {
+    pub stamp_ns: u64,
+    pub dx_m: f64,
+    pub h_m: Vec<f64>,
+    pub p_pa: Vec<f64>,
+}
+
+impl ProfileSlot {
+    pub fn new(cells: usize) -> Arc<Self> {
+        Arc::new(Self {
+            seq: AtomicU64::new(0),
+            data: Mutex::new(ProfileData {
+                stamp_ns: 0,
+                dx_m: 0.0,
+                h_m: vec![0.0; cells],
+                p_pa: vec![0.0; cells],
+            }),
+        })
+    }
+
+    /// Fill the slot (non-blocking): false when a reader holds it.
+    pub fn try_write(&self, f: impl FnOnce(&mut ProfileData)) -> bool {
+        match self.data.try_lock() {
+            Ok(mut d) => {
+                f(&mut d);
+                self.seq.fetch_add(1, Ordering::Release);
+                true
+            }
+            Err(_) => false,
+        }
+    }
+
+    /// The profile, if newer than `seen` (updates `seen`).
+    pub fn read_if_newer(&self, seen: &mut u64) -> Option<ProfileData> {
+        let s = self.seq.load(Ordering::Acquire);
+        if s == *seen {
+            return None;
+        }
+        let d = self.data.lock().ok()?.clone();
+        *seen = s;
+        Some(d)
     }
 }
 

@@ -6,14 +6,15 @@
 
 use friction_node::bag::{rosbag2, Bag};
 use friction_node::clock::SimClock;
+use friction_node::config::topics::TopicNames;
 use friction_node::config::{Config, StepMode};
+use friction_node::link::ProfileSlot;
 use friction_node::msgs::{Command, CommandKind};
 use friction_node::node::{LiveStatus, Loop, RunSummary};
 use friction_node::record::{RecordPlan, Recorder, RecorderReport};
 use friction_node::replay::{self, ReplayOptions};
 use friction_node::transport::memory::MemoryLink;
-use friction_node::transport::names::TopicNames;
-use friction_node::transport::{PeerPort, ProfileSlot};
+use friction_node::transport::PeerPort;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -409,12 +410,12 @@ fn a_run_whose_parameters_changed_midway_replays_bit_identically() {
 /// events, never by fixed sleeps.
 mod node_runs {
     use super::*;
+    use friction_node::config::topics::TopicNames;
     use friction_node::config::CommandType;
+    use friction_node::link::ProfileSlot;
     use friction_node::msgs;
     use friction_node::msgs::EstimateRecord;
     use friction_node::record::{RecordPlan, Recorder};
-    use friction_node::transport::names::TopicNames;
-    use friction_node::transport::ProfileSlot;
 
     fn timer_config() -> Config {
         let mut c = Config::default();

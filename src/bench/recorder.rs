@@ -6,10 +6,10 @@
 //! memory is sampled every simulated hour.
 
 use crate::clock::SimClock;
+use crate::config::topics::TopicNames;
 use crate::config::Config;
 use crate::msgs::{Command, CommandKind, EstimateRecord, RecordItem, StatisticsRecord};
 use crate::record::{RecordPlan, Recorder, RecorderError, RecorderReport};
-use crate::transport::names::TopicNames;
 use std::path::PathBuf;
 use std::sync::Arc;
 

@@ -35,7 +35,7 @@ pub fn run(
 /// The configuration was already loaded and validated by the caller.
 pub fn check(config: &Config, transport: Option<TransportArg>) {
     use friction_node::config::parameters::flatten;
-    use friction_node::transport::names::TopicNames;
+    use friction_node::config::topics::TopicNames;
     let r = &config.ros;
     let fqn = if r.namespace.trim_end_matches('/').is_empty() {
         format!("/{}", r.node_name)

@@ -29,6 +29,7 @@
 //! | `error.rs` | [`ConfigError`] and the [`Origin`] of a configuration |
 //! | `envelope.rs` | the inputs every entry point accepts: velocity, load, temperature ([`Envelope`]) |
 //! | `parameters.rs` | the live-parameter catalogue (declared keys, types, ranges, writability) and [`parameters::apply_set`] |
+//! | `topics.rs` | the node's ROS 2 topic names resolved from the configuration (namespace, `~/`, remappings) |
 //! | `ros_args.rs` | `--ros-args` as rcl parses them (a `launch_ros` Node action) |
 //! | `tests.rs` | unit tests of loading, overrides and validation |
 
@@ -40,6 +41,7 @@ mod load;
 mod model;
 pub mod parameters;
 pub mod ros_args;
+pub mod topics;
 mod validate;
 
 pub use contacts::{

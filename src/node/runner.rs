@@ -4,7 +4,8 @@
 use super::driver::DemoReport;
 use super::{rt, LiveStatus, Loop, NodeError, RunSummary};
 use crate::config::{Config, TransportKind};
-use crate::transport::{self, BackendSpec, NodePort, ProfileSlot, TransportError};
+use crate::link::ProfileSlot;
+use crate::transport::{self, BackendSpec, NodePort, TransportError};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -224,7 +225,7 @@ pub fn run_node(
         let r = crate::record::Recorder::start(
             plan,
             config,
-            &transport::names::TopicNames::from_config(config),
+            &crate::config::topics::TopicNames::from_config(config),
             profile.clone(),
             Arc::new(crate::clock::SystemClock::new()),
         )?;

@@ -4,9 +4,9 @@
 
 use super::entry::{Encoder, Entry, TopicId};
 use super::RecorderError;
+use crate::config::topics::TopicNames;
 use crate::config::{CommandType, Compression, Config, QosConfig, Reliability};
 use crate::msgs::{self, MsgType, RecordItem};
-use crate::transport::names::TopicNames;
 use std::collections::BTreeMap;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};

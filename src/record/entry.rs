@@ -3,8 +3,8 @@
 //! a snapshot).
 
 use crate::config::CommandType;
+use crate::link::ProfileData;
 use crate::msgs::{self, Command, CommandKind, Float64, Header, RecordItem, Time, TwistStamped};
-use crate::transport::ProfileData;
 
 /// The node's recorded topics.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]

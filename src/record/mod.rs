@@ -42,11 +42,11 @@ pub use bag_writer::{offered_qos_yaml, BagWriter};
 pub use split::SplitDir;
 
 use crate::clock::Clock;
+use crate::config::topics::TopicNames;
 use crate::config::Config;
+use crate::link::ProfileSlot;
 use crate::msgs::{Note, RecordItem};
 use crate::stats::RecorderCounters;
-use crate::transport::names::TopicNames;
-use crate::transport::ProfileSlot;
 use crossbeam_queue::ArrayQueue;
 use entry::{Encoder, Entry};
 use std::collections::BTreeMap;

@@ -8,8 +8,8 @@
 
 use super::bag_writer::BagWriter;
 use super::entry::Entry;
+use crate::config::topics::TopicNames;
 use crate::config::Config;
-use crate::transport::names::TopicNames;
 use std::collections::{BTreeMap, VecDeque};
 use std::path::PathBuf;
 

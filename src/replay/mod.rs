@@ -356,7 +356,7 @@ pub fn prepare(bag: &Bag, opts: &ReplayOptions) -> Result<PreparedReplay, Replay
     let (config, config_source) = choose_config(&scan, opts)?;
     let several = config.contacts.0.len() > 1;
     let n_contacts = config.contacts.0.len();
-    let contact_topics = crate::transport::names::TopicNames::from_config(&config).contact_friction;
+    let contact_topics = crate::config::topics::TopicNames::from_config(&config).contact_friction;
     // Several contacts: a recording of them (every contact's topic, no
     // --topic) replays its estimates; otherwise a JointState topic drives
     // every configured joint.

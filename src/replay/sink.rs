@@ -244,7 +244,7 @@ impl OutputStream {
                         InputMode::JointStates { topic, .. } => format!("joint states {topic}"),
                     },
                 );
-                let names = crate::transport::names::TopicNames::from_config(&p.config);
+                let names = crate::config::topics::TopicNames::from_config(&p.config);
                 let w = crate::record::BagWriter::create(
                     &target,
                     &p.config,

@@ -15,13 +15,11 @@
 //! | `memory.rs` | in-memory: bounded lock-free queues between threads of one process |
 //! | `iceoryx/` | iceoryx2: zero-copy shared memory on one host |
 //! | `ros2/` | ROS 2 through ros2-client (pure-Rust DDS) |
-//! | `names.rs` | the node's ROS 2 topic names, resolved from the configuration |
 //! | `rosout.rs` | log lines for `/rosout` (a `tracing` layer) |
 //! | `diagnostics.rs` | `/diagnostics`: the loop's health as a DiagnosticArray |
 
 pub mod diagnostics;
 pub mod memory;
-pub mod names;
 pub mod rosout;
 
 #[cfg(feature = "iceoryx2")]
@@ -29,10 +27,11 @@ pub mod iceoryx;
 #[cfg(feature = "ros2")]
 pub mod ros2;
 
+use crate::link::ProfileSlot;
 use crate::msgs::{Command, EstimateRecord, RecordItem, StatisticsRecord};
 use crossbeam_queue::ArrayQueue;
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// Errors of the transport layer.
@@ -314,61 +313,6 @@ pub fn recv_timeout(
         } else {
             std::hint::spin_loop();
         }
-    }
-}
-
-/// The latest film profile, shared between the loop (writer) and the I/O
-/// threads (readers) without allocation on the loop: the loop copies into a
-/// preallocated buffer under a `try_lock` and bumps the sequence number.
-#[derive(Debug)]
-pub struct ProfileSlot {
-    seq: AtomicU64,
-    data: Mutex<ProfileData>,
-}
-
-/// Contents of a [`ProfileSlot`].
-#[derive(Debug, Clone, Default)]
-pub struct ProfileData {
-    pub stamp_ns: u64,
-    pub dx_m: f64,
-    pub h_m: Vec<f64>,
-    pub p_pa: Vec<f64>,
-}
-
-impl ProfileSlot {
-    pub fn new(cells: usize) -> Arc<Self> {
-        Arc::new(Self {
-            seq: AtomicU64::new(0),
-            data: Mutex::new(ProfileData {
-                stamp_ns: 0,
-                dx_m: 0.0,
-                h_m: vec![0.0; cells],
-                p_pa: vec![0.0; cells],
-            }),
-        })
-    }
-
-    /// Fill the slot (non-blocking): false when a reader holds it.
-    pub fn try_write(&self, f: impl FnOnce(&mut ProfileData)) -> bool {
-        match self.data.try_lock() {
-            Ok(mut d) => {
-                f(&mut d);
-                self.seq.fetch_add(1, Ordering::Release);
-                true
-            }
-            Err(_) => false,
-        }
-    }
-
-    /// The profile, if newer than `seen` (updates `seen`).
-    pub fn read_if_newer(&self, seen: &mut u64) -> Option<ProfileData> {
-        let s = self.seq.load(Ordering::Acquire);
-        if s == *seen {
-            return None;
-        }
-        let d = self.data.lock().ok()?.clone();
-        *seen = s;
-        Some(d)
     }
 }
 

@@ -5,12 +5,13 @@ use super::raw::{RawAdapter, RawCdr};
 use super::{advertise, context, err, qos, ros_node, topic, Out, Ros2Spec};
 use crate::clock::system_wall_ns;
 use crate::config::CommandType;
+use crate::link::ProfileSlot;
 use crate::msgs::{
     self, Command, CommandKind, FilmProfile, Float64, FrictionEstimate, Header, LoopStatistics,
     RawSample, RecordItem, Time, TwistStamped, FILM_PROFILE, FLOAT64, FRICTION_ESTIMATE,
     LOOP_STATISTICS, TWIST_STAMPED,
 };
-use crate::transport::{record_input, ProfileSlot, RecordQueue, SharedCounters, TransportError};
+use crate::transport::{record_input, RecordQueue, SharedCounters, TransportError};
 use crossbeam_queue::ArrayQueue;
 use ros2_client::dds::rustdds::mio1::{Events, Interest, Poll, Token, Waker};
 use ros2_client::dds::rustdds::no_key::SimpleDataReader;

@@ -136,7 +136,7 @@ impl Ros2Spec {
 
     pub fn from_config(cfg: &Config) -> Result<Self, TransportError> {
         let r = &cfg.ros;
-        let names = super::names::TopicNames::from_config(cfg);
+        let names = crate::config::topics::TopicNames::from_config(cfg);
         Ok(Self {
             domain_id: domain_id(cfg)?,
             localhost_only: localhost_only(cfg),

@@ -1,7 +1,7 @@
 //! ROS 2 topic names of the node, resolved from the configuration (used by
 //! the ROS 2 transport, the recorder and replay, whatever is built in).
 
-use crate::config::Config;
+use super::Config;
 
 /// Expand a topic name: `~/x` → `/<namespace>/<node>/x`, a relative `x` →
 /// `/<namespace>/x`, an absolute one as given.
