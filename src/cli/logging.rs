@@ -3,7 +3,7 @@
 //! node's own lines from info up, other crates' from warn; RustDDS's
 //! teardown chatter is silenced), in colour only on a terminal without
 //! `NO_COLOR`. The ROS 2 transport also sends
-//! them to `/rosout` (see `friction_node::transport::rosout`).
+//! them to `/rosout` (see `friction_node::transport::ros2::rosout`).
 
 use friction_node::config::RosArgs;
 use tracing_subscriber::layer::SubscriberExt;
@@ -42,9 +42,16 @@ pub fn init(ros: Option<&RosArgs>) {
             .with_ansi(colour)
     });
     let rosout_enabled = !ros.is_some_and(|r| r.rosout_disabled);
+    #[cfg(feature = "ros2")]
+    let rosout = friction_node::transport::ros2::rosout::layer(rosout_enabled);
+    #[cfg(not(feature = "ros2"))]
+    let rosout = {
+        let _ = rosout_enabled; // no ROS 2 transport: nothing publishes /rosout
+        tracing_subscriber::layer::Identity::new()
+    };
     tracing_subscriber::registry()
         .with(filter)
         .with(terminal)
-        .with(friction_node::transport::rosout::layer(rosout_enabled))
+        .with(rosout)
         .init();
 }

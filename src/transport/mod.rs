@@ -15,12 +15,8 @@
 //! | `memory.rs` | in-memory: bounded lock-free queues between threads of one process |
 //! | `iceoryx/` | iceoryx2: zero-copy shared memory on one host |
 //! | `ros2/` | ROS 2 through ros2-client (pure-Rust DDS) |
-//! | `rosout.rs` | log lines for `/rosout` (a `tracing` layer) |
-//! | `diagnostics.rs` | `/diagnostics`: the loop's health as a DiagnosticArray |
 
-pub mod diagnostics;
 pub mod memory;
-pub mod rosout;
 
 #[cfg(feature = "iceoryx2")]
 pub mod iceoryx;

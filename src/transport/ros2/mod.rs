@@ -25,15 +25,19 @@
 //! | `io.rs` | the I/O thread: commands in, estimates and statistics out |
 //! | `raw.rs` | command samples as raw CDR bytes, decoded off the loop |
 //! | `joints.rs` | several contacts: JointState in, per-contact estimates out |
+//! | `rosout.rs` | the node's log lines for `/rosout` (a `tracing` layer) |
+//! | `diagnostics.rs` | `/diagnostics`: the loop's health as a DiagnosticArray |
 //! | `params.rs` | the node's services: parameters, reset, on their own thread |
 //! | `service.rs` | one service served in both DDS layouts ROS 2 uses |
 //! | `peer.rs` | a peer's side (tests, demo driver): its own participant on loopback |
 
+pub mod diagnostics;
 mod io;
 mod joints;
 pub mod params;
 mod peer;
 pub mod raw;
+pub mod rosout;
 pub mod service;
 
 pub use peer::Ros2Peer;
