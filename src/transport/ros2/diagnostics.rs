@@ -25,9 +25,10 @@ pub const MISS_ERROR: f64 = 0.05;
 /// Non-converged steps at or above this fraction: ERROR.
 pub const SOLVER_ERROR: f64 = 0.01;
 
-/// Builds the diagnostics from consecutive statistics.
+/// Builds `/diagnostics` (the loop's health) from consecutive statistics;
+/// not the solver's per-step [`crate::physics::Diagnostics`].
 #[derive(Debug, Default)]
-pub struct Diagnostics {
+pub struct HealthReporter {
     previous: Option<StatisticsRecord>,
 }
 
@@ -38,7 +39,7 @@ fn kv(key: &str, value: impl std::fmt::Display) -> KeyValue {
     }
 }
 
-impl Diagnostics {
+impl HealthReporter {
     /// The array for `s` (compared with the previous statistics).
     pub fn update(&mut self, s: &StatisticsRecord, node: &str, frame_id: &str) -> DiagnosticArray {
         let p = self.previous.unwrap_or_default();
@@ -205,7 +206,7 @@ mod tests {
 
     #[test]
     fn levels_follow_the_documented_thresholds_per_period() {
-        let mut d = Diagnostics::default();
+        let mut d = HealthReporter::default();
         let mut s = StatisticsRecord {
             steps: 1000,
             ..Default::default()

@@ -287,7 +287,7 @@ pub(super) fn run(
     let fqn = sh.spec.fully_qualified_name();
     // rcl's logger name: the node's name with `.` between namespace tokens.
     let logger = fqn.trim_start_matches('/').replace('/', ".");
-    let mut diagnostics = super::diagnostics::Diagnostics::default();
+    let mut diagnostics = super::diagnostics::HealthReporter::default();
     let mut last_diagnostics: Option<std::time::Instant> = None;
     let counters = &sh.counters;
     let count = |ok: bool, which: &std::sync::atomic::AtomicU64| {
