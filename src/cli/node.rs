@@ -4,7 +4,7 @@
 use super::args::TransportArg;
 use anyhow::Result;
 use friction_node::config::Config;
-use friction_node::node::driver::Profile;
+use friction_node::node::driver::DemoMotion;
 use friction_node::node::runner::{self, RunOptions, RunReport};
 use std::path::{Path, PathBuf};
 
@@ -20,7 +20,7 @@ pub fn run(
         transport: transport.map(TransportArg::kind),
         record,
         demo_s: demo,
-        profile: Profile::Paper,
+        motion: DemoMotion::Paper,
         duration_s: duration,
         status_line: !quiet,
     };
@@ -109,7 +109,7 @@ pub fn soak(
         transport: transport.map(TransportArg::kind),
         record: None,
         demo_s: Some(seconds),
-        profile: Profile::Random { seed },
+        motion: DemoMotion::Random { seed },
         duration_s: None,
         status_line: false,
     };

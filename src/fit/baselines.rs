@@ -24,7 +24,7 @@
 //! at its end (ż = v − a z is linear in z), so it is stable for any σ₀;
 //! it starts in its steady state. On a steady curve LuGre is Stribeck.
 
-use super::params::{DataScale, Parameter};
+use super::params::{DataScale, FittedParameter};
 use super::problem::Model;
 use super::series::Series;
 use nalgebra::{DMatrix, DVector};
@@ -83,7 +83,7 @@ impl LoadForm {
 pub struct Baseline {
     pub kind: BaselineKind,
     pub load_form: LoadForm,
-    params: Vec<Parameter>,
+    params: Vec<FittedParameter>,
 }
 
 /// Levels of one evaluation.
@@ -196,7 +196,7 @@ impl Baseline {
         };
         // A start outside the default bounds widens them: a bound never
         // excludes the least-squares answer.
-        let push = |params: &mut Vec<Parameter>, name: &str, start: f64, lo: f64, hi: f64| {
+        let push = |params: &mut Vec<FittedParameter>, name: &str, start: f64, lo: f64, hi: f64| {
             let (lo, hi) = (
                 if start < lo {
                     start - (lo - start).abs().max(lo.abs())
@@ -205,30 +205,31 @@ impl Baseline {
                 },
                 if start > hi { 2.0 * start } else { hi },
             );
-            params.push(Parameter::new(name, start.clamp(lo, hi), lo, hi));
+            params.push(FittedParameter::new(name, start.clamp(lo, hi), lo, hi));
         };
         let top = 4.0 * f;
         let mu_hi = top / load_min;
-        let level = |params: &mut Vec<Parameter>, name: &str, take: &mut dyn FnMut(f64) -> f64| {
-            let start = generic(name);
-            let suffix = &name[1..];
-            match load_form {
-                LoadForm::Linear => {
-                    let a = take(0.0);
-                    push(params, &format!("{name}0_n"), a, -top, top);
-                    let m = take(0.5 * start / load_min);
-                    push(params, &format!("mu_{suffix}"), m.max(0.0), 0.0, mu_hi);
+        let level =
+            |params: &mut Vec<FittedParameter>, name: &str, take: &mut dyn FnMut(f64) -> f64| {
+                let start = generic(name);
+                let suffix = &name[1..];
+                match load_form {
+                    LoadForm::Linear => {
+                        let a = take(0.0);
+                        push(params, &format!("{name}0_n"), a, -top, top);
+                        let m = take(0.5 * start / load_min);
+                        push(params, &format!("mu_{suffix}"), m.max(0.0), 0.0, mu_hi);
+                    }
+                    LoadForm::Proportional => {
+                        let m = take(start / load_min);
+                        push(params, &format!("mu_{suffix}"), m.max(0.0), 0.0, mu_hi);
+                    }
+                    LoadForm::Constant => {
+                        let c = take(start);
+                        push(params, &format!("{name}_n"), c.max(0.0), 0.0, top);
+                    }
                 }
-                LoadForm::Proportional => {
-                    let m = take(start / load_min);
-                    push(params, &format!("mu_{suffix}"), m.max(0.0), 0.0, mu_hi);
-                }
-                LoadForm::Constant => {
-                    let c = take(start);
-                    push(params, &format!("{name}_n"), c.max(0.0), 0.0, top);
-                }
-            }
-        };
+            };
         level(&mut params, "fc", &mut take);
         if kind != BaselineKind::CoulombViscous {
             level(&mut params, "fs", &mut take);
@@ -437,7 +438,7 @@ impl Model for Baseline {
         }
     }
 
-    fn parameters(&self) -> &[Parameter] {
+    fn parameters(&self) -> &[FittedParameter] {
         &self.params
     }
 

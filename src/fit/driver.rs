@@ -5,7 +5,7 @@
 
 use super::local_run::LocalRun;
 use super::options::Options;
-use super::params::Parameter;
+use super::params::FittedParameter;
 use super::problem::{Data, Model, Problem, SeriesFit};
 use std::sync::atomic::Ordering;
 use std::time::Instant;
@@ -14,7 +14,7 @@ use std::time::Instant;
 #[derive(Debug, Clone)]
 pub struct FitOutcome {
     pub label: String,
-    pub params: Vec<Parameter>,
+    pub params: Vec<FittedParameter>,
     pub best: Vec<f64>,
     /// Distinct optima, best first.
     pub optima: Vec<LocalRun>,
@@ -62,7 +62,7 @@ fn pooled(fits: &[SeriesFit], select: impl Fn(&SeriesFit, usize) -> bool) -> Opt
 pub fn fit(
     model: &dyn Model,
     data: &Data,
-    map_fit: Vec<(usize, Parameter)>,
+    map_fit: Vec<(usize, FittedParameter)>,
     options: &Options,
 ) -> Result<FitOutcome, super::FitError> {
     let wall = Instant::now();

@@ -59,7 +59,7 @@ pub use crate::table::{Delimiter, Table, TableError};
 pub use baselines::{Baseline, BaselineKind, LoadForm};
 pub use driver::FitOutcome;
 pub use options::Options;
-pub use params::{ParamSpec, Parameter};
+pub use params::{FittedParameter, ParamSpec};
 pub use physics_model::PhysicsModel;
 pub use problem::{Data, Model};
 pub use series::{Mapping, Series, Source};

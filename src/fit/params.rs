@@ -25,7 +25,7 @@ pub struct ParamSpec {
 
 /// One fitted parameter.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Parameter {
+pub struct FittedParameter {
     pub name: String,
     pub start: f64,
     pub lo: f64,
@@ -38,7 +38,7 @@ pub struct Parameter {
 /// moved inside: the sine transform is stationary at its bounds.
 const START_MARGIN: f64 = 0.02;
 
-impl Parameter {
+impl FittedParameter {
     /// A parameter on `[lo, hi]`, on the log scale when `lo > 0`.
     pub fn new(name: &str, start: f64, lo: f64, hi: f64) -> Self {
         Self {
@@ -190,7 +190,11 @@ impl ConfigKeys {
     /// Resolve a `--fit` key: its start, its bounds (given, checked against
     /// the key's valid range, or a decade either side of the start, shrunk
     /// into the valid range), its scale.
-    pub fn parameter(&self, spec: &ParamSpec, scale: &DataScale) -> Result<Parameter, FitError> {
+    pub fn parameter(
+        &self,
+        spec: &ParamSpec,
+        scale: &DataScale,
+    ) -> Result<FittedParameter, FitError> {
         let key = spec.name.as_str();
         let current = self.value(key)?;
         // A pre-sliding stiffness that is off (0) starts at the data's
@@ -226,7 +230,7 @@ impl ConfigKeys {
                 message: format!("the start {start} lies outside [{lo}, {hi}]"),
             });
         }
-        Ok(Parameter::new(key, start, lo, hi))
+        Ok(FittedParameter::new(key, start, lo, hi))
     }
 
     fn default_bounds(
@@ -297,7 +301,7 @@ pub fn check_bounds(key: &str, lo: f64, hi: f64) -> Result<(), FitError> {
 
 /// A map coefficient as a fitted parameter: `--bounds` or, for a positive
 /// start, a decade either side.
-pub fn map_parameter(spec: &ParamSpec, map_start: f64) -> Result<Parameter, FitError> {
+pub fn map_parameter(spec: &ParamSpec, map_start: f64) -> Result<FittedParameter, FitError> {
     let key = spec.name.as_str();
     let start = spec.start.unwrap_or(map_start);
     let (lo, hi) = match spec.bounds {
@@ -321,7 +325,7 @@ pub fn map_parameter(spec: &ParamSpec, map_start: f64) -> Result<Parameter, FitE
             message: format!("the start {start} lies outside [{lo}, {hi}]"),
         });
     }
-    Ok(Parameter::new(key, start, lo, hi))
+    Ok(FittedParameter::new(key, start, lo, hi))
 }
 
 #[cfg(test)]
@@ -345,7 +349,7 @@ mod tests {
 
     #[test]
     fn the_sine_transform_round_trips_inside_the_bounds_on_the_log_scale() {
-        let p = Parameter::new("roughness.sigma_m", 5e-6, 5e-7, 5e-5);
+        let p = FittedParameter::new("roughness.sigma_m", 5e-6, 5e-7, 5e-5);
         assert!(p.log);
         for v in [6e-7, 5e-6, 4e-5] {
             assert_relative_eq!(p.from_internal(p.to_internal(v)), v, max_relative = 1e-12);

@@ -10,7 +10,7 @@
 //! - A steady curve is solved point by point with the steady solver, each
 //!   point warm-started from the previous one.
 
-use super::params::{ConfigKeys, DataScale, ParamSpec, Parameter};
+use super::params::{ConfigKeys, DataScale, FittedParameter, ParamSpec};
 use super::problem::Model;
 use super::series::Series;
 use super::FitError;
@@ -21,7 +21,7 @@ use crate::physics::{Solver, Status, ViscosityModel};
 pub struct PhysicsModel {
     keys: ConfigKeys,
     names: Vec<String>,
-    params: Vec<Parameter>,
+    params: Vec<FittedParameter>,
 }
 
 impl PhysicsModel {
@@ -55,7 +55,7 @@ impl Model for PhysicsModel {
         "friction-node".into()
     }
 
-    fn parameters(&self) -> &[Parameter] {
+    fn parameters(&self) -> &[FittedParameter] {
         &self.params
     }
 

@@ -2,7 +2,7 @@
 //! coefficients), the residuals on the samples used for the fit and the
 //! predictions per source. How it is solved is `driver.rs`.
 
-use super::params::Parameter;
+use super::params::FittedParameter;
 use super::series::{Series, Source};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
@@ -14,7 +14,7 @@ pub trait Model: Sync {
     /// Its name in tables.
     fn label(&self) -> String;
     /// Its fitted parameters (values are passed in this order).
-    fn parameters(&self) -> &[Parameter];
+    fn parameters(&self) -> &[FittedParameter];
     /// Friction, N, at every sample of `series` for parameter values `x`;
     /// `Err` says why these values give no prediction.
     fn predict(&self, x: &[f64], series: &Series) -> Result<Vec<f64>, String>;
@@ -71,9 +71,9 @@ pub struct Problem<'a> {
     pub model: &'a dyn Model,
     pub data: &'a Data,
     /// Fitted map coefficients: index into `data.map_names` and bounds.
-    pub map_fit: Vec<(usize, Parameter)>,
+    pub map_fit: Vec<(usize, FittedParameter)>,
     /// The model's parameters, then the fitted map coefficients.
-    pub params: Vec<Parameter>,
+    pub params: Vec<FittedParameter>,
     fitted_samples: usize,
     friction_scale: f64,
     /// The series of every training and validation source when no map
@@ -94,7 +94,7 @@ impl<'a> Problem<'a> {
     pub fn new(
         model: &'a dyn Model,
         data: &'a Data,
-        map_fit: Vec<(usize, Parameter)>,
+        map_fit: Vec<(usize, FittedParameter)>,
     ) -> Result<Self, super::FitError> {
         let mut params = model.parameters().to_vec();
         params.extend(map_fit.iter().map(|(_, p)| p.clone()));

@@ -9,8 +9,8 @@ use super::options::{Options, Progress};
 use super::params::{map_parameter, DataScale};
 use super::problem::Model;
 use super::{
-    Baseline, BaselineKind, Data, Delimiter, FitError, LoadForm, Mapping, ParamSpec, Parameter,
-    PhysicsModel, Source, Table,
+    Baseline, BaselineKind, Data, Delimiter, FitError, FittedParameter, LoadForm, Mapping,
+    ParamSpec, PhysicsModel, Source, Table,
 };
 use crate::config::Config;
 use std::path::{Path, PathBuf};
@@ -317,7 +317,7 @@ pub fn data_scale(
 pub struct Prepared {
     pub data: Data,
     pub model: PhysicsModel,
-    pub map_fit: Vec<(usize, Parameter)>,
+    pub map_fit: Vec<(usize, FittedParameter)>,
     pub scale: DataScale,
     pub mean_abs_n: f64,
     pub loads_vary: bool,
@@ -490,7 +490,7 @@ pub fn fit_baselines(
         .iter()
         .flat_map(|s| s.load_only_coefficients())
         .collect();
-    let map_fit: Vec<(usize, Parameter)> = p
+    let map_fit: Vec<(usize, FittedParameter)> = p
         .map_fit
         .iter()
         .filter(|(i, _)| !load_only.contains(&p.data.map_names[*i]))

@@ -19,7 +19,7 @@ pub struct DemoReport {
 
 /// What the driver commands.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub enum Profile {
+pub enum DemoMotion {
     /// The paper's reciprocating case: v = V1 sin(2π f t), V1 = 1 m/s, f = 1 Hz.
     #[default]
     Paper,
@@ -29,13 +29,13 @@ pub enum Profile {
     Random { seed: u64 },
 }
 
-impl Profile {
+impl DemoMotion {
     fn start(self) -> ProfileState {
         ProfileState {
-            profile: self,
+            motion: self,
             rng: match self {
-                Profile::Random { seed } => seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1,
-                Profile::Paper => 1,
+                DemoMotion::Random { seed } => seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1,
+                DemoMotion::Paper => 1,
             },
             v: 0.0,
             target: 0.0,
@@ -44,9 +44,9 @@ impl Profile {
     }
 }
 
-/// A profile being played.
+/// A motion being played.
 struct ProfileState {
-    profile: Profile,
+    motion: DemoMotion,
     rng: u64,
     v: f64,
     target: f64,
@@ -64,9 +64,9 @@ impl ProfileState {
 
     /// The velocity at time `t` (called once per step of `dt`).
     fn at(&mut self, t: f64, dt: f64) -> f64 {
-        match self.profile {
-            Profile::Paper => (2.0 * std::f64::consts::PI * t).sin(),
-            Profile::Random { .. } => {
+        match self.motion {
+            DemoMotion::Paper => (2.0 * std::f64::consts::PI * t).sin(),
+            DemoMotion::Random { .. } => {
                 if t >= self.next_change {
                     self.target = 3.0 * self.uniform() - 1.5;
                     self.next_change = t + 0.2 + 2.8 * self.uniform();
@@ -86,7 +86,7 @@ pub struct DemoPlan {
     pub mode: StepMode,
     pub dt: f64,
     pub seconds: f64,
-    pub profile: Profile,
+    pub motion: DemoMotion,
     pub joints: Vec<String>,
 }
 
@@ -113,7 +113,7 @@ pub fn drive(
         mode,
         dt,
         seconds,
-        profile,
+        motion,
         joints,
     } = plan;
     let mut report = DemoReport::default();
@@ -131,7 +131,7 @@ pub fn drive(
         return report;
     }
     let _ = ready.send(Ok(()));
-    let mut velocity = profile.start();
+    let mut velocity = motion.start();
     let steps = (seconds / dt).round() as u64;
     let start = Instant::now();
     let t0 = crate::clock::system_wall_ns();

@@ -21,7 +21,7 @@ pub struct RunOptions {
     /// Drive the node with a velocity profile on its own topics for this long, s.
     pub demo_s: Option<f64>,
     /// The profile the demo driver commands.
-    pub profile: super::driver::Profile,
+    pub motion: super::driver::DemoMotion,
     /// Stop after this long, s (None: until SIGINT/SIGTERM).
     pub duration_s: Option<f64>,
     /// Print a live status line on stderr.
@@ -320,7 +320,7 @@ pub fn run_node(
             mode: config.node.step_mode,
             dt: config.solver.dt_s,
             seconds,
-            profile: opts.profile,
+            motion: opts.motion,
             joints: if config.contacts.0.len() > 1 {
                 config.contacts.0.iter().map(|c| c.joint.clone()).collect()
             } else {

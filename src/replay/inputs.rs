@@ -42,7 +42,7 @@ fn map_samples(
 }
 
 /// What [`decode_inputs`] read.
-pub(super) struct Inputs {
+pub(super) struct DecodedBag {
     pub(super) commands: Vec<Command>,
     pub(super) recorded: Vec<EstimateRecord>,
     pub(super) recorded_contacts: Vec<(String, Vec<EstimateRecord>)>,
@@ -109,7 +109,7 @@ pub(super) fn decode_inputs(
     config: &Config,
     mode: InputMode,
     opts: &ReplayOptions,
-) -> Result<Inputs, ReplayError> {
+) -> Result<DecodedBag, ReplayError> {
     let mut recorded = Vec::new();
     let mut velocity: Vec<(u64, f64)> = Vec::new();
     let mut load: Vec<(u64, f64)> = Vec::new();
@@ -390,7 +390,7 @@ pub(super) fn decode_inputs(
         .zip(per_contact)
         .collect();
     parameter_changes.sort_by_key(|c| c.stamp_ns);
-    Ok(Inputs {
+    Ok(DecodedBag {
         commands,
         recorded,
         recorded_contacts,
