@@ -3,6 +3,9 @@
 //! command validation and accounting, timeouts, statistics. Recording is
 //! tested in `tests/recording.rs`.
 
+mod common;
+use common::{drain, timer_config};
+
 use friction_node::clock::{Clock, SimClock};
 use friction_node::config::{Config, StepMode, TimeoutBehaviour};
 use friction_node::msgs::{
@@ -17,19 +20,6 @@ use std::time::Duration;
 
 const WALL0: u64 = 1_763_900_000_000_000_000;
 const MS: u64 = 1_000_000;
-
-fn timer_config() -> Config {
-    let mut c = Config::default();
-    c.solver.cells = 32;
-    c.node.step_mode = StepMode::Timer;
-    c.node.statistics_rate_hz = 10.0;
-    c.node.command_timeout_s = 0.05;
-    c
-}
-
-fn drain(peer: &mut dyn PeerPort) -> Vec<EstimateRecord> {
-    std::iter::from_fn(|| peer.try_recv().unwrap()).collect()
-}
 
 fn velocity(value: f64, stamp_ns: u64) -> Command {
     Command {

@@ -4,6 +4,8 @@
 //! end, in real processes ([`node_runs`]).
 #![cfg(feature = "mcap")]
 
+mod common;
+
 use friction_node::bag::{rosbag2, Bag};
 use friction_node::clock::SimClock;
 use friction_node::config::topics::TopicNames;
@@ -417,18 +419,7 @@ mod node_runs {
     use friction_node::msgs::EstimateRecord;
     use friction_node::record::{RecordPlan, Recorder};
 
-    fn timer_config() -> Config {
-        let mut c = Config::default();
-        c.solver.cells = 32;
-        c.node.step_mode = StepMode::Timer;
-        c.node.statistics_rate_hz = 10.0;
-        c.node.command_timeout_s = 0.05;
-        c
-    }
-
-    fn drain(peer: &mut dyn PeerPort) -> Vec<EstimateRecord> {
-        std::iter::from_fn(|| peer.try_recv().unwrap()).collect()
-    }
+    use crate::common::{drain, timer_config};
 
     fn tmp(name: &str) -> std::path::PathBuf {
         let d = std::env::temp_dir().join(format!("fn-node-{}", std::process::id()));

@@ -27,6 +27,7 @@
 use super::params::{DataScale, FittedParameter};
 use super::problem::Model;
 use super::series::Series;
+use crate::physics::presliding::sgn;
 use nalgebra::{DMatrix, DVector};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -417,16 +418,6 @@ fn starts(kind: BaselineKind, form: LoadForm, s: &Samples, v_scale: f64) -> Opti
 
 fn g(l: &Levels, v: f64) -> f64 {
     l.fc + (l.fs - l.fc) * (-(v / l.vs).powi(2)).exp()
-}
-
-fn sgn(v: f64) -> f64 {
-    if v > 0.0 {
-        1.0
-    } else if v < 0.0 {
-        -1.0
-    } else {
-        0.0
-    }
 }
 
 impl Model for Baseline {

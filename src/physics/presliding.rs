@@ -33,6 +33,18 @@
 //! resolve (a Δt ≫ 1) relaxes within the step, and the rigid model
 //! results. At rest (v = 0) z is held.
 
+/// sgn(v): ±1, and 0 at rest (`f64::signum` gives ±1 at ±0). The sign
+/// of gross sliding in L, and of the classic models' Coulomb terms.
+pub fn sgn(v: f64) -> f64 {
+    if v > 0.0 {
+        1.0
+    } else if v < 0.0 {
+        -1.0
+    } else {
+        0.0
+    }
+}
+
 /// The pre-sliding parameters (both zero by default: the contact is rigid
 /// and its estimate bit-identical to a model without this module).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]

@@ -105,7 +105,7 @@ impl Solver {
         let (f_hyd, f_asp, f_visc, inertia) = (w * f_hyd, w * f_asp, w * f_visc, w * inertia);
         let contact_friction = if d.presliding.is_on() {
             // Gross sliding's level, through the contact's compliance.
-            let level = f_visc + d.mu_bl * f_asp * sgn(v);
+            let level = f_visc + d.mu_bl * f_asp * crate::physics::presliding::sgn(v);
             let p = d.presliding;
             match (advance, ctx.time) {
                 (true, Some((_, dt))) => {
@@ -202,16 +202,5 @@ impl Solver {
                 substeps: 0,
             },
         }
-    }
-}
-
-/// sgn(v): ±1, and 0 at rest.
-fn sgn(v: f64) -> f64 {
-    if v > 0.0 {
-        1.0
-    } else if v < 0.0 {
-        -1.0
-    } else {
-        0.0
     }
 }
