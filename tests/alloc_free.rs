@@ -74,6 +74,30 @@ fn newton_steps_allocate_nothing_through_reversals_and_vapour_collapse() {
 }
 
 #[test]
+fn muscl_flux_steps_allocate_nothing_through_reversals() {
+    // The paper's case with the second-order flux (pentadiagonal solve).
+    let st = SolverSettings {
+        cells: 64,
+        flux: CouetteFlux::Muscl(Limiter::VanLeer),
+        ..Default::default()
+    };
+    let mut s = Solver::new(&ModelParams::default(), &st).unwrap();
+    s.initialize_steady(0.0, 20_762.0);
+    let mut worst = 0;
+    let mut iterations = 0;
+    for k in 1..=2000 {
+        let v = (2.0 * std::f64::consts::PI * k as f64 * 1e-3).sin();
+        worst = worst.max(allocations(|| {
+            let e = s.step(v, 20_762.0);
+            assert_eq!(e.status, Status::Converged, "step {k}");
+            iterations += e.diagnostics.iterations;
+        }));
+    }
+    assert_eq!(worst, 0, "a step allocated");
+    assert!(iterations > 2000, "every step iterated: {iterations}");
+}
+
+#[test]
 fn theta_scheme_steady_solves_and_reference_steps_allocate_nothing() {
     let st = SolverSettings {
         cells: 64,

@@ -198,6 +198,7 @@ impl Config {
             },
             tolerance: s.tolerance,
             max_iterations: s.max_iterations,
+            flux: s.flux.couette_flux(),
             reference: ReferenceSettings {
                 fluid_relaxation: r.fluid_relaxation,
                 fluid_relaxation_min: r.fluid_relaxation_min,

@@ -196,6 +196,44 @@ pub enum SchemeKind {
     Theta,
 }
 
+/// `solver.flux`: the Couette flux's face density (`upwind`, first order;
+/// `muscl_minmod`, `muscl_van_leer`, `muscl_van_albada`: second order where
+/// the density is smooth, see `physics/solver/flux.rs`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FluxKind {
+    Upwind,
+    MusclMinmod,
+    MusclVanLeer,
+    MusclVanAlbada,
+}
+
+impl FluxKind {
+    /// Every value, as written in a configuration.
+    pub const NAMES: &'static str = "upwind, muscl_minmod, muscl_van_leer, muscl_van_albada";
+
+    /// The value as written in a configuration.
+    pub fn name(self) -> &'static str {
+        match self {
+            FluxKind::Upwind => "upwind",
+            FluxKind::MusclMinmod => "muscl_minmod",
+            FluxKind::MusclVanLeer => "muscl_van_leer",
+            FluxKind::MusclVanAlbada => "muscl_van_albada",
+        }
+    }
+
+    /// The solver's flux.
+    pub fn couette_flux(self) -> crate::physics::CouetteFlux {
+        use crate::physics::{CouetteFlux, Limiter};
+        match self {
+            FluxKind::Upwind => CouetteFlux::Upwind,
+            FluxKind::MusclMinmod => CouetteFlux::Muscl(Limiter::Minmod),
+            FluxKind::MusclVanLeer => CouetteFlux::Muscl(Limiter::VanLeer),
+            FluxKind::MusclVanAlbada => CouetteFlux::Muscl(Limiter::VanAlbada),
+        }
+    }
+}
+
 /// `solver.*`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -208,6 +246,8 @@ pub struct SolverConfig {
     pub theta2: f64,
     pub tolerance: f64,
     pub max_iterations: u32,
+    /// Default `upwind`.
+    pub flux: FluxKind,
     pub reference: ReferenceConfig,
 }
 
@@ -226,6 +266,7 @@ impl Default for SolverConfig {
             theta2,
             tolerance: s.tolerance,
             max_iterations: s.max_iterations,
+            flux: FluxKind::Upwind,
             reference: ReferenceConfig::default(),
         }
     }

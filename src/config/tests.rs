@@ -210,3 +210,50 @@ fn a_step_that_is_not_a_whole_number_of_nanoseconds_is_refused() {
     assert!(e.to_string().contains("whole number of nanoseconds"), "{e}");
     assert!(load(DEFAULT_YAML, &["solver.dt_s=2.5e-4"]).is_ok());
 }
+
+/// A file with no keys: every default.
+const EMPTY: &str = "friction_node:\n  ros__parameters: {}\n";
+
+#[test]
+fn an_unknown_flux_names_the_key_and_the_allowed_values() {
+    let e = load(EMPTY, &["solver.flux=muscl"]).unwrap_err();
+    let msg = e.to_string();
+    assert!(msg.contains("solver.flux"), "{msg}");
+    for allowed in FluxKind::NAMES.split(", ") {
+        assert!(msg.contains(allowed), "{allowed} missing from: {msg}");
+    }
+    let e = load(
+        "friction_node:\n  ros__parameters:\n    solver:\n      flux: vanleer\n",
+        &[],
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("solver.flux"), "{e}");
+}
+
+#[test]
+fn a_muscl_flux_with_the_reference_solver_is_refused_naming_both_keys() {
+    let e = load(
+        EMPTY,
+        &["solver.flux=muscl_van_leer", "solver.method=reference"],
+    )
+    .unwrap_err();
+    assert!(
+        matches!(e, ConfigError::InvalidValue { ref key, .. } if key == "solver.flux"),
+        "{e}"
+    );
+    assert!(e.to_string().contains("solver.method: reference"), "{e}");
+    // The same refusal from the solver's own settings check.
+    let st = SolverSettings {
+        method: crate::physics::Method::Reference,
+        flux: crate::physics::CouetteFlux::Muscl(crate::physics::Limiter::VanLeer),
+        ..Default::default()
+    };
+    let err = st.check().unwrap_err().to_string();
+    assert!(err.contains("solver.flux"), "{err}");
+    // Each flux value reaches the solver.
+    let c = load(EMPTY, &["solver.flux=muscl_van_albada"]).unwrap();
+    assert_eq!(
+        c.solver_settings().flux,
+        crate::physics::CouetteFlux::Muscl(crate::physics::Limiter::VanAlbada)
+    );
+}

@@ -2,7 +2,7 @@
 //! one small function per section. Errors name the key, the value and the
 //! allowed range (or the rule broken).
 
-use super::{Config, ConfigError};
+use super::{Config, ConfigError, FluxKind, MethodKind};
 use crate::text::Num;
 
 /// One end of an allowed interval.
@@ -337,6 +337,16 @@ impl Config {
         cc("solver.max_iterations", s.max_iterations as f64, 1.0, 1e4)?;
         cc("solver.theta1", s.theta1, 0.5, 10.0)?;
         oc("solver.theta2", s.theta2, 0.0, 10.0)?;
+        if s.method == MethodKind::Reference && s.flux != FluxKind::Upwind {
+            return Err(ConfigError::InvalidValue {
+                key: "solver.flux".into(),
+                message: format!(
+                    "{} is not supported by solver.method: reference (the paper's Picard solver has the upwind flux only); allowed with it: upwind (with solver.method: newton: {})",
+                    s.flux.name(),
+                    FluxKind::NAMES
+                ),
+            });
+        }
         let r = &s.reference;
         let k = |name: &str| format!("solver.reference.{name}");
         oc(&k("fluid_relaxation"), r.fluid_relaxation, 0.0, 1.0)?;

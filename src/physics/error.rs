@@ -12,6 +12,11 @@ pub enum SetupError {
         value: f64,
         reason: &'static str,
     },
+    /// `field`'s choice is not supported with the rest of the settings.
+    Unsupported {
+        field: &'static str,
+        reason: &'static str,
+    },
 }
 
 impl SetupError {
@@ -32,6 +37,9 @@ impl fmt::Display for SetupError {
                 value,
                 reason,
             } => write!(f, "invalid solver parameter `{field}` = {value}: {reason}"),
+            SetupError::Unsupported { field, reason } => {
+                write!(f, "unsupported solver setting `{field}`: {reason}")
+            }
         }
     }
 }

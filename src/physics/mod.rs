@@ -46,8 +46,8 @@ pub use drivetrain::Drivetrain;
 pub use error::SetupError;
 pub use estimate::{Diagnostics, Estimate, Regime, Status};
 pub use params::{
-    Contact, Geometry, Lubricant, Method, ModelParams, Pocket, Profile, ReferenceSettings,
-    Roughness, SolverSettings, TimeScheme, WidthLaw,
+    Contact, CouetteFlux, Geometry, Limiter, Lubricant, Method, ModelParams, Pocket, Profile,
+    ReferenceSettings, Roughness, SolverSettings, TimeScheme, WidthLaw,
 };
 pub use presliding::Presliding;
 pub use solver::{FieldPoint, Isa, ModelMismatch, PreparedModel, Solver, StepBreakdown};

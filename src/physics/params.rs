@@ -272,6 +272,32 @@ impl Default for ReferenceSettings {
     }
 }
 
+/// The density at a face in the Couette (sliding) part of the mass flux
+/// (`solver.flux`, see `solver/flux.rs`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum CouetteFlux {
+    /// The upwind cell's density: first order, monotone.
+    #[default]
+    Upwind,
+    /// The upwind cell's density plus half a limited slope (MUSCL): second
+    /// order where the density is smooth, the limiter's monotone first
+    /// order at extrema and at the cavitation boundary.
+    Muscl(Limiter),
+}
+
+/// Slope limiter of [`CouetteFlux::Muscl`]: the slope s(Δ−, Δ+) of the upwind
+/// cell from its backward and forward differences, 0 when they differ in
+/// sign (every one is TVD).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Limiter {
+    /// The smaller difference: the most diffusive.
+    Minmod,
+    /// Their harmonic mean, 2Δ−Δ+/(Δ− + Δ+).
+    VanLeer,
+    /// Δ−Δ+(Δ− + Δ+)/(Δ−² + Δ+²).
+    VanAlbada,
+}
+
 /// Numerical settings.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SolverSettings {
@@ -285,6 +311,8 @@ pub struct SolverSettings {
     pub tolerance: f64,
     /// Newton: bound on iterations per step.
     pub max_iterations: u32,
+    /// The Couette flux's face density.
+    pub flux: CouetteFlux,
     pub reference: ReferenceSettings,
 }
 
@@ -297,6 +325,7 @@ impl Default for SolverSettings {
             scheme: TimeScheme::Bdf2,
             tolerance: 1e-6,
             max_iterations: 20,
+            flux: CouetteFlux::Upwind,
             reference: ReferenceSettings::default(),
         }
     }
@@ -439,6 +468,12 @@ impl SolverSettings {
             if !(theta2.is_finite() && theta2 > 0.0) {
                 return Err(SetupError::invalid("solver.theta2", theta2, "must be > 0"));
             }
+        }
+        if self.method == Method::Reference && self.flux != CouetteFlux::Upwind {
+            return Err(SetupError::Unsupported {
+                field: "solver.flux",
+                reason: "the reference (Picard) solver has the upwind flux only; use solver.flux: upwind with solver.method: reference",
+            });
         }
         let r = &self.reference;
         if !(r.fluid_relaxation > 0.0 && r.fluid_relaxation <= 1.0) {

@@ -7,9 +7,11 @@
 //! discrete equations.
 
 use super::cell_pass::cell_pass;
+use super::flux::muscl_pass;
 use super::lanes::{all_finite, lane_sum};
-use super::work::{CellColumns, CellProps, FaceColumns, FaceFlux, Work};
+use super::work::{CellColumns, CellProps, FaceColumns, FaceFlux, RowColumns, Work};
 use super::{Ctx, Disc, H0Mode, Level};
+use crate::physics::params::CouetteFlux;
 use crate::physics::scheme::StepCoefficients;
 
 /// What a face flux needs besides the two neighbouring states.
@@ -179,6 +181,13 @@ pub(super) fn face_pass(d: &Disc, p: &[f64], h0: f64, ctx: &Ctx, w: &mut Work) {
             }
         }
     }
+    w.banded = match d.flux {
+        CouetteFlux::Upwind => false,
+        CouetteFlux::Muscl(limiter) => {
+            muscl_pass(d, h0, ctx, limiter, w);
+            true
+        }
+    };
 }
 
 /// Interior faces without flow factors (φx = 1, φs = 0): [`FluxCtx::flux`]
@@ -290,10 +299,39 @@ pub(super) fn row_pass(d: &Disc, hist: &[Level; 2], h0: f64, ctx: &Ctx, w: &mut 
             *r -= s;
         }
     }
+    if w.banded {
+        band_rows(n, w0, ctx.v >= 0.0, &f.dqx[..=n], rows);
+    }
+    let (rr, rcol, ra, rc) = (
+        &rows.r[..n],
+        &rows.col[..n],
+        &mut rows.a[..n],
+        &mut rows.c[..n],
+    );
     let finite = all_finite(rr, rcol);
     ra[0] = 0.0;
     rc[n - 1] = 0.0;
     finite
+}
+
+/// The far-upwind derivatives of a MUSCL flux (`flux.rs`) in the rows:
+/// v ≥ 0, face i's far cell is i − 2 and face (i+1)'s is i − 1; v < 0, face
+/// (i+1)'s is i + 2 and face i's is i + 1.
+#[inline(always)]
+fn band_rows(n: usize, w0: f64, forward: bool, dqx: &[f64], rows: &mut RowColumns) {
+    if forward {
+        rows.c2[..n].fill(0.0);
+        for i in 0..n {
+            rows.a2[i] = -w0 * dqx[i];
+            rows.a[i] += w0 * dqx[i + 1];
+        }
+    } else {
+        rows.a2[..n].fill(0.0);
+        for i in 0..n {
+            rows.c2[i] = w0 * dqx[i + 1];
+            rows.c[i] -= w0 * dqx[i];
+        }
+    }
 }
 
 #[cfg(test)]
@@ -302,7 +340,9 @@ mod jacobian_tests {
     //! residual, for random states (property test).
     use super::super::Solver;
     use super::*;
-    use crate::physics::params::{ModelParams, Pocket, Profile, SolverSettings, TimeScheme};
+    use crate::physics::params::{
+        Limiter, ModelParams, Pocket, Profile, SolverSettings, TimeScheme,
+    };
     use proptest::prelude::*;
 
     fn residual(s: &mut Solver, p: &[f64], h0: f64, ctx: &Ctx) -> (Vec<f64>, f64) {
@@ -320,6 +360,7 @@ mod jacobian_tests {
         h0: f64,
         v: f64,
         theta: bool,
+        flux: CouetteFlux,
     ) {
         let mut m = ModelParams::default();
         m.geometry.profile = profile;
@@ -339,6 +380,7 @@ mod jacobian_tests {
             } else {
                 TimeScheme::Bdf2
             },
+            flux,
             ..Default::default()
         };
         let mut s = Solver::new(&m, &st).unwrap();
@@ -361,7 +403,15 @@ mod jacobian_tests {
             + s.d.mass * h0 / (st.dt * st.dt);
         let n = p.len();
         let scale: Vec<f64> = (0..p.len())
-            .map(|i| rows.a[i].abs().max(rows.b[i].abs()).max(rows.c[i].abs()) + 1e-300)
+            .map(|i| {
+                let outer = rows.a2[i].abs().max(rows.c2[i].abs());
+                rows.a[i]
+                    .abs()
+                    .max(rows.b[i].abs())
+                    .max(rows.c[i].abs())
+                    .max(outer)
+                    + 1e-300
+            })
             .collect();
         // Magnitude of the terms of each mass residual (storage levels and
         // face fluxes), for the rounding error of a difference quotient.
@@ -391,6 +441,10 @@ mod jacobian_tests {
                     rows.c[i]
                 } else if j + 1 == i {
                     rows.a[i]
+                } else if i + 2 == j && s.w.banded {
+                    rows.c2[i]
+                } else if j + 2 == i && s.w.banded {
+                    rows.a2[i]
                 } else {
                     0.0
                 };
@@ -444,7 +498,29 @@ mod jacobian_tests {
             v in -3.0..3.0f64,
             theta in any::<bool>(),
         ) {
-            check(profile, pocket, false, 5e-6, p, h0, v, theta);
+            check(profile, pocket, false, 5e-6, p, h0, v, theta, CouetteFlux::Upwind);
+        }
+
+        /// The MUSCL flux's Jacobian (pentadiagonal) with each limiter,
+        /// states reaching into the cavitation range (p down to 2 kPa).
+        #[test]
+        fn muscl_jacobian_matches_finite_differences(
+            profile in profile(),
+            pocket in any::<bool>(),
+            p in prop::collection::vec(prop_oneof![2e3..1.2e5f64, 1e5..4e6f64], 6..20),
+            h0 in 8e-6..30e-6f64,
+            v in -3.0..3.0f64,
+            theta in any::<bool>(),
+            limiter in prop_oneof![
+                Just(Limiter::Minmod),
+                Just(Limiter::VanLeer),
+                Just(Limiter::VanAlbada),
+            ],
+            flow_factors in any::<bool>(),
+        ) {
+            let (sigma, h0) = if flow_factors { (1e-6, h0.max(6e-6)) } else { (5e-6, h0) };
+            let flux = CouetteFlux::Muscl(limiter);
+            check(profile, pocket, flow_factors, sigma, p, h0, v, theta, flux);
         }
 
         #[test]
@@ -456,7 +532,7 @@ mod jacobian_tests {
         ) {
             // Stay inside one branch of Table A1's φs (it jumps at H = 5).
             let (sigma, h0) = if thick { (1e-6, 6e-6 + 20e-6 * h0f) } else { (5e-6, 3e-6 + 20e-6 * h0f * 0.05) };
-            check(Profile::Flat, false, true, sigma, p, h0, v, false);
+            check(Profile::Flat, false, true, sigma, p, h0, v, false, CouetteFlux::Upwind);
         }
     }
 }

@@ -107,6 +107,9 @@ fn up(start: usize, j: usize) -> usize {
 /// or non-finite.
 #[inline(always)]
 pub(crate) fn factor_solve(w: &mut Work) -> Option<f64> {
+    if w.banded {
+        return super::banded::factor_solve(w);
+    }
     let n = w.rows.len();
     let pl = Plan::new(n);
     let (m, k1, k2) = (pl.m, pl.k1, pl.k2);
@@ -261,6 +264,9 @@ fn back_substitute(
 /// stored (old) factors, into `w.dbar`. Returns Δh0.
 #[inline(always)]
 pub(crate) fn direction_with_old_factors(w: &mut Work) -> f64 {
+    if w.banded {
+        return super::banded::direction_with_old_factors(w);
+    }
     let n = w.rows.len();
     let pl = Plan::new(n);
     let (m, k1, k2) = (pl.m, pl.k1, pl.k2);

@@ -27,7 +27,11 @@
 //! with `d_f = Δx` (interior) or `Δx/2` (boundary face, ghost at p_amb) and
 //! `ρ_up` the density of the upwind cell. Only the density is upwinded: h is
 //! exact at the face, so in full film (ρ ≈ ρl) the scheme is second order and
-//! in cavitated zones it is monotone. Cell i's residual is
+//! in cavitated zones it is monotone, but first order (`solver.flux:
+//! upwind`, the default). With `solver.flux: muscl_*` (`flux.rs`) ρ_up gains
+//! half the upwind cell's limited slope: second order in cavitated zones
+//! too, still conservative and free of new extrema; the rows then reach two
+//! cells upwind and the solve is `banded.rs`'s. Cell i's residual is
 //!
 //! ```text
 //! R_i = Δx Σ_k a_k (ρ h̄)_i^(n−k) / Δt + Σ_k w_k (q_(i+1) − q_i)^(n−k) − s_i
@@ -48,16 +52,20 @@
 //! | `assembly.rs` | residual and Jacobian of one iterate |
 //! | `work.rs` | the scratch memory: cell, face and row columns, factors, buffers |
 //! | `cell_pass.rs` | pass 1 of the assembly: per-cell density, viscosity ratio and their derivatives |
+//! | `flux.rs` | the MUSCL Couette flux: the limited slope's part of each face flux |
 //! | `bordered.rs` | the tridiagonal-plus-border linear solve |
+//! | `banded.rs` | the pentadiagonal-plus-border linear solve (MUSCL flux) |
 //! | `lanes.rs` | lane-wise sums and maxima that vectorise |
 //! | `postprocess.rs` | forces, friction and diagnostics of a solved state |
 //! | `reference.rs` | the paper's Algorithm 1 (Picard + secant), the verification reference |
 //! | `breakdown.rs` | the cost of each part of an iteration (a benchmark aid) |
 
 mod assembly;
+mod banded;
 mod bordered;
 mod breakdown;
 mod cell_pass;
+mod flux;
 mod history;
 mod lanes;
 mod newton;
@@ -89,6 +97,8 @@ pub(crate) struct Disc {
     /// GW contact summed over the cells, as a function of h0.
     pub contact: SummedContact,
     pub ff: Option<FlowFactors>,
+    /// The Couette flux's face density.
+    pub flux: super::params::CouetteFlux,
     pub sigma: f64,
     pub p_amb: f64,
     /// ρ, ρ/μ at the boundary pressure.
@@ -323,6 +333,7 @@ impl Solver {
             gw,
             contact,
             ff,
+            flux: settings.flux,
             sigma: model.roughness.sigma,
             p_amb,
             rho_b: sb.rho,

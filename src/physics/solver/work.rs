@@ -62,13 +62,16 @@ pub(crate) struct FaceFlux {
 }
 
 /// Mass flux through every face (N + 1) and its derivatives in the left and
-/// right pressure and in h0.
+/// right pressure and in h0; with a MUSCL flux also in the pressure of the
+/// far upwind cell (`dqx`: the cell left of the left one when v ≥ 0, right
+/// of the right one when v < 0).
 #[derive(Debug, Clone)]
 pub(crate) struct FaceColumns {
     pub q: Vec<f64>,
     pub dql: Vec<f64>,
     pub dqr: Vec<f64>,
     pub dqh: Vec<f64>,
+    pub dqx: Vec<f64>,
 }
 
 impl FaceColumns {
@@ -78,6 +81,7 @@ impl FaceColumns {
             dql: vec![0.0; faces],
             dqr: vec![0.0; faces],
             dqh: vec![0.0; faces],
+            dqx: vec![0.0; faces],
         }
     }
 
@@ -91,7 +95,9 @@ impl FaceColumns {
 }
 
 /// The bordered system, one column per coefficient: tridiagonal (a, b, c),
-/// border column ∂R/∂h0 (`col`), residual (`r`).
+/// border column ∂R/∂h0 (`col`), residual (`r`); with a MUSCL flux the
+/// second sub- and super-diagonals (`a2`: ∂R_i/∂p_(i−2), `c2`:
+/// ∂R_i/∂p_(i+2); one of them is zero, by the sign of v).
 #[derive(Debug, Clone)]
 pub(crate) struct RowColumns {
     pub a: Vec<f64>,
@@ -99,6 +105,8 @@ pub(crate) struct RowColumns {
     pub c: Vec<f64>,
     pub col: Vec<f64>,
     pub r: Vec<f64>,
+    pub a2: Vec<f64>,
+    pub c2: Vec<f64>,
 }
 
 impl RowColumns {
@@ -109,6 +117,8 @@ impl RowColumns {
             c: vec![0.0; n],
             col: vec![0.0; n],
             r: vec![0.0; n],
+            a2: vec![0.0; n],
+            c2: vec![0.0; n],
         }
     }
 
@@ -127,6 +137,11 @@ pub(crate) struct Work {
     pub dgdh: f64,
     pub f_net: f64,
     pub factors: Vec<Factor>,
+    /// Factors of the banded (MUSCL) system, used when `banded`.
+    pub band: Vec<BandFactor>,
+    /// The rows are pentadiagonal (a MUSCL flux): `bordered.rs` hands the
+    /// solve to `banded.rs`.
+    pub banded: bool,
     pub schur: f64,
     pub c_row: f64,
     pub balance: bool,
@@ -165,6 +180,8 @@ impl Work {
             dgdh: 0.0,
             f_net: 0.0,
             factors: vec![Factor::default(); n],
+            band: vec![BandFactor::default(); n],
+            banded: false,
             schur: 0.0,
             c_row: 0.0,
             balance: true,
@@ -197,4 +214,17 @@ pub(crate) struct Factor {
     pub z: f64,
     /// The block's spike (v in the first block, u in the second).
     pub s: f64,
+}
+
+/// One row of the banded LU factors (no pivoting) of the pentadiagonal
+/// system: the multipliers of the two rows above (`l2`, `l1`), the inverse
+/// pivot, the two entries right of the pivot (`u1`, `u2`), and z = A⁻¹ col.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct BandFactor {
+    pub l2: f64,
+    pub l1: f64,
+    pub inv_d: f64,
+    pub u1: f64,
+    pub u2: f64,
+    pub z: f64,
 }
