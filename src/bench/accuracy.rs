@@ -51,6 +51,8 @@ impl AccuracyRow {
 /// and the reference.
 #[derive(Debug, Clone)]
 pub struct AccuracyReport {
+    /// The Couette flux of every run, the reference's included.
+    pub flux: crate::config::FluxKind,
     pub grids: Vec<AccuracyRow>,
     pub steps: Vec<AccuracyRow>,
     pub reference: AccuracyRow,
@@ -104,6 +106,7 @@ pub fn run(
     ));
     let reference = run_setting(config, reference.0, reference.1, cycles)?;
     let mut out = AccuracyReport {
+        flux: config.solver.flux,
         grids: Vec::new(),
         steps: Vec::new(),
         reference,
@@ -124,7 +127,8 @@ impl std::fmt::Display for AccuracyReport {
         let r = &self.reference;
         writeln!(
             f,
-            "Reference N = {}, dt = {} ms: loop area {:.4} N·m/s, mean COF {:.5}, COF at v = 0 {:.5}, min h0 {:.3} µm\n",
+            "solver.flux: {}. Reference N = {}, dt = {} ms: loop area {:.4} N·m/s, mean COF {:.5}, COF at v = 0 {:.5}, min h0 {:.3} µm\n",
+            self.flux.name(),
             r.cells,
             r.dt_s * 1e3,
             r.loop_area,

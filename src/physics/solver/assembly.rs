@@ -319,6 +319,7 @@ pub(super) fn row_pass(d: &Disc, hist: &[Level; 2], h0: f64, ctx: &Ctx, w: &mut 
 /// (i+1)'s is i + 2 and face i's is i + 1.
 #[inline(always)]
 fn band_rows(n: usize, w0: f64, forward: bool, dqx: &[f64], rows: &mut RowColumns) {
+    rows.reversed = !forward;
     if forward {
         rows.c2[..n].fill(0.0);
         for i in 0..n {

@@ -3,8 +3,15 @@
 //! outer diagonals is zero, by the sign of v), bordered by the dense column
 //! ∂R/∂h0 and the uniform row ∂G/∂p as in `bordered.rs`.
 //!
-//! Banded LU without pivoting, one sweep down and one up: O(N), with the
-//! same Schur complement for Δh0 as the tridiagonal solve:
+//! Banded elimination without pivoting, "twisted" like `bordered.rs`: rows
+//! above the meeting row k = N/2 are eliminated downwards (LU), rows below
+//! it upwards (UL), so two chains of dependent divisions overlap instead of
+//! one running N long. With v ≥ 0 the rows hold (a2, a, b, c): the
+//! downward chain keeps the band, and so does the upward one (eliminating
+//! c_j with row j + 1 changes only a_j and b_j). With v < 0 the rows hold
+//! (a, b, c, c2), which is the same shape read from the last row to the
+//! first; the solve runs on that reversed order. Then the same Schur
+//! complement for Δh0 as the tridiagonal solve:
 //!
 //! ```text
 //! A y = R ,  A z = ∂R/∂h0 ,  S = ∂G/∂h0 − c Σ z ,
@@ -17,45 +24,59 @@
 //! matrix and no pivoting is needed (a zero or non-finite pivot gives None,
 //! as in `bordered.rs`).
 
-use super::work::{BandFactor, Work};
+use super::work::{BandFactor, RowColumns, Work};
+
+/// Row i of the system in solve order (reversed when v < 0), as
+/// (two left, left, diagonal, right, border column, residual).
+#[inline(always)]
+fn row<const REV: bool>(rows: &RowColumns, n: usize, i: usize) -> [f64; 6] {
+    if REV {
+        let j = n - 1 - i;
+        [
+            rows.c2[j],
+            rows.c[j],
+            rows.b[j],
+            rows.a[j],
+            rows.col[j],
+            rows.r[j],
+        ]
+    } else {
+        [
+            rows.a2[i],
+            rows.a[i],
+            rows.b[i],
+            rows.c[i],
+            rows.col[i],
+            rows.r[i],
+        ]
+    }
+}
+
+/// Storage index of solve-order row i.
+#[inline(always)]
+fn at<const REV: bool>(n: usize, i: usize) -> usize {
+    if REV {
+        n - 1 - i
+    } else {
+        i
+    }
+}
 
 /// Factor the bordered pentadiagonal system and solve it for the Newton
 /// direction. Direction into `w.dp`; returns Δh0, or None when the system
 /// is singular or non-finite.
 #[inline(always)]
 pub(crate) fn factor_solve(w: &mut Work) -> Option<f64> {
-    let n = w.rows.len();
-    let rows = &w.rows;
-    let fs = &mut w.band[..n];
-    let y = &mut w.dp[..n];
-    let (mut f1, mut f2) = (BandFactor::default(), BandFactor::default());
-    let (mut y1, mut y2) = (0.0, 0.0);
-    for i in 0..n {
-        // Row i minus l2 × U-row (i−2) minus l1 × U-row (i−1).
-        let l2 = rows.a2[i] * f2.inv_d;
-        let a = rows.a[i] - l2 * f2.u1;
-        let b = rows.b[i] - l2 * f2.u2;
-        let l1 = a * f1.inv_d;
-        let d = b - l1 * f1.u1;
-        let inv_d = 1.0 / d;
-        let f = BandFactor {
-            l2,
-            l1,
-            inv_d,
-            u1: rows.c[i] - l1 * f1.u2,
-            u2: rows.c2[i],
-            z: rows.col[i] - l2 * f2.z - l1 * f1.z,
-        };
-        let yi = rows.r[i] - l2 * y2 - l1 * y1;
-        fs[i] = f;
-        y[i] = yi;
-        (f2, f1) = (f1, f);
-        (y2, y1) = (y1, yi);
-    }
-    let (sy, sz) = back_substitute(fs, y, true);
+    w.band_reversed = w.rows.reversed;
+    let (sy, sz) = if w.band_reversed {
+        factor::<true>(w)
+    } else {
+        factor::<false>(w)
+    };
     if !(sy.is_finite() && sz.is_finite()) {
         return None;
     }
+    let y = &mut w.dp[..w.rows.len()];
     if !w.balance {
         for v in y.iter_mut() {
             *v = -*v;
@@ -67,26 +88,137 @@ pub(crate) fn factor_solve(w: &mut Work) -> Option<f64> {
         return None;
     }
     let dh = (-w.g + w.c_row * sy) / w.schur;
-    for (v, f) in y.iter_mut().zip(fs.iter()) {
-        *v = -*v - f.z * dh;
+    for (v, z) in y.iter_mut().zip(&w.band_z) {
+        *v = -*v - z * dh;
     }
     Some(dh)
 }
 
-/// The upward sweep: y (and z when `all`, a fresh factorisation) from the
-/// forward-eliminated values; returns their sums.
+/// The two eliminations and the meeting row; y into `w.dp`, z into
+/// `w.band_z` (storage order). Returns (Σ y, Σ z).
 #[inline(always)]
-fn back_substitute(fs: &mut [BandFactor], y: &mut [f64], all: bool) -> (f64, f64) {
-    let (mut y1, mut y2, mut z1, mut z2) = (0.0, 0.0, 0.0, 0.0);
-    let (mut sy, mut sz) = (0.0, 0.0);
-    for (f, yi) in fs.iter_mut().zip(y.iter_mut()).rev() {
-        *yi = (*yi - f.u1 * y1 - f.u2 * y2) * f.inv_d;
-        (y2, y1) = (y1, *yi);
-        sy += *yi;
-        if all {
-            f.z = (f.z - f.u1 * z1 - f.u2 * z2) * f.inv_d;
-            (z2, z1) = (z1, f.z);
-            sz += f.z;
+fn factor<const REV: bool>(w: &mut Work) -> (f64, f64) {
+    let n = w.rows.len();
+    let k = n / 2;
+    let rows = &w.rows;
+    let fs = &mut w.band[..n];
+    let y = &mut w.dp[..n];
+    let z = &mut w.band_z[..n];
+    // Downward (rows 0..k): running (1/d, c, y, z) of the two rows above.
+    let (mut t1, mut t2) = ([0.0f64; 4], [0.0f64; 4]);
+    // Upward (rows n−1..k+1): running (1/b', a', a2, y', z') of the row below.
+    let mut u1 = [0.0f64; 5];
+    let up_len = n - 1 - k;
+    for j in 0..k.max(up_len) {
+        if j < k {
+            let i = j;
+            let [ra2, ra, rb, rc, rcol, rr] = row::<REV>(rows, n, i);
+            let l2 = ra2 * t2[0];
+            let l1 = (ra - l2 * t2[1]) * t1[0];
+            let inv = 1.0 / (rb - l1 * t1[1]);
+            let yi = rr - l2 * t2[2] - l1 * t1[2];
+            let zi = rcol - l2 * t2[3] - l1 * t1[3];
+            fs[i] = BandFactor {
+                l2,
+                l1,
+                inv_d: inv,
+                u1: rc,
+                u2: 0.0,
+            };
+            y[at::<REV>(n, i)] = yi;
+            z[at::<REV>(n, i)] = zi;
+            t2 = t1;
+            t1 = [inv, rc, yi, zi];
+        }
+        if j < up_len {
+            let i = n - 1 - j;
+            let [ra2, ra, rb, rc, rcol, rr] = row::<REV>(rows, n, i);
+            let mu = rc * u1[0];
+            let inv = 1.0 / (rb - mu * u1[1]);
+            let a = ra - mu * u1[2];
+            let yi = rr - mu * u1[3];
+            let zi = rcol - mu * u1[4];
+            fs[i] = BandFactor {
+                l2: 0.0,
+                l1: mu,
+                inv_d: inv,
+                u1: a,
+                u2: ra2,
+            };
+            y[at::<REV>(n, i)] = yi;
+            z[at::<REV>(n, i)] = zi;
+            u1 = [inv, a, ra2, yi, zi];
+        }
+    }
+    // The meeting row: its right neighbour from the row below, its two
+    // left ones from the rows above.
+    let [ra2, ra, rb, rc, rcol, rr] = row::<REV>(rows, n, k);
+    let mu = rc * u1[0];
+    let (b, a) = (rb - mu * u1[1], ra - mu * u1[2]);
+    let l2 = ra2 * t2[0];
+    let l1 = (a - l2 * t2[1]) * t1[0];
+    let inv = 1.0 / (b - l1 * t1[1]);
+    y[at::<REV>(n, k)] = (rr - mu * u1[3] - l2 * t2[2] - l1 * t1[2]) * inv;
+    z[at::<REV>(n, k)] = (rcol - mu * u1[4] - l2 * t2[3] - l1 * t1[3]) * inv;
+    fs[k] = BandFactor {
+        l2,
+        l1,
+        inv_d: inv,
+        u1: 0.0,
+        u2: mu,
+    };
+    back_substitute::<REV>(fs, y, Some(z), k)
+}
+
+/// From the meeting row outwards: x_i = (y_i − u1 x_(i+1)) / d_i above it,
+/// x_j = (y'_j − a'_j x_(j−1) − a2_j x_(j−2)) / b'_j below it, for y and,
+/// when given, z: up to four independent chains interleaved. Returns
+/// (Σ y, Σ z).
+#[inline(always)]
+fn back_substitute<const REV: bool>(
+    fs: &[BandFactor],
+    y: &mut [f64],
+    mut z: Option<&mut [f64]>,
+    k: usize,
+) -> (f64, f64) {
+    let n = y.len();
+    let kk = at::<REV>(n, k);
+    let y_k = y[kk];
+    let z_k = z.as_ref().map_or(0.0, |z| z[kk]);
+    let (mut sy, mut sz) = (y_k, z_k);
+    // Above: the row below's x; below: the two rows above's (x_(k−1) is
+    // the above chain's first, set at j = 0 before the below chain reads it).
+    let (mut ya, mut za) = (y_k, z_k);
+    let (mut yb, mut zb) = ([y_k, 0.0], [z_k, 0.0]);
+    for j in 0..k.max(n - 1 - k) {
+        if j < k {
+            let i = k - 1 - j;
+            let (f, s) = (&fs[i], at::<REV>(n, i));
+            ya = (y[s] - f.u1 * ya) * f.inv_d;
+            y[s] = ya;
+            sy += ya;
+            if let Some(z) = z.as_deref_mut() {
+                za = (z[s] - f.u1 * za) * f.inv_d;
+                z[s] = za;
+                sz += za;
+            }
+            if j == 0 {
+                (yb[1], zb[1]) = (ya, za);
+            }
+        }
+        if k + 1 + j < n {
+            let i = k + 1 + j;
+            let (f, s) = (&fs[i], at::<REV>(n, i));
+            let yi = (y[s] - f.u1 * yb[0] - f.u2 * yb[1]) * f.inv_d;
+            y[s] = yi;
+            yb = [yi, yb[0]];
+            sy += yi;
+            if let Some(z) = z.as_deref_mut() {
+                let zi = (z[s] - f.u1 * zb[0] - f.u2 * zb[1]) * f.inv_d;
+                z[s] = zi;
+                zb = [zi, zb[0]];
+                sz += zi;
+            }
         }
     }
     (sy, sz)
@@ -96,19 +228,16 @@ fn back_substitute(fs: &mut [BandFactor], y: &mut [f64], all: bool) -> (f64, f64
 /// factors, into `w.dbar`. Returns Δh0.
 #[inline(always)]
 pub(crate) fn direction_with_old_factors(w: &mut Work) -> f64 {
-    let n = w.rows.len();
-    let fs = &mut w.band[..n];
-    let y = &mut w.dbar[..n];
-    let (mut y1, mut y2) = (0.0, 0.0);
-    for ((f, yi), r) in fs.iter().zip(y.iter_mut()).zip(&w.rows.r[..n]) {
-        *yi = r - f.l2 * y2 - f.l1 * y1;
-        (y2, y1) = (y1, *yi);
-    }
-    let (sy, _) = back_substitute(fs, y, false);
+    let sy = if w.band_reversed {
+        old_factors::<true>(w)
+    } else {
+        old_factors::<false>(w)
+    };
+    let y = &mut w.dbar[..w.rows.len()];
     if w.balance {
         let dh = (-w.g + w.c_row * sy) / w.schur;
-        for (v, f) in y.iter_mut().zip(fs.iter()) {
-            *v = -*v - f.z * dh;
+        for (v, z) in y.iter_mut().zip(&w.band_z) {
+            *v = -*v - z * dh;
         }
         dh
     } else {
@@ -117,6 +246,30 @@ pub(crate) fn direction_with_old_factors(w: &mut Work) -> f64 {
         }
         0.0
     }
+}
+
+/// y = A⁻¹ r with the stored factors, into `w.dbar`; returns Σ y.
+#[inline(always)]
+fn old_factors<const REV: bool>(w: &mut Work) -> f64 {
+    let n = w.rows.len();
+    let k = n / 2;
+    let fs = &w.band[..n];
+    let r = &w.rows.r[..n];
+    let y = &mut w.dbar[..n];
+    let (mut y1, mut y2) = (0.0, 0.0);
+    for (i, f) in fs[..k].iter().enumerate() {
+        let yi = r[at::<REV>(n, i)] - f.l2 * y2 - f.l1 * y1;
+        y[at::<REV>(n, i)] = yi;
+        (y2, y1) = (y1, yi);
+    }
+    let mut yb = 0.0;
+    for i in (k + 1..n).rev() {
+        yb = r[at::<REV>(n, i)] - fs[i].l1 * yb;
+        y[at::<REV>(n, i)] = yb;
+    }
+    let f = &fs[k];
+    y[at::<REV>(n, k)] = (r[at::<REV>(n, k)] - f.u2 * yb - f.l2 * y2 - f.l1 * y1) * f.inv_d;
+    back_substitute::<REV>(fs, y, None, k).0
 }
 
 #[cfg(test)]
@@ -182,6 +335,7 @@ mod banded_tests {
                 w.rows.col[i] = s(5 * i + 4);
                 w.rows.r[i] = s(7 * i + 11);
             }
+            w.rows.reversed = !lower;
             w.c_row = -0.7;
             w.dgdh = 5.0;
             w.g = 0.3;

@@ -72,14 +72,26 @@ pub(crate) fn slope(limiter: Limiter, dm: f64, dp: f64) -> (f64, f64, f64) {
 #[inline(always)]
 pub(super) fn muscl_pass(d: &Disc, h0: f64, ctx: &Ctx, limiter: Limiter, w: &mut Work) {
     let n = d.grid.n;
-    w.faces.dqx[..=n].fill(0.0);
     let forward = ctx.v >= 0.0;
+    // The face whose upwind side is the boundary keeps the boundary density.
+    w.faces.dqx[if forward { 0 } else { n }] = 0.0;
     // Faces whose three cells are all inside (v ≥ 0: face k reads cells
     // k − 2, k − 1, k; v < 0: k − 1, k, k + 1), then the two next to the
     // boundaries, with the boundary state for the missing cell.
-    match (&d.ff, forward) {
-        (None, true) => interior::<true>(d, h0, ctx.v, limiter, w),
-        (None, false) => interior::<false>(d, h0, ctx.v, limiter, w),
+    // One loop per limiter and direction, so that each vectorises.
+    macro_rules! interior_for {
+        ($l:expr) => {
+            if forward {
+                interior::<true, _>(d, h0, ctx.v, w, |m, p| slope($l, m, p))
+            } else {
+                interior::<false, _>(d, h0, ctx.v, w, |m, p| slope($l, m, p))
+            }
+        };
+    }
+    match (&d.ff, limiter) {
+        (None, Limiter::Minmod) => interior_for!(Limiter::Minmod),
+        (None, Limiter::VanLeer) => interior_for!(Limiter::VanLeer),
+        (None, Limiter::VanAlbada) => interior_for!(Limiter::VanAlbada),
         (Some(_), _) => {
             let inner = if forward { 2..n } else { 1..n - 1 };
             for k in inner {
@@ -142,7 +154,13 @@ fn one_face(d: &Disc, h0: f64, v: f64, limiter: Limiter, k: usize, w: &mut Work)
 /// [`one_face`] over the faces whose cells are all inside, without flow
 /// factors (h_f + σφs = h_f): one branch-free loop that vectorises.
 #[inline(always)]
-fn interior<const FORWARD: bool>(d: &Disc, h0: f64, v: f64, limiter: Limiter, w: &mut Work) {
+fn interior<const FORWARD: bool, S: Fn(f64, f64) -> (f64, f64, f64)>(
+    d: &Disc,
+    h0: f64,
+    v: f64,
+    w: &mut Work,
+    slope: S,
+) {
     let n = d.grid.n;
     let half_v = 0.5 * v;
     // Faces k0..k0 + m; cell offsets of the far, upwind and downwind cells.
@@ -168,7 +186,7 @@ fn interior<const FORWARD: bool>(d: &Disc, h0: f64, v: f64, limiter: Limiter, w:
         (&mut f.dqr[k0..k0 + m], &mut f.dql[k0..k0 + m])
     };
     for j in 0..m {
-        let (s, s_m, s_p) = slope(limiter, ru[j] - rx[j], rd[j] - ru[j]);
+        let (s, s_m, s_p) = slope(ru[j] - rx[j], rd[j] - ru[j]);
         let hf = h0 + gf[j];
         let kc = half_v * hf * 0.5;
         q[j] += kc * s;

@@ -107,6 +107,9 @@ pub(crate) struct RowColumns {
     pub r: Vec<f64>,
     pub a2: Vec<f64>,
     pub c2: Vec<f64>,
+    /// The outer diagonal is `c2` (rows built for v < 0): the banded solve
+    /// runs from the last row to the first.
+    pub reversed: bool,
 }
 
 impl RowColumns {
@@ -119,6 +122,7 @@ impl RowColumns {
             r: vec![0.0; n],
             a2: vec![0.0; n],
             c2: vec![0.0; n],
+            reversed: false,
         }
     }
 
@@ -139,6 +143,10 @@ pub(crate) struct Work {
     pub factors: Vec<Factor>,
     /// Factors of the banded (MUSCL) system, used when `banded`.
     pub band: Vec<BandFactor>,
+    /// z = A⁻¹ ∂R/∂h0 of the banded system (storage order).
+    pub band_z: Vec<f64>,
+    /// The banded factors are in reversed order (rows built for v < 0).
+    pub band_reversed: bool,
     /// The rows are pentadiagonal (a MUSCL flux): `bordered.rs` hands the
     /// solve to `banded.rs`.
     pub banded: bool,
@@ -181,6 +189,8 @@ impl Work {
             f_net: 0.0,
             factors: vec![Factor::default(); n],
             band: vec![BandFactor::default(); n],
+            band_z: vec![0.0; n],
+            band_reversed: false,
             banded: false,
             schur: 0.0,
             c_row: 0.0,
@@ -216,9 +226,13 @@ pub(crate) struct Factor {
     pub s: f64,
 }
 
-/// One row of the banded LU factors (no pivoting) of the pentadiagonal
-/// system: the multipliers of the two rows above (`l2`, `l1`), the inverse
-/// pivot, the two entries right of the pivot (`u1`, `u2`), and z = A⁻¹ col.
+/// One row of the twisted banded factors (no pivoting) of the
+/// pentadiagonal system, in solve order (`banded.rs`). Above the meeting
+/// row: the multipliers of the two rows above (`l2`, `l1`), the inverse
+/// pivot and the entry right of it (`u1`). Below it: the multiplier of the
+/// row below (`l1`), the inverse pivot and the two entries left of it
+/// (`u1`, `u2`). The meeting row: `l2`, `l1`, its inverse pivot and the
+/// multiplier of the row below (`u2`).
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct BandFactor {
     pub l2: f64,
@@ -226,5 +240,4 @@ pub(crate) struct BandFactor {
     pub inv_d: f64,
     pub u1: f64,
     pub u2: f64,
-    pub z: f64,
 }
