@@ -130,6 +130,7 @@ fn theta_scheme_steady_solves_and_reference_steps_allocate_nothing() {
     let st = SolverSettings {
         cells: 16,
         method: Method::Reference,
+        flux: CouetteFlux::Upwind,
         ..Default::default()
     };
     let mut r = Solver::new(&ModelParams::default(), &st).unwrap();

@@ -485,7 +485,11 @@ fn a_simulate_run_is_fit_data_as_written_its_text_columns_skipped() {
     ]);
     assert_eq!(code, 0, "{stderr}");
     let fitted = friction_node::config::Config::load(Some(&out), &[]).unwrap();
-    approx::assert_relative_eq!(fitted.contact.boundary_friction, 0.3, max_relative = 1e-4);
+    // The fit starts from the steady state at the first row (t = 1 ms,
+    // v = 3 mm/s) where `simulate` started at rest at t = 0: the two differ
+    // by up to 47 N around t = 22 ms, which moves the estimate by 1.0e-4
+    // (0.30003, the same with either flux).
+    approx::assert_relative_eq!(fitted.contact.boundary_friction, 0.3, max_relative = 2e-4);
     // Reading a text column is refused by name, with the cell.
     let (code, _, stderr) = run(&[
         "fit",

@@ -210,12 +210,10 @@ fn several_velocity_topics_are_listed_until_one_is_chosen() {
     );
 }
 
-#[test]
-fn the_node_fixture_replays_within_one_part_per_million_of_its_recording() {
-    // Bit-identity holds for the binary that recorded it (tested below on a
-    // fresh recording); across solver versions and CPUs the fixture must
-    // still agree to the solver's tolerance.
-    let p = prepare(NODE_BAG, &ReplayOptions::default()).unwrap();
+/// Replay `bag` on its recorded configuration and check every estimate
+/// within one part per million of the recording; returns the configuration.
+fn assert_replays_within_one_ppm(bag: &str) -> friction_node::config::Config {
+    let p = prepare(bag, &ReplayOptions::default()).unwrap();
     assert_eq!(p.config_source, "recorded in the bag");
     assert!(
         matches!(&p.mode, InputMode::RecordedEstimates { .. }),
@@ -236,8 +234,31 @@ fn the_node_fixture_replays_within_one_part_per_million_of_its_recording() {
             "iterations" => continue,
             other => panic!("{other} differs by {dev} at step {at}"),
         };
-        assert!(*dev <= bound, "{field} differs by {dev:e} at step {at} (bound {bound:e}); bags/regenerate.sh after a deliberate change");
+        assert!(*dev <= bound, "{bag}: {field} differs by {dev:e} at step {at} (bound {bound:e}); bags/regenerate.sh after a deliberate change");
     }
+    p.config
+}
+
+#[test]
+fn the_node_fixture_replays_within_one_part_per_million_of_its_recording() {
+    // Bit-identity holds for the binary that recorded it (tested below on a
+    // fresh recording); across solver versions and CPUs the fixture must
+    // still agree to the solver's tolerance.
+    let c = assert_replays_within_one_ppm(NODE_BAG);
+    assert_eq!(c.solver.flux, friction_node::config::FluxKind::MusclVanLeer);
+}
+
+#[test]
+fn a_bag_recorded_before_solver_flux_existed_replays_with_the_upwind_flux_it_was_recorded_with() {
+    // tests/fixtures/node_lockstep_before_flux.mcap: bags/node_lockstep.mcap
+    // as recorded before `solver.flux` existed (upwind was the only flux);
+    // kept as it was recorded, never regenerated.
+    let old = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/fixtures/node_lockstep_before_flux.mcap"
+    );
+    let c = assert_replays_within_one_ppm(old);
+    assert_eq!(c.solver.flux, friction_node::config::FluxKind::Upwind);
 }
 
 #[test]

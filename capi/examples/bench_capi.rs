@@ -1,5 +1,5 @@
 //! The C API's cost over the Rust step: two identical models on the paper's
-//! reciprocating case (N = 256, 1 kHz, V1 = 1 m/s, f = 1 Hz), one stepped
+//! reciprocating case (the default grid and flux, 1 kHz, V1 = 1 m/s, f = 1 Hz), one stepped
 //! through `Solver::step`, one through `fn_model_step`, alternately, every
 //! step timed; the overhead is the median of the per-step differences (same
 //! states, same work), beside both medians.

@@ -1,7 +1,7 @@
 """Benchmarks of the Python package (issue 17's targets), side by side in
 one run on this machine:
 
-1. ``Model.run`` over 60 s at 1 kHz (the shipped default, N = 256) against
+1. ``Model.run`` over 60 s at 1 kHz (the shipped default: N = 64, muscl_van_leer; N = 256 upwind before 2026-11-26) against
    the same run through the Rust API (``examples/bench_run.rs``), medians of
    alternating repetitions;
 2. 64 bags of 60 s replayed by ``fleet.replay`` on a local cluster of one
@@ -47,7 +47,7 @@ def model_run(seconds: float, repeats: int) -> None:
         m.run(t, np.sin(2 * np.pi * t))
         py_s.append(time.perf_counter() - started)
     p, r = statistics.median(py_s), statistics.median(rust_s)
-    print(f"Model.run, {seconds:g} s at 1 kHz, N = 256, {repeats} alternating repetitions:")
+    print(f"Model.run, {seconds:g} s at 1 kHz, the default grid and flux, {repeats} alternating repetitions:")
     print(f"  Python Model.run median {p:.3f} s (min {min(py_s):.3f}), Rust API median {r:.3f} s (min {min(rust_s):.3f})")
     print(f"  ratio Python/Rust: median {p / r:.3f}, best-of {min(py_s) / min(rust_s):.3f} (target <= 1.10)")
 

@@ -10,6 +10,7 @@
 //! | `latency.rs` | `bench-latency`: command → estimate through a transport, beside an empty timer loop |
 //! | `recorder.rs` | `bench-recorder`: the recorder over simulated days |
 //! | `accuracy.rs` | `bench-accuracy`: the accuracy guide, answers against N and Δt |
+//! | `cases.rs` | `bench-cases`: the accuracy guide over a family of transient cases, passes per grid and flux |
 //! | `fit.rs` | `bench-fit`: calibration targets on synthetic data (recovery, drivetrain, pre-sliding, transfer) |
 
 use crate::config::Config;
@@ -284,6 +285,7 @@ pub fn csv(cases: &[BenchCase]) -> String {
 }
 
 pub mod accuracy;
+pub mod cases;
 pub mod fit;
 mod latency;
 #[cfg(feature = "mcap")]

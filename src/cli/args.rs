@@ -125,6 +125,23 @@ fn accuracy_cycles(s: &str) -> Result<u32, String> {
     count(s, 2, 100, "a number of cycles").map(|v| v as u32)
 }
 
+fn case_count(s: &str) -> Result<usize, String> {
+    count(s, 1, 10_000, "a number of cases").map(|v| v as usize)
+}
+
+fn flux(s: &str) -> Result<friction_node::config::FluxKind, String> {
+    use friction_node::config::FluxKind;
+    [
+        FluxKind::Upwind,
+        FluxKind::MusclMinmod,
+        FluxKind::MusclVanLeer,
+        FluxKind::MusclVanAlbada,
+    ]
+    .into_iter()
+    .find(|f| f.name() == s.trim())
+    .ok_or_else(|| format!("`{s}` is not a flux: expected one of {}", FluxKind::NAMES))
+}
+
 fn seeds(s: &str) -> Result<u64, String> {
     count(s, 1, 1000, "a number of seeds")
 }
@@ -327,6 +344,32 @@ pub enum Command {
         #[arg(long, default_value = "3", value_parser = accuracy_cycles)]
         cycles: u32,
     },
+    /// The accuracy guide over a family of transient cases (speeds, frequencies, loads, viscosities): how many pass against a fine reference per grid and flux (release build!).
+    BenchCases {
+        #[command(flatten)]
+        common: Common,
+        /// Number of cases, in [1, 10000].
+        #[arg(long, default_value = "64", value_parser = case_count)]
+        count: usize,
+        /// Grid sizes to test at the configured step, comma-separated, each in [8, 65536].
+        #[arg(long, default_value = "64,128,256", value_delimiter = ',', value_parser = cells)]
+        grids: Vec<usize>,
+        /// Couette fluxes to test, comma-separated (upwind, muscl_minmod, muscl_van_leer, muscl_van_albada).
+        #[arg(long, default_value = "upwind,muscl_van_leer", value_delimiter = ',', value_parser = flux)]
+        fluxes: Vec<friction_node::config::FluxKind>,
+        /// The reference grid, in [8, 65536] (flux muscl_van_leer).
+        #[arg(long, default_value = "2048", value_parser = cells)]
+        reference_cells: usize,
+        /// The reference step (s), in [1e-6, 0.1].
+        #[arg(long, default_value = "0.000125", value_parser = accuracy_dt)]
+        reference_dt: f64,
+        /// Cycles per run (the last one is measured), in [2, 100].
+        #[arg(long, default_value = "3", value_parser = accuracy_cycles)]
+        cycles: u32,
+        /// Cases run at once (0: one per core).
+        #[arg(long, default_value = "0")]
+        jobs: usize,
+    },
     /// The calibration targets on synthetic data: recovery of three parameters, transfer to another load and frequency against the classic models (release build!).
     BenchFit {
         #[command(flatten)]
@@ -381,6 +424,7 @@ impl Command {
             | Command::BenchRecorder { common, .. }
             | Command::BenchFit { common, .. }
             | Command::BenchAccuracy { common, .. }
+            | Command::BenchCases { common, .. }
             | Command::Soak { common, .. }
             | Command::Fit { common, .. } => common,
         }
@@ -398,6 +442,7 @@ impl Command {
                 | Command::Fit { .. }
                 | Command::BenchFit { .. }
                 | Command::BenchAccuracy { .. }
+                | Command::BenchCases { .. }
         )
     }
 }

@@ -99,6 +99,46 @@ pub fn accuracy(
     Ok(())
 }
 
+/// `bench-cases`: the transient cases' pass table (markdown, on stdout).
+pub fn cases(
+    config: &Config,
+    count: usize,
+    grids: &[usize],
+    fluxes: &[friction_node::config::FluxKind],
+    reference: (usize, f64),
+    cycles: u32,
+    jobs: usize,
+) -> Result<()> {
+    if cfg!(debug_assertions) {
+        eprintln!("warning: a debug build; the cases take much longer (use --release)");
+    }
+    let settings: Vec<_> = fluxes
+        .iter()
+        .flat_map(|&flux| grids.iter().map(move |&n| (n, config.solver.dt_s, flux)))
+        .collect();
+    let jobs = if jobs == 0 {
+        std::thread::available_parallelism().map_or(1, |n| n.get())
+    } else {
+        jobs
+    };
+    let reference = (
+        reference.0,
+        reference.1,
+        friction_node::config::FluxKind::MusclVanLeer,
+    );
+    let r = friction_node::bench::cases::run(
+        config,
+        count,
+        &settings,
+        reference,
+        cycles,
+        jobs,
+        &|m| eprintln!("  {m}"),
+    )?;
+    print!("{r}");
+    Ok(())
+}
+
 /// `bench-recorder`: simulated hours through the recorder.
 pub fn recorder(config: &Config, hours: u64, out: PathBuf) -> Result<()> {
     #[cfg(feature = "mcap")]

@@ -10,7 +10,7 @@
 //! | `study.rs` | `study`: the paper's studies, every case in parallel |
 //! | `replay.rs` | `replay`: the model over a recorded motion |
 //! | `fit.rs` | `fit`: calibration and its report |
-//! | `bench.rs` | `bench`, `bench-latency`, `bench-recorder`, `bench-accuracy`, `bench-fit` |
+//! | `bench.rs` | `bench`, `bench-latency`, `bench-recorder`, `bench-accuracy`, `bench-cases`, `bench-fit` |
 //! | `progress.rs` | progress bars on a terminal's stderr |
 //! | `logging.rs` | `tracing` to the terminal |
 
@@ -150,6 +150,24 @@ pub fn dispatch(
             &steps,
             (reference_cells, reference_dt),
             cycles,
+        ),
+        Command::BenchCases {
+            count,
+            grids,
+            fluxes,
+            reference_cells,
+            reference_dt,
+            cycles,
+            jobs,
+            ..
+        } => bench::cases(
+            &config,
+            count,
+            &grids,
+            &fluxes,
+            (reference_cells, reference_dt),
+            cycles,
+            jobs,
         ),
         Command::BenchFit {
             cells,

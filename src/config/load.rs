@@ -126,8 +126,34 @@ impl Config {
         Self::from_params(params)
     }
 
+    /// Parse a configuration recorded in a bag (`config_yaml`). A key the
+    /// recording predates takes the value that reproduces it (see
+    /// [`RECORDED_BEFORE`]), so that old bags replay to the numbers they
+    /// hold; then `overrides` apply.
+    pub fn from_recorded_yaml(
+        text: &str,
+        origin: &Origin,
+        overrides: &[String],
+    ) -> Result<Config, ConfigError> {
+        let doc: Value = serde_norway::from_str(text).map_err(|e| ConfigError::Syntax {
+            origin: origin.to_string(),
+            message: e.to_string(),
+        })?;
+        let mut params = ros_parameters(doc, origin)?;
+        for (key, value) in RECORDED_BEFORE {
+            if lookup(&params, key).is_none() {
+                apply_override(&mut params, &format!("{key}={value}"))?;
+            }
+        }
+        for o in overrides {
+            apply_override(&mut params, o)?;
+        }
+        Self::from_params(params)
+    }
+
     /// Deserialize and validate a `ros__parameters` tree.
     fn from_params(mut params: Value) -> Result<Config, ConfigError> {
+        default_flux_for_method(&mut params);
         super::contacts::inherit_top_level(&mut params);
         let cfg: Config = serde_path_to_error::deserialize(params).map_err(|e| {
             let key = e.path().to_string();
@@ -140,6 +166,32 @@ impl Config {
         })?;
         cfg.validate()?;
         Ok(cfg)
+    }
+}
+
+/// Keys added after the first recordings, with the value that reproduces a
+/// recording made before each existed (a recorded configuration always
+/// lists every key of its time: it is the resolved configuration).
+///
+/// | key | before it existed |
+/// |---|---|
+/// | `solver.flux` | `upwind`, the only flux then (the default since is `muscl_van_leer`) |
+pub const RECORDED_BEFORE: &[(&str, &str)] = &[("solver.flux", "upwind")];
+
+/// The value at a dotted key of a `ros__parameters` tree.
+fn lookup<'a>(params: &'a Value, key: &str) -> Option<&'a Value> {
+    key.split('.').try_fold(params, |v, k| v.get(k))
+}
+
+/// `solver.flux` left unset takes the best flux the method supports:
+/// `muscl_van_leer` with `newton` (the serde default), `upwind` with
+/// `reference` (the paper's Picard solver has no other).
+fn default_flux_for_method(params: &mut Value) {
+    let reference = lookup(params, "solver.method").and_then(Value::as_str) == Some("reference");
+    if reference && lookup(params, "solver.flux").is_none() {
+        if let Some(Value::Mapping(solver)) = params.get_mut("solver") {
+            solver.insert(Value::String("flux".into()), Value::String("upwind".into()));
+        }
     }
 }
 

@@ -222,6 +222,17 @@ impl FluxKind {
         }
     }
 
+    /// The configuration value of the solver's flux.
+    pub fn of(flux: crate::physics::CouetteFlux) -> Self {
+        use crate::physics::{CouetteFlux, Limiter};
+        match flux {
+            CouetteFlux::Upwind => FluxKind::Upwind,
+            CouetteFlux::Muscl(Limiter::Minmod) => FluxKind::MusclMinmod,
+            CouetteFlux::Muscl(Limiter::VanLeer) => FluxKind::MusclVanLeer,
+            CouetteFlux::Muscl(Limiter::VanAlbada) => FluxKind::MusclVanAlbada,
+        }
+    }
+
     /// The solver's flux.
     pub fn couette_flux(self) -> crate::physics::CouetteFlux {
         use crate::physics::{CouetteFlux, Limiter};
@@ -246,7 +257,8 @@ pub struct SolverConfig {
     pub theta2: f64,
     pub tolerance: f64,
     pub max_iterations: u32,
-    /// Default `upwind`.
+    /// Default `muscl_van_leer` (bags recorded before the key existed
+    /// replay with `upwind`, see [`crate::config::Config::from_recorded_yaml`]).
     pub flux: FluxKind,
     pub reference: ReferenceConfig,
 }
@@ -266,7 +278,7 @@ impl Default for SolverConfig {
             theta2,
             tolerance: s.tolerance,
             max_iterations: s.max_iterations,
-            flux: FluxKind::Upwind,
+            flux: FluxKind::of(s.flux),
             reference: ReferenceConfig::default(),
         }
     }

@@ -257,3 +257,34 @@ fn a_muscl_flux_with_the_reference_solver_is_refused_naming_both_keys() {
         crate::physics::CouetteFlux::Muscl(crate::physics::Limiter::VanAlbada)
     );
 }
+
+#[test]
+fn an_unset_flux_is_the_best_one_the_method_supports() {
+    let c = load(DEFAULT_YAML, &[]).unwrap();
+    assert_eq!(c.solver.flux, FluxKind::MusclVanLeer);
+    let c = load(DEFAULT_YAML, &["solver.method=reference"]).unwrap();
+    assert_eq!(c.solver.flux, FluxKind::Upwind);
+    // Set by hand, it is kept (and checked against the method).
+    let c = load(DEFAULT_YAML, &["solver.flux=upwind"]).unwrap();
+    assert_eq!(c.solver.flux, FluxKind::Upwind);
+}
+
+#[test]
+fn a_recorded_configuration_without_a_flux_replays_with_the_upwind_flux_it_was_recorded_with() {
+    let mut old = Config::default().to_yaml();
+    old = old
+        .lines()
+        .filter(|l| !l.trim_start().starts_with("flux:"))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let origin = Origin::Text("recorded in the bag");
+    let c = Config::from_recorded_yaml(&old, &origin, &[]).unwrap();
+    assert_eq!(c.solver.flux, FluxKind::Upwind);
+    // A recording that names its flux keeps it; overrides still apply.
+    let new = Config::default().to_yaml();
+    let c = Config::from_recorded_yaml(&new, &origin, &[]).unwrap();
+    assert_eq!(c.solver.flux, FluxKind::MusclVanLeer);
+    let c =
+        Config::from_recorded_yaml(&old, &origin, &["solver.flux=muscl_minmod".into()]).unwrap();
+    assert_eq!(c.solver.flux, FluxKind::MusclMinmod);
+}

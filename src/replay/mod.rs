@@ -265,8 +265,9 @@ fn choose_config(scan: &BagScan, opts: &ReplayOptions) -> Result<(Config, String
         ));
     }
     if let Some(text) = &scan.recorded_config {
-        let c = Config::from_yaml(text, &Origin::Text("recorded in the bag"), &opts.overrides)
-            .map_err(ReplayError::RecordedConfig)?;
+        let c =
+            Config::from_recorded_yaml(text, &Origin::Text("recorded in the bag"), &opts.overrides)
+                .map_err(ReplayError::RecordedConfig)?;
         return Ok((c, "recorded in the bag".into()));
     }
     Ok((

@@ -28,7 +28,8 @@
 //! `ρ_up` the density of the upwind cell. Only the density is upwinded: h is
 //! exact at the face, so in full film (ρ ≈ ρl) the scheme is second order and
 //! in cavitated zones it is monotone, but first order (`solver.flux:
-//! upwind`, the default). With `solver.flux: muscl_*` (`flux.rs`) ρ_up gains
+//! upwind`). With `solver.flux: muscl_*` (`flux.rs`; `muscl_van_leer` is the
+//! default) ρ_up gains
 //! half the upwind cell's limited slope: second order in cavitated zones
 //! too, still conservative and free of new extrema; the rows then reach two
 //! cells upwind and the solve is `banded.rs`'s. Cell i's residual is
