@@ -24,7 +24,9 @@
 //! | `model.rs` | the model's sections (`contact`, `texture`, `lubricant`, `roughness`, `solver`) |
 //! | `io.rs` | the node's sections (`node`, `ros`, `iceoryx2`, `recording`) |
 //! | `load.rs` | parameter files, their ROS 2 shapes, `--set` overrides |
-//! | `validate.rs` | physical ranges and ROS 2 names, one function per section |
+//! | `validate.rs` | physical ranges of the model's sections, one function per section; the range checks |
+//! | `validate_io.rs` | ranges and names of the node's sections (`node`, `ros`, `iceoryx2`, `recording`), the snapshot ring's memory |
+//! | `ros_names.rs` | the ROS 2 naming rules for topics, node names and namespaces |
 //! | `contacts.rs` | `contacts.*`: several contacts, each overriding the top-level sections |
 //! | `error.rs` | [`ConfigError`] and the [`Origin`] of a configuration |
 //! | `envelope.rs` | the inputs every entry point accepts: velocity, load, temperature ([`Envelope`]) |
@@ -41,8 +43,10 @@ mod load;
 mod model;
 pub mod parameters;
 pub mod ros_args;
+mod ros_names;
 pub mod topics;
 mod validate;
+mod validate_io;
 
 pub use contacts::{
     ContactEntry, ContactList, ContactSolverConfig, ResolvedContact, CONTACT_SECTIONS,
@@ -56,9 +60,9 @@ pub use io::*;
 pub use load::apply_override;
 pub use model::*;
 pub use ros_args::RosArgs;
-pub use validate::{
-    check_namespace, check_node_name, check_topic, key_ranges, snapshot_bytes, KeyRange,
-};
+pub use ros_names::{check_namespace, check_node_name, check_topic};
+pub use validate::{key_ranges, KeyRange};
+pub use validate_io::snapshot_bytes;
 
 use crate::physics::{
     Contact, Geometry, Lubricant, Method, ModelParams, Pocket, Profile, ReferenceSettings,
