@@ -14,13 +14,13 @@
 //! | [`table`] | numeric tables from text (the csv crate): delimiters, columns, line numbers |
 //! | [`expression`] | size and depth limits on the column expressions people write |
 //! | [`clock`] | monotonic and wall time, system or simulated |
-//! | [`stats`] | fixed-memory statistics, the recorder's counters |
+//! | [`stats`] | fixed-memory statistics windows and histograms |
 //! | [`text`] | text formatting shared by the output layers |
 //! | [`output`] | atomic, checked output files; free-space checks |
 //! | [`interrupt`] | SIGINT/SIGTERM as a stop request for long offline work |
 //! | [`analysis`] | hysteresis-loop metrics of a run |
 //! | [`msgs`] | wire structs mirroring `msg/*.msg`, the loop's records, CDR |
-//! | [`link`] | what the loop shares with its threads: loop settings, the parameter hand-over |
+//! | [`link`] | what the loop shares with its threads: loop settings, the parameter hand-over, the film-profile slot, record items, the recorder's counters, the live status |
 //! | [`transport`] | in-memory, iceoryx2 and ROS 2 backends behind small traits |
 //! | [`contacts`] | several contacts stepped together, the worker pool |
 //! | [`node`] | the fixed-step real-time loop, its runner and live parameters |

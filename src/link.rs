@@ -7,11 +7,15 @@
 //! transport that serves parameters). The loop applies an update between two
 //! steps without blocking or allocating and hands it back stamped with the
 //! first step that used it (for `/parameter_events`, the recording and
-//! replay).
+//! replay). Also what the loop hands to the recorder ([`RecordItem`], through
+//! a preallocated queue), the recorder's counters the loop reports
+//! ([`RecorderCounters`]) and the loop's live values for a status line
+//! ([`LiveStatus`]).
 
 use crate::config::parameters::SetRefusal;
 use crate::config::{Config, StepMode, TimeoutBehaviour};
 use crate::msgs::ros_interfaces::ParameterValue;
+use crate::msgs::{Command, EstimateRecord, Note, RawSample, RecordingStatus, StatisticsRecord};
 use crate::physics::{PreparedModel, SetupError, Solver};
 use crossbeam_queue::ArrayQueue;
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
@@ -236,6 +240,98 @@ impl ProfileSlot {
         let d = self.data.lock().ok()?.clone();
         *seen = s;
         Some(d)
+    }
+}
+
+/// What the loop and the transports hand to the recorder.
+// Items travel through preallocated lock-free queues: boxing the larger
+// variants would allocate on the loop.
+#[allow(clippy::large_enum_variant)]
+#[derive(Debug, Clone, PartialEq)]
+pub enum RecordItem {
+    /// A received command (transports without a serialized form: memory,
+    /// iceoryx2) and when it arrived (wall clock, ns); recorded as the
+    /// configured command type.
+    Command { command: Command, received_ns: u64 },
+    /// A received ROS 2 sample, recorded byte for byte.
+    Raw(RawSample),
+    /// An estimate of contact `contact` (0 with one contact) and when it
+    /// was published (wall clock, ns).
+    Estimate {
+        record: EstimateRecord,
+        logged_ns: u64,
+        contact: u16,
+    },
+    /// Loop statistics and when they were published (wall clock, ns).
+    Statistics {
+        record: StatisticsRecord,
+        logged_ns: u64,
+    },
+    /// An `rcl_interfaces/msg/ParameterEvent` (CDR with its encapsulation
+    /// header) stamped with the first step that used the new values.
+    ParameterEvent {
+        cdr: Vec<u8>,
+        stamp_ns: u64,
+        logged_ns: u64,
+    },
+}
+
+/// Counters the recorder shares with the loop (statistics) and the report.
+#[derive(Debug, Default)]
+pub struct RecorderCounters {
+    pub messages: AtomicU64,
+    /// Files started (1 without splitting).
+    pub files: AtomicU64,
+    /// Files deleted to keep to the budget.
+    pub files_deleted: AtomicU64,
+    /// Messages lost because writing had failed (until it resumed).
+    pub lost: AtomicU64,
+    pub snapshots: AtomicU64,
+    /// The latest snapshot file and its span, s.
+    pub last_snapshot: Mutex<(Note, f64)>,
+}
+
+impl RecorderCounters {
+    /// A snapshot of the counters (never blocks: a busy snapshot slot
+    /// reports an empty note).
+    pub fn status(&self) -> RecordingStatus {
+        let l = |a: &AtomicU64| a.load(Ordering::Relaxed);
+        let (last_snapshot, last_snapshot_span_s) = self
+            .last_snapshot
+            .try_lock()
+            .map(|g| *g)
+            .unwrap_or_default();
+        RecordingStatus {
+            files: l(&self.files),
+            files_deleted: l(&self.files_deleted),
+            lost: l(&self.lost),
+            snapshots: l(&self.snapshots),
+            last_snapshot,
+            last_snapshot_span_s,
+        }
+    }
+}
+
+/// Live values for a status line (written by the loop, read anywhere).
+#[derive(Debug, Default)]
+pub struct LiveStatus {
+    pub steps: AtomicU64,
+    pub deadline_misses: AtomicU64,
+    pub commands_applied: AtomicU64,
+    pub commands_rejected: AtomicU64,
+    pub drops: AtomicU64,
+    pub velocity_bits: AtomicU64,
+    pub friction_bits: AtomicU64,
+    pub cof_bits: AtomicU64,
+    pub h0_bits: AtomicU64,
+    pub compute_ns: AtomicU64,
+    pub status: AtomicU64,
+}
+
+impl LiveStatus {
+    /// The f64 stored (as its bits) in one of the `*_bits` fields.
+    pub fn load_f64(v: &AtomicU64) -> f64 {
+        f64::from_bits(v.load(Ordering::Relaxed))
     }
 }
 

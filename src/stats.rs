@@ -1,45 +1,4 @@
-//! Fixed-memory statistics for the loop (no allocation after construction),
-//! and the recorder's counters the loop reports.
-
-use crate::msgs::{Note, RecordingStatus};
-use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::Mutex;
-
-/// Counters the recorder shares with the loop (statistics) and the report.
-#[derive(Debug, Default)]
-pub struct RecorderCounters {
-    pub messages: AtomicU64,
-    /// Files started (1 without splitting).
-    pub files: AtomicU64,
-    /// Files deleted to keep to the budget.
-    pub files_deleted: AtomicU64,
-    /// Messages lost because writing had failed (until it resumed).
-    pub lost: AtomicU64,
-    pub snapshots: AtomicU64,
-    /// The latest snapshot file and its span, s.
-    pub last_snapshot: Mutex<(Note, f64)>,
-}
-
-impl RecorderCounters {
-    /// A snapshot of the counters (never blocks: a busy snapshot slot
-    /// reports an empty note).
-    pub fn status(&self) -> RecordingStatus {
-        let l = |a: &AtomicU64| a.load(Ordering::Relaxed);
-        let (last_snapshot, last_snapshot_span_s) = self
-            .last_snapshot
-            .try_lock()
-            .map(|g| *g)
-            .unwrap_or_default();
-        RecordingStatus {
-            files: l(&self.files),
-            files_deleted: l(&self.files_deleted),
-            lost: l(&self.lost),
-            snapshots: l(&self.snapshots),
-            last_snapshot,
-            last_snapshot_span_s,
-        }
-    }
-}
+//! Fixed-memory statistics for the loop (no allocation after construction).
 
 /// The samples of one statistics window (ns).
 #[derive(Debug, Clone)]

@@ -147,8 +147,9 @@ fn theta_scheme_steady_solves_and_reference_steps_allocate_nothing() {
 fn the_loop_allocates_nothing_while_a_transport_refuses_every_output_for_ten_minutes() {
     use friction_node::clock::SimClock;
     use friction_node::config::{Config, StepMode};
+    use friction_node::link::LiveStatus;
     use friction_node::msgs::{Command, CommandKind};
-    use friction_node::node::{LiveStatus, Loop};
+    use friction_node::node::Loop;
     use friction_node::transport::memory::MemoryLink;
     use friction_node::transport::PeerPort;
     use std::sync::atomic::AtomicBool;
@@ -240,10 +241,11 @@ fn a_prepared_model_swaps_in_between_two_steps_without_allocating() {
 fn a_parameter_change_is_applied_by_the_loop_between_two_steps_without_allocating() {
     use friction_node::config::parameters::{apply_set, declare};
     use friction_node::config::{Config, StepMode};
+    use friction_node::link::LiveStatus;
     use friction_node::link::{ParameterChannel, ParameterUpdate};
     use friction_node::msgs::ros_interfaces::{parameter_type, ParameterValue};
     use friction_node::msgs::{Command, CommandKind};
-    use friction_node::node::{LiveStatus, Loop};
+    use friction_node::node::Loop;
     use friction_node::transport::memory::MemoryLink;
     use friction_node::transport::PeerPort;
     use std::sync::Arc;
@@ -308,7 +310,8 @@ fn a_parameter_change_is_applied_by_the_loop_between_two_steps_without_allocatin
 #[test]
 fn a_loop_of_several_contacts_allocates_nothing_per_joint_state() {
     use friction_node::config::{Config, Origin};
-    use friction_node::node::{LiveStatus, Loop};
+    use friction_node::link::LiveStatus;
+    use friction_node::node::Loop;
     use friction_node::transport::memory::MemoryLink;
     use friction_node::transport::{JointStateCommand, PeerPort};
     use std::sync::Arc;

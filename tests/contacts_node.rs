@@ -5,8 +5,9 @@
 
 use friction_node::clock::SimClock;
 use friction_node::config::{Config, ContactList, Origin};
+use friction_node::link::LiveStatus;
 use friction_node::msgs::{estimate_constants as codes, Command, CommandKind, EstimateRecord};
-use friction_node::node::{LiveStatus, Loop, RunSummary};
+use friction_node::node::{Loop, RunSummary};
 use friction_node::transport::memory::MemoryLink;
 use friction_node::transport::{JointEfforts, JointStateCommand, PeerPort};
 use std::sync::atomic::AtomicBool;

@@ -5,8 +5,9 @@
 
 use friction_node::clock::SimClock;
 use friction_node::config::{Config, Envelope, StepMode};
+use friction_node::link::LiveStatus;
 use friction_node::msgs::{estimate_constants as codes, Command, CommandKind};
-use friction_node::node::{LiveStatus, Loop};
+use friction_node::node::Loop;
 use friction_node::transport::memory::MemoryLink;
 use friction_node::transport::PeerPort;
 use std::process::Command as Process;

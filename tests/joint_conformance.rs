@@ -9,8 +9,9 @@
 //! bounded generously.
 
 use friction_node::config::{Config, ContactList, Origin};
+use friction_node::link::LiveStatus;
 use friction_node::msgs::{estimate_constants as codes, EstimateRecord};
-use friction_node::node::{LiveStatus, Loop, RunSummary};
+use friction_node::node::{Loop, RunSummary};
 use friction_node::offline;
 use friction_node::signal::Signal;
 use friction_node::transport::{self, BackendSpec, JointEfforts, JointStateCommand, PeerPort};

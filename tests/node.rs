@@ -8,10 +8,11 @@ use common::{drain, timer_config};
 
 use friction_node::clock::{Clock, SimClock};
 use friction_node::config::{Config, StepMode, TimeoutBehaviour};
+use friction_node::link::LiveStatus;
 use friction_node::msgs::{
     estimate_constants as codes, Command, CommandKind, EstimateRecord, StatisticsRecord,
 };
-use friction_node::node::{LiveStatus, Loop, RunSummary};
+use friction_node::node::{Loop, RunSummary};
 use friction_node::transport::memory::{MemoryLink, MemoryNode};
 use friction_node::transport::{NodePort, PeerPort, PortCounters, TransportError};
 use std::sync::atomic::AtomicBool;

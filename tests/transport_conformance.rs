@@ -11,10 +11,11 @@
 //! generously; nothing sleeps and hopes.
 
 use friction_node::config::{CommandType, Config, Durability, Reliability, StepMode};
+use friction_node::link::LiveStatus;
 use friction_node::msgs::{
     estimate_constants as codes, Command, CommandKind, EstimateRecord, StatisticsRecord,
 };
-use friction_node::node::{LiveStatus, Loop, RunSummary};
+use friction_node::node::{Loop, RunSummary};
 use friction_node::offline;
 use friction_node::signal::Signal;
 use friction_node::transport::{self, BackendSpec};

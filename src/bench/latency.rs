@@ -29,8 +29,9 @@ pub fn latency(
     samples: usize,
     warmup: usize,
 ) -> Result<LatencyReport, crate::node::runner::RunError> {
+    use crate::link::LiveStatus;
     use crate::msgs::{Command, CommandKind};
-    use crate::node::{LiveStatus, Loop};
+    use crate::node::Loop;
     use std::sync::atomic::{AtomicBool, Ordering};
     use std::sync::Arc;
     use std::time::Duration;

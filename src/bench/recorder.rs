@@ -8,7 +8,8 @@
 use crate::clock::SimClock;
 use crate::config::topics::TopicNames;
 use crate::config::Config;
-use crate::msgs::{Command, CommandKind, EstimateRecord, RecordItem, StatisticsRecord};
+use crate::link::RecordItem;
+use crate::msgs::{Command, CommandKind, EstimateRecord, StatisticsRecord};
 use crate::record::{RecordPlan, Recorder, RecorderError, RecorderReport};
 use std::path::PathBuf;
 use std::sync::Arc;

@@ -427,36 +427,3 @@ pub struct RawSample {
     /// When the node took it from the transport (wall clock), ns.
     pub received_ns: u64,
 }
-
-/// What the loop and the transports hand to the recorder.
-// Items travel through preallocated lock-free queues: boxing the larger
-// variants would allocate on the loop.
-#[allow(clippy::large_enum_variant)]
-#[derive(Debug, Clone, PartialEq)]
-pub enum RecordItem {
-    /// A received command (transports without a serialized form: memory,
-    /// iceoryx2) and when it arrived (wall clock, ns); recorded as the
-    /// configured command type.
-    Command { command: Command, received_ns: u64 },
-    /// A received ROS 2 sample, recorded byte for byte.
-    Raw(RawSample),
-    /// An estimate of contact `contact` (0 with one contact) and when it
-    /// was published (wall clock, ns).
-    Estimate {
-        record: EstimateRecord,
-        logged_ns: u64,
-        contact: u16,
-    },
-    /// Loop statistics and when they were published (wall clock, ns).
-    Statistics {
-        record: StatisticsRecord,
-        logged_ns: u64,
-    },
-    /// An `rcl_interfaces/msg/ParameterEvent` (CDR with its encapsulation
-    /// header) stamped with the first step that used the new values.
-    ParameterEvent {
-        cdr: Vec<u8>,
-        stamp_ns: u64,
-        logged_ns: u64,
-    },
-}

@@ -52,36 +52,14 @@ use crate::config::{Config, StepMode};
 use crate::contacts::ContactSet;
 use crate::link::LoopSettings;
 use crate::link::ProfileSlot;
-use crate::msgs::RecordItem;
+use crate::link::{LiveStatus, RecordItem};
 use crate::physics::SetupError;
 use crate::stats::{Histogram, Window};
 use crate::transport::{NodePort, PortCounters};
 use crossbeam_queue::ArrayQueue;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 use std::time::Duration;
-
-/// Live values for a status line (written by the loop, read anywhere).
-#[derive(Debug, Default)]
-pub struct LiveStatus {
-    pub steps: AtomicU64,
-    pub deadline_misses: AtomicU64,
-    pub commands_applied: AtomicU64,
-    pub commands_rejected: AtomicU64,
-    pub drops: AtomicU64,
-    pub velocity_bits: AtomicU64,
-    pub friction_bits: AtomicU64,
-    pub cof_bits: AtomicU64,
-    pub h0_bits: AtomicU64,
-    pub compute_ns: AtomicU64,
-    pub status: AtomicU64,
-}
-
-impl LiveStatus {
-    pub fn f(v: &AtomicU64) -> f64 {
-        f64::from_bits(v.load(Ordering::Relaxed))
-    }
-}
 
 /// What a run reports when it ends (and what LoopStatistics carries).
 #[derive(Debug, Clone, Default)]
@@ -168,7 +146,7 @@ pub struct Loop {
     started_ns: u64,
     /// Timer mode: steps counted as already taken when the run starts.
     first_step: u64,
-    recorder: Option<Arc<crate::stats::RecorderCounters>>,
+    recorder: Option<Arc<crate::link::RecorderCounters>>,
     /// Parameter changes while running (see [`parameters`]).
     parameters: Option<Arc<crate::link::ParameterChannel>>,
 }
@@ -264,7 +242,7 @@ impl Loop {
 
     /// Report the recorder's counters (files, deletions, snapshots) in the
     /// loop statistics.
-    pub fn with_recorder(mut self, counters: Arc<crate::stats::RecorderCounters>) -> Self {
+    pub fn with_recorder(mut self, counters: Arc<crate::link::RecorderCounters>) -> Self {
         self.recorder = Some(counters);
         self
     }

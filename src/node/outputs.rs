@@ -3,7 +3,8 @@
 
 use super::Loop;
 use crate::config::StepMode;
-use crate::msgs::{EstimateRecord, RecordItem, StatisticsRecord};
+use crate::link::RecordItem;
+use crate::msgs::{EstimateRecord, StatisticsRecord};
 use crate::physics::Estimate;
 use std::sync::atomic::Ordering;
 

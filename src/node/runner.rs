@@ -2,8 +2,9 @@
 //! demo driver and the live status line around the [`Loop`].
 
 use super::driver::DemoReport;
-use super::{rt, LiveStatus, Loop, NodeError, RunSummary};
+use super::{rt, Loop, NodeError, RunSummary};
 use crate::config::{Config, TransportKind};
+use crate::link::LiveStatus;
 use crate::link::ProfileSlot;
 use crate::transport::{self, BackendSpec, NodePort, TransportError};
 use std::path::{Path, PathBuf};
@@ -130,10 +131,10 @@ fn status_thread(
             let line = format!(
                 "t {:7.2} s | v {:+6.3} m/s | F {:+9.1} N | COF {:.4} | h0 {:6.3} µm | step {:5.1} µs | {} {} | miss {} | rejected {} | drops {}",
                 n as f64 * dt,
-                LiveStatus::f(&live.velocity_bits),
-                LiveStatus::f(&live.friction_bits),
-                LiveStatus::f(&live.cof_bits),
-                LiveStatus::f(&live.h0_bits) * 1e6,
+                LiveStatus::load_f64(&live.velocity_bits),
+                LiveStatus::load_f64(&live.friction_bits),
+                LiveStatus::load_f64(&live.cof_bits),
+                LiveStatus::load_f64(&live.h0_bits) * 1e6,
                 live.compute_ns.load(Ordering::Relaxed) as f64 / 1e3,
                 n,
                 crate::msgs::status_name(live.status.load(Ordering::Relaxed) as u8),

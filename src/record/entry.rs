@@ -4,7 +4,8 @@
 
 use crate::config::CommandType;
 use crate::link::ProfileData;
-use crate::msgs::{self, Command, CommandKind, Float64, Header, RecordItem, Time, TwistStamped};
+use crate::link::RecordItem;
+use crate::msgs::{self, Command, CommandKind, Float64, Header, Time, TwistStamped};
 
 /// The node's recorded topics.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]

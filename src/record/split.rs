@@ -18,7 +18,7 @@ use super::RecorderError;
 use crate::bag::rosbag2::{FileInfo, Metadata, Nanoseconds, Since, TopicMetadata, TopicWithCount};
 use crate::config::topics::TopicNames;
 use crate::config::Config;
-use crate::stats::RecorderCounters;
+use crate::link::RecorderCounters;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;

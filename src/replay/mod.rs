@@ -41,8 +41,9 @@ use crate::bag::{
     TopicDecoder,
 };
 use crate::config::{Config, ConfigError, Origin};
+use crate::link::LiveStatus;
 use crate::msgs::{self, Command, CommandKind, EstimateRecord};
-use crate::node::{LiveStatus, Loop, NodeError};
+use crate::node::{Loop, NodeError};
 use crate::physics::Estimate;
 use crate::transport::memory::MemoryLink;
 use crate::transport::PeerPort;

@@ -103,7 +103,7 @@ impl McapSink {
 
     fn commands_up_to(&mut self, stamp: u64) -> Result<(), String> {
         while let Some(&c) = self.commands.get(self.next).filter(|c| c.stamp_ns <= stamp) {
-            let item = msgs::RecordItem::Command {
+            let item = crate::link::RecordItem::Command {
                 command: c,
                 received_ns: c.stamp_ns,
             };
@@ -118,11 +118,12 @@ impl Sink for McapSink {
     fn write(&mut self, steps: &[Step]) -> Result<(), String> {
         for (_, rec, k) in steps {
             self.commands_up_to(rec.stamp_ns)?;
-            self.writer()?.write_item(&msgs::RecordItem::Estimate {
-                record: *rec,
-                logged_ns: rec.stamp_ns,
-                contact: *k,
-            })?;
+            self.writer()?
+                .write_item(&crate::link::RecordItem::Estimate {
+                    record: *rec,
+                    logged_ns: rec.stamp_ns,
+                    contact: *k,
+                })?;
         }
         Ok(())
     }

@@ -11,7 +11,8 @@ use super::{
     PortCounters, RecordQueue, SharedCounters, TransportError,
 };
 use crate::clock::system_wall_ns;
-use crate::msgs::{Command, EstimateRecord, RecordItem, StatisticsRecord};
+use crate::link::RecordItem;
+use crate::msgs::{Command, EstimateRecord, StatisticsRecord};
 use crossbeam_queue::ArrayQueue;
 use std::sync::Arc;
 use std::time::{Duration, Instant};

@@ -24,7 +24,8 @@ pub mod iceoryx;
 pub mod ros2;
 
 use crate::link::ProfileSlot;
-use crate::msgs::{Command, EstimateRecord, RecordItem, StatisticsRecord};
+use crate::link::RecordItem;
+use crate::msgs::{Command, EstimateRecord, StatisticsRecord};
 use crossbeam_queue::ArrayQueue;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;

@@ -12,7 +12,8 @@
 use super::{err, service, ContactEstimatePayload, EffortsPayload, EstimatePayload};
 use super::{IceoryxSpec, JointStatePayload, Sequences, JOINT_NAME_BYTES};
 use crate::clock::system_wall_ns;
-use crate::msgs::{Command, EstimateRecord, RecordItem};
+use crate::link::RecordItem;
+use crate::msgs::{Command, EstimateRecord};
 use crate::transport::{
     joint_commands, record_input, JointEfforts, JointStateCommand, RecordQueue, SharedCounters,
     TransportError, MAX_CONTACTS,

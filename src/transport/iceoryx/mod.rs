@@ -29,7 +29,8 @@ use super::{
 };
 use crate::clock::system_wall_ns;
 use crate::config::Iceoryx2Config;
-use crate::msgs::{Command, CommandKind, EstimateRecord, RecordItem, StatisticsRecord};
+use crate::link::RecordItem;
+use crate::msgs::{Command, CommandKind, EstimateRecord, StatisticsRecord};
 use iceoryx2::identifiers::UniquePublisherId;
 use iceoryx2::prelude::*;
 use iceoryx2::service::port_factory::PortFactory;

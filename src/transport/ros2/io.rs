@@ -6,10 +6,11 @@ use super::{advertise, context, err, qos, ros_node, topic, Out, Ros2Spec};
 use crate::clock::system_wall_ns;
 use crate::config::CommandType;
 use crate::link::ProfileSlot;
+use crate::link::RecordItem;
 use crate::msgs::{
     self, Command, CommandKind, FilmProfile, Float64, FrictionEstimate, Header, LoopStatistics,
-    RawSample, RecordItem, Time, TwistStamped, FILM_PROFILE, FLOAT64, FRICTION_ESTIMATE,
-    LOOP_STATISTICS, TWIST_STAMPED,
+    RawSample, Time, TwistStamped, FILM_PROFILE, FLOAT64, FRICTION_ESTIMATE, LOOP_STATISTICS,
+    TWIST_STAMPED,
 };
 use crate::transport::{record_input, RecordQueue, SharedCounters, TransportError};
 use crossbeam_queue::ArrayQueue;

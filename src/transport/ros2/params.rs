@@ -405,14 +405,14 @@ pub fn event(node_fqn: &str, u: &ParameterUpdate) -> crate::msgs::ros_interfaces
 /// Hand an applied update's event to the recorder (replay re-applies it at
 /// the same step); `logged_ns` is the wall time now.
 pub fn record_applied(
-    queue: &crossbeam_queue::ArrayQueue<crate::msgs::RecordItem>,
+    queue: &crossbeam_queue::ArrayQueue<crate::link::RecordItem>,
     node_fqn: &str,
     u: &ParameterUpdate,
     logged_ns: u64,
 ) -> Result<(), String> {
     let cdr = crate::msgs::to_cdr(&event(node_fqn, u))?;
     queue
-        .push(crate::msgs::RecordItem::ParameterEvent {
+        .push(crate::link::RecordItem::ParameterEvent {
             cdr,
             stamp_ns: u.applied_stamp_ns,
             logged_ns,
