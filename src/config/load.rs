@@ -115,11 +115,7 @@ impl Config {
         origin: &Origin,
         overrides: &[String],
     ) -> Result<Config, ConfigError> {
-        let doc: Value = serde_norway::from_str(text).map_err(|e| ConfigError::Syntax {
-            origin: origin.to_string(),
-            message: e.to_string(),
-        })?;
-        let mut params = ros_parameters(doc, origin)?;
+        let mut params = parse_params(text, origin)?;
         for o in overrides {
             apply_override(&mut params, o)?;
         }
@@ -135,11 +131,7 @@ impl Config {
         origin: &Origin,
         overrides: &[String],
     ) -> Result<Config, ConfigError> {
-        let doc: Value = serde_norway::from_str(text).map_err(|e| ConfigError::Syntax {
-            origin: origin.to_string(),
-            message: e.to_string(),
-        })?;
-        let mut params = ros_parameters(doc, origin)?;
+        let mut params = parse_params(text, origin)?;
         for (key, value) in RECORDED_BEFORE {
             if lookup(&params, key).is_none() {
                 apply_override(&mut params, &format!("{key}={value}"))?;
@@ -167,6 +159,15 @@ impl Config {
         cfg.validate()?;
         Ok(cfg)
     }
+}
+
+/// The `ros__parameters` tree of parameter-file text.
+fn parse_params(text: &str, origin: &Origin) -> Result<Value, ConfigError> {
+    let doc: Value = serde_norway::from_str(text).map_err(|e| ConfigError::Syntax {
+        origin: origin.to_string(),
+        message: e.to_string(),
+    })?;
+    ros_parameters(doc, origin)
 }
 
 /// Keys added after the first recordings, with the value that reproduces a
