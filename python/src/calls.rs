@@ -17,7 +17,6 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use std::time::Instant;
 
 /// The built-in default parameter file.
 #[pyfunction]
@@ -95,82 +94,70 @@ pub fn replay<'py>(
     out: Option<PathBuf>,
     report_dir: Option<PathBuf>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    use friction_node::bag::Bag;
-    use friction_node::replay::{self as rp, OutputFormat, OutputStream, ReplayOptions};
-    let started = Instant::now();
-    let format = match &out {
-        Some(o) => Some(OutputFormat::from_path(o).ok_or_else(|| {
-            errors::value(format!(
-                "out = {}: the output must end in .mcap or .csv",
-                o.display()
-            ))
-        })?),
+    use friction_node::replay::{OutputFormat, ReplayOptions, ReplayRequest};
+    let out = match out {
+        Some(o) => {
+            let format = OutputFormat::from_path(&o).ok_or_else(|| {
+                errors::value(format!(
+                    "out = {}: the output must end in .mcap or .csv",
+                    o.display()
+                ))
+            })?;
+            Some((o, format))
+        }
         None => None,
     };
-    let opts = ReplayOptions {
-        topic: text_or_none(topic),
-        joint: text_or_none(joint),
-        load_topic: text_or_none(load_topic),
-        temperature_topic: text_or_none(temperature_topic),
-        config: config_path,
-        overrides,
-        velocity_map,
-        load_map,
+    let request = ReplayRequest {
+        bag,
+        options: ReplayOptions {
+            topic: text_or_none(topic),
+            joint: text_or_none(joint),
+            load_topic: text_or_none(load_topic),
+            temperature_topic: text_or_none(temperature_topic),
+            config: config_path,
+            overrides,
+            velocity_map,
+            load_map,
+        },
+        out,
+        report: report_dir,
     };
     let in_bag = |e: PyErr| -> PyErr {
-        let message = format!("bag {}: {}", bag.display(), e.value(py));
+        let message = format!("bag {}: {}", request.bag.display(), e.value(py));
         if e.is_instance_of::<pyo3::exceptions::PyOSError>(py) {
             e
         } else {
             errors::value(message)
         }
     };
-    let (prepared, result, written, wall, model_wall) =
-        crate::interrupts::interruptible(py, |stop| -> PyResult<_> {
-            let b = Bag::open(&bag).map_err(errors::bag)?;
-            let prepared = rp::prepare(&b, &opts).map_err(errors::replay)?;
-            if let Some(r) = &report_dir {
-                friction_node::output::prepare_dir(r).map_err(|e| errors::os(e.to_string()))?;
-            }
-            let mut stream = match (&out, format) {
-                (Some(o), Some(f)) => {
-                    Some(OutputStream::start(o, f, &prepared, &bag).map_err(errors::replay)?)
-                }
-                _ => None,
-            };
-            let model_started = Instant::now();
-            let result = rp::run(&prepared, &mut |_, _| stop.check(), &mut |e, rec, k| {
-                if let Some(s) = stream.as_mut() {
-                    s.push(e, rec, k)
-                }
-            })
-            .map_err(errors::replay)?;
-            let model_wall = model_started.elapsed().as_secs_f64();
-            let written = match stream {
-                Some(s) => Some(s.finish(result.oracle.as_ref()).map_err(errors::replay)?),
-                None => None,
-            };
-            let wall = started.elapsed().as_secs_f64();
-            if let Some(r) = &report_dir {
-                rp::write_report(r, &bag, &prepared, &result, wall)
-                    .map_err(|e| errors::os(e.to_string()))?;
-            }
-            Ok((prepared, result, written, wall, model_wall))
-        })?
-        .map_err(in_bag)?;
-    // Columns as the CSV output has them: t_s from the first stamp; with
-    // several contacts every contact's rows, named in a `contact` column.
+    let outcome = crate::interrupts::interruptible(py, |stop| -> PyResult<_> {
+        let ready = request.prepare().map_err(errors::replay)?;
+        ready.run(&mut |_, _| stop.check()).map_err(errors::replay)
+    })?
+    .map_err(in_bag)?;
+    let d = PyDict::new(py);
+    d.set_item("estimates", estimate_columns(py, &outcome.result)?)?;
+    d.set_item("cycles", cycle_columns(py, &outcome)?)?;
+    d.set_item("summary", replay_summary(py, &request.bag, &outcome)?)?;
+    Ok(d)
+}
+
+/// The replayed estimates as the CSV output has them: t_s from the first
+/// stamp; with several contacts every contact's rows, named in a `contact`
+/// column.
+fn estimate_columns<'py>(
+    py: Python<'py>,
+    result: &friction_node::replay::ReplayResult,
+) -> PyResult<Bound<'py, PyDict>> {
     let t0 = result.estimates.first().map_or(0, |(_, r)| r.stamp_ns);
-    let one = [(String::new(), &result.estimates)];
-    let several: Vec<(String, &Vec<_>)> = result
-        .contacts
-        .iter()
-        .map(|c| (c.name.clone(), &c.estimates))
-        .collect();
-    let parts: Vec<(String, &Vec<_>)> = if several.is_empty() {
-        one.iter().map(|(n, e)| (n.clone(), *e)).collect()
+    let parts: Vec<(&str, &Vec<_>)> = if result.contacts.is_empty() {
+        vec![("", &result.estimates)]
     } else {
-        several
+        result
+            .contacts
+            .iter()
+            .map(|c| (c.name.as_str(), &c.estimates))
+            .collect()
     };
     let rows: usize = parts.iter().map(|(_, e)| e.len()).sum();
     let mut c = Columns::with_capacity(rows);
@@ -181,17 +168,23 @@ pub fn replay<'py>(
             c.push(e, t, msgs::status_name(rec.status), rec.temperature_c);
             c.push_stamp(rec.stamp_ns, msgs::command_status_name(rec.command_status));
             if !result.contacts.is_empty() {
-                names.push(name.clone());
+                names.push(name.to_string());
             }
         }
     }
-    let d = PyDict::new(py);
     let est = c.into_dict(py)?;
     if !names.is_empty() {
         est.set_item("contact", names)?;
     }
-    d.set_item("estimates", est)?;
-    let cycles = rp::cycles(&result, prepared.config.contact.mass_kg);
+    Ok(est)
+}
+
+/// The loop metrics of every velocity cycle (the report's `cycles.csv`).
+fn cycle_columns<'py>(
+    py: Python<'py>,
+    o: &friction_node::replay::ReplayOutcome,
+) -> PyResult<Bound<'py, PyDict>> {
+    let cycles = friction_node::replay::cycles(&o.result, o.prepared.config.contact.mass_kg);
     let cd = PyDict::new(py);
     cd.set_item(
         "cycle",
@@ -212,21 +205,25 @@ pub fn replay<'py>(
             .collect();
         cd.set_item(name, PyArray1::from_vec(py, col))?;
     }
-    d.set_item("cycles", cd)?;
+    Ok(cd)
+}
+
+/// The command line's summary lines as a dict.
+fn replay_summary<'py>(
+    py: Python<'py>,
+    bag: &Path,
+    o: &friction_node::replay::ReplayOutcome,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (prepared, result) = (&o.prepared, &o.result);
     let s = PyDict::new(py);
-    let e = &result.estimates;
-    let span = match (e.first(), e.last()) {
-        (Some(a), Some(b)) => b.1.stamp_ns.saturating_sub(a.1.stamp_ns) as f64 / 1e9,
-        _ => 0.0,
-    };
     s.set_item("bag", bag.display().to_string())?;
     s.set_item("input", prepared.mode.describe())?;
     s.set_item("configuration", &prepared.config_source)?;
     s.set_item("velocity_messages", prepared.velocity_messages)?;
-    s.set_item("steps", e.len())?;
-    s.set_item("span_s", span)?;
-    s.set_item("wall_s", wall)?;
-    s.set_item("model_wall_s", model_wall)?;
+    s.set_item("steps", result.estimates.len())?;
+    s.set_item("span_s", o.span_s())?;
+    s.set_item("wall_s", o.wall_s)?;
+    s.set_item("model_wall_s", o.model_wall_s)?;
     s.set_item("commands_rejected", result.commands_rejected)?;
     s.set_item("gaps", prepared.gaps.len())?;
     s.set_item("files", prepared.scan.files.len())?;
@@ -235,22 +232,14 @@ pub fn replay<'py>(
         prepared.scan.damage.as_ref().map(|d| d.to_string()),
     )?;
     s.set_item("parameter_changes", prepared.parameter_changes.len())?;
-    match &result.oracle {
-        Some(o) => {
-            s.set_item("identical", o.identical)?;
-            s.set_item("compared", o.compared)?;
-            let devs = PyList::empty(py);
-            for (f, dmax, k) in &o.deviations {
-                devs.append((*f, *dmax, *k))?;
-            }
-            s.set_item("deviations", devs)?;
-        }
-        None => {
-            s.set_item("identical", py.None())?;
-            s.set_item("compared", 0)?;
-            s.set_item("deviations", PyList::empty(py))?;
-        }
+    let oracle = result.oracle.as_ref();
+    s.set_item("identical", oracle.map(|o| o.identical))?;
+    s.set_item("compared", oracle.map_or(0, |o| o.compared))?;
+    let devs = PyList::empty(py);
+    for (f, dmax, k) in oracle.map_or(&[][..], |o| &o.deviations[..]) {
+        devs.append((*f, *dmax, *k))?;
     }
+    s.set_item("deviations", devs)?;
     let contacts = PyList::empty(py);
     for c in &result.contacts {
         let o = c.oracle.as_ref();
@@ -261,9 +250,8 @@ pub fn replay<'py>(
         ))?;
     }
     s.set_item("contacts", contacts)?;
-    s.set_item("out", written.map(|p| p.display().to_string()))?;
-    d.set_item("summary", s)?;
-    Ok(d)
+    s.set_item("out", o.written.as_ref().map(|p| p.display().to_string()))?;
+    Ok(s)
 }
 
 fn outcome_dict<'py>(py: Python<'py>, o: &FitOutcome) -> PyResult<Bound<'py, PyDict>> {

@@ -1,201 +1,90 @@
-//! `replay`: the model over the velocity recorded in a bag.
+//! `replay`: the model over the velocity recorded in a bag, through the
+//! same [`ReplayRequest`] as Python's `friction_node.replay()`.
 
 use super::args::{FormatArg, ReplayArgs};
-use anyhow::{Context, Result};
-use std::path::PathBuf;
+use anyhow::Result;
+use friction_node::replay::{
+    gap_list, OutputFormat, ReadyReplay, ReplayOptions, ReplayOutcome, ReplayRequest,
+};
+use std::path::{Path, PathBuf};
 
-pub fn run(args: ReplayArgs, config: Option<PathBuf>, overrides: Vec<String>) -> Result<()> {
-    use friction_node::bag::Bag;
-    use friction_node::replay::{self, OutputFormat, OutputStream, ReplayOptions};
-    let ReplayArgs {
-        bag: bag_path,
-        topic,
-        joint,
-        load_topic,
-        temperature_topic,
-        velocity_map,
-        load_map,
-        out,
-        format,
-        report,
-        expect_identical,
-    } = args;
-    let started = std::time::Instant::now();
-    let format = match (format, OutputFormat::from_path(&out)) {
-        (Some(FormatArg::Csv), _) => OutputFormat::Csv,
-        (Some(FormatArg::Mcap), _) => OutputFormat::Mcap,
-        (None, Some(f)) => f,
+/// The output's format: `--format`, else the file's extension.
+fn output_format(out: &Path, format: Option<FormatArg>) -> Result<OutputFormat> {
+    match (format, OutputFormat::from_path(out)) {
+        (Some(FormatArg::Csv), _) => Ok(OutputFormat::Csv),
+        (Some(FormatArg::Mcap), _) => Ok(OutputFormat::Mcap),
+        (None, Some(f)) => Ok(f),
         (None, None) => anyhow::bail!(
             "--out {}: the output must end in .mcap or .csv, or give --format csv|mcap",
             out.display()
         ),
+    }
+}
+
+/// The request the arguments describe.
+fn request(
+    args: ReplayArgs,
+    config: Option<PathBuf>,
+    overrides: Vec<String>,
+) -> Result<(ReplayRequest, bool)> {
+    let format = output_format(&args.out, args.format)?;
+    let request = ReplayRequest {
+        bag: args.bag,
+        options: ReplayOptions {
+            topic: args.topic,
+            joint: args.joint,
+            load_topic: args.load_topic,
+            temperature_topic: args.temperature_topic,
+            config,
+            overrides,
+            velocity_map: args.velocity_map,
+            load_map: args.load_map,
+        },
+        out: Some((args.out, format)),
+        report: args.report,
     };
-    // Validate the input completely before touching any output.
-    let in_bag = || format!("bag {}", bag_path.display());
-    let bag = Bag::open(&bag_path)?;
-    let opts = ReplayOptions {
-        topic,
-        joint,
-        load_topic,
-        temperature_topic,
-        config,
-        overrides,
-        velocity_map,
-        load_map,
-    };
-    let prepared = replay::prepare(&bag, &opts).with_context(in_bag)?;
-    if expect_identical && !prepared.mode.has_recorded_estimates() {
+    Ok((request, args.expect_identical))
+}
+
+pub fn run(args: ReplayArgs, config: Option<PathBuf>, overrides: Vec<String>) -> Result<()> {
+    let (request, expect_identical) = request(args, config, overrides)?;
+    let bag = request.bag.display().to_string();
+    // The input is validated completely before any output is touched.
+    let ready = request.prepare().map_err(|e| {
+        if e.names_the_bag() {
+            anyhow::Error::new(e)
+        } else {
+            anyhow::Error::new(e).context(format!("bag {bag}"))
+        }
+    })?;
+    let mode = &ready.prepared.mode;
+    if expect_identical && !mode.has_recorded_estimates() {
         // Nothing to compare: not a difference (3), its own status.
         eprintln!(
-            "error: --expect-identical: bag {} holds no estimates recorded by friction-node ({}), so there is nothing to compare the replay with; replay it without --expect-identical",
-            bag_path.display(),
-            prepared.mode.describe()
+            "error: --expect-identical: bag {bag} holds no estimates recorded by friction-node ({}), so there is nothing to compare the replay with; replay it without --expect-identical",
+            mode.describe()
         );
         std::process::exit(5);
     }
-    if let Some(r) = &report {
-        friction_node::output::prepare_dir(r)?;
-    }
-    let steps = prepared
-        .commands
-        .iter()
-        .filter(|c| {
-            matches!(
-                c.kind,
-                friction_node::msgs::CommandKind::Velocity
-                    | friction_node::msgs::CommandKind::JointVelocity { last: true, .. }
-            )
-        })
-        .count();
-    eprintln!(
-        "replay {}: {} ({} velocity messages → {} steps of {} s), configuration {}",
-        bag_path.display(),
-        prepared.mode.describe(),
-        prepared.velocity_messages,
-        steps,
-        prepared.config.solver.dt_s,
-        prepared.config_source,
-    );
-    if let Some(d) = &prepared.scan.damage {
-        eprintln!("warning: the bag is damaged {d}; replaying everything before it");
-    }
-    if !prepared.gaps.is_empty() {
-        eprintln!(
-            "warning: {} velocity gaps longer than node.command_timeout_s = {} s (the node's timeout rule applied): {}",
-            prepared.gaps.len(),
-            prepared.config.node.command_timeout_s,
-            replay::gap_list(&prepared.gaps, prepared.commands.first().map_or(0, |c| c.stamp_ns))
-        );
-    }
-    // Written to a temporary sibling while the model runs; moved into place
-    // only when complete.
-    let mut stream = OutputStream::start(&out, format, &prepared, &bag_path)?;
-    let bar = super::progress::bar(prepared.commands.len() as u64, "commands");
+    print_input(&bag, &ready);
+    let bar = super::progress::bar(ready.prepared.commands.len() as u64, "commands");
     let stop = friction_node::interrupt::Stop::process();
-    let model_started = std::time::Instant::now();
-    let result = replay::run(
-        &prepared,
-        &mut |done, _| {
-            bar.set_position(done as u64);
-            stop.check()
-        },
-        &mut |e, rec, k| stream.push(e, rec, k),
-    )?;
-    let model_wall = model_started.elapsed().as_secs_f64();
+    let outcome = ready.run(&mut |done, _| {
+        bar.set_position(done as u64);
+        stop.check()
+    })?;
     bar.finish_and_clear();
-    let written = stream.finish(result.oracle.as_ref())?;
-    let wall = started.elapsed().as_secs_f64();
-    let e = &result.estimates;
-    let span = match (e.first(), e.last()) {
-        (Some(a), Some(b)) => (b.1.stamp_ns.saturating_sub(a.1.stamp_ns)) as f64 / 1e9,
-        _ => 0.0,
-    };
-    println!(
-        "steps            {} over {:.3} s of bag time",
-        e.len(),
-        span
-    );
-    let rate = |w: f64| if w > 0.0 { span / w } else { f64::NAN };
-    println!(
-        "replay time      {:.3} s ({:.0}× real time; reading, model and writing), model {:.3} s ({:.0}×)",
-        wall,
-        rate(wall),
-        model_wall,
-        rate(model_wall)
-    );
-    if prepared.scan.files.len() > 1 {
-        println!(
-            "bag              rosbag2 directory: {} split files, replayed in order as one run",
-            prepared.scan.files.len()
-        );
+    print_outcome(&outcome);
+    print_contacts(&outcome);
+    let identical = print_determinism(&outcome);
+    if let Some(w) = &outcome.written {
+        println!("wrote {}", w.display());
     }
-    println!("commands         {} rejected", result.commands_rejected);
-    if !prepared.parameter_changes.is_empty() {
-        println!(
-            "parameters       {} changes re-applied at the steps that used them (recorded /parameter_events)",
-            prepared.parameter_changes.len()
-        );
-    }
-    if let Some(d) = &prepared.scan.damage {
-        println!("damaged bag      stopped {d}");
-    }
-    if !result.contacts.is_empty() {
-        println!(
-            "contacts         {} replayed together (the report and figures show the first, `{}`)",
-            result.contacts.len(),
-            result.contacts[0].name
-        );
-        for c in &result.contacts {
-            if c.oracle.is_none() {
-                println!("  {:<22} {} steps", c.name, c.estimates.len());
-            }
-            if let Some(o) = &c.oracle {
-                println!(
-                    "  {:<22} {}",
-                    c.name,
-                    if o.identical {
-                        format!("bit-identical ({} steps)", o.compared)
-                    } else {
-                        let worst = o
-                            .deviations
-                            .iter()
-                            .map(|d| format!("{} {:.3e}", d.0, d.1))
-                            .collect::<Vec<_>>()
-                            .join(", ");
-                        format!("DIFFERS over {} steps: {worst}", o.compared)
-                    }
-                );
-            }
-        }
-    }
-    let mut identical = true;
-    if let Some(o) = &result.oracle {
-        identical = o.identical;
-        if o.identical {
-            println!(
-                "determinism      bit-identical to the recorded estimates ({} steps)",
-                o.compared
-            );
-        } else {
-            println!(
-                "determinism      DIFFERS from the recording over {} steps:",
-                o.compared
-            );
-            for (f, d, k) in &o.deviations {
-                println!("                 {f:<22} up to {d:.3e} (first largest at step {k})");
-            }
-            if let Some((a, b)) = o.count_mismatch {
-                println!("                 {a} steps recorded, {b} replayed");
-            }
-        }
-    }
-    println!("wrote {}", written.display());
-    if let Some(r) = &report {
-        let files = replay::write_report(r, &bag_path, &prepared, &result, wall)?;
+    if let Some(r) = &request.report {
         println!(
             "report           {} ({} files)",
             r.join("summary.md").display(),
-            files.len()
+            outcome.report_files.len()
         );
     }
     if expect_identical && !identical {
@@ -203,4 +92,118 @@ pub fn run(args: ReplayArgs, config: Option<PathBuf>, overrides: Vec<String>) ->
         std::process::exit(3);
     }
     Ok(())
+}
+
+/// What will be replayed, and warnings about the input (stderr).
+fn print_input(bag: &str, ready: &ReadyReplay<'_>) {
+    let p = &ready.prepared;
+    eprintln!(
+        "replay {bag}: {} ({} velocity messages → {} steps of {} s), configuration {}",
+        p.mode.describe(),
+        p.velocity_messages,
+        ready.steps(),
+        p.config.solver.dt_s,
+        p.config_source,
+    );
+    if let Some(d) = &p.scan.damage {
+        eprintln!("warning: the bag is damaged {d}; replaying everything before it");
+    }
+    if !p.gaps.is_empty() {
+        eprintln!(
+            "warning: {} velocity gaps longer than node.command_timeout_s = {} s (the node's timeout rule applied): {}",
+            p.gaps.len(),
+            p.config.node.command_timeout_s,
+            gap_list(&p.gaps, p.commands.first().map_or(0, |c| c.stamp_ns))
+        );
+    }
+}
+
+/// Steps, speed and what the input held.
+fn print_outcome(o: &ReplayOutcome) {
+    let (p, r) = (&o.prepared, &o.result);
+    let span = o.span_s();
+    println!(
+        "steps            {} over {:.3} s of bag time",
+        r.estimates.len(),
+        span
+    );
+    let rate = |w: f64| if w > 0.0 { span / w } else { f64::NAN };
+    println!(
+        "replay time      {:.3} s ({:.0}× real time; reading, model and writing), model {:.3} s ({:.0}×)",
+        o.wall_s,
+        rate(o.wall_s),
+        o.model_wall_s,
+        rate(o.model_wall_s)
+    );
+    if p.scan.files.len() > 1 {
+        println!(
+            "bag              rosbag2 directory: {} split files, replayed in order as one run",
+            p.scan.files.len()
+        );
+    }
+    println!("commands         {} rejected", r.commands_rejected);
+    if !p.parameter_changes.is_empty() {
+        println!(
+            "parameters       {} changes re-applied at the steps that used them (recorded /parameter_events)",
+            p.parameter_changes.len()
+        );
+    }
+    if let Some(d) = &p.scan.damage {
+        println!("damaged bag      stopped {d}");
+    }
+}
+
+/// Several contacts: each one's steps or verdict.
+fn print_contacts(o: &ReplayOutcome) {
+    let contacts = &o.result.contacts;
+    if contacts.is_empty() {
+        return;
+    }
+    println!(
+        "contacts         {} replayed together (the report and figures show the first, `{}`)",
+        contacts.len(),
+        contacts[0].name
+    );
+    for c in contacts {
+        let verdict = match &c.oracle {
+            None => format!("{} steps", c.estimates.len()),
+            Some(o) if o.identical => format!("bit-identical ({} steps)", o.compared),
+            Some(o) => {
+                let worst = o
+                    .deviations
+                    .iter()
+                    .map(|d| format!("{} {:.3e}", d.0, d.1))
+                    .collect::<Vec<_>>()
+                    .join(", ");
+                format!("DIFFERS over {} steps: {worst}", o.compared)
+            }
+        };
+        println!("  {:<22} {verdict}", c.name);
+    }
+}
+
+/// The determinism oracle's verdict; whether the replay is identical (true
+/// when there was nothing to compare).
+fn print_determinism(o: &ReplayOutcome) -> bool {
+    let Some(o) = &o.result.oracle else {
+        return true;
+    };
+    if o.identical {
+        println!(
+            "determinism      bit-identical to the recorded estimates ({} steps)",
+            o.compared
+        );
+        return true;
+    }
+    println!(
+        "determinism      DIFFERS from the recording over {} steps:",
+        o.compared
+    );
+    for (f, d, k) in &o.deviations {
+        println!("                 {f:<22} up to {d:.3e} (first largest at step {k})");
+    }
+    if let Some((a, b)) = o.count_mismatch {
+        println!("                 {a} steps recorded, {b} replayed");
+    }
+    false
 }

@@ -174,6 +174,187 @@ fn spin_under_fifo(config: &Config) -> Option<String> {
         })
 }
 
+/// A ROS 2 transport whose discovery leaves the host says so.
+fn discovery_warnings(specs: &[BackendSpec]) -> Vec<String> {
+    #[cfg(feature = "ros2")]
+    return specs
+        .iter()
+        .filter_map(|s| match s {
+            BackendSpec::Ros2(r) if !r.localhost_only => Some(format!(
+                "ROS 2 discovery range SUBNET: DDS traffic (multicast included) goes to every interface (domain {})",
+                r.domain_id
+            )),
+            _ => None,
+        })
+        .collect();
+    #[cfg(not(feature = "ros2"))]
+    {
+        let _ = specs;
+        Vec::new()
+    }
+}
+
+/// The recording's file: `--record`, else `recording.path` (or a stamped
+/// name under `bags/`) when recording is enabled.
+fn record_path(config: &Config, opts: &RunOptions) -> Option<PathBuf> {
+    opts.record.clone().or_else(|| {
+        config.recording.enabled.then(|| {
+            if config.recording.path.is_empty() {
+                default_recording_path(Path::new("bags"), config.recording.splits())
+            } else {
+                PathBuf::from(&config.recording.path)
+            }
+        })
+    })
+}
+
+/// The recorder (and the snapshot ring), checked and created before
+/// anything runs: a path that cannot be recorded into is an error now, not a
+/// surprise later.
+#[cfg(feature = "mcap")]
+fn start_recorder(
+    config: &Config,
+    record_path: Option<PathBuf>,
+    profile: Option<Arc<ProfileSlot>>,
+    warnings: &mut Vec<String>,
+) -> Result<Option<crate::record::Recorder>, RunError> {
+    if record_path.is_none() && config.recording.snapshot_s == 0 {
+        return Ok(None);
+    }
+    let snapshot_dir = record_path
+        .as_deref()
+        .and_then(|p| p.parent())
+        .filter(|p| !p.as_os_str().is_empty())
+        .map_or_else(|| PathBuf::from("bags"), Path::to_path_buf);
+    let plan = crate::record::RecordPlan {
+        path: record_path,
+        snapshot_dir,
+    };
+    let r = crate::record::Recorder::start(
+        plan,
+        config,
+        &crate::config::topics::TopicNames::from_config(config),
+        profile,
+        Arc::new(crate::clock::SystemClock::new()),
+    )?;
+    if config.recording.snapshot_s > 0 {
+        let flag = r.snapshot_request();
+        if let Err(e) = signal_hook::flag::register(signal_hook::consts::SIGUSR1, flag) {
+            warnings.push(format!("snapshots on SIGUSR1 are not available: {e}"));
+        }
+        tracing::info!(
+            "snapshot ring: the last {} s of every topic, up to about {} MB (recording.snapshot_s)",
+            config.recording.snapshot_s,
+            crate::config::snapshot_bytes(config) / 1_000_000
+        );
+    }
+    Ok(Some(r))
+}
+
+/// The loop's transports; the first that serves parameters gets the
+/// parameter hand-over. Returns whether one does.
+fn open_ports(
+    config: &Config,
+    specs: &[BackendSpec],
+    io: transport::PortIo,
+    channel: &Arc<crate::link::ParameterChannel>,
+) -> Result<(Vec<Box<dyn NodePort>>, bool), RunError> {
+    let mut ports: Vec<Box<dyn NodePort>> = Vec::new();
+    let mut served = false;
+    for s in specs {
+        let parameters = (!served && s.serves_parameters()).then(|| {
+            served = true;
+            crate::link::ParameterIo {
+                config: config.clone(),
+                channel: channel.clone(),
+            }
+        });
+        ports.push(s.open_node(transport::PortIo {
+            profile: io.profile.clone(),
+            record: io.record.clone(),
+            snapshot: io.snapshot.clone(),
+            parameters,
+            sim_time: io.sim_time.clone().filter(|_| s.serves_parameters()),
+        })?);
+    }
+    Ok((ports, served))
+}
+
+/// `use_sim_time`: timer mode follows ROS 2 `/clock` (only a ROS 2
+/// transport carries it).
+fn sim_clock(
+    config: &Config,
+    specs: &[BackendSpec],
+    stop: &Arc<AtomicBool>,
+) -> Result<Option<Arc<crate::clock::ExternalClock>>, RunError> {
+    if !config.use_sim_time {
+        return Ok(None);
+    }
+    if !specs.iter().any(|s| s.serves_parameters()) {
+        return Err(RunError::Option(
+            "use_sim_time: true needs the ros2 transport (it follows /clock)".into(),
+        ));
+    }
+    Ok(Some(Arc::new(crate::clock::ExternalClock::new(
+        stop.clone(),
+    ))))
+}
+
+/// The demo driver, publishing on the first transport's real topics for
+/// `seconds`; it stops with `driver_stop` (in lockstep it waits for each
+/// estimate, and a loop that has ended sends none).
+fn start_demo(
+    config: &Config,
+    opts: &RunOptions,
+    seconds: f64,
+    spec: BackendSpec,
+    driver_stop: Arc<AtomicBool>,
+    warnings: &mut Vec<String>,
+) -> Result<std::thread::JoinHandle<DemoReport>, RunError> {
+    if !(seconds > 0.0 && seconds.is_finite()) {
+        return Err(RunError::Option(format!(
+            "--demo {seconds}: needs a positive number of seconds"
+        )));
+    }
+    let (tx, rx) = std::sync::mpsc::channel();
+    let plan = super::driver::DemoPlan {
+        mode: config.node.step_mode,
+        dt: config.solver.dt_s,
+        seconds,
+        motion: opts.motion,
+        joints: if config.contacts.0.len() > 1 {
+            config.contacts.0.iter().map(|c| c.joint.clone()).collect()
+        } else {
+            Vec::new()
+        },
+    };
+    let driver = std::thread::spawn(move || super::driver::drive(spec, plan, tx, driver_stop));
+    match rx.recv_timeout(Duration::from_secs(30)) {
+        Ok(Ok(())) => {}
+        Ok(Err(e)) => warnings.push(format!("demo driver: {e}")),
+        Err(_) => warnings.push("demo driver: no match within 30 s".into()),
+    }
+    Ok(driver)
+}
+
+/// What the recorder wrote.
+#[cfg(feature = "mcap")]
+fn finish_recording(r: crate::record::Recorder, report: &mut RunReport) {
+    let rep = r.finish();
+    report.snapshots = rep.snapshots.clone();
+    if let Some(path) = rep.path.clone() {
+        report.recording = Some(RecordingOutcome {
+            path,
+            messages: rep.messages,
+            bytes: rep.bytes,
+            files: rep.files,
+            files_deleted: rep.files_deleted,
+            lost: rep.lost,
+            error: rep.error,
+        });
+    }
+}
+
 /// Run the node until `stop`, the duration or the demo ends.
 pub fn run_node(
     config: &Config,
@@ -184,69 +365,15 @@ pub fn run_node(
     let specs = backend_specs(config, kind)?;
     let mut report = RunReport {
         transports: specs.iter().map(|s| s.name().to_string()).collect(),
+        warnings: discovery_warnings(&specs),
         ..Default::default()
     };
-    #[cfg(feature = "ros2")]
-    for s in &specs {
-        if let BackendSpec::Ros2(r) = s {
-            if !r.localhost_only {
-                report.warnings.push(format!(
-                    "ROS 2 discovery range SUBNET: DDS traffic (multicast included) goes to every interface (domain {})",
-                    r.domain_id
-                ));
-            }
-        }
-    }
     report.warnings.extend(spin_under_fifo(config));
     let profile =
         (config.node.profile_rate_hz > 0.0).then(|| ProfileSlot::new(config.solver.cells));
-    // Recording: checked and created before anything runs; a path that
-    // cannot be recorded into is an error now, not a surprise later.
-    let split = config.recording.splits();
-    let record_path = opts.record.clone().or_else(|| {
-        config.recording.enabled.then(|| {
-            if config.recording.path.is_empty() {
-                default_recording_path(Path::new("bags"), split)
-            } else {
-                PathBuf::from(&config.recording.path)
-            }
-        })
-    });
+    let record_path = record_path(config, opts);
     #[cfg(feature = "mcap")]
-    let recorder = if record_path.is_some() || config.recording.snapshot_s > 0 {
-        let snapshot_dir = record_path
-            .as_deref()
-            .and_then(|p| p.parent())
-            .filter(|p| !p.as_os_str().is_empty())
-            .map_or_else(|| PathBuf::from("bags"), Path::to_path_buf);
-        let plan = crate::record::RecordPlan {
-            path: record_path.clone(),
-            snapshot_dir,
-        };
-        let r = crate::record::Recorder::start(
-            plan,
-            config,
-            &crate::config::topics::TopicNames::from_config(config),
-            profile.clone(),
-            Arc::new(crate::clock::SystemClock::new()),
-        )?;
-        if config.recording.snapshot_s > 0 {
-            let flag = r.snapshot_request();
-            if let Err(e) = signal_hook::flag::register(signal_hook::consts::SIGUSR1, flag) {
-                report
-                    .warnings
-                    .push(format!("snapshots on SIGUSR1 are not available: {e}"));
-            }
-            tracing::info!(
-                "snapshot ring: the last {} s of every topic, up to about {} MB (recording.snapshot_s)",
-                config.recording.snapshot_s,
-                crate::config::snapshot_bytes(config) / 1_000_000
-            );
-        }
-        Some(r)
-    } else {
-        None
-    };
+    let recorder = start_recorder(config, record_path, profile.clone(), &mut report.warnings)?;
     #[cfg(not(feature = "mcap"))]
     if record_path.is_some() || config.recording.snapshot_s > 0 {
         return Err(RunError::Option(
@@ -254,43 +381,22 @@ pub fn run_node(
         ));
     }
     #[cfg(feature = "mcap")]
-    let queue = recorder.as_ref().map(|r| r.queue());
+    let (queue, snapshot) = (
+        recorder.as_ref().map(|r| r.queue()),
+        recorder.as_ref().map(|r| r.snapshot_request()),
+    );
     #[cfg(not(feature = "mcap"))]
-    let queue = None;
-    #[cfg(feature = "mcap")]
-    let snapshot_flag = recorder.as_ref().map(|r| r.snapshot_request());
-    #[cfg(not(feature = "mcap"))]
-    let snapshot_flag = None;
-    let mut ports: Vec<Box<dyn NodePort>> = Vec::new();
+    let (queue, snapshot) = (None, None);
     let channel = Arc::new(crate::link::ParameterChannel::default());
-    let mut served = false;
-    // use_sim_time: timer mode follows ROS 2 /clock.
-    let sim_time = if config.use_sim_time {
-        if !specs.iter().any(|s| s.serves_parameters()) {
-            return Err(RunError::Option(
-                "use_sim_time: true needs the ros2 transport (it follows /clock)".into(),
-            ));
-        }
-        Some(Arc::new(crate::clock::ExternalClock::new(stop.clone())))
-    } else {
-        None
+    let sim_time = sim_clock(config, &specs, &stop)?;
+    let io = transport::PortIo {
+        profile: profile.clone(),
+        record: queue.clone(),
+        snapshot,
+        parameters: None,
+        sim_time: sim_time.clone(),
     };
-    for s in &specs {
-        let parameters = (!served && s.serves_parameters()).then(|| {
-            served = true;
-            crate::link::ParameterIo {
-                config: config.clone(),
-                channel: channel.clone(),
-            }
-        });
-        ports.push(s.open_node(transport::PortIo {
-            profile: profile.clone(),
-            record: queue.clone(),
-            snapshot: snapshot_flag.clone(),
-            parameters,
-            sim_time: sim_time.clone().filter(|_| s.serves_parameters()),
-        })?);
-    }
+    let (ports, served) = open_ports(config, &specs, io, &channel)?;
     let live = Arc::new(LiveStatus::default());
     let mut l = Loop::new(config, ports, queue, profile, live.clone())?;
     if served {
@@ -304,42 +410,18 @@ pub fn run_node(
     if let Some(r) = &recorder {
         l = l.with_recorder(r.counters());
     }
-    // The demo driver publishes on the first transport's real topics.
-    let mut driver = None;
-    // The driver stops with the loop (or on a signal): in lockstep it waits
-    // for each estimate, and a loop that has ended sends none.
     let driver_stop = Arc::new(AtomicBool::new(false));
-    if let Some(seconds) = opts.demo_s {
-        if !(seconds > 0.0 && seconds.is_finite()) {
-            return Err(RunError::Option(format!(
-                "--demo {seconds}: needs a positive number of seconds"
-            )));
-        }
-        let (tx, rx) = std::sync::mpsc::channel();
-        let spec = specs[0].clone();
-        let plan = super::driver::DemoPlan {
-            mode: config.node.step_mode,
-            dt: config.solver.dt_s,
+    let driver = match opts.demo_s {
+        Some(seconds) => Some(start_demo(
+            config,
+            opts,
             seconds,
-            motion: opts.motion,
-            joints: if config.contacts.0.len() > 1 {
-                config.contacts.0.iter().map(|c| c.joint.clone()).collect()
-            } else {
-                Vec::new()
-            },
-        };
-        let s2 = driver_stop.clone();
-        driver = Some(std::thread::spawn(move || {
-            super::driver::drive(spec, plan, tx, s2)
-        }));
-        match rx.recv_timeout(Duration::from_secs(30)) {
-            Ok(Ok(())) => {}
-            Ok(Err(e)) => report.warnings.push(format!("demo driver: {e}")),
-            Err(_) => report
-                .warnings
-                .push("demo driver: no match within 30 s".into()),
-        }
-    }
+            specs[0].clone(),
+            driver_stop.clone(),
+            &mut report.warnings,
+        )?),
+        None => None,
+    };
     let (applied, warnings) = rt::apply(&config.node.realtime);
     report.realtime_applied = applied;
     report.warnings.extend(warnings);
@@ -376,19 +458,7 @@ pub fn run_node(
     }
     #[cfg(feature = "mcap")]
     if let Some(r) = recorder {
-        let rep = r.finish();
-        report.snapshots = rep.snapshots.clone();
-        if let Some(path) = rep.path.clone() {
-            report.recording = Some(RecordingOutcome {
-                path,
-                messages: rep.messages,
-                bytes: rep.bytes,
-                files: rep.files,
-                files_deleted: rep.files_deleted,
-                lost: rep.lost,
-                error: rep.error,
-            });
-        }
+        finish_recording(r, &mut report);
     }
     report.rss_bytes = rt::resident_bytes();
     report.peak_rss_bytes = rt::peak_resident_bytes();

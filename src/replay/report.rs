@@ -1,7 +1,7 @@
 //! The replay report: `summary.md`, loop metrics per cycle (`cycles.csv`)
 //! and figures.
 
-use super::{PreparedReplay, ReplayResult};
+use super::{Oracle, PreparedReplay, ReplayResult};
 use crate::bag::Silence;
 use crate::msgs;
 use crate::output::OutputError;
@@ -86,26 +86,18 @@ pub fn cycles(r: &ReplayResult, mass: f64) -> Vec<crate::analysis::LoopMetrics> 
         .collect()
 }
 
-/// Write the report: `summary.md`, `cycles.csv` and (feature `plots`) SVG
-/// figures into `dir`.
-pub fn write_report(
+/// `cycles.csv`: every cycle's loop metrics.
+fn write_cycles_csv(
     dir: &Path,
-    bag: &Path,
-    p: &PreparedReplay,
-    r: &ReplayResult,
-    wall_s: f64,
-) -> Result<Vec<PathBuf>, OutputError> {
-    use crate::output::AtomicFile;
+    cyc: &[crate::analysis::LoopMetrics],
+) -> Result<PathBuf, OutputError> {
     use crate::text::Num;
-    std::fs::create_dir_all(dir).map_err(|e| OutputError::new(dir, e))?;
-    let mut files = Vec::new();
-    let cyc = cycles(r, p.config.contact.mass_kg);
-    let mut f = AtomicFile::create(&dir.join("cycles.csv"))?;
+    let mut f = crate::output::AtomicFile::create(&dir.join("cycles.csv"))?;
     f.line(format_args!(
         "cycle,t_start_s,t_end_s,{}",
         crate::analysis::metrics::LOOP_METRIC_COLUMNS
     ))?;
-    for m in &cyc {
+    for m in cyc {
         f.line(format_args!(
             "{},{},{},{}",
             m.cycle + 1,
@@ -114,12 +106,12 @@ pub fn write_report(
             m.csv_fields()
         ))?;
     }
-    files.push(f.commit()?);
-    #[cfg(feature = "plots")]
-    let figures = plots::write(dir, r)?;
-    #[cfg(not(feature = "plots"))]
-    let figures: Vec<PathBuf> = Vec::new();
-    // Markdown summary.
+    f.commit()
+}
+
+/// The summary's table: input, configuration, steps, gaps, damage,
+/// statuses, regimes and the determinism verdict.
+fn summary_table(bag: &Path, p: &PreparedReplay, r: &ReplayResult, wall_s: f64) -> String {
     let e = &r.estimates;
     let span = match (e.first(), e.last()) {
         (Some(a), Some(b)) => (b.1.stamp_ns.saturating_sub(a.1.stamp_ns)) as f64 / 1e9,
@@ -188,61 +180,87 @@ pub fn write_report(
         100.0 * regime[2] as f64 / n
     ));
     if let Some(o) = &r.oracle {
+        md.push_str(&format!("| determinism | {} |\n", verdict(o)));
+    }
+    md
+}
+
+/// The determinism oracle's verdict in one line.
+fn verdict(o: &Oracle) -> String {
+    if o.identical {
+        return format!(
+            "re-simulation **bit-identical** to the recording ({} steps)",
+            o.compared
+        );
+    }
+    format!(
+        "**differs** from the recording: {}{}",
+        o.deviations
+            .iter()
+            .map(|(f, d, k)| format!("{f} by up to {d:.3e} (step {k})"))
+            .collect::<Vec<_>>()
+            .join("; "),
+        o.count_mismatch.map_or(String::new(), |(a, b)| format!(
+            "; {a} steps recorded, {b} replayed"
+        ))
+    )
+}
+
+/// The summary's loop-metrics section (the first 20 cycles).
+fn loop_metrics_section(cyc: &[crate::analysis::LoopMetrics]) -> String {
+    if cyc.is_empty() {
+        return "\nNo periodic cycles were detected (the velocity does not cross its mean repeatedly).\n".into();
+    }
+    let mut md = format!(
+        "\n## Loop metrics ({} cycles; `cycles.csv` has all columns)\n\n",
+        cyc.len()
+    );
+    md.push_str("| cycle | t (s) | friction loop area (N·m/s) | COF loop area (m/s) | peak COF at v | mean COF | h0 range (µm) | asperity share | M raw / smooth |\n|---|---|---|---|---|---|---|---|---|\n");
+    for m in cyc.iter().take(20) {
         md.push_str(&format!(
-            "| determinism | {} |\n",
-            if o.identical {
-                format!(
-                    "re-simulation **bit-identical** to the recording ({} steps)",
-                    o.compared
-                )
-            } else {
-                format!(
-                    "**differs** from the recording: {}{}",
-                    o.deviations
-                        .iter()
-                        .map(|(f, d, k)| format!("{f} by up to {d:.3e} (step {k})"))
-                        .collect::<Vec<_>>()
-                        .join("; "),
-                    o.count_mismatch.map_or(String::new(), |(a, b)| format!(
-                        "; {a} steps recorded, {b} replayed"
-                    ))
-                )
-            }
+            "| {} | {:.3}–{:.3} | {:.2} | {:.5} | {:.4} at {:+.3} m/s | {:.4} | {:.3}–{:.3} | {:.1} % | {:.1e} / {:.1e} |\n",
+            m.cycle + 1,
+            m.t_start,
+            m.t_end,
+            m.friction_loop_area,
+            m.cof_loop_area,
+            m.peak_cof,
+            m.peak_cof_velocity,
+            m.mean_cof,
+            m.h0_min * 1e6,
+            m.h0_max * 1e6,
+            100.0 * m.mean_asperity_share,
+            m.inertia_share,
+            m.inertia_share_smooth
         ));
     }
-    if !cyc.is_empty() {
+    if cyc.len() > 20 {
         md.push_str(&format!(
-            "\n## Loop metrics ({} cycles; `cycles.csv` has all columns)\n\n",
-            cyc.len()
+            "| … | {} more in `cycles.csv` | | | | | | | |\n",
+            cyc.len() - 20
         ));
-        md.push_str("| cycle | t (s) | friction loop area (N·m/s) | COF loop area (m/s) | peak COF at v | mean COF | h0 range (µm) | asperity share | M raw / smooth |\n|---|---|---|---|---|---|---|---|---|\n");
-        for m in cyc.iter().take(20) {
-            md.push_str(&format!(
-                "| {} | {:.3}–{:.3} | {:.2} | {:.5} | {:.4} at {:+.3} m/s | {:.4} | {:.3}–{:.3} | {:.1} % | {:.1e} / {:.1e} |\n",
-                m.cycle + 1,
-                m.t_start,
-                m.t_end,
-                m.friction_loop_area,
-                m.cof_loop_area,
-                m.peak_cof,
-                m.peak_cof_velocity,
-                m.mean_cof,
-                m.h0_min * 1e6,
-                m.h0_max * 1e6,
-                100.0 * m.mean_asperity_share,
-                m.inertia_share,
-                m.inertia_share_smooth
-            ));
-        }
-        if cyc.len() > 20 {
-            md.push_str(&format!(
-                "| … | {} more in `cycles.csv` | | | | | | | |\n",
-                cyc.len() - 20
-            ));
-        }
-    } else {
-        md.push_str("\nNo periodic cycles were detected (the velocity does not cross its mean repeatedly).\n");
     }
+    md
+}
+
+/// Write the report: `summary.md`, `cycles.csv` and (feature `plots`) SVG
+/// figures into `dir`.
+pub fn write_report(
+    dir: &Path,
+    bag: &Path,
+    p: &PreparedReplay,
+    r: &ReplayResult,
+    wall_s: f64,
+) -> Result<Vec<PathBuf>, OutputError> {
+    std::fs::create_dir_all(dir).map_err(|e| OutputError::new(dir, e))?;
+    let cyc = cycles(r, p.config.contact.mass_kg);
+    let mut files = vec![write_cycles_csv(dir, &cyc)?];
+    #[cfg(feature = "plots")]
+    let figures = plots::write(dir, r)?;
+    #[cfg(not(feature = "plots"))]
+    let figures: Vec<PathBuf> = Vec::new();
+    let mut md = summary_table(bag, p, r, wall_s);
+    md.push_str(&loop_metrics_section(&cyc));
     if !figures.is_empty() {
         md.push_str("\n## Figures\n\n");
         for f in &figures {
@@ -252,7 +270,7 @@ pub fn write_report(
         }
     }
     files.extend(figures);
-    let mut f = AtomicFile::create(&dir.join("summary.md"))?;
+    let mut f = crate::output::AtomicFile::create(&dir.join("summary.md"))?;
     f.line(format_args!("{}", md.trim_end()))?;
     files.push(f.commit()?);
     Ok(files)
@@ -265,116 +283,141 @@ mod plots {
     use crate::plot::{figure, Axes, Line, Panel, COLORS};
     use plotters::prelude::SeriesLabelPosition;
 
-    pub fn write(dir: &Path, r: &ReplayResult) -> Result<Vec<PathBuf>, OutputError> {
-        let e = &r.estimates;
-        let t0 = e.first().map_or(0, |x| x.1.stamp_ns);
-        let t = |rec: &EstimateRecord| rec.stamp_ns.saturating_sub(t0) as f64 / 1e9;
-        let line = |label: &str, k: usize, pts: Vec<(f64, f64)>| Line {
+    type Steps = [(crate::physics::Estimate, EstimateRecord)];
+
+    fn line(label: &str, k: usize, points: Vec<(f64, f64)>) -> Line {
+        Line {
             label: Some(label.to_string()),
-            points: pts,
+            points,
             color: COLORS[k % COLORS.len()],
             dashed: false,
-        };
-        let ax = |x, y, legend| Axes {
+        }
+    }
+
+    fn axes(x: &'static str) -> Axes<'static> {
+        Axes {
             x,
-            y,
+            y: "",
             log_x: false,
             log_y: false,
-            legend,
+            legend: SeriesLabelPosition::UpperRight,
             legend_everywhere: true,
-        };
-        let files = vec![
-            figure(
-                &dir.join("friction_velocity.svg"),
-                "friction against velocity",
-                &[
-                    Panel {
-                        title: "friction force".into(),
-                        lines: vec![line(
-                            "F_f",
+        }
+    }
+
+    /// Seconds since the first step.
+    fn seconds(e: &Steps) -> impl Fn(&EstimateRecord) -> f64 {
+        let t0 = e.first().map_or(0, |x| x.1.stamp_ns);
+        move |rec| rec.stamp_ns.saturating_sub(t0) as f64 / 1e9
+    }
+
+    fn friction_velocity(dir: &Path, e: &Steps) -> Result<PathBuf, OutputError> {
+        figure(
+            &dir.join("friction_velocity.svg"),
+            "friction against velocity",
+            &[
+                Panel {
+                    title: "friction force".into(),
+                    lines: vec![line(
+                        "F_f",
+                        0,
+                        e.iter()
+                            .map(|(_, r)| (r.velocity_m_s, r.friction_force_n))
+                            .collect(),
+                    )],
+                },
+                Panel {
+                    title: "coefficient of friction".into(),
+                    lines: vec![line(
+                        "COF",
+                        1,
+                        e.iter().map(|(_, r)| (r.velocity_m_s, r.cof)).collect(),
+                    )],
+                },
+            ],
+            &axes("velocity (m/s)"),
+        )
+    }
+
+    fn time_series(dir: &Path, e: &Steps) -> Result<PathBuf, OutputError> {
+        let t = seconds(e);
+        figure(
+            &dir.join("time_series.svg"),
+            "velocity, friction and film thickness against time",
+            &[
+                Panel {
+                    title: "velocity (m/s)".into(),
+                    lines: vec![line(
+                        "v",
+                        0,
+                        e.iter().map(|(_, r)| (t(r), r.velocity_m_s)).collect(),
+                    )],
+                },
+                Panel {
+                    title: "friction force (N)".into(),
+                    lines: vec![line(
+                        "F_f",
+                        1,
+                        e.iter().map(|(_, r)| (t(r), r.friction_force_n)).collect(),
+                    )],
+                },
+                Panel {
+                    title: "h0 (µm)".into(),
+                    lines: vec![line(
+                        "h0",
+                        2,
+                        e.iter().map(|(_, r)| (t(r), r.h0_m * 1e6)).collect(),
+                    )],
+                },
+            ],
+            &axes("time (s)"),
+        )
+    }
+
+    fn regime_share(dir: &Path, e: &Steps) -> Result<PathBuf, OutputError> {
+        let t = seconds(e);
+        figure(
+            &dir.join("regime_share.svg"),
+            "lubrication regime and load share against time",
+            &[
+                Panel {
+                    title: "load share".into(),
+                    lines: vec![
+                        line(
+                            "asperities",
                             0,
                             e.iter()
-                                .map(|(_, r)| (r.velocity_m_s, r.friction_force_n))
+                                .map(|(_, r)| (t(r), r.asperity_load_share))
                                 .collect(),
-                        )],
-                    },
-                    Panel {
-                        title: "coefficient of friction".into(),
-                        lines: vec![line(
-                            "COF",
+                        ),
+                        line(
+                            "fluid",
                             1,
-                            e.iter().map(|(_, r)| (r.velocity_m_s, r.cof)).collect(),
-                        )],
-                    },
-                ],
-                &ax("velocity (m/s)", "", SeriesLabelPosition::UpperRight),
-            )?,
-            figure(
-                &dir.join("time_series.svg"),
-                "velocity, friction and film thickness against time",
-                &[
-                    Panel {
-                        title: "velocity (m/s)".into(),
-                        lines: vec![line(
-                            "v",
-                            0,
-                            e.iter().map(|(_, r)| (t(r), r.velocity_m_s)).collect(),
-                        )],
-                    },
-                    Panel {
-                        title: "friction force (N)".into(),
-                        lines: vec![line(
-                            "F_f",
-                            1,
-                            e.iter().map(|(_, r)| (t(r), r.friction_force_n)).collect(),
-                        )],
-                    },
-                    Panel {
-                        title: "h0 (µm)".into(),
-                        lines: vec![line(
-                            "h0",
-                            2,
-                            e.iter().map(|(_, r)| (t(r), r.h0_m * 1e6)).collect(),
-                        )],
-                    },
-                ],
-                &ax("time (s)", "", SeriesLabelPosition::UpperRight),
-            )?,
-            figure(
-                &dir.join("regime_share.svg"),
-                "lubrication regime and load share against time",
-                &[
-                    Panel {
-                        title: "load share".into(),
-                        lines: vec![
-                            line(
-                                "asperities",
-                                0,
-                                e.iter()
-                                    .map(|(_, r)| (t(r), r.asperity_load_share))
-                                    .collect(),
-                            ),
-                            line(
-                                "fluid",
-                                1,
-                                e.iter()
-                                    .map(|(_, r)| (t(r), r.hydrodynamic_force_n / r.load_n))
-                                    .collect(),
-                            ),
-                        ],
-                    },
-                    Panel {
-                        title: "regime: 0 boundary, 1 mixed, 2 hydrodynamic".into(),
-                        lines: vec![line(
-                            "regime",
-                            3,
-                            e.iter().map(|(_, r)| (t(r), r.regime as f64)).collect(),
-                        )],
-                    },
-                ],
-                &ax("time (s)", "", SeriesLabelPosition::UpperRight),
-            )?,
-        ];
-        Ok(files)
+                            e.iter()
+                                .map(|(_, r)| (t(r), r.hydrodynamic_force_n / r.load_n))
+                                .collect(),
+                        ),
+                    ],
+                },
+                Panel {
+                    title: "regime: 0 boundary, 1 mixed, 2 hydrodynamic".into(),
+                    lines: vec![line(
+                        "regime",
+                        3,
+                        e.iter().map(|(_, r)| (t(r), r.regime as f64)).collect(),
+                    )],
+                },
+            ],
+            &axes("time (s)"),
+        )
+    }
+
+    pub fn write(dir: &Path, r: &ReplayResult) -> Result<Vec<PathBuf>, OutputError> {
+        let e = &r.estimates;
+        Ok(vec![
+            friction_velocity(dir, e)?,
+            time_series(dir, e)?,
+            regime_share(dir, e)?,
+        ])
     }
 }

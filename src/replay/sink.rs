@@ -4,7 +4,7 @@
 
 use super::{InputMode, Oracle, PreparedReplay, ReplayError};
 use crate::msgs::{self, Command, EstimateRecord};
-use crate::output::tmp_sibling;
+use crate::output::{tmp_sibling, OutputError};
 use crate::physics::Estimate;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -75,11 +75,7 @@ impl Sink for CsvSink {
     }
 
     fn finish(self: Box<Self>, _: Option<&Oracle>) -> Result<PathBuf, ReplayError> {
-        let path = self.file.path().to_path_buf();
-        self.file.commit().map_err(|e| ReplayError::Output {
-            path,
-            message: e.to_string(),
-        })
+        Ok(self.file.commit()?)
     }
 }
 
@@ -129,10 +125,7 @@ impl Sink for McapSink {
     }
 
     fn finish(mut self: Box<Self>, oracle: Option<&Oracle>) -> Result<PathBuf, ReplayError> {
-        let err = |path: &Path, message: String| ReplayError::Output {
-            path: path.to_path_buf(),
-            message,
-        };
+        let err = |path: &Path, message: String| OutputError::other(path, message);
         let result = (|| {
             self.commands_up_to(u64::MAX)?;
             if let Some(o) = oracle {
@@ -158,7 +151,7 @@ impl Sink for McapSink {
             result.and_then(|_| w.ok_or_else(|| "already finished".to_string())?.finish());
         if let Err(e) = finished {
             let _ = std::fs::remove_file(&tmp);
-            return Err(err(&path, e));
+            return Err(err(&path, e).into());
         }
         std::fs::rename(&tmp, &path).map_err(|e| err(&path, e.to_string()))?;
         Ok(path)
@@ -201,14 +194,10 @@ impl OutputStream {
         p: &PreparedReplay,
         source: &Path,
     ) -> Result<Self, ReplayError> {
-        let out_err = |message: String| ReplayError::Output {
-            path: path.to_path_buf(),
-            message,
-        };
+        let out_err = |message: String| OutputError::other(path, message);
         let sink: Box<dyn Sink> = match format {
             OutputFormat::Csv => {
-                let mut file =
-                    crate::output::AtomicFile::create(path).map_err(|e| out_err(e.to_string()))?;
+                let mut file = crate::output::AtomicFile::create(path)?;
                 let contacts: Vec<String> = if p.config.contacts.0.len() > 1 {
                     p.config.contacts.0.iter().map(|c| c.name.clone()).collect()
                 } else {
@@ -218,8 +207,7 @@ impl OutputStream {
                     "{},stamp_ns,command_status{}",
                     crate::offline::SIMULATE_COLUMNS,
                     if contacts.is_empty() { "" } else { ",contact" }
-                ))
-                .map_err(|e| out_err(e.to_string()))?;
+                ))?;
                 Box::new(CsvSink {
                     file,
                     t0: None,
@@ -315,17 +303,11 @@ impl OutputStream {
             .take()
             .expect("finish once")
             .join()
-            .map_err(|_| ReplayError::Output {
-                path: self.path.clone(),
-                message: "the writer thread panicked".into(),
-            })?;
+            .map_err(|_| OutputError::other(&self.path, "the writer thread panicked"))?;
         if let Err(message) = result {
             // Dropping the sink removes the temporary file.
             drop(sink);
-            return Err(ReplayError::Output {
-                path: self.path.clone(),
-                message,
-            });
+            return Err(OutputError::other(&self.path, message).into());
         }
         sink.finish(oracle)
     }

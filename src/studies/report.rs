@@ -194,234 +194,264 @@ mod plots {
             .collect()
     }
 
-    pub fn study(dir: &Path, r: &StudyResult) -> Result<Vec<PathBuf>, OutputError> {
-        let mut files = Vec::new();
-        let name = r.study.name();
-        let fig = r.study.figure();
-        let v_ax = |y, legend| Axes {
+    /// Velocity on the x axis, linear axes.
+    fn velocity_axes(y: &'static str, legend: SeriesLabelPosition) -> Axes<'static> {
+        Axes {
             x: "velocity (m/s)",
             y,
             log_x: false,
             log_y: false,
             legend,
             legend_everywhere: false,
-        };
-        if r.study == StudyKind::Stribeck {
-            let mut panels = Vec::new();
-            for load in ["5720", "20762"] {
-                let lines = r
-                    .steady
+        }
+    }
+
+    /// Stribeck curves at the two loads, on linear and logarithmic axes.
+    fn stribeck_figures(
+        dir: &Path,
+        r: &StudyResult,
+        files: &mut Vec<PathBuf>,
+    ) -> Result<(), OutputError> {
+        let fig = r.study.figure();
+        let mut panels = Vec::new();
+        for load in ["5720", "20762"] {
+            let lines = r
+                .steady
+                .iter()
+                .filter(|s| format!("{}", s.load_n) == load)
+                .enumerate()
+                .map(|(k, s)| Line {
+                    label: Some(format!("μ = {} Pa·s", s.viscosity)),
+                    points: s.points.iter().map(|e| (e.velocity, e.cof)).collect(),
+                    color: COLORS[k],
+                    dashed: false,
+                })
+                .collect();
+            panels.push(Panel {
+                title: format!("F = {load} N"),
+                lines,
+            });
+        }
+        files.push(figure(
+            &dir.join("stribeck.svg"),
+            &format!("Stribeck curves ({fig})"),
+            &panels,
+            &velocity_axes("COF", SeriesLabelPosition::UpperRight),
+        )?);
+        let log_panels: Vec<Panel> = panels
+            .into_iter()
+            .map(|mut p| {
+                for l in &mut p.lines {
+                    l.points.retain(|&(v, _)| v > 0.0);
+                }
+                p
+            })
+            .collect();
+        files.push(figure(
+            &dir.join("stribeck_log.svg"),
+            &format!("Stribeck curves, v > 0, logarithmic axes ({fig})"),
+            &log_panels,
+            &Axes {
+                x: "velocity (m/s)",
+                y: "COF",
+                log_x: true,
+                log_y: true,
+                legend: SeriesLabelPosition::LowerLeft,
+                legend_everywhere: false,
+            },
+        )?);
+        Ok(())
+    }
+
+    /// COF against the Hersey number, one line per series.
+    fn hersey_figure(dir: &Path, r: &StudyResult) -> Result<PathBuf, OutputError> {
+        let fig = r.study.figure();
+        let panels: Vec<Panel> = by_panel(r)
+            .into_iter()
+            .map(|(title, cases)| Panel {
+                title,
+                lines: cases
                     .iter()
-                    .filter(|s| format!("{}", s.load_n) == load)
                     .enumerate()
-                    .map(|(k, s)| Line {
-                        label: Some(format!("μ = {} Pa·s", s.viscosity)),
-                        points: s.points.iter().map(|e| (e.velocity, e.cof)).collect(),
-                        color: COLORS[k],
-                        dashed: false,
+                    .map(|(k, c)| {
+                        let (mu, f) = (c.case.viscosity(), c.case.load_n());
+                        Line {
+                            label: Some(c.case.series.clone()),
+                            points: c
+                                .last_cycle
+                                .iter()
+                                .map(|e| (mu * e.velocity / f, e.cof))
+                                .collect(),
+                            color: COLORS[k % COLORS.len()],
+                            dashed: false,
+                        }
                     })
-                    .collect();
-                panels.push(Panel {
-                    title: format!("F = {load} N"),
-                    lines,
-                });
-            }
-            files.push(figure(
-                &dir.join("stribeck.svg"),
-                &format!("Stribeck curves ({fig})"),
-                &panels,
-                &v_ax("COF", SeriesLabelPosition::UpperRight),
-            )?);
-            let log_panels: Vec<Panel> = panels
-                .into_iter()
-                .map(|mut p| {
-                    for l in &mut p.lines {
-                        l.points.retain(|&(v, _)| v > 0.0);
-                    }
-                    p
-                })
-                .collect();
-            files.push(figure(
-                &dir.join("stribeck_log.svg"),
-                &format!("Stribeck curves, v > 0, logarithmic axes ({fig})"),
-                &log_panels,
-                &Axes {
-                    x: "velocity (m/s)",
-                    y: "COF",
-                    log_x: true,
-                    log_y: true,
-                    legend: SeriesLabelPosition::LowerLeft,
-                    legend_everywhere: false,
-                },
-            )?);
-            return Ok(files);
-        }
-        if r.study == StudyKind::Hersey {
-            let panels: Vec<Panel> = by_panel(r)
-                .into_iter()
-                .map(|(title, cases)| Panel {
-                    title,
-                    lines: cases
-                        .iter()
-                        .enumerate()
-                        .map(|(k, c)| {
-                            let (mu, f) = (c.case.viscosity(), c.case.load_n());
-                            Line {
-                                label: Some(c.case.series.clone()),
-                                points: c
-                                    .last_cycle
-                                    .iter()
-                                    .map(|e| (mu * e.velocity / f, e.cof))
-                                    .collect(),
-                                color: COLORS[k % COLORS.len()],
-                                dashed: false,
-                            }
+                    .collect(),
+            })
+            .collect();
+        figure(
+            &dir.join("hersey.svg"),
+            &format!("COF against the Hersey number μv/F ({fig})"),
+            &panels,
+            &Axes {
+                x: "Hersey number μv/F (m/N)",
+                y: "COF",
+                log_x: false,
+                log_y: false,
+                legend: SeriesLabelPosition::LowerMiddle,
+                legend_everywhere: true,
+            },
+        )
+    }
+
+    /// Asperity and fluid load shares through the cycle (Fig. 13).
+    fn load_share_figure(dir: &Path, r: &StudyResult) -> Result<PathBuf, OutputError> {
+        let panels: Vec<Panel> = by_panel(r)
+            .into_iter()
+            .map(|(title, cases)| {
+                let mut lines = Vec::new();
+                for (k, c) in cases.iter().enumerate() {
+                    let color = COLORS[k % COLORS.len()];
+                    lines.push(Line {
+                        label: Some(format!("{} asperity", c.case.series)),
+                        points: c
+                            .last_cycle
+                            .iter()
+                            .map(|e| (e.velocity, e.asperity_force / e.load))
+                            .collect(),
+                        color,
+                        dashed: false,
+                    });
+                    lines.push(Line {
+                        label: None,
+                        points: c
+                            .last_cycle
+                            .iter()
+                            .map(|e| (e.velocity, e.hydrodynamic_force / e.load))
+                            .collect(),
+                        color,
+                        dashed: true,
+                    });
+                }
+                Panel { title, lines }
+            })
+            .collect();
+        figure(
+            &dir.join("load_share.svg"),
+            "roughness: load share, asperity solid / fluid dashed (Fig. 13)",
+            &panels,
+            &velocity_axes("share of F_ext", SeriesLabelPosition::MiddleLeft),
+        )
+    }
+
+    /// The inertia share against frequency and mass (Fig. 10).
+    fn inertia_figure(r: &StudyResult, dir: &Path) -> Result<PathBuf, OutputError> {
+        let masses = ["0.1", "1", "10", "100"];
+        let freqs = [0.25, 1.0, 4.0];
+        let mut lines = Vec::new();
+        for (k, m) in masses.iter().enumerate() {
+            let get = |smooth: bool| -> Vec<(f64, f64)> {
+                freqs
+                    .iter()
+                    .filter_map(|f| {
+                        let id = format!("m-{m}_f-{}", super::super::fmt_g(*f));
+                        r.metrics(&id).map(|x| {
+                            (
+                                *f,
+                                100.0
+                                    * if smooth {
+                                        x.inertia_share_smooth
+                                    } else {
+                                        x.inertia_share
+                                    },
+                            )
                         })
-                        .collect(),
-                })
-                .collect();
-            files.push(figure(
-                &dir.join("hersey.svg"),
-                &format!("COF against the Hersey number μv/F ({fig})"),
-                &panels,
-                &Axes {
-                    x: "Hersey number μv/F (m/N)",
-                    y: "COF",
-                    log_x: false,
-                    log_y: false,
-                    legend: SeriesLabelPosition::LowerMiddle,
-                    legend_everywhere: true,
-                },
-            )?);
-            return Ok(files);
+                    })
+                    .collect()
+            };
+            lines.push(Line {
+                label: Some(format!("m = {m} kg (raw max)")),
+                points: get(false),
+                color: COLORS[k],
+                dashed: false,
+            });
+            lines.push(Line {
+                label: None,
+                points: get(true),
+                color: COLORS[k],
+                dashed: true,
+            });
         }
+        let mass_lines: Vec<Line> = freqs
+            .iter()
+            .enumerate()
+            .map(|(k, f)| Line {
+                label: Some(format!("f = {f} Hz")),
+                points: masses
+                    .iter()
+                    .filter_map(|m| {
+                        let id = format!("m-{m}_f-{}", super::super::fmt_g(*f));
+                        r.metrics(&id)
+                            .map(|x| (m.parse::<f64>().expect("mass"), 100.0 * x.inertia_share))
+                    })
+                    .collect(),
+                color: COLORS[k],
+                dashed: false,
+            })
+            .collect();
+        let panels = [
+            Panel {
+                title: "against frequency (smooth part dashed)".into(),
+                lines,
+            },
+            Panel {
+                title: "against mass (raw max)".into(),
+                lines: mass_lines,
+            },
+        ];
+        figure(
+            &dir.join("inertia_share.svg"),
+            "inertia share M = max|m h0''|/F_ext (Fig. 10)",
+            &panels,
+            &Axes {
+                x: "f (Hz) / m (kg)",
+                y: "M (%)",
+                log_x: true,
+                log_y: true,
+                legend: SeriesLabelPosition::LowerRight,
+                legend_everywhere: true,
+            },
+        )
+    }
+
+    pub fn study(dir: &Path, r: &StudyResult) -> Result<Vec<PathBuf>, OutputError> {
+        let mut files = Vec::new();
+        match r.study {
+            StudyKind::Stribeck => {
+                stribeck_figures(dir, r, &mut files)?;
+                return Ok(files);
+            }
+            StudyKind::Hersey => return Ok(vec![hersey_figure(dir, r)?]),
+            _ => {}
+        }
+        let (name, fig) = (r.study.name(), r.study.figure());
         files.push(figure(
             &dir.join("cof_loops.svg"),
             &format!("{name}: COF loops, steady curves dashed ({fig})"),
             &loop_panels(r, |e| e.cof),
-            &v_ax("COF", SeriesLabelPosition::LowerMiddle),
+            &velocity_axes("COF", SeriesLabelPosition::LowerMiddle),
         )?);
         files.push(figure(
             &dir.join("film_loops.svg"),
             &format!("{name}: film-thickness loops, steady dashed ({fig})"),
             &loop_panels(r, |e| e.h0 * 1e6),
-            &v_ax("h0 (µm)", SeriesLabelPosition::UpperMiddle),
+            &velocity_axes("h0 (µm)", SeriesLabelPosition::UpperMiddle),
         )?);
         if r.study == StudyKind::Roughness {
-            let panels: Vec<Panel> = by_panel(r)
-                .into_iter()
-                .map(|(title, cases)| {
-                    let mut lines = Vec::new();
-                    for (k, c) in cases.iter().enumerate() {
-                        let color = COLORS[k % COLORS.len()];
-                        lines.push(Line {
-                            label: Some(format!("{} asperity", c.case.series)),
-                            points: c
-                                .last_cycle
-                                .iter()
-                                .map(|e| (e.velocity, e.asperity_force / e.load))
-                                .collect(),
-                            color,
-                            dashed: false,
-                        });
-                        lines.push(Line {
-                            label: None,
-                            points: c
-                                .last_cycle
-                                .iter()
-                                .map(|e| (e.velocity, e.hydrodynamic_force / e.load))
-                                .collect(),
-                            color,
-                            dashed: true,
-                        });
-                    }
-                    Panel { title, lines }
-                })
-                .collect();
-            files.push(figure(
-                &dir.join("load_share.svg"),
-                "roughness: load share, asperity solid / fluid dashed (Fig. 13)",
-                &panels,
-                &v_ax("share of F_ext", SeriesLabelPosition::MiddleLeft),
-            )?);
+            files.push(load_share_figure(dir, r)?);
         }
         if r.study == StudyKind::Inertia {
-            let masses = ["0.1", "1", "10", "100"];
-            let freqs = [0.25, 1.0, 4.0];
-            let mut lines = Vec::new();
-            for (k, m) in masses.iter().enumerate() {
-                let get = |smooth: bool| -> Vec<(f64, f64)> {
-                    freqs
-                        .iter()
-                        .filter_map(|f| {
-                            let id = format!("m-{m}_f-{}", super::super::fmt_g(*f));
-                            r.metrics(&id).map(|x| {
-                                (
-                                    *f,
-                                    100.0
-                                        * if smooth {
-                                            x.inertia_share_smooth
-                                        } else {
-                                            x.inertia_share
-                                        },
-                                )
-                            })
-                        })
-                        .collect()
-                };
-                lines.push(Line {
-                    label: Some(format!("m = {m} kg (raw max)")),
-                    points: get(false),
-                    color: COLORS[k],
-                    dashed: false,
-                });
-                lines.push(Line {
-                    label: None,
-                    points: get(true),
-                    color: COLORS[k],
-                    dashed: true,
-                });
-            }
-            let mass_lines: Vec<Line> = freqs
-                .iter()
-                .enumerate()
-                .map(|(k, f)| Line {
-                    label: Some(format!("f = {f} Hz")),
-                    points: masses
-                        .iter()
-                        .filter_map(|m| {
-                            let id = format!("m-{m}_f-{}", super::super::fmt_g(*f));
-                            r.metrics(&id)
-                                .map(|x| (m.parse::<f64>().expect("mass"), 100.0 * x.inertia_share))
-                        })
-                        .collect(),
-                    color: COLORS[k],
-                    dashed: false,
-                })
-                .collect();
-            let panels = [
-                Panel {
-                    title: "against frequency (smooth part dashed)".into(),
-                    lines,
-                },
-                Panel {
-                    title: "against mass (raw max)".into(),
-                    lines: mass_lines,
-                },
-            ];
-            files.push(figure(
-                &dir.join("inertia_share.svg"),
-                "inertia share M = max|m h0''|/F_ext (Fig. 10)",
-                &panels,
-                &Axes {
-                    x: "f (Hz) / m (kg)",
-                    y: "M (%)",
-                    log_x: true,
-                    log_y: true,
-                    legend: SeriesLabelPosition::LowerRight,
-                    legend_everywhere: true,
-                },
-            )?);
+            files.push(inertia_figure(r, dir)?);
         }
         Ok(files)
     }

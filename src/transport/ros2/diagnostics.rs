@@ -39,163 +39,218 @@ fn kv(key: &str, value: impl std::fmt::Display) -> KeyValue {
     }
 }
 
+/// One period: the statistics now and at the previous update.
+struct Period<'a> {
+    now: &'a StatisticsRecord,
+    before: StatisticsRecord,
+    /// Steps in the period (at least 1).
+    steps: u64,
+    node: &'a str,
+}
+
+impl Period<'_> {
+    /// A counter's increase over the period.
+    fn delta(&self, counter: impl Fn(&StatisticsRecord) -> u64) -> u64 {
+        counter(self.now).saturating_sub(counter(&self.before))
+    }
+
+    /// `n` as a fraction of the period's steps.
+    fn frac(&self, n: u64) -> f64 {
+        n as f64 / self.steps as f64
+    }
+
+    fn status(
+        &self,
+        name: &str,
+        level: u8,
+        message: String,
+        values: Vec<KeyValue>,
+    ) -> DiagnosticStatus {
+        DiagnosticStatus {
+            level,
+            name: format!("{}: {name}", self.node),
+            message,
+            hardware_id: self.node.to_string(),
+            values,
+        }
+    }
+}
+
+/// Microseconds with one decimal.
+fn us(ns: u64) -> String {
+    format!("{:.1}", ns as f64 / 1e3)
+}
+
+fn timing(p: &Period) -> DiagnosticStatus {
+    let (s, steps) = (p.now, p.steps);
+    let misses = p.delta(|r| r.deadline_misses);
+    let jumps = p.delta(|r| r.time_jumps);
+    let (lvl, msg) = if p.frac(misses) >= MISS_ERROR {
+        (
+            level::ERROR,
+            format!("{misses} deadline misses in {steps} steps"),
+        )
+    } else if p.frac(misses) >= MISS_WARN || jumps > 0 {
+        (
+            level::WARN,
+            format!("{misses} deadline misses, {jumps} long steps over lost time in {steps} steps"),
+        )
+    } else {
+        (level::OK, "on time".into())
+    };
+    p.status(
+        "loop timing",
+        lvl,
+        msg,
+        vec![
+            kv("steps", s.steps),
+            kv("deadline misses", s.deadline_misses),
+            kv("deadline misses in the period", misses),
+            kv("catch-up steps", s.catch_up_steps),
+            kv("long steps over lost time", s.time_jumps),
+            kv("wall clock jumps", s.clock_jumps),
+            kv("compute p50 (us)", us(s.compute_time_ns[0])),
+            kv("compute p99 (us)", us(s.compute_time_ns[1])),
+            kv("compute max (us)", us(s.compute_time_ns[2])),
+            kv("jitter p50 (us)", us(s.period_jitter_ns[0])),
+            kv("jitter p99 (us)", us(s.period_jitter_ns[1])),
+            kv("jitter max (us)", us(s.period_jitter_ns[2])),
+        ],
+    )
+}
+
+fn solver(p: &Period) -> DiagnosticStatus {
+    let (s, steps) = (p.now, p.steps);
+    let bad = p.delta(|r| r.steps_not_converged);
+    let (lvl, msg) = if p.frac(bad) >= SOLVER_ERROR {
+        (
+            level::ERROR,
+            format!("{bad} of {steps} steps not converged"),
+        )
+    } else if bad > 0 {
+        (level::WARN, format!("{bad} of {steps} steps not converged"))
+    } else {
+        (level::OK, "every step converged".into())
+    };
+    p.status(
+        "solver",
+        lvl,
+        msg,
+        vec![
+            kv("steps not converged", s.steps_not_converged),
+            kv("steps not converged in the period", bad),
+            kv("parameter updates", s.parameter_updates),
+        ],
+    )
+}
+
+fn commands(p: &Period) -> DiagnosticStatus {
+    let s = p.now;
+    let rejected = p.delta(|r| r.commands_rejected);
+    let overwritten = p.delta(|r| r.commands_overwritten);
+    let timeouts = p.delta(|r| r.command_timeouts);
+    let (lvl, msg) = if rejected + overwritten + timeouts > 0 {
+        (
+            level::WARN,
+            format!(
+                "{rejected} rejected, {overwritten} overwritten, {timeouts} steps on a timed-out command"
+            ),
+        )
+    } else {
+        (level::OK, "every command applied".into())
+    };
+    p.status(
+        "commands",
+        lvl,
+        msg,
+        vec![
+            kv("received", s.commands_received),
+            kv("applied", s.commands_applied),
+            kv("overwritten", s.commands_overwritten),
+            kv("rejected", s.commands_rejected),
+            kv("steps on a timed-out command", s.command_timeouts),
+        ],
+    )
+}
+
+fn outputs(p: &Period) -> DiagnosticStatus {
+    let s = p.now;
+    let lost = p.delta(|r| r.publish_drops)
+        + p.delta(|r| r.publish_failures)
+        + p.delta(|r| r.statistics_not_sent);
+    p.status(
+        "outputs",
+        if lost > 0 { level::WARN } else { level::OK },
+        if lost > 0 {
+            format!("{lost} outputs dropped or not sent")
+        } else {
+            "every output sent".into()
+        },
+        vec![
+            kv("publish drops", s.publish_drops),
+            kv("publish failures", s.publish_failures),
+            kv("statistics not sent", s.statistics_not_sent),
+        ],
+    )
+}
+
+fn recorder(p: &Period) -> DiagnosticStatus {
+    let s = p.now;
+    let drops = p.delta(|r| r.recorder_drops);
+    let lost = p.delta(|r| r.recording.lost);
+    let (lvl, msg) = if lost > 0 {
+        (
+            level::ERROR,
+            format!("{lost} messages lost: writing failed"),
+        )
+    } else if drops > 0 {
+        (
+            level::WARN,
+            format!("{drops} messages dropped by a full recorder queue"),
+        )
+    } else if s.recording.files == 0 {
+        (level::OK, "not recording".into())
+    } else {
+        (level::OK, "recording".into())
+    };
+    p.status(
+        "recorder",
+        lvl,
+        msg,
+        vec![
+            kv("files", s.recording.files),
+            kv("files deleted for the budget", s.recording.files_deleted),
+            kv("messages lost", s.recording.lost),
+            kv("queue drops", s.recorder_drops),
+            kv("snapshots", s.recording.snapshots),
+            kv("last snapshot", s.recording.last_snapshot.as_str()),
+        ],
+    )
+}
+
 impl HealthReporter {
     /// The array for `s` (compared with the previous statistics).
     pub fn update(&mut self, s: &StatisticsRecord, node: &str, frame_id: &str) -> DiagnosticArray {
-        let p = self.previous.unwrap_or_default();
+        let before = self.previous.unwrap_or_default();
         self.previous = Some(*s);
-        let d = |now: u64, before: u64| now.saturating_sub(before);
-        let steps = d(s.steps, p.steps).max(1);
-        let frac = |n: u64| n as f64 / steps as f64;
-        let status =
-            |name: &str, lvl: u8, message: String, values: Vec<KeyValue>| DiagnosticStatus {
-                level: lvl,
-                name: format!("{node}: {name}"),
-                message,
-                hardware_id: node.to_string(),
-                values,
-            };
-        let us = |ns: u64| format!("{:.1}", ns as f64 / 1e3);
-
-        let misses = d(s.deadline_misses, p.deadline_misses);
-        let jumps = d(s.time_jumps, p.time_jumps);
-        let (lvl, msg) = if frac(misses) >= MISS_ERROR {
-            (
-                level::ERROR,
-                format!("{misses} deadline misses in {steps} steps"),
-            )
-        } else if frac(misses) >= MISS_WARN || jumps > 0 {
-            (
-                level::WARN,
-                format!(
-                    "{misses} deadline misses, {jumps} long steps over lost time in {steps} steps"
-                ),
-            )
-        } else {
-            (level::OK, "on time".into())
+        let period = Period {
+            now: s,
+            before,
+            steps: s.steps.saturating_sub(before.steps).max(1),
+            node,
         };
-        let timing = status(
-            "loop timing",
-            lvl,
-            msg,
-            vec![
-                kv("steps", s.steps),
-                kv("deadline misses", s.deadline_misses),
-                kv("deadline misses in the period", misses),
-                kv("catch-up steps", s.catch_up_steps),
-                kv("long steps over lost time", s.time_jumps),
-                kv("wall clock jumps", s.clock_jumps),
-                kv("compute p50 (us)", us(s.compute_time_ns[0])),
-                kv("compute p99 (us)", us(s.compute_time_ns[1])),
-                kv("compute max (us)", us(s.compute_time_ns[2])),
-                kv("jitter p50 (us)", us(s.period_jitter_ns[0])),
-                kv("jitter p99 (us)", us(s.period_jitter_ns[1])),
-                kv("jitter max (us)", us(s.period_jitter_ns[2])),
-            ],
-        );
-
-        let bad = d(s.steps_not_converged, p.steps_not_converged);
-        let (lvl, msg) = if frac(bad) >= SOLVER_ERROR {
-            (
-                level::ERROR,
-                format!("{bad} of {steps} steps not converged"),
-            )
-        } else if bad > 0 {
-            (level::WARN, format!("{bad} of {steps} steps not converged"))
-        } else {
-            (level::OK, "every step converged".into())
-        };
-        let solver = status(
-            "solver",
-            lvl,
-            msg,
-            vec![
-                kv("steps not converged", s.steps_not_converged),
-                kv("steps not converged in the period", bad),
-                kv("parameter updates", s.parameter_updates),
-            ],
-        );
-
-        let rejected = d(s.commands_rejected, p.commands_rejected);
-        let overwritten = d(s.commands_overwritten, p.commands_overwritten);
-        let timeouts = d(s.command_timeouts, p.command_timeouts);
-        let (lvl, msg) = if rejected + overwritten + timeouts > 0 {
-            (
-                level::WARN,
-                format!(
-                    "{rejected} rejected, {overwritten} overwritten, {timeouts} steps on a timed-out command"
-                ),
-            )
-        } else {
-            (level::OK, "every command applied".into())
-        };
-        let commands = status(
-            "commands",
-            lvl,
-            msg,
-            vec![
-                kv("received", s.commands_received),
-                kv("applied", s.commands_applied),
-                kv("overwritten", s.commands_overwritten),
-                kv("rejected", s.commands_rejected),
-                kv("steps on a timed-out command", s.command_timeouts),
-            ],
-        );
-
-        let lost_out = d(s.publish_drops, p.publish_drops)
-            + d(s.publish_failures, p.publish_failures)
-            + d(s.statistics_not_sent, p.statistics_not_sent);
-        let outputs = status(
-            "outputs",
-            if lost_out > 0 { level::WARN } else { level::OK },
-            if lost_out > 0 {
-                format!("{lost_out} outputs dropped or not sent")
-            } else {
-                "every output sent".into()
-            },
-            vec![
-                kv("publish drops", s.publish_drops),
-                kv("publish failures", s.publish_failures),
-                kv("statistics not sent", s.statistics_not_sent),
-            ],
-        );
-
-        let drops = d(s.recorder_drops, p.recorder_drops);
-        let lost = d(s.recording.lost, p.recording.lost);
-        let (lvl, msg) = if lost > 0 {
-            (
-                level::ERROR,
-                format!("{lost} messages lost: writing failed"),
-            )
-        } else if drops > 0 {
-            (
-                level::WARN,
-                format!("{drops} messages dropped by a full recorder queue"),
-            )
-        } else if s.recording.files == 0 {
-            (level::OK, "not recording".into())
-        } else {
-            (level::OK, "recording".into())
-        };
-        let recorder = status(
-            "recorder",
-            lvl,
-            msg,
-            vec![
-                kv("files", s.recording.files),
-                kv("files deleted for the budget", s.recording.files_deleted),
-                kv("messages lost", s.recording.lost),
-                kv("queue drops", s.recorder_drops),
-                kv("snapshots", s.recording.snapshots),
-                kv("last snapshot", s.recording.last_snapshot.as_str()),
-            ],
-        );
         DiagnosticArray {
             header: Header {
                 stamp: Time::from_ns(s.stamp_ns),
                 frame_id: frame_id.to_string(),
             },
-            status: vec![timing, solver, commands, outputs, recorder],
+            status: vec![
+                timing(&period),
+                solver(&period),
+                commands(&period),
+                outputs(&period),
+                recorder(&period),
+            ],
         }
     }
 }
