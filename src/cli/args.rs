@@ -19,6 +19,21 @@ pub struct Cli {
     pub command: Command,
 }
 
+/// The fine reference the accuracy benches compare with, and the cycles
+/// they run (`bench-accuracy`, `bench-cases`).
+#[derive(clap::Args, Clone, Copy, Debug)]
+pub struct ReferenceArgs {
+    /// The reference grid, in [8, 65536] (bench-cases: with the muscl_van_leer flux).
+    #[arg(long, default_value = "2048", value_parser = cells)]
+    pub reference_cells: usize,
+    /// The reference step (s), in [1e-6, 0.1].
+    #[arg(long, default_value = "0.000125", value_parser = accuracy_dt)]
+    pub reference_dt: f64,
+    /// Cycles per run (the last one is measured), in [2, 100].
+    #[arg(long, default_value = "3", value_parser = accuracy_cycles)]
+    pub cycles: u32,
+}
+
 /// Accepted before and after the subcommand; overrides accumulate in order
 /// (clap's `global` would replace the earlier ones).
 #[derive(clap::Args, Clone, Default)]
@@ -334,15 +349,8 @@ pub enum Command {
         /// Steps (s) at the configured grid, comma-separated, each in [1e-6, 0.1].
         #[arg(long, default_value = "0.004,0.002,0.001,0.0005,0.00025", value_delimiter = ',', value_parser = accuracy_dt)]
         steps: Vec<f64>,
-        /// The reference grid, in [8, 65536].
-        #[arg(long, default_value = "2048", value_parser = cells)]
-        reference_cells: usize,
-        /// The reference step (s), in [1e-6, 0.1].
-        #[arg(long, default_value = "0.000125", value_parser = accuracy_dt)]
-        reference_dt: f64,
-        /// Cycles per run (the last one is measured), in [2, 100].
-        #[arg(long, default_value = "3", value_parser = accuracy_cycles)]
-        cycles: u32,
+        #[command(flatten)]
+        reference: ReferenceArgs,
     },
     /// The accuracy guide over a family of transient cases (speeds, frequencies, loads, viscosities): how many pass against a fine reference per grid and flux (release build!).
     BenchCases {
@@ -357,15 +365,8 @@ pub enum Command {
         /// Couette fluxes to test, comma-separated (upwind, muscl_minmod, muscl_van_leer, muscl_van_albada).
         #[arg(long, default_value = "upwind,muscl_van_leer", value_delimiter = ',', value_parser = flux)]
         fluxes: Vec<friction_node::config::FluxKind>,
-        /// The reference grid, in [8, 65536] (flux muscl_van_leer).
-        #[arg(long, default_value = "2048", value_parser = cells)]
-        reference_cells: usize,
-        /// The reference step (s), in [1e-6, 0.1].
-        #[arg(long, default_value = "0.000125", value_parser = accuracy_dt)]
-        reference_dt: f64,
-        /// Cycles per run (the last one is measured), in [2, 100].
-        #[arg(long, default_value = "3", value_parser = accuracy_cycles)]
-        cycles: u32,
+        #[command(flatten)]
+        reference: ReferenceArgs,
         /// Cases run at once (0: one per core).
         #[arg(long, default_value = "0")]
         jobs: usize,

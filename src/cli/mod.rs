@@ -140,24 +140,20 @@ pub fn dispatch(
         Command::BenchAccuracy {
             grids,
             steps,
-            reference_cells,
-            reference_dt,
-            cycles,
+            reference: r,
             ..
         } => bench::accuracy(
             &config,
             &grids,
             &steps,
-            (reference_cells, reference_dt),
-            cycles,
+            (r.reference_cells, r.reference_dt),
+            r.cycles,
         ),
         Command::BenchCases {
             count,
             grids,
             fluxes,
-            reference_cells,
-            reference_dt,
-            cycles,
+            reference: r,
             jobs,
             ..
         } => bench::cases(
@@ -165,8 +161,8 @@ pub fn dispatch(
             count,
             &grids,
             &fluxes,
-            (reference_cells, reference_dt),
-            cycles,
+            (r.reference_cells, r.reference_dt),
+            r.cycles,
             jobs,
         ),
         Command::BenchFit {

@@ -24,6 +24,7 @@
 //! matrix and no pivoting is needed (a zero or non-finite pivot gives None,
 //! as in `bordered.rs`).
 
+use super::bordered::{close_border, Border};
 use super::work::{BandFactor, RowColumns, Work};
 
 /// Row i of the system in solve order (reversed when v < 0), as
@@ -76,22 +77,14 @@ pub(crate) fn factor_solve(w: &mut Work) -> Option<f64> {
     if !(sy.is_finite() && sz.is_finite()) {
         return None;
     }
+    let border = Border {
+        balance: w.balance,
+        dgdh: w.dgdh,
+        c_row: w.c_row,
+        g: w.g,
+    };
     let y = &mut w.dp[..w.rows.len()];
-    if !w.balance {
-        for v in y.iter_mut() {
-            *v = -*v;
-        }
-        return Some(0.0);
-    }
-    w.schur = w.dgdh - w.c_row * sz;
-    if !(w.schur.is_finite() && w.schur != 0.0) {
-        return None;
-    }
-    let dh = (-w.g + w.c_row * sy) / w.schur;
-    for (v, z) in y.iter_mut().zip(&w.band_z) {
-        *v = -*v - z * dh;
-    }
-    Some(dh)
+    close_border(border, y, w.band_z.iter().copied(), (sy, sz), &mut w.schur)
 }
 
 /// The two eliminations and the meeting row; y into `w.dp`, z into
