@@ -33,7 +33,7 @@ pub fn replay(e: ReplayError) -> PyErr {
     match e {
         ReplayError::Bag(b) => bag(b),
         ReplayError::Config(c) => config(c),
-        ReplayError::Output(_) => PyOSError::new_err(e.to_string()),
+        ReplayError::Output(_) | ReplayError::Recording { .. } => PyOSError::new_err(e.to_string()),
         other => PyValueError::new_err(keywords(&other.to_string())),
     }
 }

@@ -3,7 +3,7 @@
 //! the `friction_node` metadata record, messages, per-topic counts.
 
 use super::entry::{Encoder, Entry, TopicId};
-use super::RecorderError;
+use super::{RecorderError, WriteError};
 use crate::config::topics::TopicNames;
 use crate::config::{CommandType, Compression, Config, QosConfig, Reliability};
 use crate::link::RecordItem;
@@ -255,32 +255,28 @@ impl BagWriter {
         &mut self,
         name: &str,
         metadata: BTreeMap<String, String>,
-    ) -> Result<(), String> {
-        self.w
-            .write_metadata(&mcap::records::Metadata {
-                name: name.into(),
-                metadata,
-            })
-            .map_err(|e| e.to_string())
+    ) -> Result<(), WriteError> {
+        Ok(self.w.write_metadata(&mcap::records::Metadata {
+            name: name.into(),
+            metadata,
+        })?)
     }
 
     /// Write one serialized message.
-    pub fn write_entry(&mut self, e: &Entry) -> Result<(), String> {
+    pub fn write_entry(&mut self, e: &Entry) -> Result<(), WriteError> {
         let Some(channel_id) = self.channels.get(e.topic.index()).copied().flatten() else {
-            return Err(format!("{:?} is not a topic of this recording", e.topic));
+            return Err(WriteError::UnknownTopic(e.topic));
         };
         self.sequence = self.sequence.wrapping_add(1);
-        self.w
-            .write_to_known_channel(
-                &mcap::records::MessageHeader {
-                    channel_id,
-                    sequence: self.sequence,
-                    log_time: e.log_ns,
-                    publish_time: e.publish_ns,
-                },
-                &e.data,
-            )
-            .map_err(|x| x.to_string())?;
+        self.w.write_to_known_channel(
+            &mcap::records::MessageHeader {
+                channel_id,
+                sequence: self.sequence,
+                log_time: e.log_ns,
+                publish_time: e.publish_ns,
+            },
+            &e.data,
+        )?;
         self.messages += 1;
         self.counts[e.topic.index()] += 1;
         self.first_log_ns.get_or_insert(e.log_ns);
@@ -290,7 +286,7 @@ impl BagWriter {
     }
 
     /// Write one item the loop or a transport produced.
-    pub fn write_item(&mut self, item: &RecordItem) -> Result<(), String> {
+    pub fn write_item(&mut self, item: &RecordItem) -> Result<(), WriteError> {
         let mut out = std::mem::take(&mut self.scratch);
         out.clear();
         let r = self
@@ -302,13 +298,13 @@ impl BagWriter {
     }
 
     /// Close the open chunk (what is on disk is then readable after a crash).
-    pub fn flush(&mut self) -> Result<(), String> {
-        self.w.flush().map_err(|e| e.to_string())
+    pub fn flush(&mut self) -> Result<(), WriteError> {
+        Ok(self.w.flush()?)
     }
 
     /// Write the summary and footer; returns the file's size.
-    pub fn finish(mut self) -> Result<u64, String> {
-        self.w.finish().map_err(|e| e.to_string())?;
+    pub fn finish(mut self) -> Result<u64, WriteError> {
+        self.w.finish()?;
         drop(self.w);
         Ok(std::fs::metadata(&self.path).map_or(0, |m| m.len()))
     }

@@ -2,6 +2,7 @@
 //! the node's topics, ready for any file (a single recording, a split file,
 //! a snapshot).
 
+use super::WriteError;
 use crate::config::CommandType;
 use crate::link::ProfileData;
 use crate::link::RecordItem;
@@ -97,34 +98,42 @@ pub struct Encoder {
     pub joints: Vec<String>,
 }
 
-fn cdr<T: serde::Serialize>(m: &T) -> Result<Vec<u8>, String> {
-    msgs::to_cdr(m)
+fn cdr<T: serde::Serialize>(topic: TopicId, m: &T) -> Result<Vec<u8>, WriteError> {
+    msgs::to_cdr(m).map_err(|message| WriteError::Encode { topic, message })
 }
 
 impl Encoder {
-    fn command(&self, c: &Command, received_ns: u64) -> Result<Entry, String> {
+    fn command(&self, c: &Command, received_ns: u64) -> Result<Entry, WriteError> {
         let (topic, data) = match (c.kind, self.command_type) {
-            (CommandKind::Load, _) => (TopicId::Load, cdr(&Float64 { data: c.value })?),
+            (CommandKind::Load, _) => (
+                TopicId::Load,
+                cdr(TopicId::Load, &Float64 { data: c.value })?,
+            ),
             (CommandKind::Temperature, _) => (
                 TopicId::Temperature,
-                cdr(&msgs::Temperature {
-                    header: Header {
-                        stamp: Time::from_ns(c.stamp_ns),
-                        frame_id: self.frame_id.clone(),
+                cdr(
+                    TopicId::Temperature,
+                    &msgs::Temperature {
+                        header: Header {
+                            stamp: Time::from_ns(c.stamp_ns),
+                            frame_id: self.frame_id.clone(),
+                        },
+                        temperature: c.value,
+                        variance: 0.0,
                     },
-                    temperature: c.value,
-                    variance: 0.0,
-                })?,
+                )?,
             ),
-            (CommandKind::Velocity, CommandType::Float64) => {
-                (TopicId::Velocity, cdr(&Float64 { data: c.value })?)
-            }
+            (CommandKind::Velocity, CommandType::Float64) => (
+                TopicId::Velocity,
+                cdr(TopicId::Velocity, &Float64 { data: c.value })?,
+            ),
             (CommandKind::JointVelocity { contact, .. }, _) => {
                 let Some(joint) = self.joints.get(usize::from(contact)) else {
-                    return Err(format!(
-                        "a joint velocity for contact {contact}, but the recording has {} contacts",
-                        self.joints.len()
-                    ));
+                    return Err(WriteError::NoSuchContact {
+                        what: "a joint velocity",
+                        contact,
+                        contacts: self.joints.len(),
+                    });
                 };
                 let m = msgs::JointState {
                     header: Header {
@@ -136,7 +145,7 @@ impl Encoder {
                     velocity: vec![c.value],
                     effort: Vec::new(),
                 };
-                (TopicId::JointCommands, cdr(&m)?)
+                (TopicId::JointCommands, cdr(TopicId::JointCommands, &m)?)
             }
             (CommandKind::Velocity, CommandType::TwistStamped) => {
                 let mut m = TwistStamped {
@@ -147,7 +156,7 @@ impl Encoder {
                     ..Default::default()
                 };
                 m.twist.linear.x = c.value;
-                (TopicId::Velocity, cdr(&m)?)
+                (TopicId::Velocity, cdr(TopicId::Velocity, &m)?)
             }
         };
         Ok(Entry {
@@ -161,7 +170,7 @@ impl Encoder {
     /// The entries of one item (an estimate is two: the full estimate and
     /// the plain friction force), logged when the item says it was received
     /// or published.
-    pub fn encode(&self, item: &RecordItem, out: &mut Vec<Entry>) -> Result<(), String> {
+    pub fn encode(&self, item: &RecordItem, out: &mut Vec<Entry>) -> Result<(), WriteError> {
         match item {
             RecordItem::Command {
                 command,
@@ -185,37 +194,46 @@ impl Encoder {
             } => {
                 if !self.joints.is_empty() {
                     if usize::from(contact) >= self.joints.len() {
-                        return Err(format!(
-                            "an estimate of contact {contact}, but the recording has {} contacts",
-                            self.joints.len()
-                        ));
+                        return Err(WriteError::NoSuchContact {
+                            what: "an estimate",
+                            contact,
+                            contacts: self.joints.len(),
+                        });
                     }
                     out.push(Entry {
                         topic: TopicId::ContactFriction(contact),
                         log_ns,
                         publish_ns: e.stamp_ns,
-                        data: cdr(&e.to_wire(&self.frame_id))?,
+                        data: cdr(
+                            TopicId::ContactFriction(contact),
+                            &e.to_wire(&self.frame_id),
+                        )?,
                     });
                     return Ok(());
                 }
                 if contact != 0 {
-                    return Err(format!(
-                        "an estimate of contact {contact} in a one-contact recording"
-                    ));
+                    return Err(WriteError::NoSuchContact {
+                        what: "an estimate",
+                        contact,
+                        contacts: 1,
+                    });
                 }
                 out.push(Entry {
                     topic: TopicId::Friction,
                     log_ns,
                     publish_ns: e.stamp_ns,
-                    data: cdr(&e.to_wire(&self.frame_id))?,
+                    data: cdr(TopicId::Friction, &e.to_wire(&self.frame_id))?,
                 });
                 out.push(Entry {
                     topic: TopicId::FrictionForce,
                     log_ns,
                     publish_ns: e.stamp_ns,
-                    data: cdr(&Float64 {
-                        data: e.friction_force_n,
-                    })?,
+                    data: cdr(
+                        TopicId::FrictionForce,
+                        &Float64 {
+                            data: e.friction_force_n,
+                        },
+                    )?,
                 });
             }
             &RecordItem::Statistics {
@@ -225,7 +243,7 @@ impl Encoder {
                 topic: TopicId::Statistics,
                 log_ns,
                 publish_ns: s.stamp_ns,
-                data: cdr(&s.to_wire(&self.frame_id))?,
+                data: cdr(TopicId::Statistics, &s.to_wire(&self.frame_id))?,
             }),
             RecordItem::ParameterEvent {
                 cdr,
@@ -242,7 +260,7 @@ impl Encoder {
     }
 
     /// A film profile's entry.
-    pub fn profile(&self, p: ProfileData, log_ns: u64) -> Result<Entry, String> {
+    pub fn profile(&self, p: ProfileData, log_ns: u64) -> Result<Entry, WriteError> {
         let stamp = p.stamp_ns;
         let m = msgs::FilmProfile {
             header: Header {
@@ -257,7 +275,7 @@ impl Encoder {
             topic: TopicId::FilmProfile,
             log_ns,
             publish_ns: stamp,
-            data: cdr(&m)?,
+            data: cdr(TopicId::FilmProfile, &m)?,
         })
     }
 }

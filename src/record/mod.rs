@@ -49,7 +49,7 @@ use crate::link::RecordItem;
 use crate::link::RecorderCounters;
 use crate::msgs::Note;
 use crossbeam_queue::ArrayQueue;
-use entry::{Encoder, Entry};
+use entry::{Encoder, Entry, TopicId};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -68,6 +68,40 @@ pub enum RecorderError {
     Mcap { path: PathBuf, message: String },
     #[error("recording directory {}: {message}", path.display())]
     Directory { path: PathBuf, message: String },
+}
+
+/// A write into a recording failed (the recording stops; what is on disk
+/// stays readable up to the last chunk).
+#[derive(Debug, thiserror::Error)]
+pub enum WriteError {
+    /// The MCAP writer (an I/O error underneath, or a full disk).
+    #[error(transparent)]
+    Mcap(#[from] mcap::McapError),
+    #[error(transparent)]
+    Io(#[from] std::io::Error),
+    /// A message did not serialize as CDR.
+    #[error("cannot encode {topic:?} as CDR: {message}")]
+    Encode { topic: TopicId, message: String },
+    /// An item for a contact the recording does not have.
+    #[error("{what} of contact {contact}, but the recording has {contacts} contacts")]
+    NoSuchContact {
+        what: &'static str,
+        contact: u16,
+        contacts: usize,
+    },
+    /// An entry on a topic this recording did not declare.
+    #[error("{0:?} is not a topic of this recording")]
+    UnknownTopic(TopicId),
+    /// A file beside the messages (`metadata.yaml`) could not be written.
+    #[error(transparent)]
+    Output(#[from] crate::output::OutputError),
+    /// The next file of a split recording (or a snapshot) could not be
+    /// created.
+    #[error(transparent)]
+    Open(Box<RecorderError>),
+    /// The recording was already closed.
+    #[error("the recording is already finished")]
+    Finished,
 }
 
 /// What a finished recording reports.
@@ -113,7 +147,7 @@ pub struct Recorder {
 }
 
 /// A snapshot being written: (file, span ns, bytes) or an error.
-type SnapshotThread = std::thread::JoinHandle<Result<(PathBuf, u64, u64), String>>;
+type SnapshotThread = std::thread::JoinHandle<Result<(PathBuf, u64, u64), WriteError>>;
 
 /// The recorder thread's state.
 struct Writer {
@@ -246,7 +280,8 @@ impl Drop for Recorder {
 }
 
 impl Writer {
-    fn fail(&mut self, message: String) {
+    fn fail(&mut self, error: WriteError) {
+        let message = error.to_string();
         if let Output::Single(w @ Some(_), path) = &mut self.out {
             tracing::error!(
                 "recording {} failed: {message}; the node goes on without recording",
@@ -327,7 +362,7 @@ impl Writer {
         let (config, names, entries) = (self.config.clone(), self.names.clone(), ring.contents());
         self.snapshot_threads.push(std::thread::spawn(move || {
             if let Some(d) = path.parent() {
-                std::fs::create_dir_all(d).map_err(|e| e.to_string())?;
+                std::fs::create_dir_all(d)?;
             }
             snapshot::write(path, &config, &names, entries, now)
         }));
@@ -415,7 +450,7 @@ impl Writer {
             Output::Single(Some(w), path) => match w.finish() {
                 Ok(bytes) => report.bytes = bytes,
                 Err(e) => {
-                    self.error.get_or_insert(e);
+                    self.error.get_or_insert(e.to_string());
                     report.bytes = std::fs::metadata(&path).map_or(0, |m| m.len());
                 }
             },
@@ -425,7 +460,7 @@ impl Writer {
             Output::Split(d) => match d.finish() {
                 Ok((_, bytes)) => report.bytes = bytes,
                 Err(e) => {
-                    self.error.get_or_insert(e);
+                    self.error.get_or_insert(e.to_string());
                 }
             },
         }

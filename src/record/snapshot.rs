@@ -8,6 +8,7 @@
 
 use super::bag_writer::BagWriter;
 use super::entry::Entry;
+use super::WriteError;
 use crate::config::topics::TopicNames;
 use crate::config::Config;
 use std::collections::{BTreeMap, VecDeque};
@@ -72,7 +73,7 @@ pub fn write(
     names: &TopicNames,
     mut entries: Vec<Entry>,
     now_ns: u64,
-) -> Result<(PathBuf, u64, u64), String> {
+) -> Result<(PathBuf, u64, u64), WriteError> {
     entries.sort_by_key(|e| e.log_ns);
     let span = match (entries.first(), entries.last()) {
         (Some(a), Some(b)) => b.log_ns - a.log_ns,
@@ -81,14 +82,15 @@ pub fn write(
     let mut extra = BTreeMap::new();
     extra.insert("snapshot_span_ns".to_string(), span.to_string());
     let tmp = crate::output::tmp_sibling(&path);
-    let mut w = BagWriter::create(&tmp, config, names, extra, now_ns).map_err(|e| e.to_string())?;
+    let mut w = BagWriter::create(&tmp, config, names, extra, now_ns)
+        .map_err(|e| WriteError::Open(Box::new(e)))?;
     let result = entries
         .iter()
         .try_for_each(|e| w.write_entry(e))
         .and_then(|_| w.finish());
     match result {
         Ok(bytes) => {
-            std::fs::rename(&tmp, &path).map_err(|e| e.to_string())?;
+            std::fs::rename(&tmp, &path)?;
             Ok((path, span, bytes))
         }
         Err(e) => {

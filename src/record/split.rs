@@ -14,7 +14,7 @@
 
 use super::bag_writer::{BagWriter, TopicTable};
 use super::entry::Entry;
-use super::RecorderError;
+use super::{RecorderError, WriteError};
 use crate::bag::rosbag2::{FileInfo, Metadata, Nanoseconds, Since, TopicMetadata, TopicWithCount};
 use crate::config::topics::TopicNames;
 use crate::config::Config;
@@ -46,7 +46,7 @@ pub struct SplitDir {
     budget: u64,
     /// The last time the current file's size was looked at (entries).
     since_size_check: u64,
-    finalisers: Vec<std::thread::JoinHandle<Result<u64, String>>>,
+    finalisers: Vec<std::thread::JoinHandle<Result<u64, WriteError>>>,
     /// Entries written since the last failure was seen.
     pub failed: Option<String>,
 }
@@ -104,7 +104,7 @@ impl SplitDir {
             failed: None,
         };
         s.open(started_ns)?;
-        s.write_metadata().map_err(err)?;
+        s.write_metadata().map_err(|e| err(e.to_string()))?;
         Ok(s)
     }
 
@@ -156,7 +156,7 @@ impl SplitDir {
     }
 
     /// Finish the current file off this thread, start the next.
-    fn rotate(&mut self, now_ns: u64, counters: &RecorderCounters) -> Result<(), String> {
+    fn rotate(&mut self, now_ns: u64, counters: &RecorderCounters) -> Result<(), WriteError> {
         if let Some(w) = self.current.take() {
             let name = w
                 .path()
@@ -180,7 +180,8 @@ impl SplitDir {
             self.finalisers.push(std::thread::spawn(move || w.finish()));
         }
         self.reap();
-        self.open(now_ns).map_err(|e| e.to_string())?;
+        self.open(now_ns)
+            .map_err(|e| WriteError::Open(Box::new(e)))?;
         counters.files.fetch_add(1, Ordering::Relaxed);
         self.enforce_budget(counters);
         self.write_metadata()
@@ -224,7 +225,7 @@ impl SplitDir {
     }
 
     /// `metadata.yaml` for the files present (written atomically).
-    fn write_metadata(&self) -> Result<(), String> {
+    fn write_metadata(&self) -> Result<(), WriteError> {
         let table = TopicTable::new(&self.config, &self.names);
         let mut counts = vec![0u64; table.slots()];
         let mut files = Vec::new();
@@ -290,9 +291,8 @@ impl SplitDir {
             files,
             ..Default::default()
         };
-        crate::output::write_file(&self.dir.join("metadata.yaml"), m.to_yaml().as_bytes())
-            .map(|_| ())
-            .map_err(|e| e.to_string())
+        crate::output::write_file(&self.dir.join("metadata.yaml"), m.to_yaml().as_bytes())?;
+        Ok(())
     }
 
     /// Write one entry, splitting first when due. After a failure, entries
@@ -332,7 +332,8 @@ impl SplitDir {
         }
     }
 
-    fn fail(&mut self, message: String) {
+    fn fail(&mut self, error: WriteError) {
+        let message = error.to_string();
         tracing::error!(
             "recording into {} failed: {message}; retrying in a new file",
             self.dir.display()
@@ -370,7 +371,7 @@ impl SplitDir {
     }
 
     /// Finish the last file, wait for every finaliser, write the metadata.
-    pub fn finish(mut self) -> Result<(PathBuf, u64), String> {
+    pub fn finish(mut self) -> Result<(PathBuf, u64), WriteError> {
         let mut result = Ok(());
         if let Some(w) = self.current.take() {
             let first = w.first_log_ns.unwrap_or(0);

@@ -51,6 +51,7 @@ use crate::bag::decode::VELOCITY_TYPES;
 use crate::bag::{self, BagError, Damage};
 use crate::config::ConfigError;
 use crate::node::NodeError;
+use std::path::PathBuf;
 
 /// Errors of the replay layer.
 #[derive(Debug, thiserror::Error)]
@@ -74,6 +75,11 @@ pub enum ReplayError {
     },
     #[error(transparent)]
     Output(#[from] crate::output::OutputError),
+    #[error("cannot write {}: {source}", path.display())]
+    Recording {
+        path: PathBuf,
+        source: crate::record::WriteError,
+    },
     #[error("topic `{topic}`: its stamps span {span_s:.3e} s, more than {MAX_REPLAY_STEPS} steps of {dt_s} s (a stamp is probably wrong; or replay a shorter part)")]
     TooLong {
         topic: String,

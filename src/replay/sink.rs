@@ -6,6 +6,7 @@ use super::{InputMode, Oracle, PreparedReplay, ReplayError};
 use crate::msgs::{self, Command, EstimateRecord};
 use crate::output::{tmp_sibling, OutputError};
 use crate::physics::Estimate;
+use crate::record::WriteError;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -36,7 +37,7 @@ type Step = (Estimate, EstimateRecord, u16);
 /// One output file, written to a temporary sibling and renamed over the
 /// destination only when complete.
 trait Sink: Send {
-    fn write(&mut self, steps: &[Step]) -> Result<(), String>;
+    fn write(&mut self, steps: &[Step]) -> Result<(), ReplayError>;
     fn finish(self: Box<Self>, oracle: Option<&Oracle>) -> Result<PathBuf, ReplayError>;
 }
 
@@ -49,7 +50,7 @@ struct CsvSink {
 }
 
 impl Sink for CsvSink {
-    fn write(&mut self, steps: &[Step]) -> Result<(), String> {
+    fn write(&mut self, steps: &[Step]) -> Result<(), ReplayError> {
         for (e, rec, k) in steps {
             let t0 = *self.t0.get_or_insert(rec.stamp_ns);
             let mut e = *e;
@@ -63,13 +64,11 @@ impl Sink for CsvSink {
                 Some(name) => format!(",{name}"),
                 None => String::new(),
             };
-            self.file
-                .line(format_args!(
-                    "{row},{},{}{contact}",
-                    rec.stamp_ns,
-                    msgs::command_status_name(rec.command_status)
-                ))
-                .map_err(|e| e.to_string())?;
+            self.file.line(format_args!(
+                "{row},{},{}{contact}",
+                rec.stamp_ns,
+                msgs::command_status_name(rec.command_status)
+            ))?;
         }
         Ok(())
     }
@@ -91,13 +90,19 @@ struct McapSink {
 }
 
 impl McapSink {
-    fn writer(&mut self) -> Result<&mut crate::record::BagWriter, String> {
-        self.w
-            .as_mut()
-            .ok_or_else(|| "already finished".to_string())
+    fn writer(&mut self) -> Result<&mut crate::record::BagWriter, WriteError> {
+        self.w.as_mut().ok_or(WriteError::Finished)
     }
 
-    fn commands_up_to(&mut self, stamp: u64) -> Result<(), String> {
+    /// A write error of this output.
+    fn error(&self, source: WriteError) -> ReplayError {
+        ReplayError::Recording {
+            path: self.path.clone(),
+            source,
+        }
+    }
+
+    fn commands_up_to(&mut self, stamp: u64) -> Result<(), WriteError> {
         while let Some(&c) = self.commands.get(self.next).filter(|c| c.stamp_ns <= stamp) {
             let item = crate::link::RecordItem::Command {
                 command: c,
@@ -111,21 +116,23 @@ impl McapSink {
 }
 
 impl Sink for McapSink {
-    fn write(&mut self, steps: &[Step]) -> Result<(), String> {
-        for (_, rec, k) in steps {
-            self.commands_up_to(rec.stamp_ns)?;
-            self.writer()?
-                .write_item(&crate::link::RecordItem::Estimate {
-                    record: *rec,
-                    logged_ns: rec.stamp_ns,
-                    contact: *k,
-                })?;
-        }
-        Ok(())
+    fn write(&mut self, steps: &[Step]) -> Result<(), ReplayError> {
+        let mut write = || -> Result<(), WriteError> {
+            for (_, rec, k) in steps {
+                self.commands_up_to(rec.stamp_ns)?;
+                self.writer()?
+                    .write_item(&crate::link::RecordItem::Estimate {
+                        record: *rec,
+                        logged_ns: rec.stamp_ns,
+                        contact: *k,
+                    })?;
+            }
+            Ok(())
+        };
+        write().map_err(|e| self.error(e))
     }
 
     fn finish(mut self: Box<Self>, oracle: Option<&Oracle>) -> Result<PathBuf, ReplayError> {
-        let err = |path: &Path, message: String| OutputError::other(path, message);
         let result = (|| {
             self.commands_up_to(u64::MAX)?;
             if let Some(o) = oracle {
@@ -135,26 +142,21 @@ impl Sink for McapSink {
                 self.writer()?
                     .write_metadata("friction_node_replay_oracle", m)?;
             }
-            Ok::<(), String>(())
+            Ok::<(), WriteError>(())
         })();
-        let (path, tmp) = (self.path.clone(), self.tmp.clone());
-        let Some(tmp) = tmp else {
-            // A device: written in place, nothing to move.
-            let w = self.w.take();
-            result
-                .and_then(|_| w.ok_or_else(|| "already finished".to_string())?.finish())
-                .map_err(|e| err(&path, e))?;
-            return Ok(path);
-        };
         let w = self.w.take();
-        let finished =
-            result.and_then(|_| w.ok_or_else(|| "already finished".to_string())?.finish());
+        let finished = result.and_then(|_| w.ok_or(WriteError::Finished)?.finish());
+        let Some(tmp) = self.tmp.clone() else {
+            // A device: written in place, nothing to move.
+            finished.map_err(|e| self.error(e))?;
+            return Ok(self.path.clone());
+        };
         if let Err(e) = finished {
             let _ = std::fs::remove_file(&tmp);
-            return Err(err(&path, e).into());
+            return Err(self.error(e));
         }
-        std::fs::rename(&tmp, &path).map_err(|e| err(&path, e.to_string()))?;
-        Ok(path)
+        std::fs::rename(&tmp, &self.path).map_err(|e| OutputError::new(&self.path, e))?;
+        Ok(self.path.clone())
     }
 }
 
@@ -184,7 +186,7 @@ pub struct OutputStream {
 const BATCH: usize = 1024;
 
 /// The writer thread hands its sink back with the first write error.
-type SinkOutcome = (Box<dyn Sink>, Result<(), String>);
+type SinkOutcome = (Box<dyn Sink>, Result<(), ReplayError>);
 
 impl OutputStream {
     /// Create the temporary output next to `path` and start the writer.
@@ -304,10 +306,10 @@ impl OutputStream {
             .expect("finish once")
             .join()
             .map_err(|_| OutputError::other(&self.path, "the writer thread panicked"))?;
-        if let Err(message) = result {
+        if let Err(e) = result {
             // Dropping the sink removes the temporary file.
             drop(sink);
-            return Err(OutputError::other(&self.path, message).into());
+            return Err(e);
         }
         sink.finish(oracle)
     }
