@@ -11,6 +11,8 @@
 //! | deadlines, timeouts, durations | monotonic ([`Clock::now_ns`]), from an arbitrary origin | ns |
 //! | message stamps, log times | wall ([`Clock::wall_ns`]), since the Unix epoch | ns |
 
+#![warn(missing_docs)]
+
 use std::sync::atomic::{AtomicI64, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
@@ -42,6 +44,7 @@ impl Default for SystemClock {
 }
 
 impl SystemClock {
+    /// The system's clocks (monotonic for deadlines, wall for stamps).
     pub fn new() -> Self {
         Self {
             origin: Instant::now(),
@@ -271,6 +274,7 @@ impl WallStamps {
     /// step of the wall clock, not drift.
     pub const JUMP_NS: u64 = 1_000_000;
 
+    /// Stamps that start at `clock`'s wall time now.
     pub fn new(clock: &dyn Clock) -> Self {
         let mono = clock.now_ns();
         Self {

@@ -10,6 +10,8 @@
 //! process at once (exit 130/143; a temporary file may then stay behind).
 //! The real-time node has its own handlers (it finalises its recording).
 
+#![warn(missing_docs)]
+
 use std::sync::atomic::{AtomicBool, AtomicI32, Ordering};
 use std::sync::{Arc, OnceLock};
 
@@ -46,6 +48,7 @@ pub struct Stop {
 }
 
 impl Stop {
+    /// A stop nothing has requested yet (not tied to the process's signals).
     pub fn new() -> Self {
         Self::default()
     }
@@ -62,6 +65,7 @@ impl Stop {
         self.flag.store(true, Ordering::Release);
     }
 
+    /// Whether a stop was requested.
     pub fn requested(&self) -> bool {
         self.flag.load(Ordering::Acquire)
     }

@@ -25,21 +25,24 @@ use std::sync::{Arc, Mutex};
 #[derive(Debug, Clone, PartialEq)]
 pub struct LoopSettings {
     pub mode: StepMode,
-    pub dt: f64,
+    /// The step, s.
+    pub dt_s: f64,
     /// The step in integer nanoseconds (validated to be whole).
     pub dt_ns: u64,
     pub command_timeout_ns: u64,
     pub timeout_behaviour: TimeoutBehaviour,
-    pub deceleration: f64,
+    /// The ramp to zero after a command timeout, m/s².
+    pub deceleration_m_s2: f64,
     /// The velocity and load commands accepted.
     pub limits: crate::config::InputLimits,
     /// Steps between profile and statistics publications (0 = never).
-    pub profile_every: u64,
-    pub statistics_every: u64,
+    pub profile_every_steps: u64,
+    pub statistics_every_steps: u64,
     pub lockstep_spin_ns: u64,
     /// Timer mode: busy-wait before each deadline, ns.
     pub timer_spin_ns: u64,
-    /// Lost steps caught up one by one before a long step is taken.
+    /// Lost steps caught up one by one before a time jump (the lost time
+    /// advanced in one step).
     pub max_catch_up_steps: u64,
 }
 
@@ -68,14 +71,14 @@ impl LoopSettings {
         };
         Self {
             mode: c.node.step_mode,
-            dt,
+            dt_s: dt,
             dt_ns,
             command_timeout_ns: secs_to_ns(c.node.command_timeout_s),
             timeout_behaviour: c.node.timeout_behaviour,
-            deceleration: c.node.timeout_deceleration_m_s2,
+            deceleration_m_s2: c.node.timeout_deceleration_m_s2,
             limits: crate::config::InputLimits::of(c),
-            profile_every: every(c.node.profile_rate_hz),
-            statistics_every: every(c.node.statistics_rate_hz),
+            profile_every_steps: every(c.node.profile_rate_hz),
+            statistics_every_steps: every(c.node.statistics_rate_hz),
             lockstep_spin_ns: c.node.lockstep_spin_us.saturating_mul(1000),
             timer_spin_ns: c.node.timer_spin_us.saturating_mul(1000),
             max_catch_up_steps: secs_to_ns(c.node.max_catch_up_s) / dt_ns,

@@ -13,6 +13,8 @@
 //!   error naming the path, reported before any computation when the caller
 //!   creates the file first (as the commands do).
 
+#![warn(missing_docs)]
+
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
@@ -22,11 +24,14 @@ use std::sync::atomic::{AtomicU64, Ordering};
 #[derive(Debug, thiserror::Error)]
 #[error("cannot write {}: {cause}", path.display())]
 pub struct OutputError {
+    /// The file that could not be written.
     pub path: PathBuf,
+    /// Why.
     pub cause: std::io::Error,
 }
 
 impl OutputError {
+    /// `cause` writing `path`.
     pub fn new(path: &Path, cause: std::io::Error) -> Self {
         Self {
             path: path.to_path_buf(),
@@ -118,6 +123,7 @@ impl AtomicFile {
         })
     }
 
+    /// The destination (not the temporary sibling).
     pub fn path(&self) -> &Path {
         &self.path
     }

@@ -1,5 +1,7 @@
 //! Fixed-memory statistics for the loop (no allocation after construction).
 
+#![warn(missing_docs)]
+
 /// The samples of one statistics window (ns).
 #[derive(Debug, Clone)]
 pub struct Window {
@@ -9,6 +11,7 @@ pub struct Window {
 }
 
 impl Window {
+    /// A window of the last `capacity` samples.
     pub fn new(capacity: usize) -> Self {
         Self {
             samples: vec![0; capacity],
@@ -24,6 +27,7 @@ impl Window {
         self.len += 1;
     }
 
+    /// Forget every sample.
     pub fn clear(&mut self) {
         self.len = 0;
     }
@@ -64,6 +68,7 @@ impl Default for Histogram {
 }
 
 impl Histogram {
+    /// An empty histogram.
     pub fn new() -> Self {
         Self {
             bins: vec![0; FINE + COARSE + 1],
@@ -92,6 +97,7 @@ impl Histogram {
         }
     }
 
+    /// Count one duration, ns.
     pub fn record(&mut self, ns: u64) {
         let b = &mut self.bins[Self::bin(ns)];
         *b = b.saturating_add(1);
@@ -99,6 +105,7 @@ impl Histogram {
         self.max = self.max.max(ns);
     }
 
+    /// Durations counted.
     pub fn count(&self) -> u64 {
         self.count
     }

@@ -257,7 +257,7 @@ fn ros2_transport_carries_several_contacts() {
     let spec = transport::ros2::Ros2Spec::from_config(&cfg).unwrap();
     assert!(spec.localhost_only, "tests keep discovery on loopback");
     assert_eq!(
-        spec.contact_friction[2],
+        spec.topics.contact_friction[2],
         format!(
             "{}/friction_node/contacts/wrist/friction",
             cfg.ros.namespace

@@ -181,7 +181,7 @@ fn a_late_wake_up_is_caught_up_step_by_step_and_model_time_stays_wall_time() {
 }
 
 #[test]
-fn a_stall_beyond_the_catch_up_bound_is_advanced_in_one_long_step() {
+fn a_stall_beyond_the_catch_up_bound_is_advanced_in_one_time_jump() {
     let cfg = timer_config(); // max_catch_up_s = 0.1
     let link = MemoryLink::new(1000);
     let mut peer = link.peer();
@@ -196,7 +196,7 @@ fn a_stall_beyond_the_catch_up_bound_is_advanced_in_one_long_step() {
     let s = run_sim(&cfg, Box::new(port), clock, 0, 1000);
     let est = drain(&mut peer);
     assert_eq!(s.time_jumps, 1);
-    // 50 steps, the stall during the 50th; one long step over the 500 ms
+    // 50 steps, the stall during the 50th; one time jump over the 500 ms
     // lost (to the last deadline passed, 550 ms), then 450 steps.
     assert_eq!(s.steps, 50 + 1 + 450);
     let jump = est

@@ -425,7 +425,7 @@ fn a_command_of_the_wrong_layout_over_dds_is_received_and_rejected() {
         .history(ros2_client::qos::History::KeepLast { depth: 1000 });
     let topic = n
         .create_topic(
-            &Name::parse(&spec.cmd_velocity).unwrap(),
+            &Name::parse(&spec.topics.cmd_velocity).unwrap(),
             MessageTypeName::new("std_msgs", "Float64"),
             &q,
         )

@@ -238,7 +238,7 @@ fn a_rejected_first_input_reports_a_defined_zero() {
 }
 
 #[test]
-fn a_long_step_over_lost_time_is_backward_euler_and_bdf2_resumes_after_it() {
+fn a_time_jump_is_one_backward_euler_step_and_bdf2_resumes_after_it() {
     // The node's answer to a stall: one step over the lost time. It lands
     // near the fixed-step solution and the following steps converge.
     let mut a = Solver::new(&ModelParams::default(), &settings(64)).unwrap();
@@ -247,7 +247,7 @@ fn a_long_step_over_lost_time_is_backward_euler_and_bdf2_resumes_after_it() {
     for _ in 0..50 {
         a.step(0.5, 20_762.0);
     }
-    let long = b.step_over(0.5, 20_762.0, 0.05);
+    let long = b.step_lasting(0.5, 20_762.0, 0.05);
     assert_eq!(long.status, Status::Converged);
     assert_relative_eq!(long.time, a.time(), max_relative = 1e-12);
     // Constant input from a steady state: both stay at the steady state.
@@ -256,7 +256,7 @@ fn a_long_step_over_lost_time_is_backward_euler_and_bdf2_resumes_after_it() {
         assert_eq!(b.step(0.5, 20_762.0).status, Status::Converged);
     }
     assert_eq!(
-        b.step_over(0.5, 20_762.0, -1.0).status,
+        b.step_lasting(0.5, 20_762.0, -1.0).status,
         Status::InputOutOfRange
     );
 }

@@ -425,7 +425,7 @@ fn step_one(s: &mut Solver, config: &Config, v: f64, load: f64, dt_s: f64) -> Es
     if dt_s == s.settings().dt {
         s.step(v, load)
     } else {
-        s.step_over(v, load, dt_s)
+        s.step_lasting(v, load, dt_s)
     }
 }
 

@@ -196,7 +196,7 @@ impl Model {
             .map_err(|e| errors::value(e.to_string()))?;
         let e = match dt {
             Some(dt) if dt != self.solver.settings().dt => {
-                self.solver.step_over(velocity, load, dt)
+                self.solver.step_lasting(velocity, load, dt)
             }
             _ => self.solver.step(velocity, load),
         };
@@ -300,7 +300,7 @@ impl Model {
                         if (h - dt).abs() <= 1e-9 * dt {
                             solver.step(v[k], f(k))
                         } else {
-                            solver.step_over(v[k], f(k), h)
+                            solver.step_lasting(v[k], f(k), h)
                         }
                     };
                     c.push(&e, t[k], e.status.as_str(), temp(k));

@@ -202,7 +202,7 @@ fn summary(config: &Config, r: &RunReport) {
             us(s.jitter_ns[2])
         );
         println!(
-            "  deadline misses  {} ({} steps caught up late, {} long steps over lost time)",
+            "  deadline misses  {} ({} steps caught up late, {} time jumps (lost time advanced in one step))",
             s.deadline_misses, s.catch_up_steps, s.time_jumps
         );
         if s.clock_jumps > 0 {

@@ -22,10 +22,10 @@
 //! | file | content |
 //! |---|---|
 //! | `model.rs` | the model's sections (`contact`, `texture`, `lubricant`, `roughness`, `solver`) |
-//! | `io.rs` | the node's sections (`node`, `ros`, `iceoryx2`, `recording`) |
+//! | `node_sections.rs` | the node's sections (`node`, `ros`, `iceoryx2`, `recording`) |
 //! | `load.rs` | parameter files, their ROS 2 shapes, `--set` overrides |
 //! | `validate.rs` | physical ranges of the model's sections, one function per section; the range checks |
-//! | `validate_io.rs` | ranges and names of the node's sections (`node`, `ros`, `iceoryx2`, `recording`), the snapshot ring's memory |
+//! | `validate_node.rs` | ranges and names of the node's sections (`node`, `ros`, `iceoryx2`, `recording`), the snapshot ring's memory |
 //! | `ros_names.rs` | the ROS 2 naming rules for topics, node names and namespaces |
 //! | `contacts.rs` | `contacts.*`: several contacts, each overriding the top-level sections |
 //! | `error.rs` | [`ConfigError`] and the [`Origin`] of a configuration |
@@ -38,15 +38,15 @@
 mod contacts;
 mod envelope;
 mod error;
-mod io;
 mod load;
 mod model;
+mod node_sections;
 pub mod parameters;
 pub mod ros_args;
 mod ros_names;
 pub mod topics;
 mod validate;
-mod validate_io;
+mod validate_node;
 
 pub use contacts::{
     ContactEntry, ContactList, ContactSolverConfig, ResolvedContact, CONTACT_SECTIONS,
@@ -56,13 +56,13 @@ pub use envelope::{
     Envelope, InputLimits, OutOfEnvelope, ViscosityLaw, TEMPERATURE_RANGE_C, VISCOSITY_RANGE_PA_S,
 };
 pub use error::{ConfigError, Origin};
-pub use io::*;
 pub use load::apply_override;
 pub use model::*;
+pub use node_sections::*;
 pub use ros_args::RosArgs;
 pub use ros_names::{check_namespace, check_node_name, check_topic};
 pub use validate::{key_ranges, KeyRange};
-pub use validate_io::snapshot_bytes;
+pub use validate_node::snapshot_bytes;
 
 use crate::physics::{
     Contact, Geometry, Lubricant, Method, ModelParams, Pocket, Profile, ReferenceSettings,

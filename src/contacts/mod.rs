@@ -25,6 +25,8 @@
 //! | `pool.rs` | a fixed pool of worker threads stepping their share of the contacts |
 //! | `tests.rs` | unit tests: one contact equals the single solver, the pool equals serial |
 
+#![warn(missing_docs)]
+
 mod pool;
 
 use crate::clock::Clock;
@@ -38,10 +40,23 @@ use std::sync::Arc;
 #[derive(Debug, thiserror::Error)]
 pub enum ContactSetError {
     #[error("contact `{name}`: {cause}")]
-    Setup { name: String, cause: SetupError },
+    /// A contact's solver could not be built.
+    Setup {
+        /// The contact.
+        name: String,
+        /// Why.
+        cause: SetupError,
+    },
     #[error("node.contact_workers = {workers}: at most one worker per contact beyond the first ({contacts} contacts)")]
-    TooManyWorkers { workers: usize, contacts: usize },
+    /// More worker threads than contacts to step.
+    TooManyWorkers {
+        /// `node.contact_workers`.
+        workers: usize,
+        /// Contacts configured.
+        contacts: usize,
+    },
     #[error("cannot start contact worker threads: {0}")]
+    /// A worker thread could not be started.
     Spawn(std::io::Error),
 }
 
@@ -92,7 +107,7 @@ impl ContactSet {
                 solver,
                 velocity: v0,
                 load: c.config.contact.load_n,
-                step_over_s: 0.0,
+                jump_s: 0.0,
                 estimate,
                 compute_ns: 0,
             }));
@@ -123,22 +138,28 @@ impl ContactSet {
         })
     }
 
+    /// The number of contacts.
     pub fn len(&self) -> usize {
         self.names.len()
     }
 
+    /// Whether the set has no contact.
     pub fn is_empty(&self) -> bool {
         self.names.is_empty()
     }
 
+    /// The contacts' names, in configured order.
     pub fn names(&self) -> &[String] {
         &self.names
     }
 
+    /// The contacts' joint names, in configured order.
     pub fn joints(&self) -> &[String] {
         &self.joints
     }
 
+    /// Each contact's friction-to-effort factor (1 for a linear joint, the
+    /// lever arm in m for a rotary one), in configured order.
     pub fn gains(&self) -> &[f64] {
         &self.gains
     }
@@ -149,16 +170,11 @@ impl ContactSet {
     }
 
     /// One step of every contact with `velocities[i]` (m/s) and `loads[i]`
-    /// (N); `step_over_s` = None for a regular step of `solver.dt_s`, or
+    /// (N); `jump_s` = None for a regular step of `solver.dt_s`, or
     /// Some(dt) for one backward-Euler step over dt (a loop that fell far
     /// behind). Slices shorter than the set leave the missing contacts'
     /// inputs as they were.
-    pub fn step(
-        &mut self,
-        velocities: &[f64],
-        loads: &[f64],
-        step_over_s: Option<f64>,
-    ) -> SetTiming {
+    pub fn step(&mut self, velocities: &[f64], loads: &[f64], jump_s: Option<f64>) -> SetTiming {
         let sh = &self.pool.shared;
         for i in 0..self.names.len() {
             // SAFETY: no step is in flight; the caller owns every cell.
@@ -169,7 +185,7 @@ impl ContactSet {
             if let Some(l) = loads.get(i) {
                 c.load = *l;
             }
-            c.step_over_s = step_over_s.unwrap_or(0.0);
+            c.jump_s = jump_s.unwrap_or(0.0);
         }
         self.pool.step_all();
         let mut timing = SetTiming::default();

@@ -24,7 +24,7 @@ pub(super) struct CellData {
     pub velocity: f64,
     pub load: f64,
     /// 0: a regular step of the solver's dt; else one step over this, s.
-    pub step_over_s: f64,
+    pub jump_s: f64,
     pub estimate: Estimate,
     pub compute_ns: u64,
 }
@@ -32,9 +32,9 @@ pub(super) struct CellData {
 impl CellData {
     fn step(&mut self, clock: &dyn Clock) {
         let start = clock.now_ns();
-        self.estimate = if self.step_over_s > 0.0 {
+        self.estimate = if self.jump_s > 0.0 {
             self.solver
-                .step_over(self.velocity, self.load, self.step_over_s)
+                .step_lasting(self.velocity, self.load, self.jump_s)
         } else {
             self.solver.step(self.velocity, self.load)
         };

@@ -63,7 +63,7 @@ fn workers_give_bit_identical_estimates_to_one_thread() {
         pooled.step(&v, &l, None);
         assert_eq!(one.estimates(), pooled.estimates(), "step {k}");
     }
-    // A long step (catch-up beyond its bound) too.
+    // A time jump (catch-up beyond its bound) too.
     one.step(&[0.3; 3], &[], Some(0.05));
     pooled.step(&[0.3; 3], &[], Some(0.05));
     assert_eq!(one.estimates(), pooled.estimates());

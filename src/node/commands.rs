@@ -75,11 +75,11 @@ impl Loop {
     }
 
     pub(super) fn velocity_ok(&self, v: f64) -> bool {
-        self.s.limits.check_velocity(v).is_ok()
+        self.settings.limits.check_velocity(v).is_ok()
     }
 
     pub(super) fn load_ok(&self, f: f64) -> bool {
-        self.s.limits.check_load(f).is_ok()
+        self.settings.limits.check_load(f).is_ok()
     }
 
     /// The contact a velocity command is for (None: not a velocity, or a
@@ -166,8 +166,11 @@ impl Loop {
     /// The velocity each contact's next `steps` steps (ending at `at_ns`)
     /// apply: the command, or after the timeout the held or ramped value.
     pub(super) fn apply_timeout(&mut self, at_ns: u64, steps: u64) {
-        let (timeout, behaviour) = (self.s.command_timeout_ns, self.s.timeout_behaviour);
-        let dv = self.s.deceleration * self.s.dt * steps as f64;
+        let (timeout, behaviour) = (
+            self.settings.command_timeout_ns,
+            self.settings.timeout_behaviour,
+        );
+        let dv = self.settings.deceleration_m_s2 * self.settings.dt_s * steps as f64;
         let mut any = false;
         for c in &mut self.cmd {
             let age = at_ns.saturating_sub(c.last_velocity_at_ns);

@@ -36,7 +36,7 @@ impl Loop {
             let now = self.clock.now_ns();
             if any {
                 last_command = now;
-            } else if now.saturating_sub(last_command) < self.s.lockstep_spin_ns {
+            } else if now.saturating_sub(last_command) < self.settings.lockstep_spin_ns {
                 std::hint::spin_loop();
             } else {
                 let wait = Duration::from_millis(if self.ports.len() == 1 { 20 } else { 1 });

@@ -8,7 +8,7 @@
 //!   to zero and the estimate says so. Model time is wall time: a loop that
 //!   wakes up late catches up the lost steps at once (each marked late), and
 //!   when it is more than `node.max_catch_up_s` behind it advances the lost
-//!   time in one backward-Euler step ([`crate::physics::Solver::step_over`]).
+//!   time in one backward-Euler step ([`crate::physics::Solver::step_lasting`]).
 //!   A step that ends after the next deadline is a deadline miss. Stamps are
 //!   the deadlines in wall time; a step of the wall clock (NTP) is counted
 //!   and never makes a stamp go backwards ([`crate::clock::WallStamps`]).
@@ -29,10 +29,10 @@
 //! | file | content |
 //! |---|---|
 //! | `mod.rs` | [`Loop`], its settings, counters and summary |
-//! | `timer.rs` | timer mode: deadlines, catch-up, long steps |
+//! | `timer.rs` | timer mode: deadlines, catch-up, time jumps |
 //! | `lockstep.rs` | lockstep mode and [`Loop::feed`] (replay) |
 //! | `commands.rs` | command validation, timeouts, command status |
-//! | `outputs.rs` | one step and its outputs: estimates, profiles, statistics |
+//! | `publish.rs` | one step and what it publishes: estimates, profiles, statistics |
 //! | `parameters.rs` | the loop's side of live parameters: changes applied between steps |
 //! | `runner.rs` | the `run` command around the loop |
 //! | `rt.rs` | real-time settings |
@@ -41,8 +41,8 @@
 mod commands;
 pub mod driver;
 mod lockstep;
-mod outputs;
 pub mod parameters;
+mod publish;
 pub mod rt;
 pub mod runner;
 mod timer;
@@ -71,7 +71,7 @@ pub struct RunSummary {
     pub deadline_misses: u64,
     /// Steps taken after their deadline had passed (catch-up).
     pub catch_up_steps: u64,
-    /// Lost time advanced in one long step.
+    /// Time jumps: lost time advanced in one step.
     pub time_jumps: u64,
     /// Steps of the wall clock seen.
     pub clock_jumps: u64,
@@ -126,7 +126,9 @@ pub struct Loop {
     velocities: Vec<f64>,
     loads: Vec<f64>,
     efforts: Vec<f64>,
-    s: LoopSettings,
+    /// What the loop takes from the configuration (replaced by a live
+    /// parameter update).
+    settings: LoopSettings,
     ports: Vec<Box<dyn NodePort>>,
     record: Option<Arc<ArrayQueue<RecordItem>>>,
     profile: Option<Arc<ProfileSlot>>,
@@ -166,7 +168,7 @@ impl Loop {
         if ports.is_empty() {
             return Err(NodeError::NoTransport);
         }
-        let s = LoopSettings::from_config(config);
+        let settings = LoopSettings::from_config(config);
         let realtime = config.node.realtime.clone();
         let cpus = config.node.realtime.worker_cpus.clone();
         let setup = Arc::new(move |k: usize| {
@@ -180,7 +182,7 @@ impl Loop {
         let contacts = ContactSet::new(
             config,
             config.node.contact_workers,
-            s.lockstep_spin_ns.max(50_000),
+            settings.lockstep_spin_ns.max(50_000),
             Arc::new(SystemClock::new()),
             setup,
         )?;
@@ -195,7 +197,7 @@ impl Loop {
             .map(|c| crate::config::ViscosityLaw::of(&c.config))
             .collect();
         let n = contacts.len();
-        let window = (s.statistics_every as usize).clamp(16, 1 << 16);
+        let window = (settings.statistics_every_steps as usize).clamp(16, 1 << 16);
         let clock: Arc<dyn Clock> = Arc::new(SystemClock::new());
         Ok(Self {
             contacts,
@@ -221,7 +223,7 @@ impl Loop {
             first_step: 0,
             recorder: None,
             parameters: None,
-            s,
+            settings,
         })
     }
 
@@ -285,7 +287,7 @@ impl Loop {
         self.summary.contacts = u32::try_from(self.cmd.len()).unwrap_or(u32::MAX);
         self.stamps = WallStamps::new(self.clock.as_ref());
         let duration_ns = duration.map(|d| u64::try_from(d.as_nanos()).unwrap_or(u64::MAX));
-        match self.s.mode {
+        match self.settings.mode {
             StepMode::Timer => self.run_timer(stop, duration_ns),
             StepMode::Lockstep => self.run_lockstep(stop, duration_ns),
         }

@@ -39,7 +39,7 @@ impl super::Loop {
         if !fits {
             return;
         }
-        self.s = u.settings.clone();
+        self.settings = u.settings.clone();
         for (i, c) in u.contacts.iter_mut().enumerate() {
             let _ = self.contacts.with_solver(i, |s| s.swap_model(&mut c.model));
             self.viscosity[i] = c.viscosity;

@@ -6,7 +6,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 impl Loop {
     pub(super) fn run_timer(&mut self, stop: &AtomicBool, duration_ns: Option<u64>) {
-        let dt = self.s.dt_ns;
+        let dt = self.settings.dt_ns;
         let end = duration_ns.map(|d| self.started_ns.saturating_add(d));
         // Steps taken so far; step k + 1 is due at t0 + (k + 1)·Δt.
         let mut k: u64 = self.first_step;
@@ -19,9 +19,9 @@ impl Loop {
             if end.is_some_and(|e| due > e) || stop.load(Ordering::Relaxed) {
                 break;
             }
-            if self.s.timer_spin_ns > 0 {
+            if self.settings.timer_spin_ns > 0 {
                 self.clock
-                    .sleep_until_ns(due.saturating_sub(self.s.timer_spin_ns));
+                    .sleep_until_ns(due.saturating_sub(self.settings.timer_spin_ns));
                 self.clock.spin_until_ns(due);
             } else {
                 self.clock.sleep_until_ns(due);
@@ -37,7 +37,7 @@ impl Loop {
                 tracing::warn!("the wall clock jumped; stamps stay monotonic");
             }
             self.drain_commands(woke);
-            if late / dt > self.s.max_catch_up_steps {
+            if late / dt > self.settings.max_catch_up_steps {
                 // Too far behind to catch up step by step: advance the lost
                 // time (to the last deadline that has passed) in one step.
                 let last_due = (woke - t0) / dt;
@@ -46,7 +46,7 @@ impl Loop {
                 self.apply_timeout(due_last, lost);
                 let stamp = self.stamps.stamp(due_last);
                 self.summary.time_jumps += 1;
-                self.step_over(lost, stamp, woke.saturating_sub(due_last));
+                self.jump_time(lost, stamp, woke.saturating_sub(due_last));
                 k = last_due;
             } else {
                 self.apply_timeout(due, 1);

@@ -21,8 +21,11 @@
 /// The drivetrain terms.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Drivetrain {
+    /// F_c, N.
     pub coulomb: f64,
+    /// b, N·s/m.
     pub viscous: f64,
+    /// c_N, dimensionless.
     pub load_coefficient: f64,
     /// c_q, N·s²/m².
     pub quadratic: f64,
@@ -31,6 +34,7 @@ pub struct Drivetrain {
 }
 
 impl Drivetrain {
+    /// Whether every term is zero (the estimate is then the contact's alone).
     pub fn is_zero(&self) -> bool {
         self.coulomb == 0.0
             && self.viscous == 0.0
@@ -51,6 +55,7 @@ impl Drivetrain {
 }
 
 #[cfg(test)]
+#[allow(clippy::float_cmp)] // the values compared exactly are exact claims (0, 1, representable sums)
 mod tests {
     use super::*;
 

@@ -78,10 +78,13 @@ pub(crate) fn exp_fast(x: f64) -> f64 {
 /// Mixture properties at one pressure, with pressure derivatives.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MixtureState {
+    /// α, the vapour volume fraction (0 liquid, 1 gas).
     pub alpha: f64,
+    /// ρ, kg/m³.
     pub rho: f64,
     /// dρ/dp, kg/(m³·Pa)
     pub drho: f64,
+    /// μ, Pa·s.
     pub mu: f64,
     /// dμ/dp, Pa·s/Pa
     pub dmu: f64,
@@ -90,15 +93,22 @@ pub struct MixtureState {
 /// The mixture EOS with its derived constants.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MixtureEos {
+    /// ρl, liquid density, kg/m³.
     pub rho_l: f64,
+    /// ρg, gas density, kg/m³.
     pub rho_g: f64,
+    /// μl, liquid viscosity, Pa·s.
     pub mu_l: f64,
+    /// μg, gas viscosity, Pa·s.
     pub mu_g: f64,
+    /// β, the transition's steepness, 1/Pa.
     pub beta: f64,
+    /// p0, the pressure at α = ½, Pa.
     pub p0: f64,
 }
 
 impl MixtureEos {
+    /// The EOS of a lubricant (β and p0 from its saturation and vapour points).
     pub fn new(l: &Lubricant) -> Self {
         let (a_s, a_v) = (l.vapour_fraction_saturation, l.vapour_fraction_vapour);
         let beta = ((a_v * (1.0 - a_s)) / (a_s * (1.0 - a_v))).ln()
@@ -185,11 +195,17 @@ impl MixtureEos {
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CellState {
+    /// ρ, kg/m³.
     pub rho: f64,
+    /// dρ/dp, kg/(m³·Pa).
     pub drho: f64,
+    /// ρ/μ, kg/(m³·Pa·s).
     pub gr: f64,
+    /// d(ρ/μ)/dp.
     pub dgr: f64,
+    /// μ, Pa·s.
     pub mu: f64,
+    /// dμ/dp, Pa·s/Pa.
     pub dmu: f64,
 }
 
@@ -203,6 +219,7 @@ pub(crate) fn saturated(z: f64) -> bool {
 
 impl MixtureEos {
     #[inline(always)]
+    /// The cell properties at pressure `p` (Pa).
     pub fn cell(&self, p: f64) -> CellState {
         let z = self.beta * (p - self.p0);
         let e = if saturated(z) { 0.0 } else { exp_fast(2.0 * z) };
@@ -299,6 +316,7 @@ impl CellConstants {
 }
 
 #[cfg(test)]
+#[allow(clippy::float_cmp)] // the values compared exactly are exact claims (0, 1, representable sums)
 mod tests {
     use super::*;
     use approx::assert_relative_eq;

@@ -8,13 +8,18 @@ use core::fmt;
 pub enum SetupError {
     /// `field` has `value`, which is not allowed: `reason`.
     InvalidParameter {
+        /// The parameter, as its configuration key or field names it.
         field: &'static str,
+        /// The value given.
         value: f64,
+        /// What the model requires instead.
         reason: &'static str,
     },
     /// `field`'s choice is not supported with the rest of the settings.
     Unsupported {
+        /// The setting.
         field: &'static str,
+        /// Why it cannot be combined with the others.
         reason: &'static str,
     },
 }

@@ -54,6 +54,7 @@ impl Status {
         }
     }
 
+    /// Whether the step converged.
     pub fn is_converged(self) -> bool {
         self == Status::Converged
     }
@@ -64,15 +65,19 @@ impl Status {
 pub enum Regime {
     /// Asperities carry at least 95 % of the load.
     Boundary,
+    /// Between the two: film and asperities share the load.
     Mixed,
     /// Asperities carry at most 5 % of the load.
     Hydrodynamic,
 }
 
 impl Regime {
+    /// Asperity load share at or above which the regime is boundary.
     pub const BOUNDARY_SHARE: f64 = 0.95;
+    /// Asperity load share at or below which the regime is hydrodynamic.
     pub const HYDRODYNAMIC_SHARE: f64 = 0.05;
 
+    /// The regime of an asperity load share (F_asp / F_ext).
     pub fn from_asperity_share(share: f64) -> Self {
         if share >= Self::BOUNDARY_SHARE {
             Regime::Boundary
@@ -83,6 +88,7 @@ impl Regime {
         }
     }
 
+    /// The name on the wire and in CSV (`boundary`, `mixed`, `hydrodynamic`).
     pub fn as_str(self) -> &'static str {
         match self {
             Regime::Boundary => "boundary",
@@ -115,23 +121,42 @@ pub struct Diagnostics {
 /// The model's output for one step.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Estimate {
+    /// Model time at the end of the step, s.
     pub time: f64,
+    /// Slider velocity of the step, m/s.
     pub velocity: f64,
+    /// Normal load F_ext, N.
     pub load: f64,
+    /// Film thickness h0 (the gap at the profile's minimum), m.
     pub h0: f64,
+    /// Smallest gap over the slider, h0 + min(hg + ht), m.
     pub h_min: f64,
+    /// Load carried by the film's pressure, N.
     pub hydrodynamic_force: f64,
+    /// Load carried by the asperities (Greenwood–Williamson), N.
     pub asperity_force: f64,
+    /// Shear force of the film (Couette and Poiseuille), N.
     pub viscous_force: f64,
+    /// Friction force: the contact's plus the drivetrain's terms, N.
     pub friction_force: f64,
+    /// The contact's friction alone (viscous + boundary, through the pre-sliding compliance when on), N.
     pub contact_friction_force: f64,
+    /// Coefficient of friction (|F_visc| + μ_bl F_asp) / F_ext.
     pub cof: f64,
+    /// F_asp / F_ext.
     pub asperity_load_share: f64,
+    /// Inertia force m ḧ0 of the slider, N.
     pub inertia_force: f64,
+    /// Real contact area over nominal area (mean over the cells).
     pub contact_area_ratio: f64,
+    /// Largest film pressure, Pa (absolute).
     pub max_pressure: f64,
+    /// Share of cells whose vapour fraction exceeds ½.
     pub cavitated_fraction: f64,
+    /// The lubrication regime from the asperity share.
     pub regime: Regime,
+    /// How the step ended.
     pub status: Status,
+    /// Iterations, residuals and fallbacks of the step.
     pub diagnostics: Diagnostics,
 }

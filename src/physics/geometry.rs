@@ -22,9 +22,13 @@ use super::params::{Geometry, Profile};
 /// Grid and shape arrays; allocated once.
 #[derive(Debug, Clone)]
 pub struct Grid {
+    /// Cells along x.
     pub n: usize,
+    /// Slider length L, m.
     pub length: f64,
+    /// Slider width B, m.
     pub width: f64,
+    /// Cell width Δx = L / n, m.
     pub dx: f64,
     /// g at faces, N+1 values.
     pub g_face: Vec<f64>,
@@ -35,6 +39,7 @@ pub struct Grid {
 }
 
 impl Grid {
+    /// The grid of `n` cells over `geom` (profile and pockets sampled on it).
     pub fn new(geom: &Geometry, n: usize) -> Self {
         let l = geom.length;
         let dx = l / n as f64;
@@ -111,6 +116,7 @@ pub fn shape_average(geom: &Geometry, a: f64, b: f64) -> f64 {
 }
 
 #[cfg(test)]
+#[allow(clippy::float_cmp)] // the values compared exactly are exact claims (0, 1, representable sums)
 mod tests {
     use super::*;
     use crate::physics::params::Pocket;

@@ -29,6 +29,9 @@
 //! assert!(e.cof > 0.2 && e.cof < 0.31);
 //! ```
 
+#![warn(missing_docs)]
+#![warn(clippy::float_cmp)]
+
 pub mod drivetrain;
 pub mod eos;
 pub mod error;

@@ -33,16 +33,22 @@ pub const MAX_ABS_VELOCITY: f64 = 100.0;
 /// The physical envelope of a step's inputs: a load above this (or ≤ 0) is
 /// rejected, N.
 pub const MAX_LOAD: f64 = 1e9;
-/// The longest single variable-length step ([`super::Solver::step_over`]), s.
-pub const MAX_STEP_OVER: f64 = 3600.0;
+/// The longest single variable-length step ([`super::Solver::step_lasting`]), s.
+pub const MAX_VARIABLE_STEP_S: f64 = 3600.0;
 
 /// Global profile `hg(x)` of the slider.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Profile {
     /// `hg = 4 d (x/L − ½)²` (the cavitation-literature benchmark slider).
-    Parabolic { depth: f64 },
+    Parabolic {
+        /// d, the depth at the edges, m.
+        depth: f64,
+    },
     /// Inclined slider: `hg = d (1 − x/L)`; the gap converges for v > 0.
-    Linear { depth: f64 },
+    Linear {
+        /// d, the depth at the leading edge, m.
+        depth: f64,
+    },
     /// Parallel (flat) pad, `hg = 0`.
     Flat,
 }
@@ -50,17 +56,24 @@ pub enum Profile {
 /// A rectangular texture pocket: `ht(x) = depth` for `start ≤ x < start + width`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Pocket {
+    /// Where the pocket starts, from the leading edge, m.
     pub start: f64,
+    /// Pocket width along x, m.
     pub width: f64,
+    /// Pocket depth, m.
     pub depth: f64,
 }
 
 /// Slider geometry.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Geometry {
+    /// Slider length L, m.
     pub length: f64,
+    /// Slider width B (across the motion), m.
     pub width: f64,
+    /// The global profile hg(x).
     pub profile: Profile,
+    /// Texture pockets ht(x).
     pub pockets: Vec<Pocket>,
 }
 
@@ -78,14 +91,23 @@ impl Default for Geometry {
 /// Lubricant and its cavitation equation of state (MODEL.md §3).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Lubricant {
+    /// μl, liquid viscosity, Pa·s.
     pub viscosity: f64,
+    /// ρl, liquid density, kg/m³.
     pub density: f64,
+    /// μg, gas viscosity, Pa·s.
     pub gas_viscosity: f64,
+    /// ρg, gas density, kg/m³.
     pub gas_density: f64,
+    /// Ambient pressure at the slider's edges, Pa.
     pub ambient_pressure: f64,
+    /// p_s, the saturation pressure, Pa.
     pub saturation_pressure: f64,
+    /// p_v, the vapour pressure, Pa.
     pub vapour_pressure: f64,
+    /// α_s, the vapour fraction at p_s.
     pub vapour_fraction_saturation: f64,
+    /// α_v, the vapour fraction at p_v.
     pub vapour_fraction_vapour: f64,
 }
 
@@ -108,9 +130,13 @@ impl Default for Lubricant {
 /// Surface roughness: Greenwood–Williamson contact and Patir–Cheng flow factors.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Roughness {
+    /// σ, combined RMS roughness, m.
     pub sigma: f64,
+    /// η, asperity density, 1/m².
     pub asperity_density: f64,
+    /// β_a, asperity tip radius, m.
     pub asperity_radius: f64,
+    /// E', effective elastic modulus, Pa.
     pub effective_modulus: f64,
     /// Patir–Cheng flow factors; off by default as in the paper's simulations.
     pub flow_factors: bool,
@@ -134,8 +160,11 @@ impl Default for Roughness {
 /// Rigid-body and boundary-friction parameters.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Contact {
+    /// m, slider mass, kg.
     pub mass: f64,
+    /// μ_bl, the boundary (asperity) friction coefficient.
     pub boundary_friction: f64,
+    /// v_reg of the sign's tanh regularisation, m/s.
     pub sign_regularization: f64,
     /// Floor on h0; 0 disables it (the default: with GW it should not bind).
     pub min_film: f64,
@@ -166,7 +195,9 @@ pub struct Contact {
 /// millionth of the load at the paper's conditions).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct WidthLaw {
+    /// κ, in [0, 1]: 0 rigid, 1 a width proportional to the load.
     pub exponent: f64,
+    /// F_ref, the load at which the width is the configured B, N.
     pub reference_load: f64,
 }
 
@@ -207,9 +238,13 @@ impl Default for Contact {
 /// Everything physical about the contact.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct ModelParams {
+    /// The slider's shape.
     pub geometry: Geometry,
+    /// The lubricant and its cavitation EOS.
     pub lubricant: Lubricant,
+    /// The surfaces' roughness.
     pub roughness: Roughness,
+    /// Mass, boundary friction and the contact's other terms.
     pub contact: Contact,
     /// Losses beside the contact (zero by default).
     pub drivetrain: super::drivetrain::Drivetrain,
@@ -232,7 +267,12 @@ pub enum TimeScheme {
     #[default]
     Bdf2,
     /// General three-level scheme with force weighting.
-    Theta { theta1: f64, theta2: f64 },
+    Theta {
+        /// θ1: the time derivative [(θ1+½) uⁿ − 2θ1 uⁿ⁻¹ + (θ1−½) uⁿ⁻²] / Δt.
+        theta1: f64,
+        /// θ2: the forces weighted ((θ1+θ2)/2, 1−θ2, (θ2−θ1)/2) over levels n, n−1, n−2.
+        theta2: f64,
+    },
 }
 
 impl TimeScheme {
@@ -251,10 +291,15 @@ pub struct ReferenceSettings {
     /// Smallest ω_fluid: ω is halved whenever the Picard update grows, and
     /// never below this (the paper's range is 5e-4 … 5e-2).
     pub fluid_relaxation_min: f64,
+    /// Picard iterations per motion iteration, at most.
     pub max_fluid_iterations: u32,
+    /// Picard: converged when the relative pressure update is below this.
     pub fluid_tolerance: f64,
+    /// Under-relaxation of the load balance's secant h0 update.
     pub motion_relaxation: f64,
+    /// Load-balance iterations per step, at most.
     pub max_motion_iterations: u32,
+    /// Load balance: converged when the relative h0 update |Δh0| / h0 is below this.
     pub motion_tolerance: f64,
 }
 
@@ -312,7 +357,9 @@ pub struct SolverSettings {
     pub cells: usize,
     /// Fixed time step, s.
     pub dt: f64,
+    /// Newton (default) or the paper's reference algorithm.
     pub method: Method,
+    /// The time discretisation (BDF2 or the paper's θ scheme).
     pub scheme: TimeScheme,
     /// Newton: converged when the scaled max-norm of the update is below this.
     pub tolerance: f64,
@@ -320,6 +367,7 @@ pub struct SolverSettings {
     pub max_iterations: u32,
     /// The Couette flux's face density.
     pub flux: CouetteFlux,
+    /// The reference algorithm's settings (`method: Reference`).
     pub reference: ReferenceSettings,
 }
 

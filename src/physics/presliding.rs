@@ -56,6 +56,7 @@ pub struct Presliding {
 }
 
 impl Presliding {
+    /// Whether the bristle is in (a stiffness above zero).
     pub fn is_on(&self) -> bool {
         self.stiffness > 0.0
     }
@@ -83,6 +84,7 @@ impl Presliding {
 }
 
 #[cfg(test)]
+#[allow(clippy::float_cmp)] // the values compared exactly are exact claims (0, 1, representable sums)
 mod tests {
     use super::*;
     use approx::assert_relative_eq;

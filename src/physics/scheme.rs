@@ -21,7 +21,9 @@ use super::params::TimeScheme;
 /// Coefficients of one step: `u' ≈ Σ a_k u^(n−k) / Δt`, forces `Σ w_k F^(n−k)`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StepCoefficients {
+    /// a_k, the weights of the time derivative (levels n, n−1, n−2).
     pub a: [f64; 3],
+    /// w_k, the weights of the force history (levels n, n−1, n−2).
     pub w: [f64; 3],
 }
 
@@ -32,6 +34,7 @@ impl StepCoefficients {
         w: [1.0, 0.0, 0.0],
     };
 
+    /// The coefficients of `scheme` with its full history.
     pub fn for_scheme(scheme: TimeScheme) -> Self {
         let (t1, t2) = match scheme {
             TimeScheme::Bdf2 => (1.0, 1.0),
@@ -50,6 +53,7 @@ impl StepCoefficients {
 }
 
 #[cfg(test)]
+#[allow(clippy::float_cmp)] // the values compared exactly are exact claims (0, 1, representable sums)
 mod tests {
     use super::*;
     use approx::assert_relative_eq;

@@ -20,13 +20,16 @@
 pub enum ViscosityModel {
     /// μ_ref at every temperature.
     Constant,
+    /// Vogel's equation.
     Vogel(VogelModel),
 }
 
 /// Vogel's equation through μ_ref at T_ref.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct VogelModel {
+    /// B, Vogel's temperature constant, °C.
     pub b_c: f64,
+    /// C, Vogel's temperature offset, °C.
     pub c_c: f64,
 }
 

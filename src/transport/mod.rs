@@ -314,6 +314,9 @@ pub fn recv_timeout(
 }
 
 /// How to open a backend (Send; opened on the thread that uses it).
+// Built once per transport at setup: the ROS 2 spec's size (its topic
+// names) costs nothing there, and boxing it would only add a step to read.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone)]
 pub enum BackendSpec {
     Memory(memory::MemoryLink),

@@ -149,6 +149,7 @@ impl Solver {
 }
 
 #[cfg(test)]
+#[allow(clippy::float_cmp)] // the values compared exactly are exact claims (0, 1, representable sums)
 mod tests {
     use crate::physics::{ModelParams, Solver, SolverSettings};
 

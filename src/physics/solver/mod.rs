@@ -445,6 +445,7 @@ impl Solver {
         self.isa
     }
 
+    /// The numerical settings the solver was built with.
     pub fn settings(&self) -> &SolverSettings {
         &self.settings
     }
@@ -458,18 +459,22 @@ impl Solver {
         self.settings.reference.motion_tolerance = tolerance;
     }
 
+    /// Cells along x.
     pub fn cells(&self) -> usize {
         self.d.grid.n
     }
 
+    /// Cell width, m.
     pub fn dx(&self) -> f64 {
         self.d.grid.dx
     }
 
+    /// Model time, s.
     pub fn time(&self) -> f64 {
         self.time
     }
 
+    /// Film thickness h0 of the current state, m.
     pub fn h0(&self) -> f64 {
         self.h0
     }

@@ -173,7 +173,8 @@ impl Solver {
                 out.status = Status::NonFinite;
                 return out;
             };
-            previous = (lambda == 1.0).then_some(norm);
+            // λ ≤ 1 always: ≥ 1 is the full step.
+            previous = (lambda >= 1.0).then_some(norm);
             damped = lambda < 1.0;
             std::mem::swap(&mut self.p, &mut self.w.p_trial);
         }
@@ -220,7 +221,7 @@ impl Solver {
             let pt = std::mem::take(&mut self.w.p_trial);
             let ok = assemble(&self.d, &self.hist, &pt, h_trial, ctx, &mut self.w);
             self.w.p_trial = pt;
-            if ok && !test && lambda == 1.0 && dh.abs() <= H0_TRUST * self.h0 {
+            if ok && !test && lambda >= 1.0 && dh.abs() <= H0_TRUST * self.h0 {
                 self.h0 = h_trial;
                 return Some(lambda);
             }

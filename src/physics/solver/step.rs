@@ -34,7 +34,7 @@ use super::newton::MAX_SUBSTEPS;
 use super::{Ctx, H0Mode, Isa, Solver};
 use crate::physics::eos::MixtureEos;
 use crate::physics::estimate::{Diagnostics, Estimate, Regime, Status};
-use crate::physics::params::{Method, MAX_ABS_VELOCITY, MAX_LOAD, MAX_STEP_OVER};
+use crate::physics::params::{Method, MAX_ABS_VELOCITY, MAX_LOAD, MAX_VARIABLE_STEP_S};
 use crate::physics::scheme::StepCoefficients;
 
 impl Solver {
@@ -54,11 +54,11 @@ impl Solver {
     }
 
     /// One backward-Euler step of arbitrary length `dt` (s, in (0,
-    /// [`MAX_STEP_OVER`]]), for a loop that lost more time than it can catch
+    /// [`MAX_VARIABLE_STEP_S`]]), for a loop that lost more time than it can catch
     /// up in fixed steps. The history restarts around it: the step and the
     /// one after it are backward Euler (first order), then BDF2 resumes.
-    pub fn step_over(&mut self, v: f64, load: f64, dt: f64) -> Estimate {
-        if !(dt.is_finite() && dt > 0.0 && dt <= MAX_STEP_OVER) {
+    pub fn step_lasting(&mut self, v: f64, load: f64, dt: f64) -> Estimate {
+        if !(dt.is_finite() && dt > 0.0 && dt <= MAX_VARIABLE_STEP_S) {
             return self.rejected_input(v, load, Status::InputOutOfRange, true);
         }
         self.restart_history();
@@ -328,6 +328,7 @@ impl PredictionGuard {
 }
 
 #[cfg(test)]
+#[allow(clippy::float_cmp)] // the guard returns one of its inputs, bit for bit
 mod guard_tests {
     use super::PredictionGuard;
     use crate::physics::eos::MixtureEos;

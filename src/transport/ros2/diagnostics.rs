@@ -93,7 +93,7 @@ fn timing(p: &Period) -> DiagnosticStatus {
     } else if p.frac(misses) >= MISS_WARN || jumps > 0 {
         (
             level::WARN,
-            format!("{misses} deadline misses, {jumps} long steps over lost time in {steps} steps"),
+            format!("{misses} deadline misses, {jumps} time jumps (lost time advanced in one step) in {steps} steps"),
         )
     } else {
         (level::OK, "on time".into())
@@ -107,7 +107,7 @@ fn timing(p: &Period) -> DiagnosticStatus {
             kv("deadline misses", s.deadline_misses),
             kv("deadline misses in the period", misses),
             kv("catch-up steps", s.catch_up_steps),
-            kv("long steps over lost time", s.time_jumps),
+            kv("time jumps (lost time advanced in one step)", s.time_jumps),
             kv("wall clock jumps", s.clock_jumps),
             kv("compute p50 (us)", us(s.compute_time_ns[0])),
             kv("compute p99 (us)", us(s.compute_time_ns[1])),

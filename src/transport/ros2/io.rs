@@ -86,21 +86,38 @@ fn setup(spec: &Ros2Spec, snapshots: bool, sim_time: bool) -> Result<Entities, T
             .create_simple_datareader_no_key::<RawCdr, RawAdapter>(&t, Some(QosPolicies::from(&cq)))
             .map_err(|e| err(format!("subscribe to {what}"), e))
     };
-    let mut velocity = raw_reader(n, &spec.cmd_velocity, velocity_type, "the velocity")?;
-    let mut load = raw_reader(n, &spec.normal_load, &FLOAT64, "the load")?;
-    let mut temperature = raw_reader(n, &spec.temperature, &msgs::TEMPERATURE, "the temperature")?;
-    let friction = advertise(n, &spec.friction, &FRICTION_ESTIMATE, &eq, "the estimate")?;
-    let force = advertise(n, &spec.friction_force, &FLOAT64, &eq, "the friction force")?;
+    let mut velocity = raw_reader(n, &spec.topics.cmd_velocity, velocity_type, "the velocity")?;
+    let mut load = raw_reader(n, &spec.topics.normal_load, &FLOAT64, "the load")?;
+    let mut temperature = raw_reader(
+        n,
+        &spec.topics.temperature,
+        &msgs::TEMPERATURE,
+        "the temperature",
+    )?;
+    let friction = advertise(
+        n,
+        &spec.topics.friction,
+        &FRICTION_ESTIMATE,
+        &eq,
+        "the estimate",
+    )?;
+    let force = advertise(
+        n,
+        &spec.topics.friction_force,
+        &FLOAT64,
+        &eq,
+        "the friction force",
+    )?;
     let film = advertise(
         n,
-        &spec.film_profile,
+        &spec.topics.film_profile,
         &FILM_PROFILE,
         &eq,
         "the film profile",
     )?;
     let stats = advertise(
         n,
-        &spec.loop_statistics,
+        &spec.topics.loop_statistics,
         &LOOP_STATISTICS,
         &eq,
         "the statistics",
@@ -127,7 +144,7 @@ fn setup(spec: &Ros2Spec, snapshots: bool, sim_time: bool) -> Result<Entities, T
     let snapshot = if snapshots {
         Some(super::subscribe(
             n,
-            &spec.snapshot,
+            &spec.topics.snapshot,
             &msgs::EMPTY,
             &cq,
             "the snapshot request",

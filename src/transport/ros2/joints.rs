@@ -42,8 +42,8 @@ impl JointTopics {
         cq: &QosProfile,
         eq: &QosProfile,
     ) -> Result<Self, TransportError> {
-        let mut contacts = Vec::with_capacity(spec.contact_friction.len());
-        for t in &spec.contact_friction {
+        let mut contacts = Vec::with_capacity(spec.topics.contact_friction.len());
+        for t in &spec.topics.contact_friction {
             contacts.push(advertise(
                 n,
                 t,
@@ -56,21 +56,21 @@ impl JointTopics {
             joints: spec.joints.clone(),
             commands: subscribe(
                 n,
-                &spec.joint_commands,
+                &spec.topics.joint_commands,
                 &JOINT_STATE,
                 cq,
                 "the joint commands",
             )?,
             efforts: advertise(
                 n,
-                &spec.joint_efforts,
+                &spec.topics.joint_efforts,
                 &FLOAT64_MULTI_ARRAY,
                 eq,
                 "the joint efforts",
             )?,
             friction: advertise(
                 n,
-                &spec.joint_friction,
+                &spec.topics.joint_friction,
                 &JOINT_STATE,
                 eq,
                 "the joint friction",
@@ -164,8 +164,8 @@ impl JointPeer {
         cq: &QosProfile,
         eq: &QosProfile,
     ) -> Result<Self, TransportError> {
-        let mut contacts = Vec::with_capacity(spec.contact_friction.len());
-        for t in &spec.contact_friction {
+        let mut contacts = Vec::with_capacity(spec.topics.contact_friction.len());
+        for t in &spec.topics.contact_friction {
             contacts.push(subscribe(
                 n,
                 t,
@@ -177,14 +177,14 @@ impl JointPeer {
         Ok(Self {
             commands: advertise(
                 n,
-                &spec.joint_commands,
+                &spec.topics.joint_commands,
                 &JOINT_STATE,
                 cq,
                 "the joint commands",
             )?,
             efforts: subscribe(
                 n,
-                &spec.joint_efforts,
+                &spec.topics.joint_efforts,
                 &FLOAT64_MULTI_ARRAY,
                 eq,
                 "the joint efforts",

@@ -43,6 +43,7 @@ pub mod service;
 pub use peer::Ros2Peer;
 
 use super::{NodePort, PortCounters, PortIo, SharedCounters, TransportError};
+use crate::config::topics::TopicNames;
 use crate::config::{self, CommandType, Config, DiscoveryRange, QosConfig, Reliability};
 use crate::msgs::{Command, EstimateRecord, MsgType, StatisticsRecord};
 use crossbeam_queue::ArrayQueue;
@@ -72,26 +73,14 @@ pub struct Ros2Spec {
     pub namespace: String,
     pub node_name: String,
     pub command_type: CommandType,
-    pub cmd_velocity: String,
-    pub normal_load: String,
-    pub temperature: String,
-    pub friction: String,
-    pub friction_force: String,
-    pub film_profile: String,
-    pub loop_statistics: String,
-    /// `~/snapshot` (std_msgs/Empty): asks the recorder for a snapshot.
-    pub snapshot: String,
+    /// Every topic, resolved from the configuration.
+    pub topics: TopicNames,
     pub command_qos: QosConfig,
     pub estimate_qos: QosConfig,
     pub frame_id: String,
     pub queue_capacity: usize,
-    /// Several contacts: the configured joints (empty: one contact), the
-    /// joint topics and each contact's estimate topic.
+    /// Several contacts: the configured joints (empty: one contact).
     pub joints: Vec<String>,
-    pub joint_commands: String,
-    pub joint_efforts: String,
-    pub joint_friction: String,
-    pub contact_friction: Vec<String>,
 }
 
 /// The domain id: the config's, else `ROS_DOMAIN_ID`, else 0.
@@ -140,21 +129,13 @@ impl Ros2Spec {
 
     pub fn from_config(cfg: &Config) -> Result<Self, TransportError> {
         let r = &cfg.ros;
-        let names = crate::config::topics::TopicNames::from_config(cfg);
         Ok(Self {
             domain_id: domain_id(cfg)?,
             localhost_only: localhost_only(cfg),
             namespace: r.namespace.clone(),
             node_name: r.node_name.clone(),
             command_type: r.command_type,
-            cmd_velocity: names.cmd_velocity.clone(),
-            normal_load: names.normal_load.clone(),
-            temperature: names.temperature.clone(),
-            friction: names.friction.clone(),
-            friction_force: names.friction_force.clone(),
-            film_profile: names.film_profile.clone(),
-            loop_statistics: names.loop_statistics.clone(),
-            snapshot: names.snapshot.clone(),
+            topics: TopicNames::from_config(cfg),
             command_qos: r.qos.commands.clone(),
             estimate_qos: r.qos.estimates.clone(),
             frame_id: cfg.node.frame_id.clone(),
@@ -164,10 +145,6 @@ impl Ros2Spec {
             } else {
                 Vec::new()
             },
-            joint_commands: names.joint_commands.clone(),
-            joint_efforts: names.joint_efforts.clone(),
-            joint_friction: names.joint_friction.clone(),
-            contact_friction: names.contact_friction.clone(),
         })
     }
 }

@@ -47,7 +47,7 @@ impl Ros2Peer {
             CommandType::Float64 => {
                 vf = Some(advertise(
                     n,
-                    &spec.cmd_velocity,
+                    &spec.topics.cmd_velocity,
                     &FLOAT64,
                     &cq,
                     "the velocity",
@@ -56,25 +56,31 @@ impl Ros2Peer {
             CommandType::TwistStamped => {
                 vt = Some(advertise(
                     n,
-                    &spec.cmd_velocity,
+                    &spec.topics.cmd_velocity,
                     &TWIST_STAMPED,
                     &cq,
                     "the velocity",
                 )?);
             }
         }
-        let load = advertise(n, &spec.normal_load, &FLOAT64, &cq, "the load")?;
+        let load = advertise(n, &spec.topics.normal_load, &FLOAT64, &cq, "the load")?;
         let temperature = advertise(
             n,
-            &spec.temperature,
+            &spec.topics.temperature,
             &msgs::TEMPERATURE,
             &cq,
             "the temperature",
         )?;
-        let estimate = subscribe(n, &spec.friction, &FRICTION_ESTIMATE, &eq, "the estimate")?;
+        let estimate = subscribe(
+            n,
+            &spec.topics.friction,
+            &FRICTION_ESTIMATE,
+            &eq,
+            "the estimate",
+        )?;
         let statistics = subscribe(
             n,
-            &spec.loop_statistics,
+            &spec.topics.loop_statistics,
             &LOOP_STATISTICS,
             &eq,
             "the statistics",

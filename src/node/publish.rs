@@ -15,21 +15,19 @@ impl Loop {
         self.step_contacts(None, stamp_ns, late_ns);
     }
 
-    /// `steps` lost periods advanced in one long step.
-    pub(super) fn step_over(&mut self, steps: u64, stamp_ns: u64, late_ns: u64) {
-        self.step_contacts(Some(self.s.dt * steps as f64), stamp_ns, late_ns);
+    /// A time jump: `steps` lost periods advanced in one step.
+    pub(super) fn jump_time(&mut self, steps: u64, stamp_ns: u64, late_ns: u64) {
+        self.step_contacts(Some(self.settings.dt_s * steps as f64), stamp_ns, late_ns);
     }
 
-    fn step_contacts(&mut self, step_over_s: Option<f64>, stamp_ns: u64, late_ns: u64) {
+    fn step_contacts(&mut self, jump_s: Option<f64>, stamp_ns: u64, late_ns: u64) {
         self.apply_parameters(stamp_ns);
         for (k, c) in self.cmd.iter().enumerate() {
             self.velocities[k] = c.applied;
             self.loads[k] = c.load;
         }
         let start = self.clock.now_ns();
-        let timing = self
-            .contacts
-            .step(&self.velocities, &self.loads, step_over_s);
+        let timing = self.contacts.step(&self.velocities, &self.loads, jump_s);
         let compute = self.clock.now_ns().saturating_sub(start);
         self.summary.steps += 1;
         let several = self.contacts.len() > 1;
@@ -99,7 +97,9 @@ impl Loop {
     /// Profiles, statistics and live values after a step of every contact.
     fn after_step(&mut self, stamp_ns: u64, compute: u64, late_ns: u64) {
         let n = self.summary.steps;
-        if self.s.profile_every > 0 && n.is_multiple_of(self.s.profile_every) {
+        if self.settings.profile_every_steps > 0
+            && n.is_multiple_of(self.settings.profile_every_steps)
+        {
             if let Some(slot) = self.profile.clone() {
                 // The first contact's film (the one-contact node's profile).
                 self.contacts.with_solver(0, |solver| {
@@ -116,11 +116,13 @@ impl Loop {
         }
         self.window_compute.push(compute);
         self.hist_compute.record(compute);
-        if self.s.mode == StepMode::Timer {
+        if self.settings.mode == StepMode::Timer {
             self.window_jitter.push(late_ns);
             self.hist_jitter.record(late_ns);
         }
-        if self.s.statistics_every > 0 && n.is_multiple_of(self.s.statistics_every) {
+        if self.settings.statistics_every_steps > 0
+            && n.is_multiple_of(self.settings.statistics_every_steps)
+        {
             self.publish_statistics(stamp_ns);
         }
         let l = &self.live;
@@ -136,7 +138,7 @@ impl Loop {
     /// itself in timer mode (it is the step's wall time), the wall clock in
     /// lockstep (stamps are the sender's).
     fn logged_ns(&self, stamp_ns: u64) -> u64 {
-        match self.s.mode {
+        match self.settings.mode {
             StepMode::Timer => stamp_ns,
             StepMode::Lockstep => self.clock.wall_ns(),
         }
@@ -167,7 +169,7 @@ impl Loop {
                 .map(|c| c.status())
                 .unwrap_or_default(),
             compute_time_ns: self.window_compute.percentiles(),
-            period_jitter_ns: if self.s.mode == StepMode::Timer {
+            period_jitter_ns: if self.settings.mode == StepMode::Timer {
                 self.window_jitter.percentiles()
             } else {
                 [0; 3]
