@@ -355,6 +355,55 @@ fn finish_recording(r: crate::record::Recorder, report: &mut RunReport) {
     }
 }
 
+/// The loop over its transports: the parameter hand-over to the first
+/// transport that serves parameters, and `/clock` when `use_sim_time`.
+fn build_loop(
+    config: &Config,
+    specs: &[BackendSpec],
+    io: transport::PortIo,
+    live: Arc<LiveStatus>,
+) -> Result<Loop, RunError> {
+    let channel = Arc::new(crate::link::ParameterChannel::default());
+    let (queue, profile, sim_time) = (io.record.clone(), io.profile.clone(), io.sim_time.clone());
+    let (ports, served) = open_ports(config, specs, io, &channel)?;
+    let mut l = Loop::new(config, ports, queue, profile, live)?;
+    if served {
+        l = l.with_parameters(channel);
+    }
+    if let Some(c) = sim_time {
+        l = l.with_clock(c);
+        tracing::info!("use_sim_time: the loop follows /clock");
+    }
+    Ok(l)
+}
+
+/// The real-time settings (`node.realtime`), and every warning of the run
+/// so far logged.
+fn apply_realtime(config: &Config, report: &mut RunReport) {
+    let (applied, warnings) = rt::apply(&config.node.realtime);
+    report.realtime_applied = applied;
+    report.warnings.extend(warnings);
+    for w in &report.warnings {
+        tracing::warn!("{w}");
+    }
+}
+
+/// One line when the loop starts (what scripts and tests wait for), and the
+/// settings in the log.
+fn announce_start(config: &Config, transports: &[String]) {
+    eprintln!(
+        "friction-node: loop running ({:?} mode)",
+        config.node.step_mode
+    );
+    tracing::info!(
+        "loop running: {:?} mode, dt = {} s, N = {}, transports {}",
+        config.node.step_mode,
+        config.solver.dt_s,
+        config.solver.cells,
+        transports.join(", ")
+    );
+}
+
 /// Run the node until `stop`, the duration or the demo ends.
 pub fn run_node(
     config: &Config,
@@ -387,25 +436,15 @@ pub fn run_node(
     );
     #[cfg(not(feature = "mcap"))]
     let (queue, snapshot) = (None, None);
-    let channel = Arc::new(crate::link::ParameterChannel::default());
-    let sim_time = sim_clock(config, &specs, &stop)?;
     let io = transport::PortIo {
-        profile: profile.clone(),
-        record: queue.clone(),
+        profile,
+        record: queue,
         snapshot,
         parameters: None,
-        sim_time: sim_time.clone(),
+        sim_time: sim_clock(config, &specs, &stop)?,
     };
-    let (ports, served) = open_ports(config, &specs, io, &channel)?;
     let live = Arc::new(LiveStatus::default());
-    let mut l = Loop::new(config, ports, queue, profile, live.clone())?;
-    if served {
-        l = l.with_parameters(channel);
-    }
-    if let Some(c) = &sim_time {
-        l = l.with_clock(c.clone());
-        tracing::info!("use_sim_time: the loop follows /clock");
-    }
+    let mut l = build_loop(config, &specs, io, live.clone())?;
     #[cfg(feature = "mcap")]
     if let Some(r) = &recorder {
         l = l.with_recorder(r.counters());
@@ -422,29 +461,13 @@ pub fn run_node(
         )?),
         None => None,
     };
-    let (applied, warnings) = rt::apply(&config.node.realtime);
-    report.realtime_applied = applied;
-    report.warnings.extend(warnings);
-    for w in &report.warnings {
-        tracing::warn!("{w}");
-    }
+    apply_realtime(config, &mut report);
     let status_stop = Arc::new(AtomicBool::new(false));
     let status = opts
         .status_line
         .then(|| status_thread(live.clone(), status_stop.clone(), config.solver.dt_s));
     let duration = opts.demo_s.or(opts.duration_s).map(Duration::from_secs_f64);
-    // One line when the loop starts: what scripts and tests wait for.
-    eprintln!(
-        "friction-node: loop running ({:?} mode)",
-        config.node.step_mode
-    );
-    tracing::info!(
-        "loop running: {:?} mode, dt = {} s, N = {}, transports {}",
-        config.node.step_mode,
-        config.solver.dt_s,
-        config.solver.cells,
-        report.transports.join(", ")
-    );
+    announce_start(config, &report.transports);
     report.summary = l.run(&stop, duration);
     report.interrupted = stop.load(Ordering::Relaxed);
     driver_stop.store(true, Ordering::Relaxed);
