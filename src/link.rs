@@ -12,6 +12,8 @@
 //! ([`RecorderCounters`]) and the loop's live values for a status line
 //! ([`LiveStatus`]).
 
+#![warn(missing_docs)]
+
 use crate::config::parameters::SetRefusal;
 use crate::config::{Config, StepMode, TimeoutBehaviour};
 use crate::msgs::ros_interfaces::ParameterValue;
@@ -24,12 +26,15 @@ use std::sync::{Arc, Mutex};
 /// Settings the loop reads every step (from the configuration).
 #[derive(Debug, Clone, PartialEq)]
 pub struct LoopSettings {
+    /// Timer or lockstep (`node.step_mode`).
     pub mode: StepMode,
     /// The step, s.
     pub dt_s: f64,
     /// The step in integer nanoseconds (validated to be whole).
     pub dt_ns: u64,
+    /// `node.command_timeout_s`, ns.
     pub command_timeout_ns: u64,
+    /// What a timed-out command does (`node.timeout_behaviour`).
     pub timeout_behaviour: TimeoutBehaviour,
     /// The ramp to zero after a command timeout, m/s².
     pub deceleration_m_s2: f64,
@@ -37,7 +42,9 @@ pub struct LoopSettings {
     pub limits: crate::config::InputLimits,
     /// Steps between profile and statistics publications (0 = never).
     pub profile_every_steps: u64,
+    /// Steps between LoopStatistics publications (0 = never).
     pub statistics_every_steps: u64,
+    /// Lockstep: busy-wait this long for the next command before sleeping, ns.
     pub lockstep_spin_ns: u64,
     /// Timer mode: busy-wait before each deadline, ns.
     pub timer_spin_ns: u64,
@@ -59,6 +66,7 @@ pub(crate) fn secs_to_ns(s: f64) -> u64 {
 }
 
 impl LoopSettings {
+    /// What the loop takes from `c` (a pure function of the configuration).
     pub fn from_config(c: &Config) -> Self {
         let dt = c.solver.dt_s;
         let dt_ns = secs_to_ns(dt).max(1);
@@ -145,6 +153,7 @@ impl ParameterUpdate {
 pub struct ParameterIo {
     /// The configuration the node runs with.
     pub config: Config,
+    /// Where the validated updates go.
     pub channel: std::sync::Arc<ParameterChannel>,
 }
 
@@ -203,13 +212,18 @@ pub struct ProfileSlot {
 /// Contents of a [`ProfileSlot`].
 #[derive(Debug, Clone, Default)]
 pub struct ProfileData {
+    /// The step the profile belongs to, ns.
     pub stamp_ns: u64,
+    /// Cell width Δx, m.
     pub dx_m: f64,
+    /// Gap h per cell, m.
     pub h_m: Vec<f64>,
+    /// Pressure per cell (absolute), Pa.
     pub p_pa: Vec<f64>,
 }
 
 impl ProfileSlot {
+    /// An empty slot for profiles of `cells` cells (allocated here, once).
     pub fn new(cells: usize) -> Arc<Self> {
         Arc::new(Self {
             seq: AtomicU64::new(0),
@@ -255,26 +269,39 @@ pub enum RecordItem {
     /// A received command (transports without a serialized form: memory,
     /// iceoryx2) and when it arrived (wall clock, ns); recorded as the
     /// configured command type.
-    Command { command: Command, received_ns: u64 },
+    Command {
+        /// The command as the loop takes it.
+        command: Command,
+        /// When it arrived (wall clock), ns.
+        received_ns: u64,
+    },
     /// A received ROS 2 sample, recorded byte for byte.
     Raw(RawSample),
     /// An estimate of contact `contact` (0 with one contact) and when it
     /// was published (wall clock, ns).
     Estimate {
+        /// The estimate as published.
         record: EstimateRecord,
+        /// When it was published (wall clock), ns.
         logged_ns: u64,
+        /// The contact (0 with one contact).
         contact: u16,
     },
     /// Loop statistics and when they were published (wall clock, ns).
     Statistics {
+        /// The statistics as published.
         record: StatisticsRecord,
+        /// When they were published (wall clock), ns.
         logged_ns: u64,
     },
     /// An `rcl_interfaces/msg/ParameterEvent` (CDR with its encapsulation
     /// header) stamped with the first step that used the new values.
     ParameterEvent {
+        /// The event, CDR with its encapsulation header.
         cdr: Vec<u8>,
+        /// The first step that used the new values, ns.
         stamp_ns: u64,
+        /// When it was published (wall clock), ns.
         logged_ns: u64,
     },
 }
@@ -282,6 +309,7 @@ pub enum RecordItem {
 /// Counters the recorder shares with the loop (statistics) and the report.
 #[derive(Debug, Default)]
 pub struct RecorderCounters {
+    /// Messages written.
     pub messages: AtomicU64,
     /// Files started (1 without splitting).
     pub files: AtomicU64,
@@ -289,6 +317,7 @@ pub struct RecorderCounters {
     pub files_deleted: AtomicU64,
     /// Messages lost because writing had failed (until it resumed).
     pub lost: AtomicU64,
+    /// Snapshots written.
     pub snapshots: AtomicU64,
     /// The latest snapshot file and its span, s.
     pub last_snapshot: Mutex<(Note, f64)>,
@@ -318,16 +347,27 @@ impl RecorderCounters {
 /// Live values for a status line (written by the loop, read anywhere).
 #[derive(Debug, Default)]
 pub struct LiveStatus {
+    /// Steps taken.
     pub steps: AtomicU64,
+    /// Steps that ended after their deadline.
     pub deadline_misses: AtomicU64,
+    /// Commands applied.
     pub commands_applied: AtomicU64,
+    /// Commands rejected (out of the envelope, non-finite, wrong layout).
     pub commands_rejected: AtomicU64,
+    /// Outputs dropped: publications and recorder items together.
     pub drops: AtomicU64,
+    /// The last step's velocity, m/s (f64 bits).
     pub velocity_bits: AtomicU64,
+    /// The last step's friction force, N (f64 bits).
     pub friction_bits: AtomicU64,
+    /// The last step's coefficient of friction (f64 bits).
     pub cof_bits: AtomicU64,
+    /// The last step's film thickness h0, m (f64 bits).
     pub h0_bits: AtomicU64,
+    /// The last step's compute time, ns.
     pub compute_ns: AtomicU64,
+    /// The last step's solver status code (see `msgs::status_name`).
     pub status: AtomicU64,
 }
 

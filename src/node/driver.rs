@@ -12,8 +12,11 @@ use std::time::{Duration, Instant};
 /// What the demo driver did.
 #[derive(Debug, Clone, Default)]
 pub struct DemoReport {
+    /// Velocity commands published.
     pub commands_sent: u64,
+    /// Estimates received back (lockstep waits for each).
     pub estimates_received: u64,
+    /// Why the driver stopped early, if it did.
     pub error: Option<String>,
 }
 
@@ -26,7 +29,10 @@ pub enum DemoMotion {
     /// A reproducible random motion (seeded): a new target velocity in
     /// [-1.5, 1.5] m/s every 0.2–3 s, followed with a 0.15 s lag, so that
     /// reversals, dwells and speed changes of every size occur.
-    Random { seed: u64 },
+    Random {
+        /// The random generator's seed (the same seed, the same motion).
+        seed: u64,
+    },
 }
 
 impl DemoMotion {
@@ -83,10 +89,15 @@ impl ProfileState {
 /// profile's velocity, in one JointState per step).
 #[derive(Debug, Clone)]
 pub struct DemoPlan {
+    /// Timer or lockstep, as the node runs.
     pub mode: StepMode,
-    pub dt: f64,
+    /// The node's step, s (one command per step).
+    pub dt_s: f64,
+    /// How long to drive, s.
     pub seconds: f64,
+    /// The velocity profile.
     pub motion: DemoMotion,
+    /// Several contacts: their joints (empty: one contact).
     pub joints: Vec<String>,
 }
 
@@ -103,6 +114,8 @@ fn efforts_timeout(peer: &mut dyn transport::PeerPort, timeout: Duration) -> boo
     false
 }
 
+/// Drive the node over `spec`'s topics as `plan` says until done or `stop`; `ready` says when its
+/// publishers matched (or why not).
 pub fn drive(
     spec: BackendSpec,
     plan: DemoPlan,
@@ -111,7 +124,7 @@ pub fn drive(
 ) -> DemoReport {
     let DemoPlan {
         mode,
-        dt,
+        dt_s: dt,
         seconds,
         motion,
         joints,

@@ -38,6 +38,8 @@
 //! | `rt.rs` | real-time settings |
 //! | `driver.rs` | the demo and soak driver: a peer commanding the node on its own topics |
 
+#![warn(missing_docs)]
+
 mod commands;
 pub mod driver;
 mod lockstep;
@@ -64,10 +66,13 @@ use std::time::Duration;
 /// What a run reports when it ends (and what LoopStatistics carries).
 #[derive(Debug, Clone, Default)]
 pub struct RunSummary {
+    /// Steps taken.
     pub steps: u64,
     /// Monotonic time the run took, ns.
     pub elapsed_ns: u64,
+    /// Wall-clock time the run took, s.
     pub wall_s: f64,
+    /// Steps that ended after their deadline.
     pub deadline_misses: u64,
     /// Steps taken after their deadline had passed (catch-up).
     pub catch_up_steps: u64,
@@ -75,20 +80,31 @@ pub struct RunSummary {
     pub time_jumps: u64,
     /// Steps of the wall clock seen.
     pub clock_jumps: u64,
+    /// Commands the transports delivered.
     pub commands_received: u64,
+    /// Commands applied.
     pub commands_applied: u64,
+    /// Commands replaced by a newer one before a step took them.
     pub commands_overwritten: u64,
+    /// Commands rejected (out of the envelope, non-finite, wrong layout).
     pub commands_rejected: u64,
+    /// Steps taken on a timed-out command.
     pub command_timeouts: u64,
+    /// Publications dropped by a full queue.
     pub publish_drops: u64,
+    /// Publications the transports failed to send.
     pub publish_failures: u64,
+    /// LoopStatistics not sent.
     pub statistics_not_sent: u64,
+    /// Items the recorder queue had no room for.
     pub recorder_drops: u64,
+    /// Errors the transports reported.
     pub transport_errors: u64,
     /// p50, p99, max, ns.
     pub compute_ns: [u64; 3],
     /// p99.9 of the step's compute time, ns.
     pub compute_p999_ns: u64,
+    /// Period jitter (lateness of the wake-up): p50, p99, max, ns.
     pub jitter_ns: [u64; 3],
     /// Steps per solver status code (index = code).
     pub status_counts: [u64; 8],
@@ -101,6 +117,7 @@ pub struct RunSummary {
     /// The contact whose step took longest in the latest step, and its
     /// compute time, ns.
     pub slowest_contact: usize,
+    /// The slowest contact's compute time, ns.
     pub slowest_contact_ns: u64,
     /// The longest contact step since the previous statistics: (contact, ns).
     pub window_slowest: (usize, u64),
@@ -109,10 +126,13 @@ pub struct RunSummary {
 /// Errors of the node layer (setup only: a running loop never fails).
 #[derive(Debug, thiserror::Error)]
 pub enum NodeError {
+    /// A solver could not be built.
     #[error(transparent)]
     Setup(#[from] SetupError),
+    /// The contact set could not be built.
     #[error(transparent)]
     Contacts(#[from] crate::contacts::ContactSetError),
+    /// No transport to take commands from.
     #[error("the node needs at least one transport")]
     NoTransport,
 }

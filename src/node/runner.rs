@@ -32,13 +32,17 @@ pub struct RunOptions {
 /// Errors that prevent the node from running.
 #[derive(Debug, thiserror::Error)]
 pub enum RunError {
+    /// The loop could not be built.
     #[error(transparent)]
     Node(#[from] NodeError),
+    /// A transport could not be opened.
     #[error(transparent)]
     Transport(#[from] TransportError),
+    /// An option (`--demo`, `use_sim_time`, recording without `mcap`) that cannot be honoured.
     #[error("invalid option: {0}")]
     Option(String),
     #[cfg(feature = "mcap")]
+    /// The recording could not be started.
     #[error(transparent)]
     Recorder(#[from] crate::record::RecorderError),
 }
@@ -46,30 +50,44 @@ pub enum RunError {
 /// Everything a run reports.
 #[derive(Debug, Clone, Default)]
 pub struct RunReport {
+    /// The loop's counters and timings.
     pub summary: RunSummary,
+    /// The transports it ran on.
     pub transports: Vec<String>,
+    /// The real-time settings that took effect.
     pub realtime_applied: Vec<String>,
+    /// Everything that did not take effect or looks wrong.
     pub warnings: Vec<String>,
+    /// The recording, if there was one.
     pub recording: Option<RecordingOutcome>,
     /// Snapshot files written.
     pub snapshots: Vec<PathBuf>,
+    /// The demo driver's report (`--demo`).
     pub demo: Option<DemoReport>,
+    /// Resident memory at the end, bytes.
     pub rss_bytes: Option<u64>,
+    /// Peak resident memory, bytes.
     pub peak_rss_bytes: Option<u64>,
+    /// Whether a signal ended the run.
     pub interrupted: bool,
 }
 
 /// How the recording went.
 #[derive(Debug, Clone, Default)]
 pub struct RecordingOutcome {
+    /// The file or directory.
     pub path: PathBuf,
+    /// Messages written.
     pub messages: u64,
+    /// Bytes on disk.
     pub bytes: u64,
     /// Files written (split recordings), and deleted to keep to the budget.
     pub files: u64,
+    /// Files deleted to keep to `recording.budget_bytes`.
     pub files_deleted: u64,
     /// Messages not recorded after a write error.
     pub lost: u64,
+    /// The write error that stopped the recording, if one did.
     pub error: Option<String>,
 }
 
@@ -319,7 +337,7 @@ fn start_demo(
     let (tx, rx) = std::sync::mpsc::channel();
     let plan = super::driver::DemoPlan {
         mode: config.node.step_mode,
-        dt: config.solver.dt_s,
+        dt_s: config.solver.dt_s,
         seconds,
         motion: opts.motion,
         joints: if config.contacts.0.len() > 1 {

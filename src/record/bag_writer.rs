@@ -148,6 +148,7 @@ pub struct BagWriter {
     pub counts: Vec<u64>,
     /// Log time of the first and last message, ns.
     pub first_log_ns: Option<u64>,
+    /// Log time of the last message, ns.
     pub last_log_ns: u64,
     /// Bytes handed to the writer (serialized messages; the file is smaller
     /// when compressed).
@@ -241,6 +242,7 @@ impl BagWriter {
         })
     }
 
+    /// The file being written.
     pub fn path(&self) -> &Path {
         &self.path
     }

@@ -11,12 +11,19 @@ use crate::msgs::{self, Command, CommandKind, Float64, Header, Time, TwistStampe
 /// The node's recorded topics.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum TopicId {
+    /// The commanded velocity.
     Velocity,
+    /// The normal load.
     Load,
+    /// The full estimate (FrictionEstimate).
     Friction,
+    /// The friction force alone (Float64).
     FrictionForce,
+    /// The film profile.
     FilmProfile,
+    /// LoopStatistics.
     Statistics,
+    /// The lubricant temperature.
     Temperature,
     /// `/parameter_events`: parameters changed while running, stamped with
     /// the first step that used them (replay re-applies them there).
@@ -71,6 +78,7 @@ impl Encoder {
 /// One serialized message.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Entry {
+    /// The topic it was on.
     pub topic: TopicId,
     /// When it was received or recorded (wall clock), ns.
     pub log_ns: u64,
@@ -90,7 +98,9 @@ impl Entry {
 /// Turns items into entries.
 #[derive(Debug, Clone)]
 pub struct Encoder {
+    /// The frame id stamped on messages with a header.
     pub frame_id: String,
+    /// How commanded velocities are recorded (Float64 or TwistStamped).
     pub command_type: CommandType,
     /// Several contacts: the joint of each contact (configured order); empty
     /// for one contact. Estimates then go to their contact's topic and joint

@@ -33,6 +33,8 @@
 //! | `split.rs` | a directory of split files, `metadata.yaml`, the budget |
 //! | `snapshot.rs` | the snapshot ring |
 
+#![warn(missing_docs)]
+
 mod bag_writer;
 pub mod entry;
 pub mod snapshot;
@@ -59,15 +61,30 @@ use std::time::{Duration, Instant};
 /// Errors of the recorder layer.
 #[derive(Debug, thiserror::Error)]
 pub enum RecorderError {
+    /// The file could not be created.
     #[error("cannot create recording {}: {cause}", path.display())]
     Create {
+        /// The recording.
         path: PathBuf,
+        /// Why.
         cause: std::io::Error,
     },
+    /// The MCAP writer refused to start.
     #[error("recording {}: {message}", path.display())]
-    Mcap { path: PathBuf, message: String },
+    Mcap {
+        /// The recording.
+        path: PathBuf,
+        /// The MCAP writer's error.
+        message: String,
+    },
+    /// A split recording's directory is not usable.
     #[error("recording directory {}: {message}", path.display())]
-    Directory { path: PathBuf, message: String },
+    Directory {
+        /// The directory.
+        path: PathBuf,
+        /// What is wrong with it.
+        message: String,
+    },
 }
 
 /// A write into a recording failed (the recording stops; what is on disk
@@ -77,16 +94,25 @@ pub enum WriteError {
     /// The MCAP writer (an I/O error underneath, or a full disk).
     #[error(transparent)]
     Mcap(#[from] mcap::McapError),
+    /// An I/O error beside the writer (renaming a finished file).
     #[error(transparent)]
     Io(#[from] std::io::Error),
     /// A message did not serialize as CDR.
     #[error("cannot encode {topic:?} as CDR: {message}")]
-    Encode { topic: TopicId, message: String },
+    Encode {
+        /// The topic the message was for.
+        topic: TopicId,
+        /// The serializer's error.
+        message: String,
+    },
     /// An item for a contact the recording does not have.
     #[error("{what} of contact {contact}, but the recording has {contacts} contacts")]
     NoSuchContact {
+        /// What the item was.
         what: &'static str,
+        /// The contact it named.
         contact: u16,
+        /// Contacts in the recording.
         contacts: usize,
     },
     /// An entry on a topic this recording did not declare.
@@ -109,11 +135,17 @@ pub enum WriteError {
 pub struct RecorderReport {
     /// The file or directory (None: snapshots only).
     pub path: Option<PathBuf>,
+    /// Messages written.
     pub messages: u64,
+    /// Bytes on disk.
     pub bytes: u64,
+    /// Files written (1 without splitting).
     pub files: u64,
+    /// Files deleted to keep to the budget.
     pub files_deleted: u64,
+    /// Messages lost after a write error.
     pub lost: u64,
+    /// Snapshot files written.
     pub snapshots: Vec<PathBuf>,
     /// Set when writing failed (the loop went on; later outputs were lost).
     pub error: Option<String>,
@@ -249,6 +281,7 @@ impl Recorder {
         self.snapshot.clone()
     }
 
+    /// The file or directory recorded into (None: snapshots only).
     pub fn path(&self) -> Option<&Path> {
         self.path.as_deref()
     }

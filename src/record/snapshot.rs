@@ -23,6 +23,7 @@ pub struct Ring {
 }
 
 impl Ring {
+    /// A ring of the last `window_s` seconds, at most `max_bytes` in memory.
     pub fn new(window_s: u64, max_bytes: u64) -> Self {
         Self {
             window_ns: window_s.saturating_mul(1_000_000_000),
@@ -32,6 +33,7 @@ impl Ring {
         }
     }
 
+    /// Add an entry; the oldest leave when the window or the bound is exceeded.
     pub fn push(&mut self, e: Entry) {
         let newest = e.log_ns;
         self.bytes += e.footprint();

@@ -361,6 +361,7 @@ impl SplitDir {
         self.failed.get_or_insert(message);
     }
 
+    /// Close the open chunk of the current file; reap finished files.
     pub fn flush(&mut self) {
         if let Some(w) = self.current.as_mut() {
             if let Err(m) = w.flush() {

@@ -30,6 +30,8 @@
 //! | `sink.rs` | CSV and MCAP outputs, written off the model's thread |
 //! | `report.rs` | `summary.md`, `cycles.csv`, figures |
 
+#![warn(missing_docs)]
+
 mod inputs;
 mod mode;
 mod oracle;
@@ -56,52 +58,84 @@ use std::path::PathBuf;
 /// Errors of the replay layer.
 #[derive(Debug, thiserror::Error)]
 pub enum ReplayError {
+    /// The bag could not be read.
     #[error(transparent)]
     Bag(#[from] BagError),
+    /// A stop was requested.
     #[error(transparent)]
     Interrupted(#[from] crate::interrupt::Interrupted),
+    /// No topic of a velocity type.
     #[error("no usable velocity topic ({VELOCITY_TYPES}); the bag has:\n{}", bag::listing(.available))]
     NoVelocityTopic {
+        /// The bag's topics: (name, type, messages).
         available: Vec<(String, String, u64)>,
     },
+    /// More than one topic could be the velocity.
     #[error("several topics could be the velocity; choose one with --topic:\n{}", bag::listing(.candidates))]
     AmbiguousVelocity {
+        /// The candidates: (name, type, messages).
         candidates: Vec<(String, String, u64)>,
     },
+    /// The input topic has no message.
     #[error("topic `{topic}` has no messages before {}", damage_note(.damage))]
     Empty {
+        /// The topic.
         topic: String,
+        /// Where the bag is damaged, if that is why.
         damage: Option<Damage>,
     },
+    /// An output file could not be written.
     #[error(transparent)]
     Output(#[from] crate::output::OutputError),
+    /// The MCAP output could not be written.
     #[error("cannot write {}: {source}", path.display())]
     Recording {
+        /// The output.
         path: PathBuf,
+        /// Why.
         source: crate::record::WriteError,
     },
+    /// The input spans more steps than [`MAX_REPLAY_STEPS`].
     #[error("topic `{topic}`: its stamps span {span_s:.3e} s, more than {MAX_REPLAY_STEPS} steps of {dt_s} s (a stamp is probably wrong; or replay a shorter part)")]
     TooLong {
+        /// The velocity topic.
         topic: String,
+        /// Its stamps' span, s.
         span_s: f64,
+        /// The step, s.
         dt_s: f64,
     },
+    /// A `--velocity-map` or `--load-map` expression failed.
     #[error("{flag} `{expr}`: {message}")]
     Map {
+        /// The flag.
         flag: &'static str,
+        /// The expression.
         expr: String,
+        /// What went wrong, and at which message.
         message: String,
     },
+    /// The configuration recorded in the bag is not valid here.
     #[error("the recorded configuration in the bag: {0}")]
     RecordedConfig(ConfigError),
+    /// A recorded parameter change was refused.
     #[error("the parameter change recorded at {stamp_ns} ns cannot be applied: {message}")]
-    Parameters { stamp_ns: u64, message: String },
+    Parameters {
+        /// The change's stamp, ns.
+        stamp_ns: u64,
+        /// Why it was refused.
+        message: String,
+    },
+    /// The model could not be set up.
     #[error(transparent)]
     Setup(#[from] crate::physics::SetupError),
+    /// The configuration (`--config`, `--set`) is not valid.
     #[error(transparent)]
     Config(#[from] ConfigError),
+    /// The node's loop could not be built.
     #[error(transparent)]
     Node(#[from] NodeError),
+    /// Several configured contacts (count, and why this bag cannot drive them).
     #[error(
         "the configuration lists {0} contacts (`contacts`): a bag is replayed for several \
          contacts from a friction-node recording of them (its `~/contacts/NAME/friction` \

@@ -9,24 +9,38 @@ use crate::bag::SampleKind;
 pub enum InputMode {
     /// A velocity (and optional load) topic.
     Topics {
+        /// The velocity topic.
         velocity: String,
+        /// How its messages carry the velocity.
         kind: SampleKind,
+        /// The load topic, if any.
         load: Option<String>,
+        /// The temperature topic, if any.
         temperature: Option<String>,
     },
     /// A friction-node bag: the recorded estimates' velocity and load.
-    RecordedEstimates { topic: String },
+    RecordedEstimates {
+        /// The FrictionEstimate topic.
+        topic: String,
+    },
     /// A friction-node bag of several contacts: each contact's recorded
     /// estimates (configured order), stepped together.
-    RecordedContacts { topics: Vec<String> },
+    RecordedContacts {
+        /// Each contact's FrictionEstimate topic, in configured order.
+        topics: Vec<String>,
+    },
     /// Several contacts from a `sensor_msgs/JointState` topic: every
     /// configured joint's velocity, resampled onto the step grid like one
     /// joint's, and the load and temperature topics (applied to every
     /// contact).
     JointStates {
+        /// The JointState topic.
         topic: String,
+        /// The configured joints, one per contact.
         joints: Vec<String>,
+        /// The load topic, if any (every contact).
         load: Option<String>,
+        /// The temperature topic, if any (every contact).
         temperature: Option<String>,
     },
 }

@@ -9,7 +9,9 @@ use crate::physics::Estimate;
 /// Outcome of the determinism check.
 #[derive(Debug, Clone)]
 pub struct Oracle {
+    /// Steps compared.
     pub compared: usize,
+    /// Whether every compared field is bit-identical.
     pub identical: bool,
     /// (field, largest |replayed − recorded|, at step index), non-zero only.
     pub deviations: Vec<(&'static str, f64, usize)>,

@@ -39,8 +39,11 @@ pub struct ReplayOptions {
 /// The validated input of a replay.
 #[derive(Debug, Clone)]
 pub struct PreparedReplay {
+    /// The configuration the replay runs with.
     pub config: Config,
+    /// Where it came from (a file, the bag, the built-in default).
     pub config_source: String,
+    /// What drives the replay.
     pub mode: InputMode,
     /// Commands in time order.
     pub commands: Vec<Command>,
@@ -50,6 +53,7 @@ pub struct PreparedReplay {
     /// Several contacts: each contact's name and recorded estimates
     /// (configured order); empty for one contact.
     pub recorded_contacts: Vec<(String, Vec<EstimateRecord>)>,
+    /// The bag's channels, recorded configuration and damage.
     pub scan: BagScan,
     /// Silences in the velocity topic longer than the command timeout.
     pub gaps: Vec<Silence>,
@@ -65,6 +69,7 @@ pub struct PreparedReplay {
 pub struct ParameterChange {
     /// The stamp of the first step that used it.
     pub stamp_ns: u64,
+    /// The parameters changed and their new values.
     pub changed: Vec<(String, crate::msgs::ros_interfaces::ParameterValue)>,
 }
 

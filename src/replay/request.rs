@@ -39,7 +39,9 @@ pub struct ReadyReplay<'r> {
 /// What a replay produced.
 #[derive(Debug)]
 pub struct ReplayOutcome {
+    /// The validated input.
     pub prepared: PreparedReplay,
+    /// The replayed estimates and verdicts.
     pub result: ReplayResult,
     /// The output file, in place (when the request asked for one).
     pub written: Option<PathBuf>,

@@ -18,6 +18,7 @@ pub struct ReplayResult {
     /// One per step: the core estimate and the published record (the first
     /// contact's when there are several).
     pub estimates: Vec<(Estimate, EstimateRecord)>,
+    /// Commands the loop rejected.
     pub commands_rejected: u64,
     /// Every contact's verdict together (all identical, deviations of all).
     pub oracle: Option<Oracle>,
@@ -28,8 +29,11 @@ pub struct ReplayResult {
 /// One contact of a replay of several.
 #[derive(Debug, Clone)]
 pub struct ContactReplay {
+    /// The contact's name.
     pub name: String,
+    /// Its estimates, one per step.
     pub estimates: Vec<(Estimate, EstimateRecord)>,
+    /// Its determinism verdict (recorded contacts only).
     pub oracle: Option<Oracle>,
 }
 
