@@ -10,28 +10,46 @@ use crate::physics::{Estimate, Regime, Status};
 /// One estimate as the loop produces it (Copy, no heap).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct EstimateRecord {
+    /// The step's stamp (the header's), ns.
     pub stamp_ns: u64,
+    /// Sliding velocity of the step (m/s).
     pub velocity_m_s: f64,
+    /// Normal load of the step (N).
     pub load_n: f64,
+    /// Lubricant temperature of the step (the reference temperature when none is measured).
     pub temperature_c: f64,
+    /// Total friction: the contact plus the drivetrain terms, signed like the velocity (N).
     pub friction_force_n: f64,
+    /// The lubricated contact alone, signed like the velocity (N).
     pub contact_friction_force_n: f64,
+    /// (|F_visc| + mu_bl F_asp) / F_ext.
     pub cof: f64,
+    /// Minimum nominal separation (m).
     pub h0_m: f64,
+    /// Minimum film thickness (m).
     pub h_min_m: f64,
+    /// B * integral of (p - p_amb), N.
     pub hydrodynamic_force_n: f64,
+    /// Greenwood-Williamson contact force (N).
     pub asperity_force_n: f64,
+    /// asperity_force_n / load_n.
     pub asperity_load_share: f64,
+    /// REGIME_*.
     pub regime: u8,
     /// `STATUS_*`: the solver's outcome.
     pub status: u8,
     /// `COMMAND_*`: the command's state.
     pub command_status: u8,
+    /// Newton iterations of the step.
     pub iterations: u32,
+    /// Wall time of the model step (ns).
     pub compute_time_ns: u64,
+    /// How long after its deadline the step started (timer mode; catch-up steps are late by
+    /// design).
     pub late_ns: u64,
 }
 
+/// The wire code of a regime (`REGIME_*`).
 pub fn regime_code(r: Regime) -> u8 {
     match r {
         Regime::Boundary => codes::REGIME_BOUNDARY,
@@ -40,6 +58,7 @@ pub fn regime_code(r: Regime) -> u8 {
     }
 }
 
+/// The wire code of a solver status (`STATUS_*`).
 pub fn status_code(s: Status) -> u8 {
     match s {
         Status::Converged => codes::STATUS_CONVERGED,
@@ -100,6 +119,7 @@ impl EstimateRecord {
         }
     }
 
+    /// The wire message, stamped with `frame_id`.
     pub fn to_wire(&self, frame_id: &str) -> FrictionEstimate {
         FrictionEstimate {
             header: Header {
@@ -126,6 +146,7 @@ impl EstimateRecord {
         }
     }
 
+    /// The record of a wire message.
     pub fn from_wire(m: &FrictionEstimate) -> Self {
         Self {
             stamp_ns: m.header.stamp.to_ns(),
@@ -247,6 +268,7 @@ impl Note {
         n
     }
 
+    /// The text held.
     pub fn as_str(&self) -> &str {
         std::str::from_utf8(&self.bytes[..usize::from(self.len)]).unwrap_or("")
     }
@@ -255,34 +277,58 @@ impl Note {
 /// What the recorder reports into the loop statistics.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct RecordingStatus {
+    /// Recording files started.
     pub files: u64,
+    /// Split files deleted for the budget.
     pub files_deleted: u64,
+    /// Messages not recorded after a write error.
     pub lost: u64,
+    /// Snapshot files written.
     pub snapshots: u64,
+    /// The latest snapshot file.
     pub last_snapshot: Note,
+    /// The time span it holds, s.
     pub last_snapshot_span_s: f64,
 }
 
 /// Loop statistics as the loop produces them.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct StatisticsRecord {
+    /// When the statistics were taken (the header's stamp), ns.
     pub stamp_ns: u64,
+    /// Model steps taken.
     pub steps: u64,
+    /// Steps that finished after the next deadline (timer mode).
     pub deadline_misses: u64,
+    /// Steps taken late, after their deadline had passed, to keep model time = wall time.
     pub catch_up_steps: u64,
+    /// Lost time beyond node.max_catch_up_s, advanced in one variable-length step.
     pub time_jumps: u64,
+    /// Steps of the wall clock (NTP) seen; stamps stay monotonic.
     pub clock_jumps: u64,
+    /// Commands the transports delivered.
     pub commands_received: u64,
+    /// Accepted as the current set point.
     pub commands_applied: u64,
+    /// Discarded by a full receive queue before the loop saw them.
     pub commands_overwritten: u64,
+    /// Non-finite, beyond limits, or out-of-order stamps (lockstep).
     pub commands_rejected: u64,
+    /// Steps taken with a timed-out command.
     pub command_timeouts: u64,
+    /// Outputs the loop could not hand to a transport (queue full).
     pub publish_drops: u64,
+    /// Outputs a transport's I/O failed to send.
     pub publish_failures: u64,
+    /// LoopStatistics that could not be handed over or sent.
     pub statistics_not_sent: u64,
+    /// Outputs dropped because the recorder queue was full.
     pub recorder_drops: u64,
+    /// The recorder's counters.
     pub recording: RecordingStatus,
+    /// Wall time of the model step (ns).
     pub compute_time_ns: [u64; 3],
+    /// Lateness of the step start against its deadline: p50, p99, max, ns.
     pub period_jitter_ns: [u64; 3],
     /// Steps whose solver status was not converged.
     pub steps_not_converged: u64,
@@ -293,10 +339,12 @@ pub struct StatisticsRecord {
     /// The contact whose step took longest since the previous statistics,
     /// and that step's compute time, ns.
     pub slowest_contact: u32,
+    /// That contact's longest step compute time since the previous LoopStatistics (ns).
     pub slowest_contact_compute_ns: u64,
 }
 
 impl StatisticsRecord {
+    /// The wire message, stamped with `frame_id`.
     pub fn to_wire(&self, frame_id: &str) -> LoopStatistics {
         LoopStatistics {
             header: Header {
@@ -337,6 +385,7 @@ impl StatisticsRecord {
         }
     }
 
+    /// The record of a wire message.
     pub fn from_wire(m: &LoopStatistics) -> Self {
         Self {
             stamp_ns: m.header.stamp.to_ns(),
@@ -394,7 +443,12 @@ pub enum CommandKind {
     /// contact's slider), for the configured contact at index `contact`;
     /// `last` marks the message's last configured joint (lockstep steps
     /// every contact once per message, on it).
-    JointVelocity { contact: u16, last: bool },
+    JointVelocity {
+        /// The contact (configured order).
+        contact: u16,
+        /// Whether it is the last contact's of the step (the lockstep loop steps after it).
+        last: bool,
+    },
 }
 
 impl CommandKind {
@@ -410,7 +464,9 @@ impl CommandKind {
 /// A command as received from a transport (Copy, no heap).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Command {
+    /// What the command sets.
     pub kind: CommandKind,
+    /// Its value, SI (m/s, N, °C).
     pub value: f64,
     /// The sender's stamp (header stamp, or the sample's source time), ns.
     pub stamp_ns: u64,
@@ -419,6 +475,7 @@ pub struct Command {
 /// A received sample exactly as it came off the wire: recorded unchanged.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RawSample {
+    /// What the sample commands.
     pub kind: CommandKind,
     /// The CDR bytes, encapsulation header included.
     pub cdr: Vec<u8>,

@@ -10,63 +10,96 @@ use serde::{Deserialize, Serialize};
 
 /// `rcl_interfaces/msg/ParameterType` constants.
 pub mod parameter_type {
+    /// No value.
     pub const NOT_SET: u8 = 0;
+    /// Bool.
     pub const BOOL: u8 = 1;
+    /// Int64.
     pub const INTEGER: u8 = 2;
+    /// Float64.
     pub const DOUBLE: u8 = 3;
+    /// String.
     pub const STRING: u8 = 4;
+    /// Byte[].
     pub const BYTE_ARRAY: u8 = 5;
+    /// Bool[].
     pub const BOOL_ARRAY: u8 = 6;
+    /// Int64[].
     pub const INTEGER_ARRAY: u8 = 7;
+    /// Float64[].
     pub const DOUBLE_ARRAY: u8 = 8;
+    /// String[].
     pub const STRING_ARRAY: u8 = 9;
 }
 
 /// `rcl_interfaces/msg/ParameterValue`.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct ParameterValue {
+    /// Which of the values is set (`parameter_type`).
     pub r#type: u8,
+    /// The value when the type is BOOL.
     pub bool_value: bool,
+    /// The value when the type is INTEGER.
     pub integer_value: i64,
+    /// The value when the type is DOUBLE.
     pub double_value: f64,
+    /// The value when the type is STRING.
     pub string_value: String,
+    /// The value when the type is BYTE_ARRAY.
     pub byte_array_value: Vec<u8>,
+    /// The value when the type is BOOL_ARRAY.
     pub bool_array_value: Vec<bool>,
+    /// The value when the type is INTEGER_ARRAY.
     pub integer_array_value: Vec<i64>,
+    /// The value when the type is DOUBLE_ARRAY.
     pub double_array_value: Vec<f64>,
+    /// The value when the type is STRING_ARRAY.
     pub string_array_value: Vec<String>,
 }
 
 /// `rcl_interfaces/msg/Parameter`.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct Parameter {
+    /// The parameter's name (a dotted configuration key).
     pub name: String,
+    /// Its value.
     pub value: ParameterValue,
 }
 
 /// `rcl_interfaces/msg/ParameterEvent`.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct ParameterEvent {
+    /// When the change took effect.
     pub stamp: Time,
+    /// The fully qualified name of the node whose parameters changed.
     pub node: String,
+    /// Parameters declared.
     pub new_parameters: Vec<Parameter>,
+    /// Parameters whose value changed.
     pub changed_parameters: Vec<Parameter>,
+    /// Parameters undeclared.
     pub deleted_parameters: Vec<Parameter>,
 }
 
 /// `rcl_interfaces/msg/FloatingPointRange`.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct FloatingPointRange {
+    /// Lower bound.
     pub from_value: f64,
+    /// Upper bound.
     pub to_value: f64,
+    /// Step between allowed values (0: any).
     pub step: f64,
 }
 
 /// `rcl_interfaces/msg/IntegerRange`.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct IntegerRange {
+    /// Lower bound.
     pub from_value: i64,
+    /// Upper bound.
     pub to_value: i64,
+    /// Step between allowed values (0: any).
     pub step: u64,
 }
 
@@ -74,11 +107,17 @@ pub struct IntegerRange {
 /// `dynamic_typing`).
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct ParameterDescriptor {
+    /// The parameter's name.
     pub name: String,
+    /// Its type (`parameter_type`).
     pub r#type: u8,
+    /// What it is, with its unit.
     pub description: String,
+    /// Constraints in words.
     pub additional_constraints: String,
+    /// Whether it can only be set at start-up.
     pub read_only: bool,
+    /// Whether its type may change.
     pub dynamic_typing: bool,
     /// At most one.
     pub floating_point_range: Vec<FloatingPointRange>,
@@ -89,27 +128,34 @@ pub struct ParameterDescriptor {
 /// `rcl_interfaces/msg/SetParametersResult`.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct SetParametersResult {
+    /// Whether the change was applied.
     pub successful: bool,
+    /// Why not, when it was refused.
     pub reason: String,
 }
 
 /// `rcl_interfaces/msg/ListParametersResult`.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct ListParametersResult {
+    /// Parameter names.
     pub names: Vec<String>,
+    /// Their distinct prefixes.
     pub prefixes: Vec<String>,
 }
 
 /// `rcl_interfaces/srv/ListParameters` request.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct ListParametersRequest {
+    /// Only names under these prefixes (empty: all).
     pub prefixes: Vec<String>,
+    /// How many levels below a prefix (0: unlimited).
     pub depth: u64,
 }
 
 /// `rcl_interfaces/srv/ListParameters` response.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct ListParametersResponse {
+    /// The names and prefixes.
     pub result: ListParametersResult,
 }
 
@@ -117,24 +163,28 @@ pub struct ListParametersResponse {
 /// `DescribeParameters`.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct NamesRequest {
+    /// The parameters asked for.
     pub names: Vec<String>,
 }
 
 /// `rcl_interfaces/srv/GetParameters` response.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct GetParametersResponse {
+    /// Their values, in the order asked.
     pub values: Vec<ParameterValue>,
 }
 
 /// `rcl_interfaces/srv/GetParameterTypes` response.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct GetParameterTypesResponse {
+    /// Their types, in the order asked.
     pub types: Vec<u8>,
 }
 
 /// `rcl_interfaces/srv/DescribeParameters` response.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct DescribeParametersResponse {
+    /// Their descriptors, in the order asked.
     pub descriptors: Vec<ParameterDescriptor>,
 }
 
@@ -142,18 +192,21 @@ pub struct DescribeParametersResponse {
 /// request.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct SetParametersRequest {
+    /// The new values.
     pub parameters: Vec<Parameter>,
 }
 
 /// `rcl_interfaces/srv/SetParameters` response.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct SetParametersResponse {
+    /// One result per parameter.
     pub results: Vec<SetParametersResult>,
 }
 
 /// `rcl_interfaces/srv/SetParametersAtomically` response.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct SetParametersAtomicallyResponse {
+    /// One result for all.
     pub result: SetParametersResult,
 }
 
@@ -161,75 +214,105 @@ pub struct SetParametersAtomicallyResponse {
 /// rosidl generates for empty structures).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct TriggerRequest {
+    /// Padding (ROS 2 gives empty messages one byte).
     pub structure_needs_at_least_one_member: u8,
 }
 
 /// `std_srvs/srv/Trigger` response.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct TriggerResponse {
+    /// Whether the request was carried out.
     pub success: bool,
+    /// What happened.
     pub message: String,
 }
 
 /// `rcl_interfaces/msg/Log` levels.
 pub mod log_level {
+    /// Debug.
     pub const DEBUG: u8 = 10;
+    /// Information.
     pub const INFO: u8 = 20;
+    /// Warning.
     pub const WARN: u8 = 30;
+    /// Error.
     pub const ERROR: u8 = 40;
+    /// Fatal.
     pub const FATAL: u8 = 50;
 }
 
 /// `rcl_interfaces/msg/Log` (what `/rosout` carries).
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct Log {
+    /// When it was logged.
     pub stamp: Time,
+    /// Severity (`log_level`).
     pub level: u8,
+    /// The logger (the node).
     pub name: String,
+    /// The message.
     pub msg: String,
+    /// The source file that logged it.
     pub file: String,
+    /// The function (module) that logged it.
     pub function: String,
+    /// The source line.
     pub line: u32,
 }
 
 /// `diagnostic_msgs/msg/KeyValue`.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct KeyValue {
+    /// The value's name.
     pub key: String,
+    /// The value, as text.
     pub value: String,
 }
 
 /// `diagnostic_msgs/msg/DiagnosticStatus` levels.
 pub mod diagnostic_level {
+    /// Healthy.
     pub const OK: u8 = 0;
+    /// Something to look at.
     pub const WARN: u8 = 1;
+    /// Something is wrong.
     pub const ERROR: u8 = 2;
+    /// No recent information.
     pub const STALE: u8 = 3;
 }
 
 /// `diagnostic_msgs/msg/DiagnosticStatus`.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct DiagnosticStatus {
+    /// OK, WARN, ERROR or STALE (`diagnostic_level`).
     pub level: u8,
+    /// `<node>: <concern>`.
     pub name: String,
+    /// The state in a few words.
     pub message: String,
+    /// What the status is about (the node).
     pub hardware_id: String,
+    /// The counters behind it.
     pub values: Vec<KeyValue>,
 }
 
 /// `diagnostic_msgs/msg/DiagnosticArray`.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct DiagnosticArray {
+    /// Stamp and frame.
     pub header: Header,
+    /// One status per concern.
     pub status: Vec<DiagnosticStatus>,
 }
 
 /// `rosgraph_msgs/msg/Clock`.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct Clock {
+    /// The simulated time.
     pub clock: Time,
 }
 
+/// The `parameter_value` message type (definition and dependencies).
 pub static PARAMETER_VALUE: MsgType = MsgType {
     package: "rcl_interfaces",
     name: "ParameterValue",
@@ -237,6 +320,7 @@ pub static PARAMETER_VALUE: MsgType = MsgType {
     dependencies: &[],
 };
 
+/// The `parameter` message type (definition and dependencies).
 pub static PARAMETER: MsgType = MsgType {
     package: "rcl_interfaces",
     name: "Parameter",
@@ -244,6 +328,7 @@ pub static PARAMETER: MsgType = MsgType {
     dependencies: &[&PARAMETER_VALUE],
 };
 
+/// The `parameter_event` message type (definition and dependencies).
 pub static PARAMETER_EVENT: MsgType = MsgType {
     package: "rcl_interfaces",
     name: "ParameterEvent",
@@ -251,6 +336,7 @@ pub static PARAMETER_EVENT: MsgType = MsgType {
     dependencies: &[&TIME, &PARAMETER],
 };
 
+/// The `log` message type (definition and dependencies).
 pub static LOG: MsgType = MsgType {
     package: "rcl_interfaces",
     name: "Log",
@@ -258,6 +344,7 @@ pub static LOG: MsgType = MsgType {
     dependencies: &[&TIME],
 };
 
+/// The `key_value` message type (definition and dependencies).
 pub static KEY_VALUE: MsgType = MsgType {
     package: "diagnostic_msgs",
     name: "KeyValue",
@@ -265,6 +352,7 @@ pub static KEY_VALUE: MsgType = MsgType {
     dependencies: &[],
 };
 
+/// The `diagnostic_status` message type (definition and dependencies).
 pub static DIAGNOSTIC_STATUS: MsgType = MsgType {
     package: "diagnostic_msgs",
     name: "DiagnosticStatus",
@@ -272,6 +360,7 @@ pub static DIAGNOSTIC_STATUS: MsgType = MsgType {
     dependencies: &[&KEY_VALUE],
 };
 
+/// The `diagnostic_array` message type (definition and dependencies).
 pub static DIAGNOSTIC_ARRAY: MsgType = MsgType {
     package: "diagnostic_msgs",
     name: "DiagnosticArray",
@@ -279,6 +368,7 @@ pub static DIAGNOSTIC_ARRAY: MsgType = MsgType {
     dependencies: &[&HEADER, &DIAGNOSTIC_STATUS],
 };
 
+/// The `clock` message type (definition and dependencies).
 pub static CLOCK: MsgType = MsgType {
     package: "rosgraph_msgs",
     name: "Clock",

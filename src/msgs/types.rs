@@ -3,9 +3,13 @@
 /// A ROS 2 message type: package, name, `.msg` text and the types it uses.
 #[derive(Debug)]
 pub struct MsgType {
+    /// The package (`std_msgs`).
     pub package: &'static str,
+    /// The type's name (`Float64`).
     pub name: &'static str,
+    /// The `.msg` text.
     pub definition: &'static str,
+    /// The types the definition uses.
     pub dependencies: &'static [&'static MsgType],
 }
 
@@ -40,6 +44,7 @@ impl MsgType {
     }
 }
 
+/// The `time` message type (definition and dependencies).
 pub static TIME: MsgType = MsgType {
     package: "builtin_interfaces",
     name: "Time",
@@ -47,6 +52,7 @@ pub static TIME: MsgType = MsgType {
     dependencies: &[],
 };
 
+/// The `header` message type (definition and dependencies).
 pub static HEADER: MsgType = MsgType {
     package: "std_msgs",
     name: "Header",
@@ -54,6 +60,7 @@ pub static HEADER: MsgType = MsgType {
     dependencies: &[&TIME],
 };
 
+/// The `float64` message type (definition and dependencies).
 pub static FLOAT64: MsgType = MsgType {
     package: "std_msgs",
     name: "Float64",
@@ -61,6 +68,7 @@ pub static FLOAT64: MsgType = MsgType {
     dependencies: &[],
 };
 
+/// The `vector3` message type (definition and dependencies).
 pub static VECTOR3: MsgType = MsgType {
     package: "geometry_msgs",
     name: "Vector3",
@@ -68,6 +76,7 @@ pub static VECTOR3: MsgType = MsgType {
     dependencies: &[],
 };
 
+/// The `twist` message type (definition and dependencies).
 pub static TWIST: MsgType = MsgType {
     package: "geometry_msgs",
     name: "Twist",
@@ -75,6 +84,7 @@ pub static TWIST: MsgType = MsgType {
     dependencies: &[&VECTOR3],
 };
 
+/// The `twist_stamped` message type (definition and dependencies).
 pub static TWIST_STAMPED: MsgType = MsgType {
     package: "geometry_msgs",
     name: "TwistStamped",
@@ -82,6 +92,7 @@ pub static TWIST_STAMPED: MsgType = MsgType {
     dependencies: &[&HEADER, &TWIST],
 };
 
+/// The `joint_state` message type (definition and dependencies).
 pub static JOINT_STATE: MsgType = MsgType {
     package: "sensor_msgs",
     name: "JointState",
@@ -89,6 +100,7 @@ pub static JOINT_STATE: MsgType = MsgType {
     dependencies: &[&HEADER],
 };
 
+/// The `multi_array_dimension` message type (definition and dependencies).
 pub static MULTI_ARRAY_DIMENSION: MsgType = MsgType {
     package: "std_msgs",
     name: "MultiArrayDimension",
@@ -96,6 +108,7 @@ pub static MULTI_ARRAY_DIMENSION: MsgType = MsgType {
     dependencies: &[],
 };
 
+/// The `multi_array_layout` message type (definition and dependencies).
 pub static MULTI_ARRAY_LAYOUT: MsgType = MsgType {
     package: "std_msgs",
     name: "MultiArrayLayout",
@@ -103,6 +116,7 @@ pub static MULTI_ARRAY_LAYOUT: MsgType = MsgType {
     dependencies: &[&MULTI_ARRAY_DIMENSION],
 };
 
+/// The `float64_multi_array` message type (definition and dependencies).
 pub static FLOAT64_MULTI_ARRAY: MsgType = MsgType {
     package: "std_msgs",
     name: "Float64MultiArray",
@@ -110,6 +124,7 @@ pub static FLOAT64_MULTI_ARRAY: MsgType = MsgType {
     dependencies: &[&MULTI_ARRAY_LAYOUT],
 };
 
+/// The `empty` message type (definition and dependencies).
 pub static EMPTY: MsgType = MsgType {
     package: "std_msgs",
     name: "Empty",
@@ -117,6 +132,7 @@ pub static EMPTY: MsgType = MsgType {
     dependencies: &[],
 };
 
+/// The `temperature` message type (definition and dependencies).
 pub static TEMPERATURE: MsgType = MsgType {
     package: "sensor_msgs",
     name: "Temperature",
@@ -124,6 +140,7 @@ pub static TEMPERATURE: MsgType = MsgType {
     dependencies: &[&HEADER],
 };
 
+/// The `friction_estimate` message type (definition and dependencies).
 pub static FRICTION_ESTIMATE: MsgType = MsgType {
     package: "friction_msgs",
     name: "FrictionEstimate",
@@ -131,6 +148,7 @@ pub static FRICTION_ESTIMATE: MsgType = MsgType {
     dependencies: &[&HEADER],
 };
 
+/// The `film_profile` message type (definition and dependencies).
 pub static FILM_PROFILE: MsgType = MsgType {
     package: "friction_msgs",
     name: "FilmProfile",
@@ -138,6 +156,7 @@ pub static FILM_PROFILE: MsgType = MsgType {
     dependencies: &[&HEADER],
 };
 
+/// The `loop_statistics` message type (definition and dependencies).
 pub static LOOP_STATISTICS: MsgType = MsgType {
     package: "friction_msgs",
     name: "LoopStatistics",
