@@ -50,10 +50,15 @@ pub struct ContactEntry {
     /// Friction force (N) → joint effort: 1 for a linear joint (N), the
     /// lever arm in m for a rotary one (N·m).
     pub gain: f64,
+    /// Overrides of the `contact` section.
     pub contact: ContactConfig,
+    /// Overrides of the `texture` section.
     pub texture: TextureConfig,
+    /// Overrides of the `lubricant` section.
     pub lubricant: LubricantConfig,
+    /// Overrides of the `roughness` section.
     pub roughness: RoughnessConfig,
+    /// Overrides of the `solver` section (its grid).
     pub solver: ContactSolverConfig,
 }
 
@@ -61,6 +66,7 @@ pub struct ContactEntry {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ContactSolverConfig {
+    /// `solver.cells` of this contact.
     pub cells: usize,
 }
 
@@ -102,6 +108,7 @@ fn unit_gain() -> f64 {
 pub struct ContactList(pub Vec<ContactEntry>);
 
 impl ContactList {
+    /// Whether no contact is configured (the top level is the one contact).
     pub fn is_empty(&self) -> bool {
         self.0.is_empty()
     }
@@ -208,9 +215,13 @@ pub(super) fn inherit_top_level(params: &mut Value) {
 /// configuration with its own sections in place of the top-level ones.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ResolvedContact {
+    /// The contact's name.
     pub name: String,
+    /// The joint whose velocity drives it.
     pub joint: String,
+    /// Friction force → joint effort (1, or the lever arm in m).
     pub gain: f64,
+    /// The whole configuration of this contact (its sections over the top level).
     pub config: Config,
 }
 

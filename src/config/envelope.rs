@@ -34,27 +34,61 @@ pub const VISCOSITY_RANGE_PA_S: (f64, f64) = (1e-5, 100.0);
 /// An input outside what the model accepts.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 pub enum OutOfEnvelope {
+    /// A velocity beyond the limit.
     #[error("velocity {} m/s: a velocity must be finite with |v| ≤ node.max_abs_velocity_m_s = {} m/s", Num(*.value), Num(*.max))]
-    Velocity { value: f64, max: f64 },
+    Velocity {
+        /// The velocity given, m/s.
+        value: f64,
+        /// `node.max_abs_velocity_m_s`.
+        max: f64,
+    },
+    /// A load outside the limits.
     #[error("load {} N: a load must be finite and lie in [node.min_load_n, node.max_load_n] = [{}, {}] N", Num(*.value), Num(*.min), Num(*.max))]
-    Load { value: f64, min: f64, max: f64 },
+    Load {
+        /// The load given, N.
+        value: f64,
+        /// `node.min_load_n`.
+        min: f64,
+        /// `node.max_load_n`.
+        max: f64,
+    },
+    /// A temperature outside the model's range.
     #[error("temperature {} °C: a temperature must be finite and lie in [{}, {}] °C", Num(*.value), Num(TEMPERATURE_RANGE_C.0), Num(TEMPERATURE_RANGE_C.1))]
-    TemperatureRange { value: f64 },
+    TemperatureRange {
+        /// The temperature given, °C.
+        value: f64,
+    },
+    /// A temperature where Vogel's law has no value.
     #[error("temperature {} °C is at or below Vogel's C = {} °C (lubricant.vogel_c_c): the viscosity law has no value there", Num(*.value), Num(*.c_c))]
-    BelowVogelC { value: f64, c_c: f64 },
+    BelowVogelC {
+        /// The temperature given, °C.
+        value: f64,
+        /// `lubricant.vogel_c_c`, °C.
+        c_c: f64,
+    },
+    /// A temperature whose viscosity is outside the model's range.
     #[error("temperature {} °C gives a liquid viscosity of {} Pa·s (lubricant.viscosity_model: vogel), outside the model's ({}, {}] Pa·s", Num(*.value), Num(*.viscosity), Num(VISCOSITY_RANGE_PA_S.0), Num(VISCOSITY_RANGE_PA_S.1))]
-    Viscosity { value: f64, viscosity: f64 },
+    Viscosity {
+        /// The temperature given, °C.
+        value: f64,
+        /// The viscosity it gives, Pa·s.
+        viscosity: f64,
+    },
 }
 
 /// The velocity and load commands a configuration accepts (`node.*`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct InputLimits {
+    /// `node.max_abs_velocity_m_s`.
     pub max_abs_velocity_m_s: f64,
+    /// `node.min_load_n`.
     pub min_load_n: f64,
+    /// `node.max_load_n`.
     pub max_load_n: f64,
 }
 
 impl InputLimits {
+    /// The limits of `config`.
     pub fn of(config: &Config) -> Self {
         Self {
             max_abs_velocity_m_s: config.node.max_abs_velocity_m_s,
@@ -63,6 +97,7 @@ impl InputLimits {
         }
     }
 
+    /// Whether velocity `v` (m/s) is accepted.
     pub fn check_velocity(&self, v: f64) -> Result<(), OutOfEnvelope> {
         if v.is_finite() && v.abs() <= self.max_abs_velocity_m_s {
             Ok(())
@@ -74,6 +109,7 @@ impl InputLimits {
         }
     }
 
+    /// Whether load `f` (N) is accepted.
     pub fn check_load(&self, f: f64) -> Result<(), OutOfEnvelope> {
         if f.is_finite() && f >= self.min_load_n && f <= self.max_load_n {
             Ok(())
@@ -91,6 +127,7 @@ impl InputLimits {
 /// temperatures it accepts.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ViscosityLaw {
+    /// Constant or Vogel.
     pub model: ViscosityModel,
     /// μ at `t_ref_c`, Pa·s.
     pub mu_ref: f64,
@@ -99,6 +136,7 @@ pub struct ViscosityLaw {
 }
 
 impl ViscosityLaw {
+    /// The law of `config`'s lubricant.
     pub fn of(config: &Config) -> Self {
         Self {
             model: config.viscosity_model(),
@@ -151,11 +189,14 @@ impl ViscosityLaw {
 /// Everything a single-contact configuration accepts.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Envelope {
+    /// Velocity and load limits.
     pub limits: InputLimits,
+    /// The viscosity against temperature.
     pub viscosity: ViscosityLaw,
 }
 
 impl Envelope {
+    /// The envelope of `config`.
     pub fn of(config: &Config) -> Self {
         Self {
             limits: InputLimits::of(config),

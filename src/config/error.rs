@@ -5,29 +5,72 @@ use std::path::PathBuf;
 /// Errors of the configuration layer.
 #[derive(Debug, thiserror::Error)]
 pub enum ConfigError {
+    /// The parameter file could not be read.
     #[error("cannot read config file {}: {cause}", path.display())]
     Io {
+        /// The file.
         path: PathBuf,
+        /// Why.
         cause: std::io::Error,
     },
+    /// The text is not YAML.
     #[error("config {origin} is not valid YAML: {message}")]
-    Syntax { origin: String, message: String },
+    Syntax {
+        /// Where the text came from.
+        origin: String,
+        /// The parser's message.
+        message: String,
+    },
+    /// The YAML is not a parameter file's shape.
     #[error("config {origin}: {message}")]
-    Layout { origin: String, message: String },
+    Layout {
+        /// Where the text came from.
+        origin: String,
+        /// What is wrong with its shape.
+        message: String,
+    },
+    /// A key the configuration does not have.
     #[error("unknown config key `{key}` ({message})")]
-    UnknownKey { key: String, message: String },
+    UnknownKey {
+        /// The dotted key.
+        key: String,
+        /// The keys it could have meant.
+        message: String,
+    },
+    /// A value of the wrong type or form.
     #[error("config key `{key}`: {message}")]
-    InvalidValue { key: String, message: String },
+    InvalidValue {
+        /// The dotted key.
+        key: String,
+        /// What was expected.
+        message: String,
+    },
+    /// A value outside its physical range.
     #[error("config key `{key}` = {value} is out of range: allowed {range}")]
     OutOfRange {
+        /// The dotted key.
         key: String,
+        /// The value given.
         value: String,
+        /// The allowed range.
         range: String,
     },
+    /// A `--set KEY=VALUE` that cannot be applied.
     #[error("override `{arg}`: {message}")]
-    BadOverride { arg: String, message: String },
+    BadOverride {
+        /// The argument.
+        arg: String,
+        /// Why.
+        message: String,
+    },
+    /// A `--ros-args` section rcl would refuse.
     #[error("--ros-args {arg}: {message}")]
-    RosArgs { arg: String, message: String },
+    RosArgs {
+        /// The argument.
+        arg: String,
+        /// Why.
+        message: String,
+    },
 }
 
 /// Where a configuration came from (for messages).
@@ -35,6 +78,7 @@ pub enum ConfigError {
 pub enum Origin {
     /// The built-in `launch-config/default.yaml`.
     Embedded,
+    /// A parameter file.
     File(PathBuf),
     /// Text handed over by a caller, described (e.g. "passed to
     /// fn_model_new_from_yaml", "recorded in the bag").

@@ -35,6 +35,8 @@
 //! | `ros_args.rs` | `--ros-args` as rcl parses them (a `launch_ros` Node action) |
 //! | `tests.rs` | unit tests of loading, overrides and validation |
 
+#![warn(missing_docs)]
+
 mod contacts;
 mod envelope;
 mod error;
@@ -84,15 +86,25 @@ pub struct Config {
     /// Follow `/clock` (`rosgraph_msgs/msg/Clock`) instead of the wall clock
     /// in timer mode, as ROS 2 nodes do for simulation and bag playback.
     pub use_sim_time: bool,
+    /// The `contact` section.
     pub contact: ContactConfig,
+    /// `texture`: rectangular pockets, as parallel arrays (none by default)
     pub texture: TextureConfig,
+    /// The `lubricant` section.
     pub lubricant: LubricantConfig,
+    /// The `roughness` section.
     pub roughness: RoughnessConfig,
+    /// The `solver` section.
     pub solver: SolverConfig,
+    /// `drivetrain`: losses beside the contact, added to its friction (all 0: the contact alone)
     pub drivetrain: DrivetrainConfig,
+    /// `node`: the fixed-step loop (friction-node run)
     pub node: NodeConfig,
+    /// The `ros` section.
     pub ros: RosConfig,
+    /// `iceoryx2`: zero-copy shared-memory IPC on one host.
     pub iceoryx2: Iceoryx2Config,
+    /// `recording`: MCAP, ROS 2 profile (run --record FILE enables it)
     pub recording: RecordingConfig,
     /// Several contacts, each overriding the top-level sections (last, so
     /// that a top-level mistake is reported first).

@@ -11,14 +11,24 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ContactConfig {
+    /// `contact.length_m`: L, slider length along the sliding direction — range (0.1 mm, 10 m]
     pub length_m: f64,
+    /// `contact.width_m`: B, slider width — range (0.1 mm, 10 m]
     pub width_m: f64,
+    /// `contact.mass_kg`: m, equivalent mass of slider and load — range [0, 1e6]
     pub mass_kg: f64,
+    /// `contact.load_n`: F_ext, normal load (the paper's text value) — range (0, 1e9]
     pub load_n: f64,
+    /// `contact.profile`: parabolic | linear (inclined slider) | flat.
     pub profile: ProfileKind,
+    /// `contact.profile_depth_m`: d: parabola rise at the edges / taper rise — range [0, 1 mm]
     pub profile_depth_m: f64,
+    /// `contact.boundary_friction`: mu_bl, boundary friction coefficient — range [0, 2]
     pub boundary_friction: f64,
+    /// `contact.sign_regularization_m_s`: v_reg in tanh(v/v_reg) for the asperity friction sign —
+    /// range (1e-9, 1]
     pub sign_regularization_m_s: f64,
+    /// `contact.min_film_m`: optional floor on h0; 0 = off (the paper uses sigma) — range [0, 1 mm]
     pub min_film_m: f64,
     /// Pre-sliding (tangential) stiffness σ0 of the contact, N/m; 0: rigid.
     pub presliding_stiffness_n_m: f64,
@@ -34,8 +44,11 @@ pub struct ContactConfig {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum ProfileKind {
+    /// `parabolic`: hg = 4 d (x/L − ½)².
     Parabolic,
+    /// `linear`: an inclined slider, hg = d (1 − x/L).
     Linear,
+    /// `flat`: a parallel pad.
     Flat,
 }
 
@@ -75,8 +88,11 @@ impl Default for ContactConfig {
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct TextureConfig {
+    /// `texture.pocket_start_m`: x of each pocket's leading edge — range [0, L)
     pub pocket_start_m: Vec<f64>,
+    /// `texture.pocket_width_m`: pocket widths — range (0, L - start]
     pub pocket_width_m: Vec<f64>,
+    /// `texture.pocket_depth_m`: pocket depths — range [0, 1 mm]
     pub pocket_depth_m: Vec<f64>,
 }
 
@@ -84,6 +100,7 @@ pub struct TextureConfig {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct LubricantConfig {
+    /// `lubricant.viscosity_pa_s`: mu_l, liquid dynamic viscosity — range (1e-5, 100]
     pub viscosity_pa_s: f64,
     /// The temperature at which `viscosity_pa_s` holds, °C (with a constant
     /// viscosity it only labels the estimates).
@@ -94,13 +111,21 @@ pub struct LubricantConfig {
     pub vogel_b_c: f64,
     /// Vogel's C, °C.
     pub vogel_c_c: f64,
+    /// `lubricant.density_kg_m3`: rho_l, liquid density — range [100, 3e4]
     pub density_kg_m3: f64,
+    /// `lubricant.gas_viscosity_pa_s`: mu_g — range (1e-7, 1e-2]
     pub gas_viscosity_pa_s: f64,
+    /// `lubricant.gas_density_kg_m3`: rho_g — range (1e-4, rho_l)
     pub gas_density_kg_m3: f64,
+    /// `lubricant.ambient_pressure_pa`: p at both slider edges (absolute) — range (0, 1e9]
     pub ambient_pressure_pa: f64,
+    /// `lubricant.saturation_pressure_pa`: p_s — range (0, 1e9]
     pub saturation_pressure_pa: f64,
+    /// `lubricant.vapour_pressure_pa`: p_v — range [0, p_s)
     pub vapour_pressure_pa: f64,
+    /// `lubricant.vapour_fraction_at_saturation`: alpha_s = alpha(p_s) — range (0, 1)
     pub vapour_fraction_at_saturation: f64,
+    /// `lubricant.vapour_fraction_at_vapour_pressure`: alpha_v = alpha(p_v) — range (alpha_s, 1)
     pub vapour_fraction_at_vapour_pressure: f64,
 }
 
@@ -158,11 +183,17 @@ pub struct DrivetrainConfig {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct RoughnessConfig {
+    /// `roughness.sigma_m`: combined RMS roughness sqrt(Rq1^2 + Rq2^2) — range (1e-10, 1e-4]
     pub sigma_m: f64,
+    /// `roughness.asperity_density_per_m2`: eta — range [0, 1e16]
     pub asperity_density_per_m2: f64,
+    /// `roughness.asperity_radius_m`: beta_a, asperity tip radius — range (1e-9, 1e-2]
     pub asperity_radius_m: f64,
+    /// `roughness.effective_modulus_pa`: E* — range (1e5, 1e13]
     pub effective_modulus_pa: f64,
+    /// `roughness.flow_factors`: Patir–Cheng flow factors (the paper's runs: off)
     pub flow_factors: bool,
+    /// `roughness.lay_gamma`: surface lay, one of 1/9 1/6 1/3 1 3 6 9 (used with flow_factors)
     pub lay_gamma: f64,
 }
 
@@ -184,7 +215,9 @@ impl Default for RoughnessConfig {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum MethodKind {
+    /// `newton`: the production solver.
     Newton,
+    /// `reference`: the paper's Algorithm 1.
     Reference,
 }
 
@@ -192,7 +225,9 @@ pub enum MethodKind {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum SchemeKind {
+    /// `bdf2`.
     Bdf2,
+    /// `theta`: with `theta1`, `theta2`.
     Theta,
 }
 
@@ -202,9 +237,13 @@ pub enum SchemeKind {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum FluxKind {
+    /// `upwind`: first order.
     Upwind,
+    /// `muscl_minmod`: second order, minmod limiter.
     MusclMinmod,
+    /// `muscl_van_leer`: second order, van Leer limiter (the default).
     MusclVanLeer,
+    /// `muscl_van_albada`: second order, van Albada limiter.
     MusclVanAlbada,
 }
 
@@ -249,17 +288,27 @@ impl FluxKind {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SolverConfig {
+    /// `solver.cells`: finite-volume cells along x (64 with muscl_van_leer: loop area within 1 %) —
+    /// range [8, 65536]
     pub cells: usize,
+    /// `solver.dt_s`: fixed time step — range (1e-7, 1]
     pub dt_s: f64,
+    /// `solver.method`: newton (production) | reference (the paper's Algorithm 1)
     pub method: MethodKind,
+    /// `solver.scheme`: bdf2 | theta (three-level scheme with theta1, theta2)
     pub scheme: SchemeKind,
+    /// `solver.theta1`: used with scheme: theta (the paper's value) — range [0.5, 10]
     pub theta1: f64,
+    /// `solver.theta2`: used with scheme: theta (the paper's value) — range (0, 10]
     pub theta2: f64,
+    /// `solver.tolerance`: Newton: scaled max-norm of the update — range (1e-14, 0.1]
     pub tolerance: f64,
+    /// `solver.max_iterations`: Newton iterations per attempt (then fallbacks) — range [1, 10000]
     pub max_iterations: u32,
     /// Default `muscl_van_leer` (bags recorded before the key existed
     /// replay with `upwind`, see [`crate::config::Config::from_recorded_yaml`]).
     pub flux: FluxKind,
+    /// `solver.reference`: the paper's Algorithm 1 (Table A2)
     pub reference: ReferenceConfig,
 }
 
@@ -288,12 +337,19 @@ impl Default for SolverConfig {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ReferenceConfig {
+    /// `solver.reference.fluid_relaxation`: largest Picard relaxation omega_fluid — range (0, 1]
     pub fluid_relaxation: f64,
+    /// `solver.reference.fluid_relaxation_min`: smallest omega_fluid (halved when the update grows)
     pub fluid_relaxation_min: f64,
+    /// `solver.reference.max_fluid_iterations`: Picard iterations per secant step, at most.
     pub max_fluid_iterations: u32,
+    /// `solver.reference.fluid_tolerance`: Picard: max |dp| / max |p|.
     pub fluid_tolerance: f64,
+    /// `solver.reference.motion_relaxation`: omega_motion of the secant update on h0 — range (0, 1]
     pub motion_relaxation: f64,
+    /// `solver.reference.max_motion_iterations`: secant iterations per step, at most.
     pub max_motion_iterations: u32,
+    /// `solver.reference.motion_tolerance`: secant: |dh0| / h0.
     pub motion_tolerance: f64,
 }
 

@@ -20,8 +20,11 @@ pub enum StepMode {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum TransportKind {
+    /// ROS 2 (ros2-client, DDS).
     Ros2,
+    /// iceoryx2 shared memory on one host.
     Iceoryx2,
+    /// Both at once.
     Both,
 }
 
@@ -69,18 +72,23 @@ impl Default for RealtimeConfig {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct NodeConfig {
+    /// `node.step_mode`: timer: fixed real-time steps; lockstep: one step per velocity command.
     pub step_mode: StepMode,
+    /// `node.transport`: ros2 | iceoryx2 | both (run --transport overrides)
     pub transport: TransportKind,
     /// Velocity of the steady state the node starts from, m/s.
     pub initial_velocity_m_s: f64,
     /// A velocity command older than this is stale, s.
     pub command_timeout_s: f64,
+    /// `node.timeout_behaviour`: hold: keep the last velocity; ramp_to_zero: decelerate.
     pub timeout_behaviour: TimeoutBehaviour,
+    /// `node.timeout_deceleration_m_s2`: deceleration of ramp_to_zero — range (0, 1e4]
     pub timeout_deceleration_m_s2: f64,
     /// Commands with |v| above this are rejected, m/s.
     pub max_abs_velocity_m_s: f64,
     /// Load commands outside [min, max] are rejected, N.
     pub min_load_n: f64,
+    /// `node.max_load_n`: load commands above this are rejected, N.
     pub max_load_n: f64,
     /// FilmProfile publication rate, Hz (0 = off).
     pub profile_rate_hz: f64,
@@ -110,6 +118,7 @@ pub struct NodeConfig {
     /// contacts). They wait for each step spinning (up to 50 µs, or
     /// `lockstep_spin_us` if longer), then parked.
     pub contact_workers: usize,
+    /// `node.realtime`: applied when permitted, with a warning otherwise.
     pub realtime: RealtimeConfig,
 }
 
@@ -167,7 +176,9 @@ pub enum CommandType {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Reliability {
+    /// `best_effort`.
     BestEffort,
+    /// `reliable`.
     Reliable,
 }
 
@@ -187,9 +198,12 @@ pub enum Durability {
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct QosConfig {
+    /// `ros.qos.commands.reliability`: best_effort | reliable.
     pub reliability: Reliability,
     /// Keep-last depth.
     pub depth: usize,
+    /// `ros.qos.commands.durability`: volatile | transient_local (late readers get the last depth
+    /// samples)
     pub durability: Durability,
 }
 
@@ -207,7 +221,9 @@ impl Default for QosConfig {
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct QosProfiles {
+    /// The `ros.qos.commands` section.
     pub commands: QosConfig,
+    /// The `ros.qos.estimates` section.
     pub estimates: QosConfig,
 }
 
@@ -228,13 +244,19 @@ impl Default for QosProfiles {
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct TopicsConfig {
+    /// `ros.topics.cmd_velocity`: the commanded velocity (std_msgs/Float64 or TwistStamped).
     pub cmd_velocity: String,
+    /// `ros.topics.normal_load`: the normal load command (std_msgs/Float64, N).
     pub normal_load: String,
     /// `sensor_msgs/msg/Temperature` of the lubricant, °C.
     pub temperature: String,
+    /// `ros.topics.friction`: the estimate (friction_msgs/FrictionEstimate).
     pub friction: String,
+    /// `ros.topics.friction_force`: the friction force alone (std_msgs/Float64, N).
     pub friction_force: String,
+    /// `ros.topics.film_profile`: the film along the slider (friction_msgs/FilmProfile).
     pub film_profile: String,
+    /// `ros.topics.loop_statistics`: the loop's health (friction_msgs/LoopStatistics).
     pub loop_statistics: String,
     /// Several contacts: `sensor_msgs/msg/JointState`, velocities by joint
     /// name (m/s of each contact's slider).
@@ -271,13 +293,21 @@ impl Default for TopicsConfig {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct RosConfig {
+    /// `ros.node_name`: the node's name.
     pub node_name: String,
+    /// `ros.namespace`: the node's namespace.
     pub namespace: String,
     /// DDS domain; -1 = ROS_DOMAIN_ID (or 0 when unset).
     pub domain_id: i64,
+    /// `ros.discovery_range`: localhost | subnet | off | env (ROS_AUTOMATIC_DISCOVERY_RANGE /
+    /// ROS_LOCALHOST_ONLY)
     pub discovery_range: DiscoveryRange,
+    /// `ros.command_type`: float64: std_msgs/Float64; twist_stamped: geometry_msgs/TwistStamped
+    /// linear.x.
     pub command_type: CommandType,
+    /// `ros.topics`: ~/ is the node's private namespace.
     pub topics: TopicsConfig,
+    /// The `ros.qos` section: quality of service of commands and estimates.
     pub qos: QosProfiles,
     /// Topic remappings `FROM:=TO` (what `--ros-args -r` gives), applied
     /// to every topic the node has, `~/` ones included.
@@ -303,10 +333,15 @@ impl Default for RosConfig {
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Iceoryx2Config {
+    /// `iceoryx2.cmd_velocity_service`: the commanded velocity.
     pub cmd_velocity_service: String,
+    /// `iceoryx2.normal_load_service`: the normal load command.
     pub normal_load_service: String,
+    /// `iceoryx2.temperature_service`: the temperature command.
     pub temperature_service: String,
+    /// `iceoryx2.friction_service`: the estimates.
     pub friction_service: String,
+    /// `iceoryx2.loop_statistics_service`: the loop statistics.
     pub loop_statistics_service: String,
     /// Event service that wakes a lockstep node when a command is sent.
     pub cmd_event_service: String,
@@ -338,8 +373,11 @@ impl Default for Iceoryx2Config {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Compression {
+    /// No compression.
     None,
+    /// zstd (the default).
     Zstd,
+    /// lz4.
     Lz4,
 }
 
@@ -357,13 +395,16 @@ pub struct SplitConfig {
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct RecordingConfig {
+    /// `recording.enabled`: record every run (`run --record FILE` enables it too).
     pub enabled: bool,
     /// File (no split) or directory (split) to write; empty =
     /// bags/friction_node_<UTC time>.mcap (or that name without `.mcap`).
     pub path: String,
     /// Chunk size, bytes: a crash loses at most the open chunk.
     pub chunk_size_bytes: u64,
+    /// `recording.compression`: zstd | lz4 | none.
     pub compression: Compression,
+    /// `recording.split`: rosbag2-style split files in a directory (0 = off: one file)
     pub split: SplitConfig,
     /// Split recordings: delete the oldest files when the directory's files
     /// exceed this many bytes (0 = no limit).

@@ -65,13 +65,17 @@ pub fn is_runtime_in(config: &Config, key: &str) -> bool {
 /// One declared parameter.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Declared {
+    /// The dotted key.
     pub name: String,
     /// `rcl_interfaces/msg/ParameterType`.
     pub r#type: u8,
+    /// Its current value.
     pub value: ParameterValue,
     /// The key's documentation in `launch-config/default.yaml`.
     pub description: String,
+    /// Its physical range, when it has one.
     pub range: Option<KeyRange>,
+    /// Whether it cannot change while the node runs.
     pub read_only: bool,
 }
 
@@ -203,19 +207,28 @@ pub fn declare(config: &Config) -> Vec<Declared> {
 /// Why a set was refused (the text goes to `SetParametersResult.reason`).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SetRefusal {
+    /// The name is not a declared parameter.
     #[error("parameter `{0}` is not declared (ros2 param list shows the names)")]
     Undeclared(String),
+    /// The parameter cannot change while the node runs.
     #[error("parameter `{0}` is read-only while the node runs (restart with the new value)")]
     ReadOnly(String),
+    /// The value's type is not the parameter's.
     #[error("parameter `{name}` is of type {want}; got {got} ({value})")]
     WrongType {
+        /// The parameter.
         name: String,
+        /// Its type.
         want: &'static str,
+        /// The type given.
         got: &'static str,
+        /// The value given.
         value: String,
     },
+    /// The new configuration does not validate (the message names the key).
     #[error("{0}")]
     Invalid(String),
+    /// An earlier change is still being applied.
     #[error("the node is still applying earlier changes; try again")]
     Busy,
 }

@@ -42,19 +42,29 @@ pub fn node_topic(cfg: &Config, topic: &str) -> String {
 /// The node's topics, resolved.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct TopicNames {
+    /// The commanded velocity.
     pub cmd_velocity: String,
+    /// The normal load command.
     pub normal_load: String,
+    /// The temperature command.
     pub temperature: String,
+    /// The estimates (FrictionEstimate).
     pub friction: String,
+    /// The friction force alone (Float64).
     pub friction_force: String,
+    /// The film profile.
     pub film_profile: String,
+    /// The loop statistics.
     pub loop_statistics: String,
     /// `~/snapshot` (std_msgs/Empty): asks for a snapshot of the last minutes.
     pub snapshot: String,
     /// `/parameter_events` (rcl_interfaces/ParameterEvent).
     pub parameter_events: String,
+    /// Several contacts: the joint velocities (JointState).
     pub joint_commands: String,
+    /// Several contacts: the efforts in joint order (Float64MultiArray).
     pub joint_efforts: String,
+    /// Several contacts: the efforts by joint name (JointState).
     pub joint_friction: String,
     /// One FrictionEstimate topic per contact (several contacts), in the
     /// configured order: `<ros.topics.contact_friction>/<name>`.
@@ -62,6 +72,7 @@ pub struct TopicNames {
 }
 
 impl TopicNames {
+    /// Every topic of `cfg`, resolved (namespace, `~/`, remappings).
     pub fn from_config(cfg: &Config) -> Self {
         let r = &cfg.ros;
         let t = |topic: &str| node_topic(cfg, topic);

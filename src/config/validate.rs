@@ -17,10 +17,15 @@ enum End {
 /// The documented range of one numeric key (see [`key_ranges`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct KeyRange {
+    /// The dotted key.
     pub key: String,
+    /// Lower bound.
     pub lo: f64,
+    /// Whether the lower bound is excluded.
     pub lo_open: bool,
+    /// Upper bound.
     pub hi: f64,
+    /// Whether the upper bound is excluded.
     pub hi_open: bool,
 }
 
