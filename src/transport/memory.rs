@@ -30,6 +30,7 @@ pub struct MemoryLink {
 }
 
 impl MemoryLink {
+    /// A link whose queues hold `capacity` items each.
     pub fn new(capacity: usize) -> Self {
         Self {
             commands: Arc::new(ArrayQueue::new(capacity)),
@@ -53,6 +54,7 @@ impl MemoryLink {
         self
     }
 
+    /// The node's side.
     pub fn node(&self) -> MemoryNode {
         self.node_recording(None)
     }
@@ -67,6 +69,7 @@ impl MemoryLink {
         }
     }
 
+    /// The peer's side.
     pub fn peer(&self) -> MemoryPeer {
         MemoryPeer { link: self.clone() }
     }

@@ -16,6 +16,8 @@
 //! | `iceoryx/` | iceoryx2: zero-copy shared memory on one host |
 //! | `ros2/` | ROS 2 through ros2-client (pure-Rust DDS) |
 
+#![warn(missing_docs)]
+
 pub mod memory;
 
 #[cfg(feature = "iceoryx2")]
@@ -34,18 +36,28 @@ use std::time::{Duration, Instant};
 /// Errors of the transport layer.
 #[derive(Debug, thiserror::Error)]
 pub enum TransportError {
+    /// The middleware refused an operation (its error, formatted: the
+    /// backends' error types stay out of this crate's API).
     #[error("{backend}: cannot {operation}: {message}")]
     Backend {
+        /// `ros2` or `iceoryx2`.
         backend: &'static str,
+        /// What was being done.
         operation: String,
+        /// The middleware's error.
         message: String,
     },
+    /// The transport's feature was not compiled in.
     #[error("the {0} transport is not built in (rebuild with the `{0}` feature)")]
     NotBuiltIn(&'static str),
+    /// A publisher or subscriber found no counterpart in time.
     #[error("{backend}: {what} not matched within {waited:?}")]
     NotMatched {
+        /// `ros2` or `iceoryx2`.
         backend: &'static str,
+        /// The topic or service.
         what: &'static str,
+        /// How long it waited.
         waited: Duration,
     },
 }
@@ -81,6 +93,7 @@ pub struct PortCounters {
 }
 
 impl PortCounters {
+    /// Add `o`'s counts.
     pub fn add(&mut self, o: &PortCounters) {
         self.received += o.received;
         self.overwritten += o.overwritten;
@@ -93,14 +106,20 @@ impl PortCounters {
 /// [`PortCounters`] shared between a port's threads.
 #[derive(Debug, Default)]
 pub struct SharedCounters {
+    /// Commands delivered.
     pub received: AtomicU64,
+    /// Commands discarded by a full receive queue or buffer.
     pub overwritten: AtomicU64,
+    /// Outputs the I/O failed to send.
     pub publish_failures: AtomicU64,
+    /// LoopStatistics not sent.
     pub statistics_failures: AtomicU64,
+    /// Received samples the recorder queue had no room for.
     pub recorder_drops: AtomicU64,
 }
 
 impl SharedCounters {
+    /// The counts now.
     pub fn snapshot(&self) -> PortCounters {
         let l = |a: &AtomicU64| a.load(Ordering::Relaxed);
         PortCounters {
@@ -112,6 +131,7 @@ impl SharedCounters {
         }
     }
 
+    /// Count one.
     pub fn bump(a: &AtomicU64) {
         a.fetch_add(1, Ordering::Relaxed);
     }
@@ -152,13 +172,16 @@ pub use crate::config::MAX_CONTACTS;
 /// joint order (Copy: the loop hands it over without allocating).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct JointEfforts {
+    /// The step's stamp, ns.
     pub stamp_ns: u64,
+    /// Efforts used.
     pub len: usize,
     /// N (linear joint) or N·m (rotary), `gain · F_f`; `len` used.
     pub effort: [f64; MAX_CONTACTS],
 }
 
 impl JointEfforts {
+    /// The efforts of a step (at most MAX_CONTACTS).
     pub fn new(stamp_ns: u64, efforts: &[f64]) -> Self {
         let len = efforts.len().min(MAX_CONTACTS);
         let mut effort = [0.0; MAX_CONTACTS];
@@ -170,6 +193,7 @@ impl JointEfforts {
         }
     }
 
+    /// The efforts used.
     pub fn as_slice(&self) -> &[f64] {
         &self.effort[..self.len.min(MAX_CONTACTS)]
     }
@@ -179,8 +203,11 @@ impl JointEfforts {
 /// name; the peer side may allocate).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct JointStateCommand {
+    /// The message's stamp, ns.
     pub stamp_ns: u64,
+    /// Joint names.
     pub name: Vec<String>,
+    /// Velocities, one per name (m/s or rad/s).
     pub velocity: Vec<f64>,
 }
 
@@ -237,6 +264,7 @@ pub fn joint_commands<'a>(
 
 /// The loop's side of a transport.
 pub trait NodePort {
+    /// The backend's name.
     fn name(&self) -> &'static str;
     /// Next pending command, if any (non-blocking).
     fn poll_command(&mut self) -> Result<Option<Command>, TransportError>;
@@ -257,7 +285,9 @@ pub trait NodePort {
 
 /// The other side: sends commands, reads estimates.
 pub trait PeerPort {
+    /// The backend's name.
     fn name(&self) -> &'static str;
+    /// Send one command.
     fn send(&mut self, c: &Command) -> Result<(), TransportError>;
     /// Next estimate, if any (non-blocking).
     fn try_recv(&mut self) -> Result<Option<EstimateRecord>, TransportError>;
@@ -319,10 +349,13 @@ pub fn recv_timeout(
 #[allow(clippy::large_enum_variant)]
 #[derive(Clone)]
 pub enum BackendSpec {
+    /// In-process queues (tests, replay).
     Memory(memory::MemoryLink),
     #[cfg(feature = "iceoryx2")]
+    /// iceoryx2 services.
     Iceoryx2(iceoryx::IceoryxSpec),
     #[cfg(feature = "ros2")]
+    /// ROS 2 topics and services.
     Ros2(ros2::Ros2Spec),
 }
 
@@ -336,6 +369,7 @@ impl BackendSpec {
         }
     }
 
+    /// The backend's name.
     pub fn name(&self) -> &'static str {
         match self {
             BackendSpec::Memory(_) => "memory",

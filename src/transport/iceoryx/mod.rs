@@ -44,17 +44,26 @@ const NAME: &str = "iceoryx2";
 /// Service names (Send; opened on the using thread).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct IceoryxSpec {
+    /// The commanded-velocity service.
     pub velocity: String,
+    /// The normal-load service.
     pub load: String,
+    /// The temperature service.
     pub temperature: String,
+    /// The estimate service.
     pub estimate: String,
+    /// The loop-statistics service.
     pub statistics: String,
+    /// The event service that wakes the node on a command.
     pub event: String,
     /// Several contacts: the configured joints (empty: one contact) and
     /// the joint services.
     pub joints: Vec<String>,
+    /// Several contacts: the joint-velocity service.
     pub joint_state: String,
+    /// Several contacts: the efforts service.
     pub efforts: String,
+    /// Several contacts: every contact's estimates, tagged with its index.
     pub contact_estimate: String,
 }
 
@@ -194,6 +203,7 @@ pub struct IceoryxNode {
 }
 
 impl IceoryxNode {
+    /// Open the node side: subscribers for the commands, publishers for the outputs.
     pub fn open(spec: &IceoryxSpec, record: RecordQueue) -> Result<Self, TransportError> {
         let n = node()?;
         let v = service::<CommandPayload>(&n, &spec.velocity, COMMAND_BUFFER)?;
@@ -372,6 +382,8 @@ pub struct IceoryxPeer {
 }
 
 impl IceoryxPeer {
+    /// Open the peer side (a controller, a test): publishers for the commands, subscribers for the
+    /// outputs.
     pub fn open(spec: &IceoryxSpec) -> Result<Self, TransportError> {
         let n = node()?;
         let v = service::<CommandPayload>(&n, &spec.velocity, COMMAND_BUFFER)?;

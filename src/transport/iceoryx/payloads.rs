@@ -23,24 +23,44 @@ pub struct CommandPayload {
 #[repr(C)]
 #[type_name("friction_node::FrictionEstimate_v2")]
 pub struct EstimatePayload {
+    /// The header's stamp, ns.
     pub stamp_ns: u64,
+    /// Sliding velocity of the step.
     pub velocity_m_s: f64,
+    /// Normal load of the step.
     pub load_n: f64,
+    /// Lubricant temperature of the step (the reference temperature when none is measured).
     pub temperature_c: f64,
+    /// Total friction: the contact plus the drivetrain terms, signed like the velocity.
     pub friction_force_n: f64,
+    /// The lubricated contact alone, signed like the velocity.
     pub contact_friction_force_n: f64,
+    /// (|F_visc| + mu_bl F_asp) / F_ext.
     pub cof: f64,
+    /// Minimum nominal separation.
     pub h0_m: f64,
+    /// Minimum film thickness.
     pub h_min_m: f64,
+    /// B * integral of (p - p_amb).
     pub hydrodynamic_force_n: f64,
+    /// Greenwood-Williamson contact force.
     pub asperity_force_n: f64,
+    /// Asperity_force_n / load_n.
     pub asperity_load_share: f64,
+    /// Wall time of the model step.
     pub compute_time_ns: u64,
+    /// How long after its deadline the step started (timer mode; catch-up steps are late by
+    /// design).
     pub late_ns: u64,
+    /// Newton iterations of the step.
     pub iterations: u32,
+    /// REGIME_*.
     pub regime: u8,
+    /// STATUS_*: the solver's outcome.
     pub status: u8,
+    /// COMMAND_*: the command's state.
     pub command_status: u8,
+    /// Padding (0).
     pub reserved: u8,
 }
 
@@ -49,35 +69,64 @@ pub struct EstimatePayload {
 #[repr(C)]
 #[type_name("friction_node::LoopStatistics_v5")]
 pub struct StatisticsPayload {
+    /// The header's stamp, ns.
     pub stamp_ns: u64,
+    /// Model steps taken.
     pub steps: u64,
+    /// Steps that finished after the next deadline (timer mode).
     pub deadline_misses: u64,
+    /// Steps taken late, after their deadline had passed, to keep model time = wall time.
     pub catch_up_steps: u64,
+    /// Lost time beyond node.max_catch_up_s, advanced in one variable-length step.
     pub time_jumps: u64,
+    /// Steps of the wall clock (NTP) seen; stamps stay monotonic.
     pub clock_jumps: u64,
+    /// Commands the transports delivered.
     pub commands_received: u64,
+    /// Accepted as the current set point.
     pub commands_applied: u64,
+    /// Discarded by a full receive queue before the loop saw them.
     pub commands_overwritten: u64,
+    /// Non-finite, beyond limits, or out-of-order stamps (lockstep).
     pub commands_rejected: u64,
+    /// Steps taken with a timed-out command.
     pub command_timeouts: u64,
+    /// Outputs the loop could not hand to a transport (queue full).
     pub publish_drops: u64,
+    /// Outputs a transport's I/O failed to send.
     pub publish_failures: u64,
+    /// LoopStatistics that could not be handed over or sent.
     pub statistics_not_sent: u64,
+    /// Outputs dropped because the recorder queue was full.
     pub recorder_drops: u64,
+    /// Recording files started (split recordings: one per split).
     pub recording_files: u64,
+    /// Split files deleted to keep to recording.budget_bytes.
     pub recording_files_deleted: u64,
+    /// Messages not recorded because writing had failed (a full disk).
     pub recording_lost: u64,
+    /// Snapshot files written.
     pub snapshots: u64,
+    /// The time span it holds.
     pub last_snapshot_span_s: f64,
     /// UTF-8, `last_snapshot_len` bytes used.
     pub last_snapshot: [u8; 255],
+    /// Bytes of `last_snapshot` used.
     pub last_snapshot_len: u8,
+    /// Model step wall time: p50, p99, max, ns.
     pub compute_time_ns: [u64; 3],
+    /// Lateness of the step start against its deadline: p50, p99, max, ns.
     pub period_jitter_ns: [u64; 3],
+    /// Steps whose solver status was not converged (iteration bound, non-finite, rejected input).
     pub steps_not_converged: u64,
+    /// Parameter changes applied while running (ros2 param set).
     pub parameter_updates: u64,
+    /// Contacts the loop steps (1 without `contacts`).
     pub contacts: u32,
+    /// Index (configured order) of the contact whose step took longest since the previous
+    /// LoopStatistics.
     pub slowest_contact: u32,
+    /// That contact's longest step compute time since the previous LoopStatistics.
     pub slowest_contact_compute_ns: u64,
 }
 
@@ -225,14 +274,19 @@ pub const JOINT_NAME_BYTES: usize = crate::config::MAX_JOINT_NAME_BYTES;
 #[repr(C)]
 #[type_name("friction_node::JointState_v1")]
 pub struct JointStatePayload {
+    /// The stamp, ns.
     pub stamp_ns: u64,
     /// 1, 2, 3, … per publisher (gaps: samples lost to a full buffer).
     pub sequence: u64,
+    /// Names used.
     pub name_count: u32,
+    /// Velocities used.
     pub velocity_count: u32,
     /// UTF-8, `name_len[i]` bytes used.
     pub name: [[u8; JOINT_NAME_BYTES]; crate::transport::MAX_CONTACTS],
+    /// Bytes of each name used.
     pub name_len: [u8; crate::transport::MAX_CONTACTS],
+    /// Velocities, m/s or rad/s, `velocity_count` used.
     pub velocity: [f64; crate::transport::MAX_CONTACTS],
 }
 
@@ -251,8 +305,11 @@ impl JointStatePayload {
 #[repr(C)]
 #[type_name("friction_node::JointEfforts_v1")]
 pub struct EffortsPayload {
+    /// The step's stamp, ns.
     pub stamp_ns: u64,
+    /// Efforts used.
     pub len: u32,
+    /// Padding (0).
     pub reserved: u32,
     /// N or N·m, `len` used.
     pub effort: [f64; crate::transport::MAX_CONTACTS],
@@ -265,6 +322,8 @@ pub struct EffortsPayload {
 pub struct ContactEstimatePayload {
     /// Index of the contact in the configured order.
     pub contact: u32,
+    /// Padding (0).
     pub reserved: u32,
+    /// The estimate.
     pub estimate: EstimatePayload,
 }

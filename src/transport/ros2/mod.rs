@@ -68,16 +68,25 @@ pub(super) fn err(op: impl Into<String>, e: impl std::fmt::Debug) -> TransportEr
 /// Everything needed to open either side (Send).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Ros2Spec {
+    /// The DDS domain.
     pub domain_id: u16,
+    /// Discovery and traffic on loopback only.
     pub localhost_only: bool,
+    /// The node's namespace.
     pub namespace: String,
+    /// The node's name.
     pub node_name: String,
+    /// Float64 or TwistStamped velocity commands.
     pub command_type: CommandType,
     /// Every topic, resolved from the configuration.
     pub topics: TopicNames,
+    /// QoS of the command topics.
     pub command_qos: QosConfig,
+    /// QoS of the output topics.
     pub estimate_qos: QosConfig,
+    /// The frame id of published messages.
     pub frame_id: String,
+    /// Capacity of each output queue.
     pub queue_capacity: usize,
     /// Several contacts: the configured joints (empty: one contact).
     pub joints: Vec<String>,
@@ -127,6 +136,7 @@ impl Ros2Spec {
         format!("{ns}/{}", self.node_name)
     }
 
+    /// The spec of `cfg`.
     pub fn from_config(cfg: &Config) -> Result<Self, TransportError> {
         let r = &cfg.ros;
         Ok(Self {
@@ -271,6 +281,7 @@ pub struct Ros2Node {
 }
 
 impl Ros2Node {
+    /// Open the node side on its own I/O thread.
     pub fn open(spec: &Ros2Spec, io: PortIo) -> Result<Self, TransportError> {
         let commands = Arc::new(ArrayQueue::new(spec.queue_capacity));
         let outputs = Arc::new(ArrayQueue::new(spec.queue_capacity));

@@ -109,12 +109,16 @@ pub fn describe(d: &Declared) -> ParameterDescriptor {
 
 /// The service state: the configuration as changed so far.
 pub struct ParamState {
+    /// The configuration with every change applied so far.
     pub config: Config,
+    /// The declared parameters.
     pub declared: Vec<Declared>,
+    /// Where validated changes go to the loop.
     pub channel: Arc<ParameterChannel>,
 }
 
 impl ParamState {
+    /// The state of a node that serves parameters.
     pub fn new(io: ParameterIo) -> Self {
         Self {
             declared: declare(&io.config),

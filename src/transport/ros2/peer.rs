@@ -30,6 +30,7 @@ pub struct Ros2Peer {
 static PEER_COUNTER: AtomicU64 = AtomicU64::new(0);
 
 impl Ros2Peer {
+    /// Open the peer side (a controller, a test).
     pub fn open(spec: &Ros2Spec) -> Result<Self, TransportError> {
         let ctx = context(spec)?;
         let name = format!(

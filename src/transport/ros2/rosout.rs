@@ -26,22 +26,32 @@ const QUEUE: usize = 256;
 
 /// rcl's severities (`rcl_interfaces/msg/Log`).
 pub mod severity {
+    /// Debug.
     pub const DEBUG: u8 = 10;
+    /// Information.
     pub const INFO: u8 = 20;
+    /// Warning.
     pub const WARN: u8 = 30;
+    /// Error.
     pub const ERROR: u8 = 40;
+    /// Fatal.
     pub const FATAL: u8 = 50;
 }
 
 /// One log line.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LogLine {
+    /// When it was logged, ns.
     pub stamp_ns: u64,
+    /// Severity (`severity`).
     pub level: u8,
     /// The module that logged it (`friction_node::node::timer`).
     pub target: String,
+    /// The message.
     pub message: String,
+    /// The source file.
     pub file: String,
+    /// The source line.
     pub line: u32,
 }
 

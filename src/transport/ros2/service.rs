@@ -58,14 +58,18 @@ impl rustdds::no_key::SerializerAdapter<RawPayload> for RawPayloadAdapter {
 /// The DDS layout of one request.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Layout {
+    /// The enhanced RPC layout (Fast DDS, ros2-client).
     Enhanced,
+    /// Cyclone DDS's: a 16-byte header before the body.
     Cyclone,
 }
 
 /// A decoded request and what its reply needs.
 #[derive(Debug, Clone)]
 pub struct Request<T> {
+    /// How the request was laid out.
     pub layout: Layout,
+    /// The decoded request.
     pub body: T,
     /// The identity the reply's inline QoS carries.
     identity: SampleIdentity,
@@ -92,8 +96,16 @@ fn decode_all<T: DeserializeOwned>(payload: &[u8], big: bool) -> Option<T> {
 /// How a request's bytes were read.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Classified<T> {
+    /// The enhanced layout's body.
     Enhanced(T),
-    Cyclone { header: [u8; 16], body: T },
+    /// Cyclone's layout.
+    Cyclone {
+        /// The header to echo in the reply.
+        header: [u8; 16],
+        /// The body.
+        body: T,
+    },
+    /// Neither layout decodes.
     Undecodable,
 }
 
@@ -143,6 +155,7 @@ pub fn classify<T: DeserializeOwned>(cdr: &[u8], related_seq: Option<i64>) -> Cl
 
 /// One service: its request reader and reply writer.
 pub struct DualServer {
+    /// The service's name.
     pub name: String,
     reader: SimpleDataReader<RawCdr, RawAdapter>,
     writer: DataWriter<RawPayload, RawPayloadAdapter>,
