@@ -15,6 +15,7 @@ use std::path::Path;
 /// Which topics hold what.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct BagTopics {
+    /// The velocity topic.
     pub velocity: String,
     /// `std_msgs/msg/Float64`, or `sensor_msgs/msg/JointState` effort.
     pub friction: String,

@@ -30,20 +30,26 @@ use super::series::Series;
 use crate::physics::presliding::sgn;
 use nalgebra::{DMatrix, DVector};
 
+/// The classic friction models fitted beside ours.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum BaselineKind {
+    /// F = F_c sgn v + b v.
     CoulombViscous,
+    /// F = (F_c + (F_s − F_c) e^(−(v/v_s)²)) sgn v + b v.
     Stribeck,
+    /// The LuGre bristle model on a Stribeck curve (σ0, σ1, σ2).
     LuGre,
 }
 
 impl BaselineKind {
+    /// Every classic model, in the order the tables list them.
     pub const ALL: [BaselineKind; 3] = [
         BaselineKind::CoulombViscous,
         BaselineKind::Stribeck,
         BaselineKind::LuGre,
     ];
 
+    /// The model's name in tables and plots.
     pub fn label(self) -> &'static str {
         match self {
             BaselineKind::CoulombViscous => "Coulomb + viscous",
@@ -82,7 +88,9 @@ impl LoadForm {
 
 /// A classic model with its fitted parameters.
 pub struct Baseline {
+    /// Which model.
     pub kind: BaselineKind,
+    /// How its levels depend on the load.
     pub load_form: LoadForm,
     params: Vec<FittedParameter>,
 }

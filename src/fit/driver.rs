@@ -13,17 +13,25 @@ use std::time::Instant;
 /// The whole outcome of a fit.
 #[derive(Debug, Clone)]
 pub struct FitOutcome {
+    /// The model's name.
     pub label: String,
+    /// The fitted parameters with their bounds.
     pub params: Vec<FittedParameter>,
+    /// The best point, one value per parameter.
     pub best: Vec<f64>,
     /// Distinct optima, best first.
     pub optima: Vec<LocalRun>,
+    /// Whether the best local run converged.
     pub converged: bool,
+    /// Standard errors, intervals and correlations at the best point.
     pub statistics: super::stats::Statistics,
+    /// The training sources with the prediction.
     pub train: Vec<SeriesFit>,
+    /// The validation sources with the prediction.
     pub validate: Vec<SeriesFit>,
     /// RMS and max |residual| on the fitted samples, N.
     pub train_rms: f64,
+    /// Max |residual| on the fitted samples, N.
     pub train_max: f64,
     /// RMS on held-out samples of the training sources, N.
     pub holdout_rms: Option<f64>,
@@ -33,8 +41,11 @@ pub struct FitOutcome {
     /// (e.g. LuGre's g(v) ≤ 0 beyond the training velocities): an outcome
     /// to report, not an error.
     pub validate_failure: Option<String>,
+    /// Model evaluations (simulations of a source).
     pub simulations: usize,
+    /// Mean wall time of one, s.
     pub simulation_mean_s: f64,
+    /// Wall time of the whole fit, s.
     pub wall_s: f64,
 }
 

@@ -11,10 +11,15 @@ use rayon::prelude::*;
 /// The result of one local run.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LocalRun {
+    /// Where it ended.
     pub x: Vec<f64>,
+    /// ½ Σ r², N².
     pub cost: f64,
+    /// Whether it met a convergence test.
     pub converged: bool,
+    /// How it ended, in words.
     pub termination: String,
+    /// Residual evaluations it used.
     pub evaluations: usize,
 }
 

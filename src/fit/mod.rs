@@ -37,6 +37,8 @@
 //! | `synthetic.rs` | synthetic data: the model along a motion, with noise |
 //! | `reversals.rs` | velocity reversals in the data and the stiffness through them (pre-sliding starts) |
 
+#![warn(missing_docs)]
+
 #[cfg(feature = "mcap")]
 pub mod bag_input;
 pub mod baselines;
@@ -70,33 +72,65 @@ use std::path::PathBuf;
 /// not converge is not an error (it is an outcome with a status).
 #[derive(Debug, thiserror::Error)]
 pub enum FitError {
+    /// A data file could not be read.
     #[error("cannot read {}: {cause}", path.display())]
     Io {
+        /// The file.
         path: PathBuf,
+        /// Why.
         cause: std::io::Error,
     },
+    /// A table's line does not parse.
     #[error("{}:{line}: {message}", path.display())]
     Table {
+        /// The file.
         path: PathBuf,
+        /// The line, 1-based.
         line: usize,
+        /// What is wrong with it.
         message: String,
     },
+    /// A column expression or map does not parse or evaluate.
     #[error("{what} `{text}`: {message}")]
     Expression {
+        /// Which expression (the flag).
         what: String,
+        /// Its text.
         text: String,
+        /// What is wrong with it.
         message: String,
     },
+    /// The data cannot be fitted (too few samples, non-finite values, …).
     #[error("{what}: {message}")]
-    Data { what: String, message: String },
+    Data {
+        /// The source or column.
+        what: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// A `--fit` key that cannot be fitted.
     #[error("--fit {key}: {message}")]
-    Key { key: String, message: String },
+    Key {
+        /// The key.
+        key: String,
+        /// Why.
+        message: String,
+    },
+    /// `--bounds` that cannot hold.
     #[error("--bounds {key}: {message}")]
-    Bounds { key: String, message: String },
+    Bounds {
+        /// The key.
+        key: String,
+        /// Why.
+        message: String,
+    },
+    /// The base configuration is not valid.
     #[error(transparent)]
     Config(#[from] crate::config::ConfigError),
+    /// A stop was requested.
     #[error(transparent)]
     Interrupted(#[from] crate::interrupt::Interrupted),
+    /// A bag could not be read.
     #[cfg(feature = "mcap")]
     #[error(transparent)]
     Bag(#[from] crate::bag::BagError),

@@ -11,6 +11,7 @@ pub struct Options {
     pub starts: usize,
     /// Points of the global phase (0: none).
     pub global_points: usize,
+    /// Seed of the global phase's points.
     pub seed: u64,
     /// Residual evaluations per LM run (the Jacobian's are extra).
     pub max_evaluations: usize,
@@ -40,6 +41,7 @@ impl Default for Options {
 }
 
 impl Options {
+    /// Report a progress line (if anyone listens).
     pub fn say(&self, line: &str) {
         if let Some(p) = &self.progress {
             p(line);

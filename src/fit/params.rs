@@ -15,6 +15,7 @@ use serde_norway::Value;
 /// What the command line asked for one fitted parameter.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct ParamSpec {
+    /// The dotted configuration key (or map coefficient).
     pub name: String,
     /// `--bounds NAME=LO:HI`.
     pub bounds: Option<(f64, f64)>,
@@ -26,9 +27,13 @@ pub struct ParamSpec {
 /// One fitted parameter.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FittedParameter {
+    /// The dotted key (or map coefficient).
     pub name: String,
+    /// The starting value.
     pub start: f64,
+    /// Lower bound.
     pub lo: f64,
+    /// Upper bound.
     pub hi: f64,
     /// Fitted on ln p.
     pub log: bool,
@@ -50,6 +55,7 @@ impl FittedParameter {
         }
     }
 
+    /// `p` on the scale the optimiser sees (ln p for a log parameter).
     pub fn scaled(&self, p: f64) -> f64 {
         if self.log {
             p.ln()
@@ -58,6 +64,7 @@ impl FittedParameter {
         }
     }
 
+    /// The value of scaled `s`.
     pub fn unscaled(&self, s: f64) -> f64 {
         if self.log {
             s.exp()
@@ -66,6 +73,7 @@ impl FittedParameter {
         }
     }
 
+    /// The bounds on the scaled axis.
     pub fn scaled_bounds(&self) -> (f64, f64) {
         (self.scaled(self.lo), self.scaled(self.hi))
     }
@@ -76,6 +84,7 @@ impl FittedParameter {
         ((self.scaled(p) - a) / (b - a)).clamp(0.0, 1.0)
     }
 
+    /// The value at position `f` (0 … 1) within the scaled bounds.
     pub fn from_fraction(&self, f: f64) -> f64 {
         let (a, b) = self.scaled_bounds();
         self.unscaled(a + (b - a) * f.clamp(0.0, 1.0))
@@ -91,6 +100,7 @@ impl FittedParameter {
         (2.0 * f - 1.0).asin() + std::f64::consts::TAU
     }
 
+    /// The value of the optimiser's unbounded variable `u` (see `to_internal`).
     pub fn from_internal(&self, u: f64) -> f64 {
         self.from_fraction(0.5 * (1.0 + u.sin()))
     }
@@ -138,6 +148,7 @@ fn lookup_mut<'a>(tree: &'a mut Value, key: &str) -> Option<&'a mut Value> {
 }
 
 impl ConfigKeys {
+    /// The key tree of `config`.
     pub fn new(config: &Config) -> Self {
         Self {
             tree: serde_norway::to_value(config).expect("a configuration serializes"),

@@ -23,18 +23,22 @@ pub trait Model: Sync {
 /// The data of a fit: training sources (a part may be held out) and
 /// validation sources, with the input maps' coefficients.
 pub struct Data {
+    /// Training sources.
     pub train: Vec<Source>,
+    /// Validation sources (not fitted).
     pub validate: Vec<Source>,
     /// Fraction of each training source held out (see [`Series::hold_out`]).
     pub holdout: f64,
     /// Map coefficient names and their values (fixed or starts).
     pub map_names: Vec<String>,
+    /// Their values.
     pub map_values: Vec<f64>,
 }
 
 /// A model's prediction beside the measurement, for one source.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SeriesFit {
+    /// The data as the model saw them (maps applied).
     pub series: Series,
     /// Model friction at every sample, N (NaN where there is none).
     pub predicted: Vec<f64>,
@@ -68,7 +72,9 @@ const RECENT_SERIES: usize = 8;
 
 /// A model on data, with the map coefficients that are fitted.
 pub struct Problem<'a> {
+    /// The model fitted.
     pub model: &'a dyn Model,
+    /// The data.
     pub data: &'a Data,
     /// Fitted map coefficients: index into `data.map_names` and bounds.
     pub map_fit: Vec<(usize, FittedParameter)>,
@@ -85,7 +91,9 @@ pub struct Problem<'a> {
     recent: Mutex<Vec<SeriesEntry>>,
     /// A stop requested from outside ends the local runs at once.
     pub stop: crate::interrupt::Stop,
+    /// Model evaluations so far.
     pub simulations: AtomicUsize,
+    /// Their total wall time, ns.
     pub simulation_ns: AtomicU64,
 }
 
@@ -151,6 +159,7 @@ impl<'a> Problem<'a> {
         })
     }
 
+    /// The starting point (every parameter's start).
     pub fn start(&self) -> Vec<f64> {
         self.params.iter().map(|p| p.start).collect()
     }
@@ -263,10 +272,12 @@ impl<'a> Problem<'a> {
         0.5 * self.residuals(x).iter().map(|r| r * r).sum::<f64>()
     }
 
+    /// Samples the cost sums over.
     pub fn fitted_samples(&self) -> usize {
         self.fitted_samples
     }
 
+    /// `x` as the optimiser's unbounded variables.
     pub fn to_internal(&self, x: &[f64]) -> Vec<f64> {
         self.params
             .iter()
@@ -275,6 +286,7 @@ impl<'a> Problem<'a> {
             .collect()
     }
 
+    /// The point of the optimiser's variables `u`.
     pub fn from_internal(&self, u: &[f64]) -> Vec<f64> {
         self.params
             .iter()

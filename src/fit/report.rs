@@ -134,12 +134,17 @@ pub fn residual_lines(o: &FitOutcome) -> String {
 /// One row of the baselines table.
 #[derive(Debug, Clone)]
 pub struct ModelRow {
+    /// The model's name.
     pub label: String,
+    /// Its fitted parameters.
     pub parameters: Vec<(String, f64)>,
+    /// RMS residual on the training samples, N.
     pub train_rms: f64,
+    /// RMS residual on the held-out samples, N.
     pub held_out_rms: Option<f64>,
     /// Why there is no held-out prediction, when there is none.
     pub held_out_failure: Option<String>,
+    /// Whether its fit converged.
     pub converged: bool,
     /// How the best local run ended.
     pub termination: String,

@@ -23,10 +23,15 @@ pub type LabelledProgress = Arc<dyn Fn(&str, &str) + Send + Sync>;
 /// a bag).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct TopicChoice {
+    /// The velocity topic.
     pub velocity: Option<String>,
+    /// The friction topic.
     pub friction: Option<String>,
+    /// JointState topics: which joint.
     pub joint: Option<String>,
+    /// The load topic.
     pub load: Option<String>,
+    /// The temperature topic.
     pub temperature: Option<String>,
 }
 
@@ -45,14 +50,19 @@ pub struct FitRequest {
     pub holdout: f64,
     /// CSV reading: column names of headerless data, rows skipped, separator.
     pub columns: Option<Vec<String>>,
+    /// Rows skipped at the top of each table.
     pub skip: usize,
+    /// The column separator.
     pub delimiter: Delimiter,
     /// Bag reading.
     pub topics: TopicChoice,
     /// Optimiser settings (as `fit`'s options).
     pub starts: usize,
+    /// Points of the global phase (0: none).
     pub global_points: usize,
+    /// Seed of the global phase.
     pub seed: u64,
+    /// Residual evaluations per local run.
     pub max_evaluations: usize,
     /// Also fit Coulomb + viscous, Stribeck and LuGre.
     pub baselines: bool,
@@ -315,11 +325,17 @@ pub fn data_scale(
 
 /// Data, the physics model's parameters and the fitted map coefficients.
 pub struct Prepared {
+    /// The sources.
     pub data: Data,
+    /// Our model with its fitted keys.
     pub model: PhysicsModel,
+    /// Fitted map coefficients (index, bounds).
     pub map_fit: Vec<(usize, FittedParameter)>,
+    /// The data's velocity and friction scales (for the baselines' starts and bounds).
     pub scale: DataScale,
+    /// Mean |friction| of the training data, N.
     pub mean_abs_n: f64,
+    /// Whether the training loads differ by more than 1 %.
     pub loads_vary: bool,
     /// The validation data hold loads outside the training data's range.
     pub other_loads: bool,
@@ -421,8 +437,11 @@ pub fn prepare(config: &Config, req: &FitRequest) -> Result<Prepared, FitError> 
 /// Our model's fit: the outcome, the fitted configuration and the map
 /// coefficients (fitted or fixed) by name.
 pub struct OursFitted {
+    /// The fit.
     pub outcome: FitOutcome,
+    /// The configuration with the fitted values.
     pub config: Config,
+    /// Map coefficients by name.
     pub map: Vec<(String, f64)>,
 }
 

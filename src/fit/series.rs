@@ -21,7 +21,9 @@ use std::path::PathBuf;
 pub struct Mapping {
     /// None: `t_s` if the table has it, else a steady curve.
     pub time: Option<String>,
+    /// The velocity column expression, m/s.
     pub velocity: String,
+    /// The friction column expression, N.
     pub friction: String,
     /// None: `load_n` if present, else `contact.load_n`.
     pub load: Option<String>,
@@ -50,12 +52,15 @@ impl Default for Mapping {
 /// One series of samples, as the model sees it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Series {
+    /// The source's name.
     pub name: String,
     /// A steady curve (no time, each point a steady state).
     pub steady: bool,
     /// Time, s (steady: the row index).
     pub t: Vec<f64>,
+    /// Velocity, m/s.
     pub velocity: Vec<f64>,
+    /// Measured friction, N.
     pub friction: Vec<f64>,
     /// Normal load, N (None: the configuration's).
     pub load: Option<Vec<f64>>,
@@ -66,14 +71,17 @@ pub struct Series {
 }
 
 impl Series {
+    /// Samples.
     pub fn len(&self) -> usize {
         self.t.len()
     }
 
+    /// Whether it has no sample.
     pub fn is_empty(&self) -> bool {
         self.t.is_empty()
     }
 
+    /// The load at sample `k`, N (`default` without a load column).
     pub fn load_at(&self, k: usize, default: f64) -> f64 {
         self.load.as_ref().map_or(default, |l| l[k])
     }
@@ -281,6 +289,7 @@ impl Source {
         Ok(s)
     }
 
+    /// The source's name (its file).
     pub fn name(&self) -> &str {
         &self.name
     }
@@ -304,6 +313,7 @@ impl Source {
         self.columns().eval_column(e, what, coeffs)
     }
 
+    /// Whether it is a steady curve.
     pub fn is_steady(&self) -> bool {
         self.steady
     }

@@ -19,6 +19,7 @@ use rayon::prelude::*;
 /// Correlations above this are flagged.
 pub const CORRELATION_FLAG: f64 = 0.95;
 
+/// Statistics of a fit at its best point.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Statistics {
     /// Standard error of each parameter (its own unit).

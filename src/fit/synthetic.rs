@@ -19,9 +19,13 @@ use rand::{RngExt, SeedableRng};
 /// for a duration (s).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Segment {
+    /// Velocity amplitude V1, m/s.
     pub amplitude_m_s: f64,
+    /// Frequency f, Hz.
     pub frequency_hz: f64,
+    /// Normal load, N.
     pub load_n: f64,
+    /// Length, s.
     pub duration_s: f64,
 }
 
