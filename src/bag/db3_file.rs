@@ -119,6 +119,7 @@ impl Db3File {
         })
     }
 
+    /// The file opened.
     pub fn path(&self) -> &Path {
         &self.path
     }

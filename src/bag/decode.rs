@@ -173,7 +173,9 @@ pub fn stamp_or(header: u64, publish: u64, log: u64) -> u64 {
 /// Turns one topic's messages into `(stamp_ns, value)` samples.
 #[derive(Debug, Clone)]
 pub struct TopicDecoder {
+    /// The channel decoded.
     pub channel: ChannelInfo,
+    /// What is read from each message.
     pub kind: SampleKind,
     /// Messages decoded so far (1-based index of the last).
     index: u64,
@@ -204,6 +206,7 @@ impl TopicDecoder {
         })
     }
 
+    /// The channel's topic.
     pub fn topic(&self) -> &str {
         &self.channel.topic
     }

@@ -59,6 +59,7 @@ fn channel_info(c: &mcap::Channel<'_>, messages: u64) -> ChannelInfo {
 }
 
 impl McapFile {
+    /// Open (map) the file; nothing is read yet.
     pub fn open(path: &Path) -> Result<Self, BagError> {
         let io = |cause| BagError::Io {
             path: path.to_path_buf(),
@@ -103,6 +104,7 @@ impl McapFile {
         })
     }
 
+    /// The file opened.
     pub fn path(&self) -> &Path {
         &self.path
     }

@@ -19,6 +19,8 @@
 //! | `resample.rs` | sampled inputs onto the model's step grid, silences |
 //! | `structure.rs` | a structural check of an MCAP file before the `mcap` reader sees it |
 
+#![warn(missing_docs)]
+
 mod db3_file;
 pub mod decode;
 mod mcap_file;
@@ -36,47 +38,82 @@ use std::path::{Path, PathBuf};
 /// Errors of the bag layer.
 #[derive(Debug, thiserror::Error)]
 pub enum BagError {
+    /// The bag could not be read.
     #[error("cannot read bag {}: {cause}", path.display())]
     Io {
+        /// The file or directory.
         path: PathBuf,
+        /// Why.
         cause: std::io::Error,
     },
+    /// Neither MCAP, SQLite nor a rosbag2 directory.
     #[error("{} is not a bag: {message}", path.display())]
-    NotABag { path: PathBuf, message: String },
+    NotABag {
+        /// The path.
+        path: PathBuf,
+        /// What was found instead.
+        message: String,
+    },
+    /// A topic asked for is not in the bag.
     #[error("topic `{topic}` is not in the bag; it has:\n{}", listing(.available))]
     TopicNotFound {
+        /// The topic.
         topic: String,
+        /// The bag's topics: (name, type, messages).
         available: Vec<(String, String, u64)>,
     },
+    /// A topic of a type this reader does not decode.
     #[error(
         "topic `{topic}` has type `{type_name}`, which cannot be read here (expected {expected})"
     )]
     UnsupportedType {
+        /// The topic.
         topic: String,
+        /// Its type.
         type_name: String,
+        /// The types that would do.
         expected: String,
     },
+    /// A schema whose fields are not its type's.
     #[error(
         "topic `{topic}`: the schema does not match its declared type `{type_name}`: {message}"
     )]
     SchemaMismatch {
+        /// The topic.
         topic: String,
+        /// Its declared type.
         type_name: String,
+        /// The difference.
         message: String,
     },
+    /// A JointState topic read without naming the joint.
     #[error("topic `{topic}` is JointState: choose a joint with --joint (joints: {})", .joints.join(", "))]
-    JointRequired { topic: String, joints: Vec<String> },
-    #[error("topic `{topic}` has no joint `{joint}` (joints: {})", .joints.join(", "))]
-    JointMissing {
+    JointRequired {
+        /// The topic.
         topic: String,
-        joint: String,
+        /// The joints it carries.
         joints: Vec<String>,
     },
+    /// The joint asked for is not in the messages.
+    #[error("topic `{topic}` has no joint `{joint}` (joints: {})", .joints.join(", "))]
+    JointMissing {
+        /// The topic.
+        topic: String,
+        /// The joint asked for.
+        joint: String,
+        /// The joints it carries.
+        joints: Vec<String>,
+    },
+    /// A message that does not decode as its type.
     #[error("topic `{topic}`, message {index}: cannot decode as {type_name}: {message}")]
     Decode {
+        /// The topic.
         topic: String,
+        /// Its type.
         type_name: String,
+        /// The message's index on the topic, 1-based.
         index: u64,
+        /// The decoder's error.
         message: String,
     },
 }
@@ -109,6 +146,7 @@ pub struct Damage {
     pub last_log_time_ns: Option<u64>,
     /// The file in which the damage is (a directory bag has several).
     pub file: PathBuf,
+    /// What was wrong.
     pub error: String,
 }
 
@@ -126,11 +164,17 @@ impl std::fmt::Display for Damage {
 /// have their own channel records, merged here by topic and type.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ChannelInfo {
+    /// The topic.
     pub topic: String,
+    /// Its type (`std_msgs/msg/Float64`).
     pub schema_name: String,
+    /// The schema's encoding (`ros2msg`).
     pub schema_encoding: String,
+    /// The schema's text.
     pub schema_text: String,
+    /// The messages' encoding (`cdr`).
     pub message_encoding: String,
+    /// Messages on it.
     pub messages: u64,
 }
 
@@ -139,9 +183,11 @@ pub struct ChannelInfo {
 pub struct BagScan {
     /// In order of first appearance.
     pub channels: Vec<ChannelInfo>,
+    /// Messages in the bag.
     pub messages: u64,
     /// `config_yaml` of the `friction_node` metadata record, if any.
     pub recorded_config: Option<String>,
+    /// Where the bag is damaged, if it is.
     pub damage: Option<Damage>,
     /// The files read, in order.
     pub files: Vec<PathBuf>,
@@ -184,16 +230,23 @@ impl BagScan {
 /// One message of the stream.
 #[derive(Debug, Clone)]
 pub struct BagMessage<'a> {
+    /// The topic.
     pub topic: &'a str,
+    /// Its type.
     pub schema_name: &'a str,
+    /// When it was recorded, ns.
     pub log_time: u64,
+    /// When it was published, ns.
     pub publish_time: u64,
+    /// The serialized message (CDR).
     pub data: &'a [u8],
 }
 
 /// One storage file of a bag.
 pub enum BagFile {
+    /// An MCAP file.
     Mcap(McapFile),
+    /// A rosbag2 SQLite file (.db3).
     Sqlite(Db3File),
 }
 
@@ -216,6 +269,7 @@ impl BagFile {
         }
     }
 
+    /// The file or directory opened.
     pub fn path(&self) -> &Path {
         match self {
             Self::Mcap(f) => f.path(),
@@ -276,6 +330,7 @@ impl Bag {
         })
     }
 
+    /// The file or directory opened.
     pub fn path(&self) -> &Path {
         &self.path
     }
@@ -341,11 +396,14 @@ pub struct Messages<'a> {
 /// A message with its channel kept alive: borrowed from an MCAP file (the
 /// stream hands out `Arc`s) or owned, read from an SQLite file.
 pub enum OwnedChannelMessage<'a> {
+    /// From an MCAP file.
     Mcap(mcap::Message<'a>),
+    /// From an SQLite file.
     Sqlite(db3_file::Db3Message),
 }
 
 impl OwnedChannelMessage<'_> {
+    /// The message, borrowed.
     pub fn view(&self) -> BagMessage<'_> {
         match self {
             Self::Mcap(m) => BagMessage {

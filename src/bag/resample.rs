@@ -10,7 +10,9 @@ pub struct Hold {
     pub dt_s: f64,
     /// `node.command_timeout_s`: a longer silence is a gap.
     pub timeout_s: f64,
+    /// `node.timeout_behaviour`.
     pub behaviour: TimeoutBehaviour,
+    /// `node.timeout_deceleration_m_s2`.
     pub deceleration_m_s2: f64,
 }
 

@@ -12,18 +12,21 @@ use std::path::{Path, PathBuf};
 /// `metadata.yaml`.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct MetadataFile {
+    /// The bag's description.
     pub rosbag2_bagfile_information: Metadata,
 }
 
 /// Nanoseconds, as rosbag2 writes durations.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub struct Nanoseconds {
+    /// A duration, ns.
     pub nanoseconds: u64,
 }
 
 /// Nanoseconds since the Unix epoch, as rosbag2 writes times.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub struct Since {
+    /// A time, ns since the Unix epoch.
     pub nanoseconds_since_epoch: u64,
 }
 
@@ -31,7 +34,9 @@ pub struct Since {
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(default)]
 pub struct TopicWithCount {
+    /// The topic.
     pub topic_metadata: TopicMetadata,
+    /// Messages on it.
     pub message_count: u64,
 }
 
@@ -39,9 +44,12 @@ pub struct TopicWithCount {
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(default)]
 pub struct TopicMetadata {
+    /// The topic's name.
     pub name: String,
     #[serde(rename = "type")]
+    /// Its type.
     pub type_name: String,
+    /// `cdr`.
     pub serialization_format: String,
     /// rosbag2 writes a YAML string; version 9 writers (e.g. `rosbags`) may
     /// write a YAML list: either is read, kept as YAML text.
@@ -66,9 +74,13 @@ fn yaml_text<'de, D: serde::Deserializer<'de>>(d: D) -> Result<String, D::Error>
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(default)]
 pub struct FileInfo {
+    /// The file, relative to the directory.
     pub path: String,
+    /// Its first message's time.
     pub starting_time: Since,
+    /// Its span.
     pub duration: Nanoseconds,
+    /// Its messages.
     pub message_count: u64,
 }
 
@@ -76,16 +88,27 @@ pub struct FileInfo {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct Metadata {
+    /// The metadata format's version.
     pub version: u32,
+    /// `mcap` or `sqlite3`.
     pub storage_identifier: String,
+    /// The whole bag's span.
     pub duration: Nanoseconds,
+    /// Its first message's time.
     pub starting_time: Since,
+    /// Its messages.
     pub message_count: u64,
+    /// Its topics with their counts.
     pub topics_with_message_count: Vec<TopicWithCount>,
+    /// File compression (empty: none).
     pub compression_format: String,
+    /// File or message compression (empty: none).
     pub compression_mode: String,
+    /// The files, in order.
     pub relative_file_paths: Vec<String>,
+    /// The files with their spans and counts.
     pub files: Vec<FileInfo>,
+    /// The ROS 2 distribution that wrote it.
     pub ros_distro: String,
 }
 
