@@ -22,6 +22,8 @@
 //! | `report.rs` | per-case CSVs, steady curves, figures and the claims' report |
 //! | `claims/` | the paper's claims 1–9 evaluated on the results |
 
+#![warn(missing_docs)]
+
 mod cases;
 pub mod claims;
 pub mod report;
@@ -33,17 +35,26 @@ use crate::physics::{Estimate, Solver, Status};
 /// The studies of MODEL.md §8.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum StudyKind {
+    /// Steady Stribeck curves (Fig. 4).
     Stribeck,
+    /// Velocity amplitude and frequency (Figs. 5–6).
     AmplitudeFrequency,
+    /// Normal load (Fig. 7).
     Load,
+    /// Lubricant viscosity (Fig. 8).
     Viscosity,
+    /// Slider mass (Figs. 9–10).
     Inertia,
+    /// Motion without reversal, an offset V0 (Fig. 11).
     Unidirectional,
+    /// Surface roughness (Figs. 12–13).
     Roughness,
+    /// COF against the Hersey number (Fig. 14).
     Hersey,
 }
 
 impl StudyKind {
+    /// Every study, in the order they run.
     pub const ALL: [StudyKind; 8] = [
         StudyKind::Stribeck,
         StudyKind::AmplitudeFrequency,
@@ -55,6 +66,7 @@ impl StudyKind {
         StudyKind::Hersey,
     ];
 
+    /// The name on the command line and in the output folders.
     pub fn name(self) -> &'static str {
         match self {
             StudyKind::Stribeck => "stribeck",
@@ -68,6 +80,7 @@ impl StudyKind {
         }
     }
 
+    /// The study named `s`.
     pub fn from_name(s: &str) -> Option<StudyKind> {
         Self::ALL.into_iter().find(|k| k.name() == s)
     }
@@ -90,20 +103,26 @@ impl StudyKind {
 /// v(t) = V0 + V1 sin(2π f t).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Motion {
+    /// V0, mean velocity, m/s.
     pub v0: f64,
+    /// V1, amplitude, m/s.
     pub v1: f64,
+    /// f, frequency, Hz.
     pub f_hz: f64,
 }
 
 impl Motion {
+    /// v at time `t` (s), m/s.
     pub fn at(&self, t: f64) -> f64 {
         self.v0 + self.v1 * (2.0 * std::f64::consts::PI * self.f_hz * t).sin()
     }
 
+    /// 1/f, s.
     pub fn period(&self) -> f64 {
         1.0 / self.f_hz
     }
 
+    /// The lowest and highest velocity, m/s.
     pub fn v_range(&self) -> (f64, f64) {
         (self.v0 - self.v1.abs(), self.v0 + self.v1.abs())
     }
@@ -112,6 +131,7 @@ impl Motion {
 /// One transient case of a study.
 #[derive(Debug, Clone)]
 pub struct Case {
+    /// The study it belongs to.
     pub study: StudyKind,
     /// File-safe identifier.
     pub id: String,
@@ -119,22 +139,28 @@ pub struct Case {
     pub panel: String,
     /// Series within the panel (e.g. "V1 = 0.5 m/s").
     pub series: String,
+    /// Its configuration.
     pub config: Config,
+    /// Its velocity.
     pub motion: Motion,
+    /// Cycles to run (the last is measured).
     pub cycles: usize,
     /// Key of the steady curve overlaid on this case.
     pub steady_key: String,
 }
 
 impl Case {
+    /// Steps it takes.
     pub fn steps(&self) -> usize {
         (self.cycles as f64 * self.motion.period() / self.config.solver.dt_s).round() as usize
     }
 
+    /// Its normal load, N.
     pub fn load_n(&self) -> f64 {
         self.config.contact.load_n
     }
 
+    /// Its liquid viscosity, Pa·s.
     pub fn viscosity(&self) -> f64 {
         self.config.lubricant.viscosity_pa_s
     }
@@ -193,9 +219,13 @@ pub use cases::cases;
 /// A steady curve to compute: its key, configuration and velocities.
 #[derive(Debug, Clone)]
 pub struct SteadySpec {
+    /// The key cases refer to it by.
     pub key: String,
+    /// Its legend.
     pub label: String,
+    /// Its configuration.
     pub config: Config,
+    /// The velocities, m/s.
     pub velocities: Vec<f64>,
 }
 
@@ -264,10 +294,15 @@ fn linspace(a: f64, b: f64, n: usize) -> Vec<f64> {
 /// A computed steady curve.
 #[derive(Debug, Clone)]
 pub struct SteadyCurve {
+    /// The key cases refer to it by.
     pub key: String,
+    /// Its legend.
     pub label: String,
+    /// Its normal load, N.
     pub load_n: f64,
+    /// Its liquid viscosity, Pa·s.
     pub viscosity: f64,
+    /// One steady state per velocity.
     pub points: Vec<Estimate>,
 }
 

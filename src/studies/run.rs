@@ -6,10 +6,15 @@ use super::*;
 /// Outcome of one case.
 #[derive(Debug, Clone)]
 pub struct CaseResult {
+    /// The case.
     pub case: Case,
+    /// Steps run.
     pub steps: usize,
+    /// Steps per solver status.
     pub status_counts: Vec<(Status, usize)>,
+    /// Steps that needed sub-steps.
     pub substepped_steps: usize,
+    /// The most Newton iterations of a step.
     pub max_iterations: u32,
     /// Metrics of the last complete cycle.
     pub metrics: Option<LoopMetrics>,
@@ -20,6 +25,7 @@ pub struct CaseResult {
 }
 
 impl CaseResult {
+    /// Whether the case failed.
     pub fn failed(&self) -> bool {
         self.failure.is_some()
     }
@@ -111,9 +117,13 @@ pub fn run_case(case: &Case, progress: &dyn Fn(usize) -> bool) -> CaseResult {
 /// velocity (accelerating: |v| rising; decelerating: |v| falling).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct SteadyOffsets {
+    /// Mean COF − COF_steady while |v| rises.
     pub cof_accelerating: f64,
+    /// Mean COF − COF_steady while |v| falls.
     pub cof_decelerating: f64,
+    /// Mean h0 − h0_steady while |v| rises, m.
     pub h0_accelerating: f64,
+    /// Mean h0 − h0_steady while |v| falls, m.
     pub h0_decelerating: f64,
     /// Mean of COF − COF_steady(v(t)) over the whole cycle.
     pub cof_mean: f64,
@@ -122,6 +132,7 @@ pub struct SteadyOffsets {
 }
 
 impl CaseResult {
+    /// The last cycle's offsets from `steady` (None without a cycle or a curve).
     pub fn steady_offsets(&self, steady: &SteadyCurve) -> Option<SteadyOffsets> {
         let lc = &self.last_cycle;
         if lc.len() < 3 {
@@ -178,12 +189,16 @@ impl CaseResult {
 /// All results of one study.
 #[derive(Debug, Clone)]
 pub struct StudyResult {
+    /// The study.
     pub study: StudyKind,
+    /// Its transient cases.
     pub cases: Vec<CaseResult>,
+    /// Its steady curves.
     pub steady: Vec<SteadyCurve>,
 }
 
 impl StudyResult {
+    /// The steady curve `key`.
     pub fn steady(&self, key: &str) -> Option<&SteadyCurve> {
         self.steady.iter().find(|s| s.key == key)
     }

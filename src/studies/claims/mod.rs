@@ -18,7 +18,9 @@ use std::collections::BTreeMap;
 /// One check of a claim.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Check {
+    /// What is checked.
     pub name: String,
+    /// Whether it holds.
     pub pass: bool,
     /// The numbers behind the check.
     pub evidence: String,
@@ -27,14 +29,18 @@ pub struct Check {
 /// Outcome of a claim.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Verdict {
+    /// Every check holds.
     Reproduced,
+    /// Some checks hold.
     Partly,
+    /// No check holds.
     NotReproduced,
     /// Some study the claim needs was not run or failed.
     NotEvaluated,
 }
 
 impl Verdict {
+    /// The verdict in words.
     pub fn as_str(self) -> &'static str {
         match self {
             Verdict::Reproduced => "reproduced",
@@ -48,14 +54,18 @@ impl Verdict {
 /// A claim of MODEL.md §8 with its checks.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Claim {
+    /// The claim's number in MODEL.md §8.
     pub number: u8,
+    /// The claim.
     pub statement: &'static str,
+    /// Its checks.
     pub checks: Vec<Check>,
     /// Facts worth reporting that are not checks.
     pub observations: Vec<String>,
 }
 
 impl Claim {
+    /// The verdict from the checks.
     pub fn verdict(&self) -> Verdict {
         if self.checks.is_empty() {
             Verdict::NotEvaluated
@@ -68,6 +78,7 @@ impl Claim {
         }
     }
 
+    /// The check named `name`.
     pub fn check(&self, name: &str) -> Option<&Check> {
         self.checks.iter().find(|c| c.name == name)
     }
