@@ -4,6 +4,8 @@
 //! existing file is never half-overwritten, and an unwritable destination is
 //! reported before any computation.
 
+#![warn(missing_docs)]
+
 use crate::analysis::{CycleCollector, LoopMetrics, LoopSample};
 use crate::config::{Config, ConfigError};
 use crate::output::OutputError;
@@ -16,20 +18,29 @@ use std::time::Instant;
 /// was given a bad argument, or could not write its output.
 #[derive(Debug, thiserror::Error)]
 pub enum SimulationError {
+    /// The configuration is not valid.
     #[error(transparent)]
     Config(#[from] ConfigError),
+    /// The model could not be set up.
     #[error(transparent)]
     Setup(#[from] SetupError),
+    /// An input signal is not usable.
     #[error(transparent)]
     Signal(#[from] SignalError),
+    /// The output could not be written.
     #[error(transparent)]
     Output(#[from] OutputError),
+    /// A stop was requested.
     #[error(transparent)]
     Interrupted(#[from] crate::interrupt::Interrupted),
+    /// An argument outside what the command accepts.
     #[error("invalid argument `{name}` = {value}: {message}")]
     Argument {
+        /// The argument.
         name: &'static str,
+        /// Its value.
         value: String,
+        /// Why it is refused.
         message: String,
     },
 }
@@ -89,9 +100,13 @@ pub fn simulate_row_with_status(e: &Estimate, status: &str, t_c: f64) -> String 
 /// Distribution of per-step solver times.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Timing {
+    /// Median, µs.
     pub median_us: f64,
+    /// 99th percentile, µs.
     pub p99_us: f64,
+    /// 99.9th percentile, µs.
     pub p999_us: f64,
+    /// Maximum, µs.
     pub max_us: f64,
 }
 
@@ -107,6 +122,7 @@ impl Timing {
         }
     }
 
+    /// From every step's time, ns.
     pub fn from_ns(ns: &[u64]) -> Self {
         if ns.is_empty() {
             return Self::default();
@@ -127,14 +143,21 @@ impl Timing {
 /// What a `simulate` run reports.
 #[derive(Debug, Clone)]
 pub struct SimulateReport {
+    /// Steps taken.
     pub steps: u64,
+    /// Simulated time, s.
     pub duration_s: f64,
+    /// Steps per status.
     pub status_counts: Vec<(Status, u64)>,
+    /// Mean Newton iterations per step.
     pub mean_iterations: f64,
+    /// The most in one step.
     pub max_iterations: u32,
+    /// Steps where the film floor (`contact.min_film_m`) held h0.
     pub film_floor_steps: u64,
     /// Steps that needed the sub-stepping fallback.
     pub substepped_steps: u64,
+    /// Compute time per step.
     pub timing: Timing,
     /// Period of the velocity input, when periodic.
     pub period_s: Option<f64>,
@@ -227,9 +250,12 @@ pub fn sample_estimate(
 /// The inputs of a transient run: velocity (m/s), load (N) and lubricant
 /// temperature (°C; None: the reference temperature) against time.
 #[derive(Debug, Clone)]
-pub struct Inputs<'a> {
+pub struct SimulationInputs<'a> {
+    /// Velocity, m/s.
     pub velocity: &'a Signal,
+    /// Normal load, N.
     pub load: &'a Signal,
+    /// Temperature, °C.
     pub temperature: Option<&'a Signal>,
 }
 
@@ -262,7 +288,7 @@ pub fn simulate(
     let mut on_step = on_step;
     simulate_inputs(
         config,
-        &Inputs {
+        &SimulationInputs {
             velocity,
             load,
             temperature: None,
@@ -276,7 +302,7 @@ pub fn simulate(
 /// vogel` the viscosity follows it every step (no allocation).
 pub fn simulate_inputs(
     config: &Config,
-    inputs: &Inputs<'_>,
+    inputs: &SimulationInputs<'_>,
     duration_s: f64,
     mut on_step: impl FnMut(&Estimate, u64, f64) -> Result<(), SimulationError>,
 ) -> Result<SimulateReport, SimulationError> {
@@ -498,6 +524,7 @@ pub fn stribeck(
 /// Columns of `stribeck`.
 pub const STRIBECK_COLUMNS: &str = "velocity_m_s,h0_m,h_min_m,f_hyd_n,f_asp_n,friction_n,cof,viscous_n,asperity_load_share,regime,status,iterations,contact_friction_n";
 
+/// One `stribeck` CSV row of a steady state.
 pub fn stribeck_row(e: &Estimate) -> String {
     format!(
         "{},{},{},{},{},{},{},{},{},{},{},{},{}",
@@ -520,7 +547,9 @@ pub fn stribeck_row(e: &Estimate) -> String {
 /// How h0 is fixed in a `profile` run.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum ProfileGap {
+    /// h0 prescribed, m.
     H0(f64),
+    /// h0 from the load balance at this load, N.
     Load(f64),
 }
 
@@ -554,6 +583,7 @@ pub fn profile(
     Ok((e, solver.field().collect()))
 }
 
+/// One `profile` CSV row of a cell.
 pub fn profile_row(p: &crate::physics::FieldPoint) -> String {
     format!(
         "{},{},{},{},{},{}",

@@ -1,10 +1,13 @@
 //! SVG figures (plotters, pure Rust, no system fonts), shared by the study
 //! reports and the replay report.
 
+#![warn(missing_docs)]
+
 use crate::output::{write_file, OutputError};
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 
+/// The figures' line colours, in order.
 pub const COLORS: [RGBColor; 6] = [
     RGBColor(31, 119, 180),
     RGBColor(214, 39, 40),
@@ -16,22 +19,35 @@ pub const COLORS: [RGBColor; 6] = [
 
 /// A line of a panel.
 pub struct Line {
+    /// Its legend (None: not in the legend).
     pub label: Option<String>,
+    /// (x, y) points.
     pub points: Vec<(f64, f64)>,
+    /// Its colour.
     pub color: RGBColor,
+    /// Dashed instead of solid.
     pub dashed: bool,
 }
 
+/// One panel of a figure.
 pub struct Panel {
+    /// Its title.
     pub title: String,
+    /// Its lines.
     pub lines: Vec<Line>,
 }
 
+/// Axis labels and scales of every panel.
 pub struct Axes<'a> {
+    /// x label with unit.
     pub x: &'a str,
+    /// y label with unit.
     pub y: &'a str,
+    /// Logarithmic x.
     pub log_x: bool,
+    /// Logarithmic y.
     pub log_y: bool,
+    /// Where the legend goes.
     pub legend: SeriesLabelPosition,
     /// Legend in every panel (series differ between panels) or only in
     /// the first (the same series everywhere).
@@ -66,6 +82,7 @@ fn tick(v: f64, span: f64, log: bool) -> String {
     }
 }
 
+/// A plotting error as an output error on `path`.
 pub fn plot_err(path: &Path, e: impl std::fmt::Display) -> OutputError {
     OutputError::other(path, e)
 }
@@ -217,6 +234,7 @@ where
     Ok(())
 }
 
+/// Draw `panels` on a grid under `title` into the SVG `path` (written atomically).
 pub fn figure(
     path: &Path,
     title: &str,

@@ -13,6 +13,8 @@
 //! times must increase strictly. A malformed line is reported with its
 //! line number.
 
+#![warn(missing_docs)]
+
 use crate::table::{Delimiter, Table, TableError};
 use crate::text::Num;
 use std::path::{Path, PathBuf};
@@ -20,16 +22,26 @@ use std::path::{Path, PathBuf};
 /// A scalar function of time.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Signal {
+    /// `const:V`.
     Const(f64),
+    /// `sine:V0,V1,F[,PHASE]`: V0 + V1 sin(2π F t + PHASE).
     Sine {
+        /// V0.
         offset: f64,
+        /// V1.
         amplitude: f64,
+        /// F, Hz.
         frequency_hz: f64,
+        /// PHASE, rad.
         phase_rad: f64,
     },
+    /// `csv:FILE[@COLUMN]`: linear interpolation between the rows.
     Table {
+        /// The file.
         source: PathBuf,
+        /// Times, s, increasing.
         t: Vec<f64>,
+        /// Values.
         y: Vec<f64>,
     },
 }
@@ -37,28 +49,44 @@ pub enum Signal {
 /// Errors reading a signal spec.
 #[derive(Debug, thiserror::Error)]
 pub enum SignalError {
+    /// A spec that does not parse.
     #[error("{what} spec `{spec}`: {message} (expected const:V, sine:V0,V1,F[,PHASE] or csv:FILE[@COLUMN])")]
     Syntax {
+        /// Which input (velocity, load, temperature).
         what: String,
+        /// The spec given.
         spec: String,
+        /// What is wrong with it.
         message: String,
     },
+    /// A table that cannot be read.
     #[error("cannot read {what} table {}: {cause}", path.display())]
     Io {
+        /// Which input.
         what: String,
+        /// The table.
         path: PathBuf,
+        /// Why.
         cause: std::io::Error,
     },
+    /// A table that does not cover the run.
     #[error("{what} table {}: {message}", path.display())]
     Coverage {
+        /// Which input.
         what: String,
+        /// The table.
         path: PathBuf,
+        /// What it does not cover.
         message: String,
     },
+    /// A table line that does not parse.
     #[error("{}:{line}: {message}", path.display())]
     Csv {
+        /// The table.
         path: PathBuf,
+        /// The line, 1-based.
         line: usize,
+        /// What is wrong with it.
         message: String,
     },
 }

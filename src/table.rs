@@ -10,6 +10,8 @@
 //! with the first text cell named by file and line. Every other cell must
 //! be a finite number; a bad one is named by file, line and column.
 
+#![warn(missing_docs)]
+
 use std::path::{Path, PathBuf};
 
 /// Column separator.
@@ -19,8 +21,11 @@ pub enum Delimiter {
     /// spaces when the first line has none of them.
     #[default]
     Auto,
+    /// `,`.
     Comma,
+    /// `;`.
     Semicolon,
+    /// Tab.
     Tab,
     /// Runs of spaces and tabs.
     Whitespace,
@@ -29,16 +34,22 @@ pub enum Delimiter {
 /// A table that could not be read.
 #[derive(Debug, thiserror::Error)]
 pub enum TableError {
+    /// The file could not be read.
     #[error("cannot read {}: {cause}", path.display())]
     Io {
+        /// The file.
         path: PathBuf,
+        /// Why.
         cause: std::io::Error,
     },
-    /// `line` 0: the file as a whole.
+    /// A cell or line that does not parse; `line` 0: the file as a whole.
     #[error("{}:{line}: {message}", path.display())]
     Cell {
+        /// The file.
         path: PathBuf,
+        /// The line, 1-based.
         line: usize,
+        /// What is wrong.
         message: String,
     },
 }
@@ -46,14 +57,18 @@ pub enum TableError {
 /// The first cell of a column that is not a number.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TextCell {
+    /// Its line, 1-based.
     pub line: usize,
+    /// Its text.
     pub text: String,
 }
 
 /// A table of named columns.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Table {
+    /// The file it was read from.
     pub source: PathBuf,
+    /// Column names.
     pub names: Vec<String>,
     /// Column-major values (NaN in a text column).
     pub columns: Vec<Vec<f64>>,
@@ -66,6 +81,7 @@ pub struct Table {
 }
 
 impl Table {
+    /// Data rows.
     pub fn rows(&self) -> usize {
         self.lines.len()
     }
@@ -91,6 +107,7 @@ impl Table {
             .map(|k| self.columns[k].as_slice())
     }
 
+    /// The index of column `name`.
     pub fn index(&self, name: &str) -> Option<usize> {
         self.names.iter().position(|n| n == name)
     }

@@ -21,15 +21,25 @@ use crate::physics::Estimate;
 /// What the metrics need of one step.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LoopSample {
+    /// Time, s.
     pub t: f64,
+    /// Velocity, m/s.
     pub velocity: f64,
+    /// Friction force, N.
     pub friction: f64,
+    /// Coefficient of friction.
     pub cof: f64,
+    /// Film thickness h0, m.
     pub h0: f64,
+    /// F_asp / F_ext.
     pub asperity_share: f64,
+    /// m ḧ0, N.
     pub inertia_force: f64,
+    /// F_ext, N.
     pub load: f64,
+    /// Load carried by the film, N.
     pub hydrodynamic_force: f64,
+    /// Load carried by the asperities, N.
     pub asperity_force: f64,
 }
 
@@ -53,23 +63,41 @@ impl From<&Estimate> for LoopSample {
 /// Metrics of one cycle (see the module table).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LoopMetrics {
+    /// The cycle, 0-based.
     pub cycle: usize,
+    /// Its start, s.
     pub t_start: f64,
+    /// Its end, s.
     pub t_end: f64,
+    /// Area of the F_f–v loop, N·m/s (module table).
     pub friction_loop_area: f64,
+    /// Area of the COF–v loop, m/s.
     pub cof_loop_area: f64,
+    /// COF at v = 0 approached while accelerating.
     pub cof_v0_accelerating: Option<f64>,
+    /// COF at v = 0 approached while decelerating.
     pub cof_v0_decelerating: Option<f64>,
+    /// Largest COF in the cycle.
     pub peak_cof: f64,
+    /// The velocity where it occurs, m/s.
     pub peak_cof_velocity: f64,
+    /// Mean COF.
     pub mean_cof: f64,
+    /// Smallest h0, m.
     pub h0_min: f64,
+    /// Largest h0, m.
     pub h0_max: f64,
+    /// Mean F_asp / F_ext.
     pub mean_asperity_share: f64,
+    /// Mean F_hyd / F_ext.
     pub mean_fluid_share: f64,
+    /// Mean COF while |v| rises minus while it falls.
     pub branch_cof_gap: Option<f64>,
+    /// The same for h0, m.
     pub branch_h0_gap: Option<f64>,
+    /// max |m ḧ0| / F_ext (raw).
     pub inertia_share: f64,
+    /// The same from the first harmonics of h0(t).
     pub inertia_share_smooth: f64,
 }
 
@@ -169,6 +197,7 @@ pub struct CycleCollector {
 }
 
 impl CycleCollector {
+    /// Cycles of `period` (s) from `t0` (s), for a slider of `mass` (kg), the smooth inertia share from `harmonics` harmonics.
     pub fn new(t0: f64, period: f64, mass: f64, harmonics: usize) -> Self {
         Self {
             t0,
@@ -201,6 +230,7 @@ impl CycleCollector {
         self.k += 1;
     }
 
+    /// Add a sample; a completed cycle's metrics are computed then.
     pub fn push(&mut self, s: LoopSample) {
         if self.period.is_nan() || self.period <= 0.0 {
             return;

@@ -56,7 +56,7 @@ pub fn simulate(
         "simulate: velocity {velocity}, load {load}, {duration} s, N = {}, dt = {} s, {:?} solver",
         config.solver.cells, config.solver.dt_s, config.solver.method
     );
-    let inputs = offline::Inputs {
+    let inputs = offline::SimulationInputs {
         velocity: &velocity,
         load: &load,
         temperature: temperature.as_ref(),
