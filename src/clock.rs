@@ -11,8 +11,6 @@
 //! | deadlines, timeouts, durations | monotonic ([`Clock::now_ns`]), from an arbitrary origin | ns |
 //! | message stamps, log times | wall ([`Clock::wall_ns`]), since the Unix epoch | ns |
 
-#![warn(missing_docs)]
-
 use std::sync::atomic::{AtomicI64, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 

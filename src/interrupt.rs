@@ -10,8 +10,6 @@
 //! process at once (exit 130/143; a temporary file may then stay behind).
 //! The real-time node has its own handlers (it finalises its recording).
 
-#![warn(missing_docs)]
-
 use std::sync::atomic::{AtomicBool, AtomicI32, Ordering};
 use std::sync::{Arc, OnceLock};
 

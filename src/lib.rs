@@ -33,6 +33,8 @@
 //! | [`plot`] | SVG figures shared by studies, replay and fit |
 //! | [`bench`] | step, latency, recorder, accuracy and fit benchmarks |
 
+#![warn(missing_docs)]
+
 pub mod analysis;
 #[cfg(feature = "mcap")]
 pub mod bag;

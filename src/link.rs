@@ -12,8 +12,6 @@
 //! ([`RecorderCounters`]) and the loop's live values for a status line
 //! ([`LiveStatus`]).
 
-#![warn(missing_docs)]
-
 use crate::config::parameters::SetRefusal;
 use crate::config::{Config, StepMode, TimeoutBehaviour};
 use crate::msgs::ros_interfaces::ParameterValue;

@@ -4,8 +4,6 @@
 //! existing file is never half-overwritten, and an unwritable destination is
 //! reported before any computation.
 
-#![warn(missing_docs)]
-
 use crate::analysis::{CycleCollector, LoopMetrics, LoopSample};
 use crate::config::{Config, ConfigError};
 use crate::output::OutputError;

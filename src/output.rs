@@ -13,8 +13,6 @@
 //!   error naming the path, reported before any computation when the caller
 //!   creates the file first (as the commands do).
 
-#![warn(missing_docs)]
-
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};

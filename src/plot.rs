@@ -1,8 +1,6 @@
 //! SVG figures (plotters, pure Rust, no system fonts), shared by the study
 //! reports and the replay report.
 
-#![warn(missing_docs)]
-
 use crate::output::{write_file, OutputError};
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};

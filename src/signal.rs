@@ -13,8 +13,6 @@
 //! times must increase strictly. A malformed line is reported with its
 //! line number.
 
-#![warn(missing_docs)]
-
 use crate::table::{Delimiter, Table, TableError};
 use crate::text::Num;
 use std::path::{Path, PathBuf};

@@ -1,7 +1,5 @@
 //! Fixed-memory statistics for the loop (no allocation after construction).
 
-#![warn(missing_docs)]
-
 /// The samples of one statistics window (ns).
 #[derive(Debug, Clone)]
 pub struct Window {

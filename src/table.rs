@@ -10,8 +10,6 @@
 //! with the first text cell named by file and line. Every other cell must
 //! be a finite number; a bad one is named by file, line and column.
 
-#![warn(missing_docs)]
-
 use std::path::{Path, PathBuf};
 
 /// Column separator.

@@ -4,8 +4,6 @@
 //! |---|---|
 //! | `metrics.rs` | hysteresis-loop metrics per motion cycle (MODEL.md §8) |
 
-#![warn(missing_docs)]
-
 pub mod metrics;
 
 pub use metrics::{cycle_metrics, CycleCollector, LoopMetrics, LoopSample};

@@ -19,8 +19,6 @@
 //! | `resample.rs` | sampled inputs onto the model's step grid, silences |
 //! | `structure.rs` | a structural check of an MCAP file before the `mcap` reader sees it |
 
-#![warn(missing_docs)]
-
 mod db3_file;
 pub mod decode;
 mod mcap_file;

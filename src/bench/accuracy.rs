@@ -18,11 +18,17 @@ use crate::signal::Signal;
 /// One setting's answers and cost.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AccuracyRow {
+    /// Grid cells.
     pub cells: usize,
+    /// Time step, s.
     pub dt_s: f64,
+    /// Area of the F_f–v loop of the last cycle, N·m/s.
     pub loop_area: f64,
+    /// Mean COF of the last cycle.
     pub mean_cof: f64,
+    /// COF at v = 0 (accelerating).
     pub cof_v0: f64,
+    /// Smallest h0 of the last cycle, m.
     pub h0_min_m: f64,
     /// Median cost of a step, µs.
     pub step_us: f64,
@@ -53,8 +59,11 @@ impl AccuracyRow {
 pub struct AccuracyReport {
     /// The Couette flux of every run, the reference's included.
     pub flux: crate::config::FluxKind,
+    /// Grids at the configured step.
     pub grids: Vec<AccuracyRow>,
+    /// Steps at the configured grid.
     pub steps: Vec<AccuracyRow>,
+    /// The reference run.
     pub reference: AccuracyRow,
 }
 

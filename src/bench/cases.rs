@@ -29,10 +29,15 @@ use crate::signal::Signal;
 /// One transient case (SI units).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TransientCase {
+    /// V1, m/s.
     pub velocity_amplitude_m_s: f64,
+    /// f, Hz.
     pub frequency_hz: f64,
+    /// V0, m/s.
     pub velocity_offset_m_s: f64,
+    /// Mean normal load, N.
     pub load_n: f64,
+    /// Liquid viscosity, Pa·s.
     pub viscosity_pa_s: f64,
     /// Relative load swing at twice the frequency.
     pub load_swing: f64,
@@ -76,7 +81,9 @@ pub struct CaseAnswers {
     pub loop_area: f64,
     /// Mean |F|, N.
     pub mean_friction_n: f64,
+    /// Mean h0, m.
     pub h0_mean_m: f64,
+    /// Smallest h0, m.
     pub h0_min_m: f64,
 }
 
@@ -96,8 +103,11 @@ impl CaseAnswers {
 /// Tolerances of a pass (relative).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Tolerances {
+    /// On the loop area.
     pub loop_area: f64,
+    /// On the mean friction.
     pub mean_friction: f64,
+    /// On the film (mean and minimum h0).
     pub film: f64,
 }
 
@@ -171,19 +181,28 @@ pub fn run_case(
 /// One setting (grid, step, flux) over all cases.
 #[derive(Debug, Clone)]
 pub struct SettingResult {
+    /// Grid cells.
     pub cells: usize,
+    /// Time step, s.
     pub dt_s: f64,
+    /// Couette flux.
     pub flux: FluxKind,
+    /// Every case's answers, in case order.
     pub answers: Vec<CaseAnswers>,
 }
 
 /// The sweep: the cases, their references, every setting's answers.
 #[derive(Debug, Clone)]
 pub struct CasesReport {
+    /// The cases.
     pub cases: Vec<TransientCase>,
+    /// The reference: cells, step (s), flux.
     pub reference_setting: (usize, f64, FluxKind),
+    /// The reference answers, in case order.
     pub references: Vec<CaseAnswers>,
+    /// Every setting tested.
     pub settings: Vec<SettingResult>,
+    /// What passes.
     pub tolerances: Tolerances,
 }
 

@@ -42,10 +42,13 @@ pub struct FitBenchOptions<'a> {
 /// Why the benchmark could not run.
 #[derive(Debug, thiserror::Error)]
 pub enum FitBenchError {
+    /// A fit could not run.
     #[error(transparent)]
     Fit(#[from] FitError),
+    /// The model could not be set up.
     #[error(transparent)]
     Setup(#[from] SetupError),
+    /// A file could not be written.
     #[error(transparent)]
     Output(#[from] OutputError),
 }

@@ -11,14 +11,17 @@ use std::time::Instant;
 /// included), measured by a peer in this process.
 #[derive(Debug, Clone)]
 pub struct LatencyReport {
+    /// The transport measured.
     pub transport: &'static str,
     /// Contacts stepped per round trip (several: JointState → efforts).
     pub contacts: usize,
+    /// Round trips measured.
     pub samples: usize,
     /// p50, p99, p99.9, max of command → estimate, µs.
     pub latency_us: [f64; 4],
     /// The node's model step, p50 / p99, µs.
     pub step_us: [f64; 2],
+    /// Round trips without an answer.
     pub lost: usize,
 }
 

@@ -21,15 +21,23 @@ use std::time::Instant;
 /// Results for one grid size.
 #[derive(Debug, Clone)]
 pub struct BenchCase {
+    /// Grid cells.
     pub cells: usize,
+    /// Steps timed.
     pub steps: usize,
+    /// Newton's time per step.
     pub newton: Timing,
+    /// Mean Newton iterations per step.
     pub newton_mean_iterations: f64,
+    /// The most in one step.
     pub newton_max_iterations: u32,
     /// Newton at the reference's tolerance, on the sampled states.
     pub newton_equal_tol: Timing,
+    /// The reference algorithm's time per step, on the sampled states.
     pub reference: Timing,
+    /// States the reference was timed on.
     pub reference_samples: usize,
+    /// Mean Picard iterations of a reference step.
     pub reference_mean_picard: f64,
     /// Allocations per Newton step (None without a counting allocator).
     pub allocations_per_step: Option<f64>,
@@ -52,16 +60,21 @@ impl BenchCase {
 
 /// Options of a benchmark run.
 pub struct BenchOptions<'a> {
+    /// Grid sizes.
     pub cells: Vec<usize>,
+    /// Timed cycles per grid.
     pub cycles: usize,
+    /// States at which the reference is timed.
     pub reference_steps: usize,
     /// Reads a global allocation counter, when the binary installs one.
     pub allocation_counter: Option<&'a dyn Fn() -> u64>,
     /// Also time each part of an iteration alone ([`StepBreakdown`]).
     pub breakdown: bool,
+    /// Progress lines.
     pub progress: &'a dyn Fn(&str),
 }
 
+/// Time the paper's reciprocating case on every grid of `opts`.
 pub fn run(config: &Config, opts: &BenchOptions<'_>) -> Result<Vec<BenchCase>, SimulationError> {
     let load = config.contact.load_n;
     let velocity = |t: f64| (2.0 * std::f64::consts::PI * t).sin();

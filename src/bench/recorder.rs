@@ -19,8 +19,11 @@ use std::sync::Arc;
 pub struct RecorderBench {
     /// Resident memory at the end of each simulated hour, bytes.
     pub rss_by_hour: Vec<u64>,
+    /// What the recorder reported.
     pub report: RecorderReport,
+    /// Wall time, s.
     pub wall_s: f64,
+    /// Steps recorded.
     pub steps: u64,
 }
 

@@ -35,8 +35,6 @@
 //! | `ros_args.rs` | `--ros-args` as rcl parses them (a `launch_ros` Node action) |
 //! | `tests.rs` | unit tests of loading, overrides and validation |
 
-#![warn(missing_docs)]
-
 mod contacts;
 mod envelope;
 mod error;

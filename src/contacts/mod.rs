@@ -25,8 +25,6 @@
 //! | `pool.rs` | a fixed pool of worker threads stepping their share of the contacts |
 //! | `tests.rs` | unit tests: one contact equals the single solver, the pool equals serial |
 
-#![warn(missing_docs)]
-
 mod pool;
 
 use crate::clock::Clock;

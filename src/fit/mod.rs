@@ -37,8 +37,6 @@
 //! | `synthetic.rs` | synthetic data: the model along a motion, with noise |
 //! | `reversals.rs` | velocity reversals in the data and the stiffness through them (pre-sliding starts) |
 
-#![warn(missing_docs)]
-
 #[cfg(feature = "mcap")]
 pub mod bag_input;
 pub mod baselines;

@@ -16,8 +16,6 @@
 //! | `ros_interfaces.rs` | standard interfaces: parameters, `/rosout`, diagnostics, `/clock`, Trigger |
 //! | `tests.rs` | round trips of every message through CDR and the records |
 
-#![warn(missing_docs)]
-
 mod cdr;
 mod records;
 pub mod ros_interfaces;

@@ -38,8 +38,6 @@
 //! | `rt.rs` | real-time settings |
 //! | `driver.rs` | the demo and soak driver: a peer commanding the node on its own topics |
 
-#![warn(missing_docs)]
-
 mod commands;
 pub mod driver;
 mod lockstep;

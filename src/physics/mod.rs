@@ -29,7 +29,6 @@
 //! assert!(e.cof > 0.2 && e.cof < 0.31);
 //! ```
 
-#![warn(missing_docs)]
 #![warn(clippy::float_cmp)]
 
 pub mod drivetrain;

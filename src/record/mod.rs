@@ -33,8 +33,6 @@
 //! | `split.rs` | a directory of split files, `metadata.yaml`, the budget |
 //! | `snapshot.rs` | the snapshot ring |
 
-#![warn(missing_docs)]
-
 mod bag_writer;
 pub mod entry;
 pub mod snapshot;

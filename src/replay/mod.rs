@@ -30,8 +30,6 @@
 //! | `sink.rs` | CSV and MCAP outputs, written off the model's thread |
 //! | `report.rs` | `summary.md`, `cycles.csv`, figures |
 
-#![warn(missing_docs)]
-
 mod inputs;
 mod mode;
 mod oracle;

@@ -16,8 +16,6 @@
 //! | `iceoryx/` | iceoryx2: zero-copy shared memory on one host |
 //! | `ros2/` | ROS 2 through ros2-client (pure-Rust DDS) |
 
-#![warn(missing_docs)]
-
 pub mod memory;
 
 #[cfg(feature = "iceoryx2")]
