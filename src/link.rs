@@ -1,7 +1,7 @@
 //! What the loop shares with the threads around it, below `node/`,
 //! `transport/` and `record/`: the settings the loop reads every step
 //! ([`LoopSettings`], a pure function of the configuration), the latest
-//! film profile ([`ProfileSlot`], written by the loop without allocating) and the
+//! film profile ([`FilmProfileSlot`], written by the loop without allocating) and the
 //! hand-over of live parameter changes ([`ParameterUpdate`] prepared off the
 //! loop, [`ParameterChannel`] to the loop and back, [`ParameterIo`] for a
 //! transport that serves parameters). The loop applies an update between two
@@ -202,14 +202,14 @@ impl ParameterChannel {
 /// threads (readers) without allocation on the loop: the loop copies into a
 /// preallocated buffer under a `try_lock` and bumps the sequence number.
 #[derive(Debug)]
-pub struct ProfileSlot {
+pub struct FilmProfileSlot {
     seq: AtomicU64,
-    data: Mutex<ProfileData>,
+    data: Mutex<FilmProfileData>,
 }
 
-/// Contents of a [`ProfileSlot`].
+/// Contents of a [`FilmProfileSlot`].
 #[derive(Debug, Clone, Default)]
-pub struct ProfileData {
+pub struct FilmProfileData {
     /// The step the profile belongs to, ns.
     pub stamp_ns: u64,
     /// Cell width Δx, m.
@@ -220,12 +220,12 @@ pub struct ProfileData {
     pub p_pa: Vec<f64>,
 }
 
-impl ProfileSlot {
+impl FilmProfileSlot {
     /// An empty slot for profiles of `cells` cells (allocated here, once).
     pub fn new(cells: usize) -> Arc<Self> {
         Arc::new(Self {
             seq: AtomicU64::new(0),
-            data: Mutex::new(ProfileData {
+            data: Mutex::new(FilmProfileData {
                 stamp_ns: 0,
                 dx_m: 0.0,
                 h_m: vec![0.0; cells],
@@ -235,7 +235,7 @@ impl ProfileSlot {
     }
 
     /// Fill the slot (non-blocking): false when a reader holds it.
-    pub fn try_write(&self, f: impl FnOnce(&mut ProfileData)) -> bool {
+    pub fn try_write(&self, f: impl FnOnce(&mut FilmProfileData)) -> bool {
         match self.data.try_lock() {
             Ok(mut d) => {
                 f(&mut d);
@@ -247,7 +247,7 @@ impl ProfileSlot {
     }
 
     /// The profile, if newer than `seen` (updates `seen`).
-    pub fn read_if_newer(&self, seen: &mut u64) -> Option<ProfileData> {
+    pub fn read_if_newer(&self, seen: &mut u64) -> Option<FilmProfileData> {
         let s = self.seq.load(Ordering::Acquire);
         if s == *seen {
             return None;

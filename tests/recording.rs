@@ -10,8 +10,8 @@ use friction_node::bag::{rosbag2, Bag};
 use friction_node::clock::SimClock;
 use friction_node::config::topics::TopicNames;
 use friction_node::config::{Config, StepMode};
+use friction_node::link::FilmProfileSlot;
 use friction_node::link::LiveStatus;
-use friction_node::link::ProfileSlot;
 use friction_node::msgs::{Command, CommandKind};
 use friction_node::node::{Loop, RunSummary};
 use friction_node::record::{RecordPlan, Recorder, RecorderReport};
@@ -52,7 +52,7 @@ fn record(
     snapshot_at: Option<u64>,
 ) -> (RunSummary, RecorderReport) {
     let clock = Arc::new(SimClock::new(WALL0));
-    let slot = ProfileSlot::new(cfg.solver.cells);
+    let slot = FilmProfileSlot::new(cfg.solver.cells);
     let rec = Recorder::start(
         plan,
         cfg,
@@ -415,7 +415,7 @@ mod node_runs {
     use super::*;
     use friction_node::config::topics::TopicNames;
     use friction_node::config::CommandType;
-    use friction_node::link::ProfileSlot;
+    use friction_node::link::FilmProfileSlot;
     use friction_node::msgs;
     use friction_node::msgs::EstimateRecord;
     use friction_node::record::{RecordPlan, Recorder};
@@ -484,7 +484,7 @@ mod node_runs {
         cfg.node.profile_rate_hz = 100.0;
         cfg.contact.load_n = 15_000.0;
         let path = tmp("roundtrip.mcap");
-        let slot = ProfileSlot::new(cfg.solver.cells);
+        let slot = FilmProfileSlot::new(cfg.solver.cells);
         let rec = Recorder::start(
             RecordPlan {
                 path: Some(path.clone()),

@@ -50,8 +50,8 @@ mod timer;
 use crate::clock::{Clock, SystemClock, WallStamps};
 use crate::config::{Config, StepMode};
 use crate::contacts::ContactSet;
+use crate::link::FilmProfileSlot;
 use crate::link::LoopSettings;
-use crate::link::ProfileSlot;
 use crate::link::{LiveStatus, RecordItem};
 use crate::physics::SetupError;
 use crate::stats::{Histogram, Window};
@@ -149,7 +149,7 @@ pub struct Loop {
     settings: LoopSettings,
     ports: Vec<Box<dyn NodePort>>,
     record: Option<Arc<ArrayQueue<RecordItem>>>,
-    profile: Option<Arc<ProfileSlot>>,
+    profile: Option<Arc<FilmProfileSlot>>,
     live: Arc<LiveStatus>,
     clock: Arc<dyn Clock>,
     stamps: WallStamps,
@@ -180,7 +180,7 @@ impl Loop {
         config: &Config,
         ports: Vec<Box<dyn NodePort>>,
         record: Option<Arc<ArrayQueue<RecordItem>>>,
-        profile: Option<Arc<ProfileSlot>>,
+        profile: Option<Arc<FilmProfileSlot>>,
         live: Arc<LiveStatus>,
     ) -> Result<Self, NodeError> {
         if ports.is_empty() {

@@ -4,8 +4,8 @@
 use super::driver::DemoReport;
 use super::{rt, Loop, NodeError, RunSummary};
 use crate::config::{Config, TransportKind};
+use crate::link::FilmProfileSlot;
 use crate::link::LiveStatus;
-use crate::link::ProfileSlot;
 use crate::transport::{self, BackendSpec, NodePort, TransportError};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -233,7 +233,7 @@ fn record_path(config: &Config, opts: &RunOptions) -> Option<PathBuf> {
 fn start_recorder(
     config: &Config,
     record_path: Option<PathBuf>,
-    profile: Option<Arc<ProfileSlot>>,
+    profile: Option<Arc<FilmProfileSlot>>,
     warnings: &mut Vec<String>,
 ) -> Result<Option<crate::record::Recorder>, RunError> {
     if record_path.is_none() && config.recording.snapshot_s == 0 {
@@ -437,7 +437,7 @@ pub fn run_node(
     };
     report.warnings.extend(spin_under_fifo(config));
     let profile =
-        (config.node.profile_rate_hz > 0.0).then(|| ProfileSlot::new(config.solver.cells));
+        (config.node.profile_rate_hz > 0.0).then(|| FilmProfileSlot::new(config.solver.cells));
     let record_path = record_path(config, opts);
     #[cfg(feature = "mcap")]
     let recorder = start_recorder(config, record_path, profile.clone(), &mut report.warnings)?;

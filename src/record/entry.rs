@@ -4,7 +4,7 @@
 
 use super::WriteError;
 use crate::config::CommandType;
-use crate::link::ProfileData;
+use crate::link::FilmProfileData;
 use crate::link::RecordItem;
 use crate::msgs::{self, Command, CommandKind, Float64, Header, Time, TwistStamped};
 
@@ -270,7 +270,7 @@ impl Encoder {
     }
 
     /// A film profile's entry.
-    pub fn profile(&self, p: ProfileData, log_ns: u64) -> Result<Entry, WriteError> {
+    pub fn profile(&self, p: FilmProfileData, log_ns: u64) -> Result<Entry, WriteError> {
         let stamp = p.stamp_ns;
         let m = msgs::FilmProfile {
             header: Header {

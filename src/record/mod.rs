@@ -44,7 +44,7 @@ pub use split::SplitDir;
 use crate::clock::Clock;
 use crate::config::topics::TopicNames;
 use crate::config::Config;
-use crate::link::ProfileSlot;
+use crate::link::FilmProfileSlot;
 use crate::link::RecordItem;
 use crate::link::RecorderCounters;
 use crate::msgs::Note;
@@ -203,7 +203,7 @@ impl Recorder {
         plan: RecordPlan,
         config: &Config,
         names: &TopicNames,
-        profile: Option<Arc<ProfileSlot>>,
+        profile: Option<Arc<FilmProfileSlot>>,
         clock: Arc<dyn Clock>,
     ) -> Result<Self, RecorderError> {
         let now = clock.wall_ns();
@@ -430,7 +430,7 @@ impl Writer {
         queue: Arc<ArrayQueue<RecordItem>>,
         stop: Arc<AtomicBool>,
         snapshot: Arc<AtomicBool>,
-        profile: Option<Arc<ProfileSlot>>,
+        profile: Option<Arc<FilmProfileSlot>>,
     ) -> RecorderReport {
         let mut seen = 0u64;
         let mut last_flush = Instant::now();

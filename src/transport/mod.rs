@@ -23,7 +23,7 @@ pub mod iceoryx;
 #[cfg(feature = "ros2")]
 pub mod ros2;
 
-use crate::link::ProfileSlot;
+use crate::link::FilmProfileSlot;
 use crate::link::RecordItem;
 use crate::msgs::{Command, EstimateRecord, StatisticsRecord};
 use crossbeam_queue::ArrayQueue;
@@ -143,7 +143,7 @@ pub type RecordQueue = Option<Arc<ArrayQueue<RecordItem>>>;
 pub struct PortIo {
     /// The slot the loop writes film profiles into (backends that publish
     /// profiles read it).
-    pub profile: Option<Arc<ProfileSlot>>,
+    pub profile: Option<Arc<FilmProfileSlot>>,
     /// The recorder's queue: the port puts every command it receives into
     /// it, as received.
     pub record: RecordQueue,

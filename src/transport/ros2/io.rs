@@ -5,7 +5,7 @@ use super::raw::{RawAdapter, RawCdr};
 use super::{advertise, context, err, qos, ros_node, topic, Out, Ros2Spec};
 use crate::clock::system_wall_ns;
 use crate::config::CommandType;
-use crate::link::ProfileSlot;
+use crate::link::FilmProfileSlot;
 use crate::link::RecordItem;
 use crate::msgs::{
     self, Command, CommandKind, FilmProfile, Float64, FrictionEstimate, Header, LoopStatistics,
@@ -29,7 +29,7 @@ pub(super) struct Shared {
     pub outputs: Arc<ArrayQueue<Out>>,
     pub stop: Arc<AtomicBool>,
     pub counters: Arc<SharedCounters>,
-    pub profile: Option<Arc<ProfileSlot>>,
+    pub profile: Option<Arc<FilmProfileSlot>>,
     pub record: RecordQueue,
     pub snapshot: Option<Arc<AtomicBool>>,
     /// `use_sim_time`: the clock `/clock` drives.
