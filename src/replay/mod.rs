@@ -24,12 +24,14 @@
 //! | `request.rs` | one replay as data, for the command line and Python: prepare, run, write |
 //! | `mode.rs` | what drives the replay (`InputMode`) |
 //! | `prepare.rs` | options, choosing the configuration and topics, validating the input |
-//! | `inputs.rs` | decoding the inputs: topics or recorded estimates → commands; maps |
+//! | `inputs.rs` | decoding the inputs: the bag's topics or recorded estimates, maps, checks |
+//! | `commands.rs` | the decoded samples as the node's commands on the step grid |
 //! | `run.rs` | running the node's loop over the commands |
 //! | `oracle.rs` | the determinism check |
 //! | `sink.rs` | CSV and MCAP outputs, written off the model's thread |
 //! | `report.rs` | `summary.md`, `cycles.csv`, figures |
 
+mod commands;
 mod inputs;
 mod mode;
 mod oracle;
