@@ -446,6 +446,19 @@ impl Command {
                 | Command::BenchCases { .. }
         )
     }
+
+    /// Whether it is one of the benchmarks (`bench*`).
+    pub fn is_bench(&self) -> bool {
+        matches!(
+            self,
+            Command::Bench { .. }
+                | Command::BenchLatency { .. }
+                | Command::BenchRecorder { .. }
+                | Command::BenchAccuracy { .. }
+                | Command::BenchCases { .. }
+                | Command::BenchFit { .. }
+        )
+    }
 }
 
 /// `replay`'s arguments.

@@ -56,17 +56,36 @@ pub fn dispatch(
             anyhow::bail!("replay needs the `mcap` feature");
         }
     }
-    let config = match (&cli.command, &ros) {
+    let config = load_config(&cli.command, ros.as_ref(), path.as_deref(), &sets)?;
+    if cli.command.is_bench() {
+        bench_command(&config, cli.command, allocations)
+    } else {
+        work_command(&config, cli.command)
+    }
+}
+
+/// The configuration: `--config` and `--set`, and `--ros-args` for the
+/// commands that start a ROS 2 node.
+fn load_config(
+    command: &Command,
+    ros: Option<&friction_node::config::RosArgs>,
+    path: Option<&std::path::Path>,
+    sets: &[String],
+) -> Result<Config> {
+    Ok(match (command, ros) {
         (Command::Run { .. } | Command::Soak { .. }, Some(r)) => {
-            Config::load_with_ros_args(path.as_deref(), &sets, r)?
+            Config::load_with_ros_args(path, sets, r)?
         }
         (_, Some(_)) => anyhow::bail!(
             "--ros-args: only `run` and `soak` start a ROS 2 node; give the configuration with --config/--set"
         ),
-        (_, None) => Config::load(path.as_deref(), &sets)?,
-    };
-    match cli.command {
-        Command::Replay { .. } => unreachable!("handled above"),
+        (_, None) => Config::load(path, sets)?,
+    })
+}
+
+/// The node, the offline jobs, the studies and the fit.
+fn work_command(config: &Config, command: Command) -> Result<()> {
+    match command {
         Command::Simulate {
             velocity,
             load,
@@ -75,7 +94,7 @@ pub fn dispatch(
             out,
             ..
         } => offline::simulate(
-            &config,
+            config,
             &velocity,
             load.as_deref(),
             temperature.as_deref(),
@@ -90,20 +109,14 @@ pub fn dispatch(
             load,
             out,
             ..
-        } => offline::stribeck(&config, v_min, v_max, points, log, load, &out),
+        } => offline::stribeck(config, v_min, v_max, points, log, load, &out),
         Command::Profile {
             velocity,
             h0,
             load,
             out,
             ..
-        } => offline::profile(&config, velocity, h0, load, &out),
-        Command::BenchLatency {
-            transport,
-            samples,
-            warmup,
-            ..
-        } => bench::latency(&config, transport, samples, warmup),
+        } => offline::profile(config, velocity, h0, load, &out),
         Command::Run {
             transport,
             record,
@@ -114,10 +127,10 @@ pub fn dispatch(
             ..
         } => {
             if check {
-                node::check(&config, transport);
+                node::check(config, transport);
                 Ok(())
             } else {
-                node::run(&config, transport, record, demo, duration, quiet)
+                node::run(config, transport, record, demo, duration, quiet)
             }
         }
         Command::Soak {
@@ -127,23 +140,39 @@ pub fn dispatch(
             rss_csv,
             every,
             ..
-        } => node::soak(&config, Some(transport), duration, seed, &rss_csv, every),
+        } => node::soak(config, Some(transport), duration, seed, &rss_csv, every),
         Command::Study {
             name,
             out,
             cycles,
             jobs,
             ..
-        } => study::run(&config, name, &out, cycles, jobs),
-        Command::Fit { args, .. } => fit::run(&config, &args),
-        Command::BenchRecorder { hours, out, .. } => bench::recorder(&config, hours, out),
+        } => study::run(config, name, &out, cycles, jobs),
+        Command::Fit { args, .. } => fit::run(config, &args),
+        Command::Replay { .. } => {
+            unreachable!("dispatch runs replay before loading a configuration")
+        }
+        _ => unreachable!("dispatch sends the benchmarks to bench_command"),
+    }
+}
+
+/// The benchmarks.
+fn bench_command(config: &Config, command: Command, allocations: &dyn Fn() -> u64) -> Result<()> {
+    match command {
+        Command::BenchLatency {
+            transport,
+            samples,
+            warmup,
+            ..
+        } => bench::latency(config, transport, samples, warmup),
+        Command::BenchRecorder { hours, out, .. } => bench::recorder(config, hours, out),
         Command::BenchAccuracy {
             grids,
             steps,
             reference: r,
             ..
         } => bench::accuracy(
-            &config,
+            config,
             &grids,
             &steps,
             (r.reference_cells, r.reference_dt),
@@ -157,7 +186,7 @@ pub fn dispatch(
             jobs,
             ..
         } => bench::cases(
-            &config,
+            config,
             count,
             &grids,
             &fluxes,
@@ -171,7 +200,7 @@ pub fn dispatch(
             seeds,
             out,
             ..
-        } => bench::fit_targets(&config, cells, duration, seeds, out),
+        } => bench::fit_targets(config, cells, duration, seeds, out),
         Command::Bench {
             cells,
             cycles,
@@ -180,7 +209,7 @@ pub fn dispatch(
             breakdown,
             ..
         } => bench::step(
-            &config,
+            config,
             cells,
             cycles,
             reference_steps,
@@ -188,5 +217,6 @@ pub fn dispatch(
             breakdown,
             allocations,
         ),
+        _ => unreachable!("dispatch sends only the benchmarks here"),
     }
 }

@@ -171,9 +171,7 @@ fn start(config: &Config, opts: &RunOptions) -> Result<RunReport> {
 
 /// The run summary; exits with status 1 when the recording failed.
 fn summary(config: &Config, r: &RunReport) {
-    use friction_node::msgs::{command_status_name, status_name};
     let s = &r.summary;
-    let us = |ns: u64| ns as f64 / 1e3;
     println!(
         "run summary{}",
         if r.interrupted {
@@ -187,31 +185,7 @@ fn summary(config: &Config, r: &RunReport) {
         "  steps            {} in {:.2} s ({:?} mode)",
         s.steps, s.wall_s, config.node.step_mode
     );
-    println!(
-        "  compute time     p50 {:.1} µs, p99 {:.1} µs, p99.9 {:.1} µs, max {:.1} µs",
-        us(s.compute_ns[0]),
-        us(s.compute_ns[1]),
-        us(s.compute_p999_ns),
-        us(s.compute_ns[2])
-    );
-    if config.node.step_mode == friction_node::config::StepMode::Timer {
-        println!(
-            "  period jitter    p50 {:.1} µs, p99 {:.1} µs, max {:.1} µs",
-            us(s.jitter_ns[0]),
-            us(s.jitter_ns[1]),
-            us(s.jitter_ns[2])
-        );
-        println!(
-            "  deadline misses  {} ({} steps caught up late, {} time jumps (lost time advanced in one step))",
-            s.deadline_misses, s.catch_up_steps, s.time_jumps
-        );
-        if s.clock_jumps > 0 {
-            println!(
-                "  wall clock       {} jumps (stamps stayed monotonic)",
-                s.clock_jumps
-            );
-        }
-    }
+    print_timing(config, s);
     println!(
         "  commands         {} received = {} applied + {} overwritten + {} rejected; {} steps timed out",
         s.commands_received,
@@ -228,30 +202,7 @@ fn summary(config: &Config, r: &RunReport) {
         s.recorder_drops,
         s.transport_errors
     );
-    if s.contacts > 1 {
-        println!(
-            "  contacts         {} per step (statuses below count contact steps); the last step's slowest: contact {} ({:.1} µs)",
-            s.contacts,
-            s.slowest_contact,
-            us(s.slowest_contact_ns)
-        );
-    }
-    let statuses: Vec<String> = s
-        .status_counts
-        .iter()
-        .enumerate()
-        .filter(|(_, n)| **n > 0)
-        .map(|(c, n)| format!("{} {n}", status_name(c as u8)))
-        .collect();
-    println!("  solver statuses  {}", statuses.join(", "));
-    let commands: Vec<String> = s
-        .command_status_counts
-        .iter()
-        .enumerate()
-        .filter(|(_, n)| **n > 0)
-        .map(|(c, n)| format!("{} {n}", command_status_name(c as u8)))
-        .collect();
-    println!("  command statuses {}", commands.join(", "));
+    print_contacts_and_statuses(s);
     if let (Some(rss), Some(peak)) = (r.rss_bytes, r.peak_rss_bytes) {
         println!(
             "  memory           RSS {:.1} MB (peak {:.1} MB)",
@@ -276,33 +227,97 @@ fn summary(config: &Config, r: &RunReport) {
         );
     }
     if let Some(rec) = &r.recording {
-        let files = if rec.files > 1 || rec.files_deleted > 0 {
-            format!(
-                " in {} files ({} deleted for the budget)",
-                rec.files, rec.files_deleted
-            )
-        } else {
-            String::new()
-        };
-        match &rec.error {
-            None => println!(
-                "  recording        {}: {} messages{files}, {:.2} MB",
-                rec.path.display(),
-                rec.messages,
-                rec.bytes as f64 / 1e6
-            ),
-            Some(e) => println!(
-                "  recording        FAILED ({}): {e}; {} messages recorded{files}, {} lost",
-                rec.path.display(),
-                rec.messages,
-                rec.lost
-            ),
-        }
+        print_recording(rec);
     }
     for s in &r.snapshots {
         println!("  snapshot         {}", s.display());
     }
     if r.recording.as_ref().is_some_and(|rec| rec.error.is_some()) {
         std::process::exit(1);
+    }
+}
+
+/// Compute time, and in timer mode jitter, misses and clock jumps.
+fn print_timing(config: &Config, s: &friction_node::node::RunSummary) {
+    let us = |ns: u64| ns as f64 / 1e3;
+    println!(
+        "  compute time     p50 {:.1} µs, p99 {:.1} µs, p99.9 {:.1} µs, max {:.1} µs",
+        us(s.compute_ns[0]),
+        us(s.compute_ns[1]),
+        us(s.compute_p999_ns),
+        us(s.compute_ns[2])
+    );
+    if config.node.step_mode == friction_node::config::StepMode::Timer {
+        println!(
+            "  period jitter    p50 {:.1} µs, p99 {:.1} µs, max {:.1} µs",
+            us(s.jitter_ns[0]),
+            us(s.jitter_ns[1]),
+            us(s.jitter_ns[2])
+        );
+        println!(
+            "  deadline misses  {} ({} steps caught up late, {} time jumps: lost time advanced in one step)",
+            s.deadline_misses, s.catch_up_steps, s.time_jumps
+        );
+        if s.clock_jumps > 0 {
+            println!(
+                "  wall clock       {} jumps (stamps stayed monotonic)",
+                s.clock_jumps
+            );
+        }
+    }
+}
+
+/// Several contacts, and the steps per solver and command status.
+fn print_contacts_and_statuses(s: &friction_node::node::RunSummary) {
+    use friction_node::msgs::{command_status_name, status_name};
+    if s.contacts > 1 {
+        println!(
+            "  contacts         {} per step (statuses below count contact steps); the last step's slowest: contact {} ({:.1} µs)",
+            s.contacts,
+            s.slowest_contact,
+            s.slowest_contact_ns as f64 / 1e3
+        );
+    }
+    let statuses: Vec<String> = s
+        .status_counts
+        .iter()
+        .enumerate()
+        .filter(|(_, n)| **n > 0)
+        .map(|(c, n)| format!("{} {n}", status_name(c as u8)))
+        .collect();
+    println!("  solver statuses  {}", statuses.join(", "));
+    let commands: Vec<String> = s
+        .command_status_counts
+        .iter()
+        .enumerate()
+        .filter(|(_, n)| **n > 0)
+        .map(|(c, n)| format!("{} {n}", command_status_name(c as u8)))
+        .collect();
+    println!("  command statuses {}", commands.join(", "));
+}
+
+/// How the recording went.
+fn print_recording(rec: &runner::RecordingOutcome) {
+    let files = if rec.files > 1 || rec.files_deleted > 0 {
+        format!(
+            " in {} files ({} deleted for the budget)",
+            rec.files, rec.files_deleted
+        )
+    } else {
+        String::new()
+    };
+    match &rec.error {
+        None => println!(
+            "  recording        {}: {} messages{files}, {:.2} MB",
+            rec.path.display(),
+            rec.messages,
+            rec.bytes as f64 / 1e6
+        ),
+        Some(e) => println!(
+            "  recording        FAILED ({}): {e}; {} messages recorded{files}, {} lost",
+            rec.path.display(),
+            rec.messages,
+            rec.lost
+        ),
     }
 }
