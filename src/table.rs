@@ -161,39 +161,7 @@ impl Table {
             line,
             message,
         };
-        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-        // Comments end every line at `#` (line numbers are kept).
-        let text: String = text
-            .lines()
-            .map(|l| l.split('#').next().unwrap_or(""))
-            .collect::<Vec<_>>()
-            .join("\n");
-        let first = text.lines().find(|l| !l.trim().is_empty()).unwrap_or("");
-        let delim = match delimiter {
-            Delimiter::Comma => Some(b','),
-            Delimiter::Semicolon => Some(b';'),
-            Delimiter::Tab => Some(b'\t'),
-            Delimiter::Whitespace => None,
-            Delimiter::Auto => [b',', b';', b'\t']
-                .into_iter()
-                .find(|d| first.as_bytes().contains(d)),
-        };
-        // The csv reader does not count blank lines: a lone separator keeps
-        // them as (skipped) empty records, so line numbers stay true.
-        let text = match delim {
-            Some(d) => text
-                .lines()
-                .map(|l| {
-                    if l.trim().is_empty() {
-                        (d as char).to_string()
-                    } else {
-                        l.to_string()
-                    }
-                })
-                .collect::<Vec<_>>()
-                .join("\n"),
-            None => text,
-        };
+        let (text, delim) = normalise(text, delimiter);
         let records = records(&text, delim).map_err(|(line, m)| bad(line, m))?;
         let Some((head_line, head_width, has_header)) = records
             .first()
@@ -220,48 +188,11 @@ impl Table {
             }
             column_names = n.to_vec();
         }
-        let width = column_names.len();
-        let mut columns: Vec<Vec<f64>> = vec![Vec::new(); width];
-        let mut cells_text: Vec<Option<TextCell>> = vec![None; width];
-        let mut lines = Vec::new();
-        for (line, fields) in rows.skip(skip) {
-            if fields.len() != width {
-                return Err(bad(
-                    line,
-                    format!(
-                        "{} columns, {} {width}",
-                        fields.len(),
-                        if has_header {
-                            "the header has"
-                        } else {
-                            "the first row has"
-                        }
-                    ),
-                ));
-            }
-            for (k, f) in fields.iter().enumerate() {
-                let v = match f.parse::<f64>() {
-                    Ok(v) if v.is_finite() => v,
-                    Ok(_) => {
-                        return Err(bad(
-                            line,
-                            format!("`{f}` in column `{}` is not finite", column_names[k]),
-                        ))
-                    }
-                    Err(_) => {
-                        if cells_text[k].is_none() {
-                            cells_text[k] = Some(TextCell {
-                                line,
-                                text: f.clone(),
-                            });
-                        }
-                        f64::NAN
-                    }
-                };
-                columns[k].push(v);
-            }
-            lines.push(line);
-        }
+        let DataRows {
+            columns,
+            text: cells_text,
+            lines,
+        } = numeric_columns(rows.skip(skip), &column_names, has_header, &bad)?;
         if lines.is_empty() {
             return Err(bad(0, "no data rows".into()));
         }
@@ -274,6 +205,112 @@ impl Table {
             has_header,
         })
     }
+}
+
+/// The text as the record reader takes it, with the field separator
+/// (None: whitespace): without a byte-order mark, comments cut at `#`, the
+/// separator detected from the first non-blank line when `Auto`, and blank
+/// lines kept as (skipped) empty records so that line numbers stay true.
+fn normalise(text: &str, delimiter: Delimiter) -> (String, Option<u8>) {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    // Comments end every line at `#` (line numbers are kept).
+    let text: String = text
+        .lines()
+        .map(|l| l.split('#').next().unwrap_or(""))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let first = text.lines().find(|l| !l.trim().is_empty()).unwrap_or("");
+    let delim = match delimiter {
+        Delimiter::Comma => Some(b','),
+        Delimiter::Semicolon => Some(b';'),
+        Delimiter::Tab => Some(b'\t'),
+        Delimiter::Whitespace => None,
+        Delimiter::Auto => [b',', b';', b'\t']
+            .into_iter()
+            .find(|d| first.as_bytes().contains(d)),
+    };
+    // The csv reader does not count blank lines: a lone separator keeps
+    // them.
+    let text = match delim {
+        Some(d) => text
+            .lines()
+            .map(|l| {
+                if l.trim().is_empty() {
+                    (d as char).to_string()
+                } else {
+                    l.to_string()
+                }
+            })
+            .collect::<Vec<_>>()
+            .join("\n"),
+        None => text,
+    };
+    (text, delim)
+}
+
+/// What [`numeric_columns`] read.
+struct DataRows {
+    columns: Vec<Vec<f64>>,
+    text: Vec<Option<TextCell>>,
+    lines: Vec<usize>,
+}
+
+/// The data rows as numeric columns (NaN in a text cell, whose first
+/// occurrence per column is kept), with each row's line. Every row must be
+/// as wide as the header; a non-finite number is refused.
+fn numeric_columns(
+    rows: impl Iterator<Item = Record>,
+    names: &[String],
+    has_header: bool,
+    bad: &dyn Fn(usize, String) -> TableError,
+) -> Result<DataRows, TableError> {
+    let width = names.len();
+    let mut columns: Vec<Vec<f64>> = vec![Vec::new(); width];
+    let mut cells_text: Vec<Option<TextCell>> = vec![None; width];
+    let mut lines = Vec::new();
+    for (line, fields) in rows {
+        if fields.len() != width {
+            return Err(bad(
+                line,
+                format!(
+                    "{} columns, {} {width}",
+                    fields.len(),
+                    if has_header {
+                        "the header has"
+                    } else {
+                        "the first row has"
+                    }
+                ),
+            ));
+        }
+        for (k, f) in fields.iter().enumerate() {
+            let v = match f.parse::<f64>() {
+                Ok(v) if v.is_finite() => v,
+                Ok(_) => {
+                    return Err(bad(
+                        line,
+                        format!("`{f}` in column `{}` is not finite", names[k]),
+                    ))
+                }
+                Err(_) => {
+                    if cells_text[k].is_none() {
+                        cells_text[k] = Some(TextCell {
+                            line,
+                            text: f.clone(),
+                        });
+                    }
+                    f64::NAN
+                }
+            };
+            columns[k].push(v);
+        }
+        lines.push(line);
+    }
+    Ok(DataRows {
+        columns,
+        text: cells_text,
+        lines,
+    })
 }
 
 /// A record: its line number and fields.
