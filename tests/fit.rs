@@ -664,6 +664,30 @@ fn the_oring_seal_is_calibrated_at_1_and_3_bar_through_mapped_inputs_and_predict
         // 3 N RMS (the data's repeatability is ±15 %).
         assert!(held_out > 0.3 && held_out < 3.0, "{r}");
     }
+    // Every model's error on 5 and 7 bar split into level and offset: one
+    // row per held-out file, a level / offset pair per model.
+    let section = stdout
+        .split("## Error by direction of motion, every model")
+        .nth(1)
+        .unwrap_or_else(|| panic!("no direction table in {stdout}"));
+    let pairs: Vec<Vec<f64>> = section
+        .lines()
+        .filter(|l| l.starts_with("| O-ring257_"))
+        .map(|l| {
+            assert!(l.contains("| validate |"), "{l}");
+            l.split('|')
+                .skip(4)
+                .filter(|c| c.contains(" / "))
+                .flat_map(|c| c.split(" / ").map(|x| x.trim().parse::<f64>().unwrap()))
+                .collect()
+        })
+        .collect();
+    assert_eq!(pairs.len(), 2, "{section}");
+    for p in &pairs {
+        assert_eq!(p.len(), 8, "{section}");
+        // Each model's level error is within its held-out RMS's scale.
+        assert!(p.iter().all(|x| x.abs() < 3.0), "{section}");
+    }
     // The sensor offset the data's README warns of is found: 0.5–1.5 N.
     let yaml = std::fs::read_to_string(&out).unwrap();
     let off: f64 = yaml

@@ -315,8 +315,12 @@ class FitResult:
     start, bounds, at_bound), ``converged``, ``train_rms_n``,
     ``held_out_rms_n``, ``models`` (DataFrame, one row per model: ours and,
     with ``baselines=True``, Coulomb + viscous, Stribeck, LuGre on the same
-    data with the same optimiser), ``fitted_yaml`` (the complete fitted
-    parameter file), ``summary`` (the command's summary text), ``raw``.
+    data with the same optimiser), ``direction_table`` (with baselines: every
+    model's level and offset error per held-out source, markdown; the level
+    error is the friction too large or small in magnitude, the offset error
+    the part that is the same in both directions of motion), ``fitted_yaml``
+    (the complete fitted parameter file), ``summary`` (the command's summary
+    text), ``raw``.
     """
 
     def __init__(self, raw: dict):
@@ -344,6 +348,7 @@ class FitResult:
             rows.append(row)
         self.models = pd.DataFrame(rows)
         self.models_table = raw.get("models_table")
+        self.direction_table = raw.get("direction_table")
 
     def value(self, name: str) -> float:
         """The fitted value of parameter ``name``."""

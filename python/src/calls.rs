@@ -5,10 +5,9 @@ use crate::columns::Columns;
 use crate::errors;
 use crate::model::load_config;
 use friction_node::analysis::metrics::LOOP_METRIC_COLUMNS;
-use friction_node::fit::report::{self, ModelRow};
+use friction_node::fit::report;
 use friction_node::fit::request::{
-    fit_baselines, fit_ours, held_out_scale, param_specs, prepare, FitRequest, LabelledProgress,
-    TopicChoice,
+    fit_baselines, fit_ours, param_specs, prepare, FitRequest, LabelledProgress, TopicChoice,
 };
 use friction_node::fit::{Delimiter, FitOutcome, Mapping};
 use friction_node::msgs;
@@ -457,11 +456,16 @@ pub fn fit<'py>(
     let mut extra = String::new();
     let d = outcome_dict(py, &ours.outcome)?;
     if baselines {
-        let mut rows = vec![ModelRow::from(&ours.outcome)];
-        rows.extend(classic.iter().map(ModelRow::from));
-        let table = report::models_table(&rows, held_out_scale(&ours.outcome));
-        extra = format!("## Models on the same data, same optimiser\n\n{table}");
-        d.set_item("models_table", table)?;
+        extra = report::models_section(&ours.outcome, &classic);
+        d.set_item(
+            "models_table",
+            report::models_table_of(&ours.outcome, &classic),
+        )?;
+        let all: Vec<&FitOutcome> = std::iter::once(&ours.outcome).chain(&classic).collect();
+        d.set_item(
+            "direction_table",
+            friction_node::fit::by_direction::models_direction_table(&all),
+        )?;
     }
     let models = PyList::empty(py);
     models.append(outcome_dict(py, &ours.outcome)?)?;

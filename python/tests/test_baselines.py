@@ -175,3 +175,8 @@ def test_on_the_oring_seal_every_baseline_reaches_an_independent_optimum():
         global_points=0, starts=1,
     )
     check_every_baseline(r)
+    # Every model's error split by direction, on the training files (no validation data here).
+    table = r.direction_table
+    assert "LuGre" in table.splitlines()[0], table
+    rows = [l for l in table.splitlines() if l.startswith("| O-ring257_")]
+    assert [l.split("|")[2].strip() for l in rows] == ["fit", "fit"], table

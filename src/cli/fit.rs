@@ -3,10 +3,9 @@
 
 use anyhow::{bail, Context, Result};
 use friction_node::config::Config;
-use friction_node::fit::report::{self, ModelRow};
+use friction_node::fit::report;
 use friction_node::fit::request::{
-    fit_baselines, fit_ours, held_out_scale, param_specs, prepare, FitRequest, OursFitted,
-    TopicChoice,
+    fit_baselines, fit_ours, param_specs, prepare, FitRequest, OursFitted, TopicChoice,
 };
 use friction_node::fit::{Delimiter, Mapping, ParamSpec};
 use std::path::PathBuf;
@@ -312,11 +311,8 @@ pub fn run(config: &Config, args: &FitArgs) -> Result<()> {
         for s in skipped {
             eprintln!("fit: {s}");
         }
-        let mut rows = vec![ModelRow::from(&ours)];
-        rows.extend(baselines.iter().map(ModelRow::from));
-        let table = report::models_table(&rows, held_out_scale(&ours));
-        println!("## Models on the same data, same optimiser\n\n{table}");
-        extra = format!("## Models on the same data, same optimiser\n\n{table}");
+        extra = report::models_section(&ours, &baselines);
+        println!("{extra}");
         classic = baselines;
     }
     if let Some(r) = &args.report {

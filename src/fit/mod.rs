@@ -34,12 +34,14 @@
 //! | `search.rs` | the global phase and the distinct optima |
 //! | `stats.rs` | standard errors, correlations, flags |
 //! | `report.rs` | the summary, the tables, plots, the fitted YAML |
+//! | `by_direction.rs` | the residual by direction of motion: level and offset errors |
 //! | `synthetic.rs` | synthetic data: the model along a motion, with noise |
 //! | `reversals.rs` | velocity reversals in the data and the stiffness through them (pre-sliding starts) |
 
 #[cfg(feature = "mcap")]
 pub mod bag_input;
 pub mod baselines;
+pub mod by_direction;
 pub mod driver;
 mod expr;
 pub mod local_run;

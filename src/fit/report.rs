@@ -211,6 +211,24 @@ pub fn models_table(rows: &[ModelRow], scale_n: f64) -> String {
     s
 }
 
+/// The models table of ours and the classic models fitted beside it.
+pub fn models_table_of(ours: &FitOutcome, classic: &[FitOutcome]) -> String {
+    let mut rows = vec![ModelRow::from(ours)];
+    rows.extend(classic.iter().map(ModelRow::from));
+    models_table(&rows, super::request::held_out_scale(ours))
+}
+
+/// The comparison section of a fit with classic models (markdown): the
+/// models table, then every model's level and offset error by source.
+pub fn models_section(ours: &FitOutcome, classic: &[FitOutcome]) -> String {
+    let all: Vec<&FitOutcome> = std::iter::once(ours).chain(classic).collect();
+    format!(
+        "## Models on the same data, same optimiser\n\n{}\n## Error by direction of motion, every model\n\n{}",
+        models_table_of(ours, classic),
+        super::by_direction::models_direction_table(&all)
+    )
+}
+
 /// Four significant digits.
 fn round4(v: f64) -> f64 {
     if v == 0.0 || !v.is_finite() {
@@ -275,11 +293,7 @@ fn write_samples(
         for sf in fits {
             let s = &sf.series;
             for k in 0..s.len() {
-                let role = match (train, s.fit[k]) {
-                    (true, true) => "fit",
-                    (true, false) => "held_out",
-                    _ => "validate",
-                };
+                let role = super::by_direction::sample_role(train, s.fit[k]);
                 f.line(format_args!(
                     "{},{role},{},{},{},{},{},{}",
                     s.name.replace(',', ";"),
@@ -301,13 +315,14 @@ fn write_samples(
 /// The whole markdown summary of one fit.
 pub fn summary(o: &FitOutcome, extra: &str) -> String {
     format!(
-        "# Fit of {}: {}\n\n{}\n## Parameters\n\n{}\n## Correlations\n\n{}\n## Distinct optima (best first)\n\n{}\n{}",
+        "# Fit of {}: {}\n\n{}\n## Parameters\n\n{}\n## Correlations\n\n{}\n## Distinct optima (best first)\n\n{}\n## Residual by direction of motion\n\n{}\n{}",
         o.label,
         if o.converged { "converged" } else { "NOT converged (best point found)" },
         residual_lines(o),
         parameter_table(o),
         correlation_table(o),
         optima_table(o),
+        super::by_direction::direction_table(o),
         extra
     )
 }
