@@ -1,6 +1,7 @@
 //! The terms real drives show, through every path: pre-sliding compliance
 //! (a bristle on the model's own friction), a soft contact whose width
-//! follows the load, and the drivetrain's quadratic loss and direction
+//! follows the load, a boundary film whose friction rises with the
+//! logarithm of speed, and the drivetrain's quadratic loss and direction
 //! asymmetry. Off by default (every other test checks that the estimates
 //! are then unchanged); here they are on.
 
@@ -127,6 +128,40 @@ fn a_soft_contact_whose_area_follows_the_load_has_a_load_independent_friction_co
 }
 
 #[test]
+fn a_rate_sensitive_boundary_film_adds_mu_r_asinh_v_over_v_a_times_the_asperity_load() {
+    let (mu_r, v_a) = (0.02, 1e-4);
+    let on = config(&[
+        "contact.boundary_friction_rate=0.02",
+        "contact.boundary_activation_speed_m_s=1e-4",
+    ]);
+    let off = config(&[]);
+    let mut a = Solver::new(&on.model(), &on.solver_settings()).unwrap();
+    let mut b = Solver::new(&off.model(), &off.solver_settings()).unwrap();
+    for v in [-0.05, -1e-3, 1e-5, 1e-3, 0.01, 0.05] {
+        let (x, y) = (a.steady(v, 20_762.0), b.steady(v, 20_762.0));
+        assert_eq!(x.status, Status::Converged);
+        // The film does not depend on the friction: the same state.
+        assert_eq!(x.h0, y.h0);
+        assert_eq!(x.asperity_force, y.asperity_force);
+        let term = x.asperity_force * mu_r * (v / v_a).asinh();
+        assert_relative_eq!(
+            x.friction_force - y.friction_force,
+            term,
+            max_relative = 1e-9
+        );
+        // The coefficient of friction counts it by magnitude.
+        assert_relative_eq!(x.cof - y.cof, term.abs() / 20_762.0, max_relative = 1e-9);
+    }
+    // Well above v_a: a rise of μ_r times the asperity load per e-fold of speed.
+    let (v1, v2) = (2e-3, 2e-3 * std::f64::consts::E);
+    let (x1, x2) = (a.steady(v1, 20_762.0), a.steady(v2, 20_762.0));
+    let (y1, y2) = (b.steady(v1, 20_762.0), b.steady(v2, 20_762.0));
+    let rise = (x2.friction_force - y2.friction_force) - (x1.friction_force - y1.friction_force);
+    let asp = 0.5 * (x1.asperity_force + x2.asperity_force);
+    assert_relative_eq!(rise, mu_r * asp, max_relative = 2e-3);
+}
+
+#[test]
 fn simulate_the_python_columns_and_a_recorded_node_carry_the_new_terms_bit_for_bit() {
     // simulate equals the solver stepped directly, with every term on.
     let sets = [
@@ -135,6 +170,8 @@ fn simulate_the_python_columns_and_a_recorded_node_carry_the_new_terms_bit_for_b
         "contact.width_load_exponent=0.5",
         "drivetrain.quadratic_n_s2_m2=300",
         "drivetrain.coulomb_asymmetry_n=40",
+        "contact.boundary_friction_rate=0.01",
+        "contact.boundary_activation_speed_m_s=1e-3",
     ];
     let c = config(&sets);
     let d = dir("simulate");
@@ -193,6 +230,8 @@ fn a_node_recording_with_the_new_terms_replays_bit_identically() {
         "contact.width_load_exponent=0.5".into(),
         "drivetrain.quadratic_n_s2_m2=300".into(),
         "drivetrain.coulomb_asymmetry_n=40".into(),
+        "contact.boundary_friction_rate=0.01".into(),
+        "contact.boundary_activation_speed_m_s=1e-3".into(),
         format!("iceoryx2.cmd_velocity_service={base}/cmd"),
         format!("iceoryx2.normal_load_service={base}/load"),
         format!("iceoryx2.friction_service={base}/friction"),
@@ -253,6 +292,18 @@ fn negative_or_non_finite_terms_are_refused_naming_the_key() {
         (
             "drivetrain.coulomb_asymmetry_n=.inf",
             "drivetrain.coulomb_asymmetry_n",
+        ),
+        (
+            "contact.boundary_friction_rate=-0.01",
+            "contact.boundary_friction_rate",
+        ),
+        (
+            "contact.boundary_friction_rate=.nan",
+            "contact.boundary_friction_rate",
+        ),
+        (
+            "contact.boundary_activation_speed_m_s=0",
+            "contact.boundary_activation_speed_m_s",
         ),
     ] {
         let e = Config::load(None, &[set.to_string()])

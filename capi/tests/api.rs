@@ -512,9 +512,9 @@ fn the_c_api_refuses_every_envelope_case_with_the_rule_of_every_entry_point() {
 
 #[test]
 fn the_real_drive_terms_are_in_the_c_api_bit_for_bit() {
-    // Pre-sliding, a soft width, a quadratic loss and an asymmetry: the C
-    // API's steps equal the solver's own.
-    let yaml = "/**:\n  ros__parameters:\n    solver: {cells: 32}\n    contact: {presliding_stiffness_n_m: 1.0e+8, width_load_exponent: 0.5}\n    drivetrain: {quadratic_n_s2_m2: 300.0, coulomb_asymmetry_n: 40.0}\n";
+    // Pre-sliding, a soft width, a rate-sensitive boundary film, a quadratic
+    // loss and an asymmetry: the C API's steps equal the solver's own.
+    let yaml = "/**:\n  ros__parameters:\n    solver: {cells: 32}\n    contact: {presliding_stiffness_n_m: 1.0e+8, width_load_exponent: 0.5, boundary_friction_rate: 0.01, boundary_activation_speed_m_s: 1.0e-3}\n    drivetrain: {quadratic_n_s2_m2: 300.0, coulomb_asymmetry_n: 40.0}\n";
     let m = new_model(yaml).unwrap();
     let c = friction_node::config::Config::from_yaml(
         yaml,

@@ -27,10 +27,12 @@ REAL_DRIVE_TERMS = {
     "contact.width_load_exponent": 0.5,
     "drivetrain.quadratic_n_s2_m2": 300.0,
     "drivetrain.coulomb_asymmetry_n": 40.0,
+    "contact.boundary_friction_rate": 0.01,
+    "contact.boundary_activation_speed_m_s": 1e-3,
 }
 
 
-@pytest.mark.parametrize("terms", [{}, REAL_DRIVE_TERMS], ids=["default", "pre-sliding, soft width, losses"])
+@pytest.mark.parametrize("terms", [{}, REAL_DRIVE_TERMS], ids=["default", "pre-sliding, soft width, boundary rate, losses"])
 def test_run_is_bit_identical_to_the_cli_simulate(cli, tmp_path, terms):
     out = tmp_path / "run.csv"
     sets = [a for k, v in terms.items() for a in ("--set", f"{k}={v}")]

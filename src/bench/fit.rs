@@ -6,6 +6,7 @@
 //! | recovery | σ = 3.5 µm, μ_bl = 0.22, μ_l = 0.08 Pa·s recovered from the defaults on two amplitudes and two loads with 2 % noise, over noise seeds |
 //! | drivetrain | σ, μ_bl and Coulomb and viscous drivetrain terms recovered together, from three global-phase seeds |
 //! | pre-sliding and losses | σ, μ_bl, the pre-sliding stiffness σ0, a quadratic loss c_q and a direction asymmetry ΔF_c recovered together (the terms of issue 32 on) |
+//! | boundary rate | σ, μ_bl and the boundary film's rate sensitivity μ_r and activation speed v_a recovered together |
 //! | transfer | fitted at one load, amplitude and frequency, validated at another: ours and the classic models, with the new terms off and on in the data |
 
 use crate::config::Config;
@@ -60,6 +61,7 @@ pub fn run(config: &Config, o: &FitBenchOptions<'_>) -> Result<String, FitBenchE
     let mut md = recovery(&base, o)?;
     md += &drivetrain(&base, o)?;
     md += &presliding_and_losses(&base, o)?;
+    md += &boundary_rate(&base, o)?;
     md += &transfer(&base, o, false)?;
     md += &transfer(&base, o, true)?;
     if let Some(d) = o.out {
@@ -242,55 +244,118 @@ fn seeds_table(
     Ok(md + "\n")
 }
 
-fn drivetrain(base: &Config, o: &FitBenchOptions<'_>) -> Result<String, FitBenchError> {
-    let keys = [
-        "roughness.sigma_m",
-        "contact.boundary_friction",
-        "drivetrain.coulomb_n",
-        "drivetrain.viscous_n_s_m",
-    ];
-    let truth = [3.5e-6, 0.22, 300.0, 800.0];
+/// One recovery experiment: data made by the model with the contact's σ =
+/// 3.5 µm and μ_bl = 0.22 and the `terms` set to `truth`, along the
+/// two-amplitude, two-load motion with 2 % noise (noise seed `noise_seed`,
+/// written as `file`), all fitted from the defaults with three
+/// global-phase seeds: `title` and `truth_line` (the terms') over the table.
+struct Recovery<'a> {
+    terms: &'a [&'a str],
+    truth: &'a [f64],
+    noise_seed: u64,
+    file: &'a str,
+    label: &'static str,
+    title: &'a str,
+    truth_line: String,
+}
+
+fn recover(
+    base: &Config,
+    o: &FitBenchOptions<'_>,
+    r: &Recovery<'_>,
+) -> Result<String, FitBenchError> {
+    let keys: Vec<&str> = ["roughness.sigma_m", "contact.boundary_friction"]
+        .into_iter()
+        .chain(r.terms.iter().copied())
+        .collect();
+    let truth: Vec<f64> = [3.5e-6, 0.22]
+        .into_iter()
+        .chain(r.truth.iter().copied())
+        .collect();
     let m = two_amplitudes_two_loads(o.duration_s, base.solver.dt_s);
-    let csv = noisy_csv(
-        &m,
-        &model_friction(&with(base, &keys, &truth), &m)?,
-        0.02,
-        11,
-    );
-    let d = data(source(o, "drivetrain.csv", &csv)?, vec![]);
+    let clean = model_friction(&with(base, &keys, &truth), &m)?;
+    let csv = noisy_csv(&m, &clean, 0.02, r.noise_seed);
+    let d = data(source(o, r.file, &csv)?, vec![]);
     let mut md = format!(
-        "## Drivetrain terms beside the contact (from the defaults; global phase with three seeds)\n\ntruth: σ = {:.2} µm, μ_bl = {}, drivetrain Coulomb {} N, viscous {} N·s/m; same motion, 2 % noise\n\n",
-        truth[0] * 1e6, truth[1], truth[2], truth[3]
+        "## {}\n\ntruth: σ = 3.50 µm, μ_bl = 0.22, {}; same motion, 2 % noise\n\n",
+        r.title, r.truth_line
     );
-    md += &seeds_table(base, o, &d, &keys, &truth, "drivetrain")?;
+    md += &seeds_table(base, o, &d, &keys, &truth, r.label)?;
     Ok(md)
+}
+
+fn drivetrain(base: &Config, o: &FitBenchOptions<'_>) -> Result<String, FitBenchError> {
+    let truth = [300.0, 800.0];
+    recover(
+        base,
+        o,
+        &Recovery {
+            terms: &[
+                "drivetrain.coulomb_n",
+                "drivetrain.viscous_n_s_m",
+            ],
+            truth: &truth,
+            noise_seed: 11,
+            file: "drivetrain.csv",
+            label: "drivetrain",
+            title: "Drivetrain terms beside the contact (from the defaults; global phase with three seeds)",
+            truth_line: format!(
+                "drivetrain Coulomb {} N, viscous {} N·s/m",
+                truth[0], truth[1]
+            ),
+        },
+    )
 }
 
 /// The terms a real drive shows, on: pre-sliding stiffness, a quadratic
 /// loss and a direction asymmetry, recovered with the contact.
 fn presliding_and_losses(base: &Config, o: &FitBenchOptions<'_>) -> Result<String, FitBenchError> {
-    let keys = [
-        "roughness.sigma_m",
-        "contact.boundary_friction",
-        "contact.presliding_stiffness_n_m",
-        "drivetrain.quadratic_n_s2_m2",
-        "drivetrain.coulomb_asymmetry_n",
-    ];
-    let truth = [3.5e-6, 0.22, 5e7, 400.0, 150.0];
-    let m = two_amplitudes_two_loads(o.duration_s, base.solver.dt_s);
-    let csv = noisy_csv(
-        &m,
-        &model_friction(&with(base, &keys, &truth), &m)?,
-        0.02,
-        12,
-    );
-    let d = data(source(o, "presliding-losses.csv", &csv)?, vec![]);
-    let mut md = format!(
-        "## Pre-sliding and drivetrain losses (from the defaults, the stiffness from the data's reversals; global phase with three seeds)\n\ntruth: σ = {:.2} µm, μ_bl = {}, pre-sliding stiffness {:.0e} N/m, quadratic loss {} N·s²/m², direction asymmetry {} N; same motion, 2 % noise\n\n",
-        truth[0] * 1e6, truth[1], truth[2], truth[3], truth[4]
-    );
-    md += &seeds_table(base, o, &d, &keys, &truth, "pre-sliding and losses")?;
-    Ok(md)
+    let truth = [5e7, 400.0, 150.0];
+    recover(
+        base,
+        o,
+        &Recovery {
+            terms: &[
+                "contact.presliding_stiffness_n_m",
+                "drivetrain.quadratic_n_s2_m2",
+                "drivetrain.coulomb_asymmetry_n",
+            ],
+            truth: &truth,
+            noise_seed: 12,
+            file: "presliding-losses.csv",
+            label: "pre-sliding and losses",
+            title: "Pre-sliding and drivetrain losses (from the defaults, the stiffness from the data's reversals; global phase with three seeds)",
+            truth_line: format!(
+                "pre-sliding stiffness {:.0e} N/m, quadratic loss {} N·s²/m², direction asymmetry {} N",
+                truth[0], truth[1], truth[2]
+            ),
+        },
+    )
+}
+
+/// A boundary film whose friction rises with the logarithm of speed,
+/// recovered with the contact (μ_r from zero, v_a from the default).
+fn boundary_rate(base: &Config, o: &FitBenchOptions<'_>) -> Result<String, FitBenchError> {
+    let truth = [0.02, 3e-3];
+    recover(
+        base,
+        o,
+        &Recovery {
+            terms: &[
+                "contact.boundary_friction_rate",
+                "contact.boundary_activation_speed_m_s",
+            ],
+            truth: &truth,
+            noise_seed: 13,
+            file: "boundary-rate.csv",
+            label: "boundary rate",
+            title: "Boundary film rate (from the defaults: μ_r = 0, v_a = 1 mm/s; global phase with three seeds)",
+            truth_line: format!(
+                "μ_r = {}, v_a = {} m/s",
+                truth[0], truth[1]
+            ),
+        },
+    )
 }
 
 /// Fitted at one operating point, validated at another: ours and the

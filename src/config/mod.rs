@@ -165,6 +165,10 @@ impl Config {
             contact: Contact {
                 mass: c.mass_kg,
                 boundary_friction: c.boundary_friction,
+                boundary_rate: crate::physics::BoundaryRate {
+                    sensitivity: c.boundary_friction_rate,
+                    activation_speed: c.boundary_activation_speed_m_s,
+                },
                 sign_regularization: c.sign_regularization_m_s,
                 min_film: c.min_film_m,
                 presliding: crate::physics::Presliding {

@@ -25,6 +25,13 @@ pub struct ContactConfig {
     pub profile_depth_m: f64,
     /// `contact.boundary_friction`: mu_bl, boundary friction coefficient — range [0, 2]
     pub boundary_friction: f64,
+    /// `contact.boundary_friction_rate`: mu_r, the boundary friction's increase per e-fold of
+    /// sliding speed above `boundary_activation_speed_m_s` (thermally activated shear of the
+    /// boundary film, Eyring); 0 = a constant mu_bl — range [0, 1]
+    pub boundary_friction_rate: f64,
+    /// `contact.boundary_activation_speed_m_s`: v_a, below it the rate term grows linearly with
+    /// speed, above it logarithmically — range (1e-12, 100]
+    pub boundary_activation_speed_m_s: f64,
     /// `contact.sign_regularization_m_s`: v_reg in tanh(v/v_reg) for the asperity friction sign —
     /// range (1e-9, 1]
     pub sign_regularization_m_s: f64,
@@ -73,6 +80,8 @@ impl Default for ContactConfig {
             profile,
             profile_depth_m: depth,
             boundary_friction: c.boundary_friction,
+            boundary_friction_rate: c.boundary_rate.sensitivity,
+            boundary_activation_speed_m_s: c.boundary_rate.activation_speed,
             sign_regularization_m_s: c.sign_regularization,
             min_film_m: c.min_film,
             presliding_stiffness_n_m: c.presliding.stiffness,

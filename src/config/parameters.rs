@@ -23,10 +23,12 @@ use serde_norway::Value;
 
 /// Whether `key` may change while the node runs.
 pub fn is_runtime(key: &str) -> bool {
-    const EXACT: [&str; 17] = [
+    const EXACT: [&str; 19] = [
         "contact.load_n",
         "contact.mass_kg",
         "contact.boundary_friction",
+        "contact.boundary_friction_rate",
+        "contact.boundary_activation_speed_m_s",
         "contact.sign_regularization_m_s",
         "contact.min_film_m",
         "contact.presliding_stiffness_n_m",

@@ -148,6 +148,18 @@ impl Config {
         oc("contact.load_n", c.load_n, 0.0, 1e9)?;
         cc("contact.profile_depth_m", c.profile_depth_m, 0.0, 1e-3)?;
         cc("contact.boundary_friction", c.boundary_friction, 0.0, 2.0)?;
+        cc(
+            "contact.boundary_friction_rate",
+            c.boundary_friction_rate,
+            0.0,
+            1.0,
+        )?;
+        oc(
+            "contact.boundary_activation_speed_m_s",
+            c.boundary_activation_speed_m_s,
+            1e-12,
+            100.0,
+        )?;
         oc(
             "contact.sign_regularization_m_s",
             c.sign_regularization_m_s,

@@ -280,6 +280,10 @@ impl ConfigKeys {
             "drivetrain.load_coefficient" => {
                 Some((2.0 * s.friction_n / s.load_min_n.max(1e-9)).min(10.0))
             }
+            // μ_r: up to twice the data's friction coefficient per e-fold.
+            "contact.boundary_friction_rate" => {
+                Some((2.0 * s.friction_n / s.load_min_n.max(1e-9)).min(1.0))
+            }
             k if k.ends_with("presliding_damping_n_s_m") => Some(100.0 * s.friction_n / v),
             _ => None,
         };

@@ -18,6 +18,7 @@
 //! | [`error`] | the core's setup errors ([`SetupError`]) |
 //! | [`drivetrain`] | losses beside the contact (bearings, seals, gears) |
 //! | [`presliding`] | the contact's elastic displacement before gross sliding |
+//! | [`boundary`] | the boundary film's friction rising with the logarithm of speed (Eyring) |
 //! | [`viscosity`] | the liquid's viscosity against temperature (Vogel) |
 //!
 //! ```
@@ -31,6 +32,7 @@
 
 #![warn(clippy::float_cmp)]
 
+pub mod boundary;
 pub mod drivetrain;
 pub mod eos;
 pub mod error;
@@ -44,6 +46,7 @@ pub mod scheme;
 pub mod solver;
 pub mod viscosity;
 
+pub use boundary::BoundaryRate;
 pub use drivetrain::Drivetrain;
 pub use error::SetupError;
 pub use estimate::{Diagnostics, Estimate, Regime, Status};

@@ -21,6 +21,7 @@
 //! | E* | `effective_modulus` | effective elastic modulus | Pa |
 //! | m | `Contact::mass` | equivalent slider mass | kg |
 //! | μ_bl | `boundary_friction` | boundary friction coefficient | – |
+//! | μ_r, v_a | `boundary_rate` | the boundary friction's rate sensitivity and activation speed (0 = constant μ_bl; see [`super::boundary`]) | –, m/s |
 //! | v_reg | `sign_regularization` | velocity scale of tanh(v/v_reg) | m/s |
 //! | h_floor | `min_film` | optional floor on h0 (0 = off) | m |
 //! | σ0, σ1 | `presliding` | pre-sliding stiffness and damping (0 = rigid; see [`super::presliding`]) | N/m, N·s/m |
@@ -164,6 +165,8 @@ pub struct Contact {
     pub mass: f64,
     /// μ_bl, the boundary (asperity) friction coefficient.
     pub boundary_friction: f64,
+    /// The boundary friction's dependence on speed (off by default).
+    pub boundary_rate: super::boundary::BoundaryRate,
     /// v_reg of the sign's tanh regularisation, m/s.
     pub sign_regularization: f64,
     /// Floor on h0; 0 disables it (the default: with GW it should not bind).
@@ -227,6 +230,7 @@ impl Default for Contact {
         Self {
             mass: 1.0,
             boundary_friction: 0.3,
+            boundary_rate: super::boundary::BoundaryRate::default(),
             sign_regularization: 1e-4,
             min_film: 0.0,
             presliding: super::presliding::Presliding::default(),
@@ -468,6 +472,14 @@ impl ModelParams {
         let c = &self.contact;
         non_negative("contact.mass", c.mass)?;
         non_negative("contact.boundary_friction", c.boundary_friction)?;
+        non_negative(
+            "contact.boundary_rate.sensitivity",
+            c.boundary_rate.sensitivity,
+        )?;
+        positive(
+            "contact.boundary_rate.activation_speed",
+            c.boundary_rate.activation_speed,
+        )?;
         positive("contact.sign_regularization", c.sign_regularization)?;
         non_negative("contact.min_film", c.min_film)?;
         non_negative("contact.presliding.stiffness", c.presliding.stiffness)?;

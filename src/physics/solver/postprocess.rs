@@ -145,10 +145,17 @@ impl Solver {
     #[inline(always)]
     fn contact_friction(&mut self, ctx: &Ctx, f_visc: f64, f_asp: f64, advance: bool) -> f64 {
         let (d, v) = (&self.d, ctx.v);
+        // The boundary film's rate-dependent part (0 when off: the paper's
+        // constant μ_bl, bit for bit).
+        let rate = if d.boundary_rate.is_on() {
+            f_asp * d.boundary_rate.signed_term(v)
+        } else {
+            0.0
+        };
         if !d.presliding.is_on() {
-            return f_visc + d.mu_bl * f_asp * (v / d.v_reg).tanh();
+            return f_visc + d.mu_bl * f_asp * (v / d.v_reg).tanh() + rate;
         }
-        let level = f_visc + d.mu_bl * f_asp * crate::physics::presliding::sgn(v);
+        let level = f_visc + d.mu_bl * f_asp * crate::physics::presliding::sgn(v) + rate;
         let p = d.presliding;
         match (advance, ctx.time) {
             (true, Some((_, dt))) => {
@@ -232,7 +239,12 @@ impl Solver {
         } else {
             contact_friction + d.drivetrain.force(v, load, d.v_reg)
         };
-        let cof = (f_visc.abs() + d.mu_bl * f_asp) / load;
+        let mu = if d.boundary_rate.is_on() {
+            d.mu_bl + d.boundary_rate.signed_term(v.abs())
+        } else {
+            d.mu_bl
+        };
+        let cof = (f_visc.abs() + mu * f_asp) / load;
         let share = f_asp / load;
         let load_residual = match ctx.gap {
             H0Mode::Balance => load_res,
