@@ -74,6 +74,47 @@ fn newton_steps_allocate_nothing_through_reversals_and_vapour_collapse() {
 }
 
 #[test]
+fn steps_with_every_real_drive_term_on_allocate_nothing_through_reversals() {
+    // Pre-sliding, a soft width, a rate-sensitive boundary film and the
+    // drivetrain's losses, all on.
+    let mut m = ModelParams::default();
+    m.contact.presliding = Presliding {
+        stiffness: 1e8,
+        damping: 50.0,
+    };
+    m.contact.width_law = WidthLaw {
+        exponent: 0.5,
+        reference_load: 20_762.0,
+    };
+    m.contact.boundary_rate = BoundaryRate {
+        sensitivity: 0.01,
+        activation_speed: 1e-3,
+    };
+    m.drivetrain.quadratic = 300.0;
+    m.drivetrain.coulomb_asymmetry = 40.0;
+    let mut s = Solver::new(
+        &m,
+        &SolverSettings {
+            cells: 64,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    s.initialize_steady(0.0, 20_762.0);
+    let mut worst = 0;
+    for k in 1..=1000 {
+        let v = (2.0 * std::f64::consts::PI * 2.0 * k as f64 * 1e-3).sin();
+        let f = 20_762.0 + 5000.0 * (std::f64::consts::PI * k as f64 * 1e-3).sin();
+        let n = allocations(|| {
+            let e = s.step(v, f);
+            assert!(e.status.is_converged(), "step {k}: {:?}", e.status);
+        });
+        worst = worst.max(n);
+    }
+    assert_eq!(worst, 0, "a step allocated");
+}
+
+#[test]
 fn muscl_flux_steps_allocate_nothing_through_reversals() {
     // The paper's case with the second-order flux (pentadiagonal solve).
     let st = SolverSettings {
