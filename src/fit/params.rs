@@ -396,6 +396,19 @@ mod tests {
             .parameter(&spec("drivetrain.viscous_n_s_m"), &SCALE)
             .unwrap();
         assert_eq!((p.lo, p.hi, p.log), (0.0, 400.0, false));
+        // The boundary film's rate: up to twice the data's friction
+        // coefficient (100 N over 1000 N) per e-fold; its activation speed
+        // a decade either side of 1 mm/s.
+        let p = keys
+            .parameter(&spec("contact.boundary_friction_rate"), &SCALE)
+            .unwrap();
+        assert_eq!((p.lo, p.log), (0.0, false));
+        assert_relative_eq!(p.hi, 0.2, max_relative = 1e-12);
+        let p = keys
+            .parameter(&spec("contact.boundary_activation_speed_m_s"), &SCALE)
+            .unwrap();
+        assert_relative_eq!(p.lo, 1e-4, max_relative = 1e-12);
+        assert_relative_eq!(p.hi, 1e-2, max_relative = 1e-12);
         let c = keys.with(&["roughness.sigma_m".into()], &[3.5e-6]).unwrap();
         assert_eq!(c.roughness.sigma_m, 3.5e-6);
     }
