@@ -145,17 +145,19 @@ impl Solver {
     #[inline(always)]
     fn contact_friction(&mut self, ctx: &Ctx, f_visc: f64, f_asp: f64, advance: bool) -> f64 {
         let (d, v) = (&self.d, ctx.v);
-        // The boundary film's rate-dependent part (0 when off: the paper's
-        // constant μ_bl, bit for bit).
-        let rate = if d.boundary_rate.is_on() {
-            f_asp * d.boundary_rate.signed_term(v)
-        } else {
-            0.0
+        // The boundary film's rate-dependent part, added only when on (off:
+        // the paper's constant μ_bl, bit for bit, signed zeros included).
+        let with_rate = |f: f64| {
+            if d.boundary_rate.is_on() {
+                f + f_asp * d.boundary_rate.signed_term(v)
+            } else {
+                f
+            }
         };
         if !d.presliding.is_on() {
-            return f_visc + d.mu_bl * f_asp * (v / d.v_reg).tanh() + rate;
+            return with_rate(f_visc + d.mu_bl * f_asp * (v / d.v_reg).tanh());
         }
-        let level = f_visc + d.mu_bl * f_asp * crate::physics::presliding::sgn(v) + rate;
+        let level = with_rate(f_visc + d.mu_bl * f_asp * crate::physics::presliding::sgn(v));
         let p = d.presliding;
         match (advance, ctx.time) {
             (true, Some((_, dt))) => {
