@@ -7,7 +7,8 @@ use crate::model::load_config;
 use friction_node::analysis::metrics::LOOP_METRIC_COLUMNS;
 use friction_node::fit::report;
 use friction_node::fit::request::{
-    fit_baselines, fit_ours, param_specs, prepare, FitRequest, LabelledProgress, TopicChoice,
+    fit_baselines, fit_ours, param_specs, prepare, FitRequest, LabelledProgress, OursFitted,
+    Prepared, TopicChoice,
 };
 use friction_node::fit::{Delimiter, FitOutcome, Mapping};
 use friction_node::msgs;
@@ -376,18 +377,7 @@ pub fn fit<'py>(
         Some(p) => load_config(None, Some(&p.display().to_string()), &overrides)?,
         None => load_config(None, None, &overrides)?,
     };
-    let delimiter = match delimiter {
-        "auto" => Delimiter::Auto,
-        "comma" | "," => Delimiter::Comma,
-        "semicolon" | ";" => Delimiter::Semicolon,
-        "tab" | "\t" => Delimiter::Tab,
-        "whitespace" => Delimiter::Whitespace,
-        other => {
-            return Err(errors::value(format!(
-                "delimiter = {other:?}: one of auto, comma, semicolon, tab, whitespace"
-            )))
-        }
-    };
+    let delimiter = delimiter_named(delimiter)?;
     if let Some((n, _)) = map.iter().find(|(n, _)| n.contains('.')) {
         return Err(errors::value(format!(
             "map {n}: a map coefficient's name has no dots (dotted names are configuration keys)"
@@ -427,54 +417,9 @@ pub fn fit<'py>(
         }),
         stop: friction_node::interrupt::Stop::new(),
     };
-    let (p, ours, classic, skipped) =
-        crate::interrupts::interruptible(py, |stop| -> PyResult<_> {
-            let req = FitRequest {
-                stop: stop.clone(),
-                ..req.clone()
-            };
-            let p = prepare(&config, &req).map_err(errors::fit)?;
-            // Outputs are checked before any computation.
-            if let Some(o) = &out {
-                drop(
-                    friction_node::output::AtomicFile::create(o)
-                        .map_err(|e| errors::os(e.to_string()))?,
-                );
-            }
-            if let Some(r) = &report_dir {
-                friction_node::output::prepare_dir(r).map_err(|e| errors::os(e.to_string()))?;
-            }
-            let ours = fit_ours(&p, &req).map_err(errors::fit)?;
-            let (classic, skipped) = if baselines {
-                fit_baselines(&p, &req).map_err(errors::fit)?
-            } else {
-                (Vec::new(), Vec::new())
-            };
-            Ok((p, ours, classic, skipped))
-        })??;
+    let (p, ours, classic, skipped) = calibrate(py, &config, &req, &out, &report_dir)?;
     let yaml = report::fitted_yaml(&ours.config, &ours.outcome, &p.names, &ours.map);
-    let mut extra = String::new();
-    let d = outcome_dict(py, &ours.outcome)?;
-    if baselines {
-        extra = report::models_section(&ours.outcome, &classic);
-        d.set_item(
-            "models_table",
-            report::models_table_of(&ours.outcome, &classic),
-        )?;
-        let all: Vec<&FitOutcome> = std::iter::once(&ours.outcome).chain(&classic).collect();
-        d.set_item(
-            "direction_table",
-            friction_node::fit::by_direction::models_direction_table(&all),
-        )?;
-    }
-    let models = PyList::empty(py);
-    models.append(outcome_dict(py, &ours.outcome)?)?;
-    for b in &classic {
-        models.append(outcome_dict(py, b)?)?;
-    }
-    d.set_item("models", models)?;
-    d.set_item("map", ours.map.clone())?;
-    d.set_item("fitted_yaml", &yaml)?;
+    let d = fit_dict(py, &ours, baselines.then_some(&classic[..]), &yaml)?;
     let mut notes = p.notes.clone();
     notes.extend(skipped);
     d.set_item("notes", notes)?;
@@ -483,8 +428,96 @@ pub fn fit<'py>(
             .map_err(|e| errors::os(e.to_string()))?;
     }
     if let Some(r) = &report_dir {
+        let extra = if baselines {
+            report::models_section(&ours.outcome, &classic)
+        } else {
+            String::new()
+        };
         write_fit_report(r, &ours.outcome, &classic, &extra)?;
     }
+    Ok(d)
+}
+
+/// `delimiter` by its Python name.
+fn delimiter_named(name: &str) -> PyResult<Delimiter> {
+    Ok(match name {
+        "auto" => Delimiter::Auto,
+        "comma" | "," => Delimiter::Comma,
+        "semicolon" | ";" => Delimiter::Semicolon,
+        "tab" | "\t" => Delimiter::Tab,
+        "whitespace" => Delimiter::Whitespace,
+        other => {
+            return Err(errors::value(format!(
+                "delimiter = {other:?}: one of auto, comma, semicolon, tab, whitespace"
+            )))
+        }
+    })
+}
+
+/// What a calibration fitted: the prepared problem, ours, the classic
+/// models (with `req.baselines`) and the notes on those skipped. Outputs
+/// are checked before any computation; Ctrl-C stops the fit.
+fn calibrate(
+    py: Python<'_>,
+    config: &friction_node::config::Config,
+    req: &FitRequest,
+    out: &Option<PathBuf>,
+    report_dir: &Option<PathBuf>,
+) -> PyResult<(Prepared, OursFitted, Vec<FitOutcome>, Vec<String>)> {
+    crate::interrupts::interruptible(py, |stop| -> PyResult<_> {
+        let req = FitRequest {
+            stop: stop.clone(),
+            ..req.clone()
+        };
+        let p = prepare(config, &req).map_err(errors::fit)?;
+        if let Some(o) = out {
+            drop(
+                friction_node::output::AtomicFile::create(o)
+                    .map_err(|e| errors::os(e.to_string()))?,
+            );
+        }
+        if let Some(r) = report_dir {
+            friction_node::output::prepare_dir(r).map_err(|e| errors::os(e.to_string()))?;
+        }
+        let ours = fit_ours(&p, &req).map_err(errors::fit)?;
+        let (classic, skipped) = if req.baselines {
+            fit_baselines(&p, &req).map_err(errors::fit)?
+        } else {
+            (Vec::new(), Vec::new())
+        };
+        Ok((p, ours, classic, skipped))
+    })?
+}
+
+/// The result dict of a fit: ours at the top level, every model in
+/// `models`, with baselines asked for (`classic` is then Some) the models
+/// and direction tables, the map and the fitted YAML.
+fn fit_dict<'py>(
+    py: Python<'py>,
+    ours: &OursFitted,
+    classic: Option<&[FitOutcome]>,
+    yaml: &str,
+) -> PyResult<Bound<'py, PyDict>> {
+    let d = outcome_dict(py, &ours.outcome)?;
+    if let Some(classic) = classic {
+        d.set_item(
+            "models_table",
+            report::models_table_of(&ours.outcome, classic),
+        )?;
+        let all: Vec<&FitOutcome> = std::iter::once(&ours.outcome).chain(classic).collect();
+        d.set_item(
+            "direction_table",
+            friction_node::fit::by_direction::models_direction_table(&all),
+        )?;
+    }
+    let models = PyList::empty(py);
+    models.append(outcome_dict(py, &ours.outcome)?)?;
+    for b in classic.unwrap_or_default() {
+        models.append(outcome_dict(py, b)?)?;
+    }
+    d.set_item("models", models)?;
+    d.set_item("map", ours.map.clone())?;
+    d.set_item("fitted_yaml", yaml)?;
     Ok(d)
 }
 
