@@ -130,45 +130,24 @@ impl Source {
     pub fn new(table: Table, mapping: &Mapping) -> Result<Self, FitError> {
         let coeffs = &mapping.coefficients;
         let mut derived_cols: Vec<(String, String)> = Vec::new();
-        let time_text = mapping
-            .time
-            .clone()
-            .or_else(|| table.column("t_s").map(|_| "t_s".to_string()));
-        let time = time_text
-            .as_deref()
-            .map(|t| compile("--time", t, &table, &mut derived_cols, &[]))
-            .transpose()?;
-        let velocity = compile(
-            "--velocity",
-            &mapping.velocity,
-            &table,
-            &mut derived_cols,
+        let mut expr = |what: &str, text: Option<String>, default: &str, c: &[(String, f64)]| {
+            text.or_else(|| table.column(default).map(|_| default.to_string()))
+                .as_deref()
+                .map(|t| compile(what, t, &table, &mut derived_cols, c))
+                .transpose()
+        };
+        let time = expr("--time", mapping.time.clone(), "t_s", &[])?;
+        let velocity = expr("--velocity", Some(mapping.velocity.clone()), "", coeffs)?
+            .expect("the velocity is always given");
+        let friction = expr("--friction", Some(mapping.friction.clone()), "", coeffs)?
+            .expect("the friction is always given");
+        let load = expr("--load", mapping.load.clone(), "load_n", coeffs)?;
+        let temperature = expr(
+            "--temperature",
+            mapping.temperature.clone(),
+            "temperature_c",
             coeffs,
         )?;
-        let friction = compile(
-            "--friction",
-            &mapping.friction,
-            &table,
-            &mut derived_cols,
-            coeffs,
-        )?;
-        let load_text = mapping
-            .load
-            .clone()
-            .or_else(|| table.column("load_n").map(|_| "load_n".to_string()));
-        let load = load_text
-            .as_deref()
-            .map(|t| compile("--load", t, &table, &mut derived_cols, coeffs))
-            .transpose()?;
-        let temp_text = mapping.temperature.clone().or_else(|| {
-            table
-                .column("temperature_c")
-                .map(|_| "temperature_c".to_string())
-        });
-        let temperature = temp_text
-            .as_deref()
-            .map(|t| compile("--temperature", t, &table, &mut derived_cols, coeffs))
-            .transpose()?;
         let name = table.source.display().to_string();
         let mut s = Source {
             steady: time.is_none(),
@@ -184,53 +163,72 @@ impl Source {
             times: Vec::new(),
         };
         let t = s.compute_times()?;
-        if !derived_cols.is_empty() {
-            if s.steady {
-                return Err(FitError::Expression {
-                    what: "ddt()".into(),
-                    text: derived_cols[0].1.clone(),
-                    message: "a steady curve has no time to differentiate over".into(),
-                });
-            }
-            let span = t.last().copied().unwrap_or(0.0) - t[0];
-            if t.len() < 5 || span < 2.0 * mapping.smooth_s {
-                return Err(FitError::Data {
-                    what: s.name.clone(),
-                    message: format!(
-                        "ddt() needs at least 5 samples over twice the smoothing window ({} s); the data has {} over {span} s",
-                        2.0 * mapping.smooth_s,
-                        t.len()
-                    ),
-                });
-            }
-            // In order: a nested ddt reads a derived column made before it.
-            for (id, col) in derived_cols {
-                let y = match s.table.column(&col) {
-                    Some(y) => y.to_vec(),
-                    None => s
-                        .derived
-                        .iter()
-                        .find(|(d, _)| *d == col)
-                        .map(|(_, y)| y.clone())
-                        .expect("checked when compiled"),
-                };
-                s.derived.push((id, derivative(&t, &y, mapping.smooth_s)));
-            }
-        }
+        s.derive_columns(derived_cols, &t, mapping.smooth_s)?;
         s.times = t;
-        // Resolve every expression's variables; those that read no map
-        // coefficient are evaluated once, here.
+        s.resolve_variables();
+        let c0: Vec<f64> = coeffs.iter().map(|(_, v)| *v).collect();
+        s.precompute(&c0)?;
+        Ok(s)
+    }
+
+    /// The `ddt` columns the expressions read, in order (a nested ddt reads
+    /// a derived column made before it), over the times `t`.
+    fn derive_columns(
+        &mut self,
+        derived_cols: Vec<(String, String)>,
+        t: &[f64],
+        smooth_s: f64,
+    ) -> Result<(), FitError> {
+        let Some((_, first)) = derived_cols.first() else {
+            return Ok(());
+        };
+        if self.steady {
+            return Err(FitError::Expression {
+                what: "ddt()".into(),
+                text: first.clone(),
+                message: "a steady curve has no time to differentiate over".into(),
+            });
+        }
+        let span = t.last().copied().unwrap_or(0.0) - t[0];
+        if t.len() < 5 || span < 2.0 * smooth_s {
+            return Err(FitError::Data {
+                what: self.name.clone(),
+                message: format!(
+                    "ddt() needs at least 5 samples over twice the smoothing window ({} s); the data has {} over {span} s",
+                    2.0 * smooth_s,
+                    t.len()
+                ),
+            });
+        }
+        for (id, col) in derived_cols {
+            let y = match self.table.column(&col) {
+                Some(y) => y.to_vec(),
+                None => self
+                    .derived
+                    .iter()
+                    .find(|(d, _)| *d == col)
+                    .map(|(_, y)| y.clone())
+                    .expect("checked when compiled"),
+            };
+            self.derived.push((id, derivative(t, &y, smooth_s)));
+        }
+        Ok(())
+    }
+
+    /// Every expression's variables resolved to a column, a derived column
+    /// or a map coefficient.
+    fn resolve_variables(&mut self) {
         let resolve = |e: &Expr| -> Vec<(String, Var)> {
             e.node
                 .iter_variable_identifiers()
                 .map(|id| {
-                    let var = if let Some(i) = s.table.names.iter().position(|n| n == id) {
+                    let var = if let Some(i) = self.table.names.iter().position(|n| n == id) {
                         Var::Column(i)
-                    } else if let Some(i) = s.derived.iter().position(|(n, _)| n == id) {
+                    } else if let Some(i) = self.derived.iter().position(|(n, _)| n == id) {
                         Var::Derived(i)
                     } else {
                         Var::Coefficient(
-                            s.coefficients
+                            self.coefficients
                                 .iter()
                                 .position(|c| c == id)
                                 .expect("checked when compiled"),
@@ -240,24 +238,23 @@ impl Source {
                 })
                 .collect()
         };
-        let vars: Vec<Vec<(String, Var)>> = [
-            Some(&s.velocity),
-            Some(&s.friction),
-            s.load.as_ref(),
-            s.temperature.as_ref(),
-        ]
-        .into_iter()
-        .map(|e| e.map(resolve).unwrap_or_default())
-        .collect();
-        let mut vars = vars.into_iter();
-        s.velocity.vars = vars.next().unwrap_or_default();
-        s.friction.vars = vars.next().unwrap_or_default();
-        if let Some(e) = s.load.as_mut() {
-            e.vars = vars.next().unwrap_or_default();
+        let velocity = resolve(&self.velocity);
+        let friction = resolve(&self.friction);
+        let load = self.load.as_ref().map(resolve);
+        let temperature = self.temperature.as_ref().map(resolve);
+        self.velocity.vars = velocity;
+        self.friction.vars = friction;
+        if let (Some(e), Some(v)) = (self.load.as_mut(), load) {
+            e.vars = v;
         }
-        if let Some(e) = s.temperature.as_mut() {
-            e.vars = vars.next().unwrap_or_default();
+        if let (Some(e), Some(v)) = (self.temperature.as_mut(), temperature) {
+            e.vars = v;
         }
+    }
+
+    /// Expressions that read no map coefficient evaluated once, and each
+    /// expression's affine fast path at the starting coefficients `c0`.
+    fn precompute(&mut self, c0: &[f64]) -> Result<(), FitError> {
         let fixed = |s: &Source, e: &Expr, what: &str| -> Result<Option<Vec<f64>>, FitError> {
             if e.reads_coefficients() {
                 Ok(None)
@@ -265,28 +262,31 @@ impl Source {
                 s.eval_column(e, what, &[]).map(Some)
             }
         };
-        s.velocity.fixed = fixed(&s, &s.velocity, "--velocity")?;
-        s.friction.fixed = fixed(&s, &s.friction, "--friction")?;
-        if let Some(e) = &s.load {
-            let f = fixed(&s, e, "--load")?;
-            s.load.as_mut().expect("some").fixed = f;
+        let velocity = (
+            fixed(self, &self.velocity, "--velocity")?,
+            self.affine(&self.velocity, c0),
+        );
+        let friction = (
+            fixed(self, &self.friction, "--friction")?,
+            self.affine(&self.friction, c0),
+        );
+        let load = match &self.load {
+            Some(e) => Some((fixed(self, e, "--load")?, self.affine(e, c0))),
+            None => None,
+        };
+        let temperature = match &self.temperature {
+            Some(e) => Some((fixed(self, e, "--temperature")?, self.affine(e, c0))),
+            None => None,
+        };
+        (self.velocity.fixed, self.velocity.affine) = velocity;
+        (self.friction.fixed, self.friction.affine) = friction;
+        if let (Some(e), Some((f, a))) = (self.load.as_mut(), load) {
+            (e.fixed, e.affine) = (f, a);
         }
-        if let Some(e) = &s.temperature {
-            let f = fixed(&s, e, "--temperature")?;
-            s.temperature.as_mut().expect("some").fixed = f;
+        if let (Some(e), Some((f, a))) = (self.temperature.as_mut(), temperature) {
+            (e.fixed, e.affine) = (f, a);
         }
-        let c0: Vec<f64> = coeffs.iter().map(|(_, v)| *v).collect();
-        s.velocity.affine = s.affine(&s.velocity, &c0);
-        s.friction.affine = s.affine(&s.friction, &c0);
-        if let Some(e) = &s.load {
-            let a = s.affine(e, &c0);
-            s.load.as_mut().expect("some").affine = a;
-        }
-        if let Some(e) = &s.temperature {
-            let a = s.affine(e, &c0);
-            s.temperature.as_mut().expect("some").affine = a;
-        }
-        Ok(s)
+        Ok(())
     }
 
     /// The source's name (its file).
