@@ -4,7 +4,7 @@
 //! |---|---|---|
 //! | `friction_loop_area` | Σ over half-cycles (between velocity zero crossings) of the absolute enclosed area of the F_f–v loop | N·m/s |
 //! | `cof_loop_area` | the same for the COF–v loop | m/s |
-//! | `cof_v0_accelerating`, `cof_v0_decelerating` | one-sided limits of the COF at v = 0: linear extrapolation from the two samples after (accelerating) or before (decelerating) each zero crossing, averaged over the crossings of the cycle | – |
+//! | `cof_v0_accelerating`, `cof_v0_decelerating` | one-sided limits of the COF at v = 0: linear extrapolation from the two samples after (accelerating) or before (decelerating) each zero crossing, averaged over the crossings of the cycle; the boundary rate's part of the COF, which is 0 at v = 0 and steep near it, is taken out before extrapolating | – |
 //! | `peak_cof`, `peak_cof_velocity` | maximum COF in the cycle and the velocity where it occurs | –, m/s |
 //! | `h0_min`, `h0_max` | range of the minimum separation | m |
 //! | `mean_asperity_share` | mean F_asp/F_ext | – |
@@ -29,6 +29,9 @@ pub struct LoopSample {
     pub friction: f64,
     /// Coefficient of friction.
     pub cof: f64,
+    /// The boundary rate's part of the COF (zero at v = 0; see
+    /// [`Estimate::boundary_rate_cof`]).
+    pub boundary_rate_cof: f64,
     /// Film thickness h0, m.
     pub h0: f64,
     /// F_asp / F_ext.
@@ -50,6 +53,7 @@ impl From<&Estimate> for LoopSample {
             velocity: e.velocity,
             friction: e.friction_force,
             cof: e.cof,
+            boundary_rate_cof: e.boundary_rate_cof,
             h0: e.h0,
             asperity_share: e.asperity_load_share,
             inertia_force: e.inertia_force,
@@ -299,7 +303,10 @@ pub fn one_cycle(
         if dv == 0.0 {
             return None;
         }
-        Some(s2.cof + (s2.cof - s1.cof) * (0.0 - s2.velocity) / dv)
+        // The boundary rate's part is exactly 0 at v = 0 and steep near it
+        // (asinh): only the smooth remainder is extrapolated.
+        let (c1, c2) = (s1.cof - s1.boundary_rate_cof, s2.cof - s2.boundary_rate_cof);
+        Some(c2 + (c2 - c1) * (0.0 - s2.velocity) / dv)
     };
     let mut acc = Vec::new();
     let mut dec = Vec::new();
@@ -451,6 +458,7 @@ mod tests {
             velocity: v,
             friction: cof * 100.0 * v.signum(),
             cof,
+            boundary_rate_cof: 0.0,
             h0,
             asperity_share: 0.5,
             inertia_force: 0.0,
@@ -569,6 +577,7 @@ mod collector_tests {
                     velocity: v,
                     friction: 100.0 * v + 10.0 * (t * 7.0).cos(),
                     cof: 0.1 + 0.01 * v.abs(),
+                    boundary_rate_cof: 0.0,
                     h0: 1e-5 + 1e-6 * v,
                     asperity_share: 0.5,
                     inertia_force: 1e-3 * v,

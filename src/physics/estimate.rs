@@ -141,8 +141,15 @@ pub struct Estimate {
     pub friction_force: f64,
     /// The contact's friction alone (viscous + boundary, through the pre-sliding compliance when on), N.
     pub contact_friction_force: f64,
-    /// Coefficient of friction (|F_visc| + μ_bl F_asp) / F_ext.
+    /// Coefficient of friction: the magnitude of the friction the contact
+    /// transmits per unit load. Rigid contact (the paper's):
+    /// (|F_visc| + μ F_asp) / F_ext, μ = μ_bl + μ_r asinh(|v|/v_a); with
+    /// pre-sliding: |F_contact| / F_ext, the bristle's force (the drivetrain's
+    /// terms are not the contact's and are not in it).
     pub cof: f64,
+    /// The boundary rate's part of `cof`, μ_r asinh(|v|/v_a) F_asp / F_ext
+    /// (0 when the rate term is off, and with pre-sliding); zero at v = 0.
+    pub boundary_rate_cof: f64,
     /// F_asp / F_ext.
     pub asperity_load_share: f64,
     /// Inertia force m ḧ0 of the slider, N.

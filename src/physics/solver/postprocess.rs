@@ -85,6 +85,42 @@ fn shear_per_cell(d: &Disc, h0: f64, v: f64, p: &[f64], rho: &mut [f64], mu: &mu
     }
 }
 
+/// The coefficient of friction: the magnitude of the friction force the
+/// contact transmits, per unit load, and the boundary rate's part of it.
+///
+/// - Rigid contact (the paper's): the contact always slides, so it transmits
+///   its sliding friction (|F_visc| + μ(v) F_asp) / F_ext, with
+///   μ(v) = μ_bl + μ_r asinh(|v|/v_a); the sign's regularisation is a
+///   numerical device and is not applied to it.
+/// - With pre-sliding the contact transmits the bristle's force:
+///   |σ0 z + σ1 ż| / F_ext. In steady sliding that is |L| / F_ext, the rigid
+///   value wherever the shear has the motion's sign; through a reversal it
+///   passes zero with the force, and at rest it is the force held.
+///
+/// The second value is μ_r asinh(|v|/v_a) F_asp / F_ext, the part of the
+/// COF that the boundary rate adds (0 when it is off, or with pre-sliding,
+/// where the bristle filters it): it vanishes at v = 0 with a slope that
+/// is steep at low speed, so the one-sided limits at v = 0 are taken
+/// without it.
+#[inline(always)]
+fn contact_cof(
+    d: &Disc,
+    v: f64,
+    (f_visc, f_asp, f_contact): (f64, f64, f64),
+    load: f64,
+) -> (f64, f64) {
+    if d.presliding.is_on() {
+        return (f_contact.abs() / load, 0.0);
+    }
+    if d.boundary_rate.is_on() {
+        let rate = d.boundary_rate.signed_term(v.abs()) * f_asp / load;
+        let mu = d.mu_bl + d.boundary_rate.signed_term(v.abs());
+        ((f_visc.abs() + mu * f_asp) / load, rate)
+    } else {
+        ((f_visc.abs() + d.mu_bl * f_asp) / load, 0.0)
+    }
+}
+
 impl Solver {
     // ------------------------------------------------------------------
     // Post-processing
@@ -241,12 +277,7 @@ impl Solver {
         } else {
             contact_friction + d.drivetrain.force(v, load, d.v_reg)
         };
-        let mu = if d.boundary_rate.is_on() {
-            d.mu_bl + d.boundary_rate.signed_term(v.abs())
-        } else {
-            d.mu_bl
-        };
-        let cof = (f_visc.abs() + mu * f_asp) / load;
+        let (cof, boundary_rate_cof) = contact_cof(d, v, (f_visc, f_asp, contact_friction), load);
         let share = f_asp / load;
         let load_residual = match ctx.gap {
             H0Mode::Balance => load_res,
@@ -268,6 +299,7 @@ impl Solver {
             friction_force: friction,
             contact_friction_force: contact_friction,
             cof,
+            boundary_rate_cof,
             asperity_load_share: share,
             inertia_force: inertia,
             contact_area_ratio: sum_area / n as f64,

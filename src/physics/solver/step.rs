@@ -131,6 +131,7 @@ impl Solver {
             friction_force: 0.0,
             contact_friction_force: 0.0,
             cof: 0.0,
+            boundary_rate_cof: 0.0,
             asperity_load_share: 0.0,
             inertia_force: 0.0,
             contact_area_ratio: 0.0,
