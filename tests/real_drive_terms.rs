@@ -370,3 +370,39 @@ fn fitting_a_presliding_key_on_data_without_a_reversal_warns_that_it_cannot_be_i
         "{err}"
     );
 }
+
+#[test]
+fn a_stiff_bristle_is_the_rigid_contact_without_sign_regularisation() {
+    // The documented relation of `contact.sign_regularization_m_s` and the
+    // bristle: the bristle's level takes the exact sign, so a stiff one
+    // meets the rigid contact as v_reg → 0, not at the default v_reg.
+    // σ0 = 1e15 N/m: the reversal takes 2L/σ0 ≈ 1e-11 m, far within the
+    // first step's travel after it (≈ 6e-9 m at 1 mm/s, 1 kHz).
+    let stiff = run(
+        &config(&["contact.presliding_stiffness_n_m=1e15"]),
+        1e-3,
+        1000,
+    );
+    let sharp = run(
+        &config(&["contact.sign_regularization_m_s=1e-8"]),
+        1e-3,
+        1000,
+    );
+    let smooth = run(
+        &config(&["contact.sign_regularization_m_s=3e-4"]),
+        1e-3,
+        1000,
+    );
+    let mut worst_smooth: f64 = 0.0;
+    for ((a, b), c) in stiff.iter().zip(&sharp).zip(&smooth) {
+        if a.0.abs() < 1e-6 {
+            continue; // at rest the bristle holds its force; the rigid contact has none
+        }
+        assert_relative_eq!(a.1, b.1, max_relative = 1e-6);
+        worst_smooth = worst_smooth.max(((a.1 - c.1) / a.1).abs());
+    }
+    assert!(
+        worst_smooth > 0.1,
+        "v_reg = 3e-4 smooths a 1 mm/s motion visibly: {worst_smooth}"
+    );
+}

@@ -32,14 +32,17 @@ pub struct ContactConfig {
     /// `contact.boundary_activation_speed_m_s`: v_a, below it the rate term grows linearly with
     /// speed, above it logarithmically — range (1e-12, 100]
     pub boundary_activation_speed_m_s: f64,
-    /// `contact.sign_regularization_m_s`: v_reg in tanh(v/v_reg) for the asperity friction sign —
+    /// `contact.sign_regularization_m_s`: v_reg in tanh(v/v_reg) for the rigid contact's and the
+    /// drivetrain's friction sign; with pre-sliding on, the bristle (exact sign) shapes the
+    /// contact's reversal instead, so a stiff bristle reaches the rigid result as v_reg → 0 —
     /// range (1e-9, 1]
     pub sign_regularization_m_s: f64,
     /// `contact.min_film_m`: optional floor on h0; 0 = off (the paper uses sigma) — range [0, 1 mm]
     pub min_film_m: f64,
     /// Pre-sliding (tangential) stiffness σ0 of the contact, N/m; 0: rigid.
     pub presliding_stiffness_n_m: f64,
-    /// Damping σ1 of the pre-sliding displacement, N·s/m.
+    /// Damping σ1 of the pre-sliding displacement, N·s/m; the force it adds never carries |F|
+    /// past the sliding level.
     pub presliding_damping_n_s_m: f64,
     /// Soft contact: the width follows (F/F_ref)^κ; 0 = rigid.
     pub width_load_exponent: f64,
