@@ -165,6 +165,11 @@ pub fn source_residuals(train: &[SeriesFit], validate: &[SeriesFit]) -> Vec<Sour
     out
 }
 
+/// A force in significant digits (any scale: N, N·m, mN).
+fn force_cell(v: Option<f64>) -> String {
+    v.map_or("–".into(), super::report::sig)
+}
+
 fn cell(v: Option<f64>, scale: f64, digits: usize) -> String {
     v.map_or("–".into(), |x| format!("{:.*}", digits, x * scale))
 }
@@ -195,10 +200,10 @@ pub fn direction_table(o: &FitOutcome) -> String {
                 r.role,
                 g.samples,
                 cell(g.mean_speed_m_s(), 1e3, 2),
-                cell(g.measured_mean_n(), 1.0, 3),
-                cell(g.predicted_mean_n(), 1.0, 3),
-                cell(g.bias_n(), 1.0, 3),
-                cell(g.rms_n(), 1.0, 3),
+                force_cell(g.measured_mean_n()),
+                force_cell(g.predicted_mean_n()),
+                force_cell(g.bias_n()),
+                force_cell(g.rms_n()),
             );
         }
     }
@@ -239,14 +244,14 @@ pub fn models_direction_table(models: &[&FitOutcome]) -> String {
             "| {} | {} | {} / {} |",
             short(&r.source),
             r.role,
-            cell(r.forward.measured_mean_n(), 1.0, 2),
-            cell(r.backward.measured_mean_n(), 1.0, 2)
+            force_cell(r.forward.measured_mean_n()),
+            force_cell(r.backward.measured_mean_n())
         );
         for m in &rows {
             let (level, offset) = m
                 .get(i)
                 .map_or((None, None), |x| (x.level_error_n(), x.offset_error_n()));
-            let _ = write!(s, " {} / {} |", cell(level, 1.0, 3), cell(offset, 1.0, 3));
+            let _ = write!(s, " {} / {} |", force_cell(level), force_cell(offset));
         }
         s.push('\n');
     }

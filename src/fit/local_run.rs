@@ -158,6 +158,8 @@ fn termination_text(t: &TerminationReason) -> String {
             format!("converged to machine precision ({w})")
         }
         TerminationReason::LostPatience => "not converged: evaluation limit reached".into(),
+        // Our residuals and Jacobian return None only when a stop is asked.
+        TerminationReason::User(_) => "stopped on request".into(),
         other => format!("not converged: {other:?}"),
     }
 }

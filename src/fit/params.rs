@@ -215,7 +215,7 @@ impl ConfigKeys {
         } else {
             None
         };
-        let start = spec.start.or(data_start).unwrap_or(current);
+        let implied = spec.start.or(data_start).unwrap_or(current);
         let (lo, hi) = match spec.bounds {
             Some((lo, hi)) => {
                 check_bounds(key, lo, hi)?;
@@ -227,20 +227,16 @@ impl ConfigKeys {
                 }
                 (lo, hi)
             }
-            None => self.default_bounds(key, start, scale)?,
+            None => self.default_bounds(key, implied, scale)?,
         };
+        let start = start_within(spec, implied, (lo, hi));
         if let Some(s) = spec.start {
             self.valid(key, s).map_err(|e| FitError::Key {
                 key: key.into(),
                 message: format!("--start {s} is not valid: {e}"),
             })?;
         }
-        if !(lo..=hi).contains(&start) {
-            return Err(FitError::Bounds {
-                key: key.into(),
-                message: format!("the start {start} lies outside [{lo}, {hi}]"),
-            });
-        }
+        check_start(key, start, (lo, hi))?;
         Ok(FittedParameter::new(key, start, lo, hi))
     }
 
@@ -291,7 +287,9 @@ impl ConfigKeys {
             Some(h) if h > 0.0 && h.is_finite() => Ok((0.0, h)),
             _ => Err(FitError::Bounds {
                 key: key.into(),
-                message: format!("starts at {start}: give its range with --bounds {key}=LO:HI"),
+                message: format!(
+                    "starts at {start}: give its range with --bounds {key}=LO:HI (the fit then starts inside it; --start {key}=V to choose where)"
+                ),
             }),
         }
     }
@@ -318,29 +316,53 @@ pub fn check_bounds(key: &str, lo: f64, hi: f64) -> Result<(), FitError> {
 /// start, a decade either side.
 pub fn map_parameter(spec: &ParamSpec, map_start: f64) -> Result<FittedParameter, FitError> {
     let key = spec.name.as_str();
-    let start = spec.start.unwrap_or(map_start);
+    let implied = spec.start.unwrap_or(map_start);
     let (lo, hi) = match spec.bounds {
         Some((lo, hi)) => {
             check_bounds(key, lo, hi)?;
             (lo, hi)
         }
-        None if start > 0.0 => (start / 10.0, start * 10.0),
+        None if implied > 0.0 => (implied / 10.0, implied * 10.0),
         None => {
+            let start = implied;
             return Err(FitError::Bounds {
                 key: key.into(),
                 message: format!(
-                "the map coefficient starts at {start}: give its range with --bounds {key}=LO:HI"
+                "the map coefficient starts at {start}: give its range with --bounds {key}=LO:HI (the fit then starts inside it; --start {key}=V to choose where)"
             ),
-            })
+            });
         }
     };
-    if !(lo..=hi).contains(&start) {
-        return Err(FitError::Bounds {
-            key: key.into(),
-            message: format!("the start {start} lies outside [{lo}, {hi}]"),
-        });
-    }
+    let start = start_within(spec, implied, (lo, hi));
+    check_start(key, start, (lo, hi))?;
     Ok(FittedParameter::new(key, start, lo, hi))
+}
+
+/// The start of a fitted parameter: the `--start` given, else the start
+/// the configuration (or the data) implies when it lies within the bounds,
+/// else a point inside them: their geometric mean when both are positive
+/// (scale parameters), their midpoint otherwise. So `--bounds` alone is
+/// enough for a key that is off (0) by default.
+fn start_within(spec: &ParamSpec, implied: f64, (lo, hi): (f64, f64)) -> f64 {
+    match spec.start {
+        Some(s) => s,
+        None if (lo..=hi).contains(&implied) => implied,
+        None if lo > 0.0 => (lo * hi).sqrt(),
+        None => 0.5 * (lo + hi),
+    }
+}
+
+/// An explicit start must lie within the bounds.
+fn check_start(key: &str, start: f64, (lo, hi): (f64, f64)) -> Result<(), FitError> {
+    if (lo..=hi).contains(&start) {
+        return Ok(());
+    }
+    Err(FitError::Bounds {
+        key: key.into(),
+        message: format!(
+            "--start {start} lies outside [{lo}, {hi}] (give a start inside --bounds {key}=LO:HI, or leave --start out to start inside them)"
+        ),
+    })
 }
 
 #[cfg(test)]
@@ -442,5 +464,39 @@ mod tests {
         assert!(m.contains("outside [0.1, 1]"), "{m}");
         let m = map_parameter(&spec("c0"), 0.0).unwrap_err().to_string();
         assert!(m.contains("--bounds c0=LO:HI"), "{m}");
+    }
+
+    #[test]
+    fn following_the_advice_for_a_key_at_zero_gives_a_fit_that_starts_inside_the_bounds() {
+        // A key off by default with no data scale: the advice names --bounds.
+        let keys = ConfigKeys::new(&Config::default());
+        let m = keys
+            .parameter(&spec("contact.min_film_m"), &SCALE)
+            .unwrap_err()
+            .to_string();
+        assert!(m.contains("--bounds contact.min_film_m=LO:HI"), "{m}");
+        // Doing exactly that works (before: "the start 0 lies outside").
+        let p = keys
+            .parameter(
+                &ParamSpec {
+                    bounds: Some((1e-7, 1e-5)),
+                    ..spec("contact.min_film_m")
+                },
+                &SCALE,
+            )
+            .unwrap();
+        assert_relative_eq!(p.start, 1e-6, max_relative = 1e-12);
+        // The same for a map coefficient, and a bound through zero starts mid-way.
+        let c = |lo, hi| {
+            map_parameter(
+                &ParamSpec {
+                    bounds: Some((lo, hi)),
+                    ..spec("c0")
+                },
+                0.0,
+            )
+        };
+        assert_eq!(c(-2.0, 4.0).unwrap().start, 0.0);
+        assert_relative_eq!(c(1.0, 100.0).unwrap().start, 10.0, max_relative = 1e-12);
     }
 }

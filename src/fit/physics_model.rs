@@ -1,8 +1,13 @@
 //! Our model as a predictor: the configuration with the fitted keys set,
 //! run over a series.
 //!
-//! - A time series is simulated from the steady state of its first sample
-//!   (as `simulate` does) on the solver's fixed step `solver.dt_s`; the
+//! - A time series is simulated on the solver's fixed step `solver.dt_s`
+//!   from the state its start implies: a series that starts at rest (its
+//!   first speed within two sample intervals' change of zero) starts, as
+//!   `simulate` does, from the steady state at rest one sample interval
+//!   before its first sample, the velocity ramped from 0 to the first
+//!   sample's (film at rest, pre-sliding bristle undeflected); any other
+//!   from the steady state of its first sample (steady sliding). The
 //!   inputs (velocity, load, temperature) are interpolated linearly between
 //!   samples, and the friction is read at the sample times by linear
 //!   interpolation between steps. With `lubricant.viscosity_model: vogel`
@@ -103,12 +108,62 @@ fn viscosity(law: &ViscosityLaw, t_c: f64) -> Result<f64, String> {
     law.viscosity_at(t_c).map_err(|e| e.to_string())
 }
 
+/// Where a simulated series starts (see the module documentation).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Start {
+    /// The time the simulation starts, s.
+    t: f64,
+    /// The first sample's time and velocity, s and m/s.
+    first: (f64, f64),
+    /// Whether it starts at rest (one sample interval before the first sample).
+    at_rest: bool,
+}
+
+impl Start {
+    fn of(s: &Series) -> Self {
+        let (t, v) = (&s.t, &s.velocity);
+        let first = (t[0], v[0]);
+        let at_rest =
+            v[0] == 0.0 || (t.len() >= 2 && t[1] > t[0] && v[0].abs() <= 2.0 * (v[1] - v[0]).abs());
+        let start = if at_rest && t.len() >= 2 {
+            t[0] - (t[1] - t[0])
+        } else {
+            t[0]
+        };
+        Self {
+            t: start,
+            first,
+            at_rest,
+        }
+    }
+
+    /// The steady velocity the solver starts from, m/s.
+    fn initial_velocity(&self) -> f64 {
+        if self.at_rest {
+            0.0
+        } else {
+            self.first.1
+        }
+    }
+
+    /// The velocity at `t`: ramped from rest before the first sample.
+    fn velocity(&self, t: f64, v_at: &mut Cursor) -> f64 {
+        let (t1, v1) = self.first;
+        if self.at_rest && t < t1 {
+            v1 * ((t - self.t) / (t1 - self.t)).clamp(0.0, 1.0)
+        } else {
+            v_at.at(t)
+        }
+    }
+}
+
 fn transient(config: &Config, s: &Series) -> Result<Vec<f64>, String> {
     let settings = config.solver_settings();
     let dt = settings.dt;
     let mut solver = Solver::new(&config.model(), &settings).map_err(|e| e.to_string())?;
     let n = s.len();
-    let t0 = s.t[0];
+    let start = Start::of(s);
+    let t0 = start.t;
     let steps = ((s.t[n - 1] - t0) / dt).ceil() as u64;
     let default_load = vec![config.contact.load_n; n];
     let load = s.load.as_deref().unwrap_or(&default_load);
@@ -121,11 +176,14 @@ fn transient(config: &Config, s: &Series) -> Result<Vec<f64>, String> {
         let temp = temp_at.as_mut().expect("follows").at(t0);
         solver.set_liquid_viscosity(viscosity(&law, temp)?);
     }
-    let first = solver.initialize_steady(v_at.at(t0), f_at.at(t0));
+    let first = solver.initialize_steady(start.initial_velocity(), f_at.at(t0));
     let mut out = vec![f64::NAN; n];
-    out[0] = first.friction_force;
     let (mut t_prev, mut f_prev) = (t0, first.friction_force);
-    let mut k = 1;
+    let mut k = 0;
+    if !start.at_rest {
+        out[0] = first.friction_force;
+        k = 1;
+    }
     // Parameters that make the inputs unreachable (a load the contact cannot
     // carry) leave the solver at its iteration bound step after step, each
     // at the cost of its fallbacks: such a run is no prediction.
@@ -137,7 +195,7 @@ fn transient(config: &Config, s: &Series) -> Result<Vec<f64>, String> {
             let temp = temp_at.as_mut().expect("follows").at(t);
             solver.set_liquid_viscosity(viscosity(&law, temp)?);
         }
-        let e = solver.step(v_at.at(t), f_at.at(t));
+        let e = solver.step(start.velocity(t, &mut v_at), f_at.at(t));
         if !e.friction_force.is_finite()
             || !matches!(e.status, Status::Converged | Status::MaxIterations)
         {
@@ -229,6 +287,44 @@ mod tests {
             let e = solver.step(v[k], config.contact.load_n);
             assert_relative_eq!(got[k], e.friction_force, max_relative = 1e-9);
         }
+    }
+
+    #[test]
+    fn a_series_that_starts_at_rest_is_predicted_as_simulate_ran_it() {
+        // simulate starts at rest at t = 0 and writes its first row at t = dt:
+        // with the bristle on, a start in steady sliding would begin it fully
+        // deflected (the biased fit).
+        let mut config = Config::default();
+        config.solver.cells = 32;
+        config.contact.presliding_stiffness_n_m = 5e7;
+        let dt = config.solver.dt_s;
+        let mut solver = Solver::new(&config.model(), &config.solver_settings()).unwrap();
+        solver.initialize_steady(0.0, config.contact.load_n);
+        let (mut t, mut v, mut f) = (Vec::new(), Vec::new(), Vec::new());
+        for k in 1..=300 {
+            let tk = k as f64 * dt;
+            let vk = 0.05 * (std::f64::consts::TAU * tk).sin();
+            f.push(solver.step(vk, config.contact.load_n).friction_force);
+            t.push(tk);
+            v.push(vk);
+        }
+        let s = series(t, v, false);
+        assert!(Start::of(&s).at_rest);
+        let got = transient(&config, &s).unwrap();
+        for (g, e) in got.iter().zip(&f) {
+            assert_relative_eq!(g, e, max_relative = 1e-9);
+        }
+    }
+
+    #[test]
+    fn a_series_in_motion_starts_in_steady_sliding_and_one_at_zero_speed_at_rest() {
+        let moving = series(vec![0.0, 1e-3, 2e-3], vec![0.05, 0.0502, 0.0504], false);
+        assert!(!Start::of(&moving).at_rest);
+        assert_eq!(Start::of(&moving).t, 0.0);
+        let resting = series(vec![1.0, 1.001], vec![0.0, 0.0], false);
+        let start = Start::of(&resting);
+        assert!(start.at_rest);
+        assert_relative_eq!(start.t, 0.999, max_relative = 1e-12);
     }
 
     #[test]

@@ -27,13 +27,7 @@ pub fn parameter_table(o: &FitOutcome) -> String {
     );
     for (j, p) in o.params.iter().enumerate() {
         let st = &o.statistics;
-        let flag = if st.at_bound[j] {
-            "at a bound"
-        } else if !st.standard_error[j].is_finite() {
-            "not identifiable"
-        } else {
-            ""
-        };
+        let flag = parameter_flag(st.at_bound[j], o.best[j], st.standard_error[j]);
         let _ = writeln!(
             s,
             "| `{}` | {} | {} | [{}, {}] | [{}, {}]{} | {flag} |",
@@ -48,6 +42,22 @@ pub fn parameter_table(o: &FitOutcome) -> String {
         );
     }
     s
+}
+
+/// What a parameter's row warns of: at a bound; not identifiable (no
+/// finite standard error); or poorly identified, a standard error as large
+/// as the value itself (the 95 % interval then spans zero, or the whole
+/// bounds: the data hardly constrain it).
+fn parameter_flag(at_bound: bool, value: f64, standard_error: f64) -> &'static str {
+    if at_bound {
+        "at a bound"
+    } else if !standard_error.is_finite() {
+        "not identifiable"
+    } else if standard_error > 0.0 && standard_error >= value.abs() {
+        "poorly identified (std. error ≥ |value|)"
+    } else {
+        ""
+    }
 }
 
 /// The correlation matrix with pairs above the flag named.
@@ -106,17 +116,20 @@ pub fn optima_table(o: &FitOutcome) -> String {
 /// Residual summary lines.
 pub fn residual_lines(o: &FitOutcome) -> String {
     let mut s = format!(
-        "training RMS {:.4} N, max |residual| {:.4} N (σ = {:.4} N)\n",
-        o.train_rms, o.train_max, o.statistics.sigma
+        "training RMS {} N, max |residual| {} N (σ = {} N)\n",
+        sig(o.train_rms),
+        sig(o.train_max),
+        sig(o.statistics.sigma)
     );
     if let Some(h) = o.holdout_rms {
         let _ = writeln!(
             s,
-            "held-out RMS {h:.4} N (held-out part of the training data)"
+            "held-out RMS {} N (held-out part of the training data)",
+            sig(h)
         );
     }
     if let Some(v) = o.validate_rms {
-        let _ = writeln!(s, "validation RMS {v:.4} N (--validate data)");
+        let _ = writeln!(s, "validation RMS {} N (--validate data)", sig(v));
     }
     if let Some(why) = &o.validate_failure {
         let _ = writeln!(s, "no prediction on the --validate data: {why}");
@@ -189,7 +202,7 @@ pub fn models_table(rows: &[ModelRow], scale_n: f64) -> String {
             .collect();
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {:.4} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} |",
             r.label,
             r.parameters.len(),
             params.join(", "),
@@ -198,9 +211,9 @@ pub fn models_table(rows: &[ModelRow], scale_n: f64) -> String {
             } else {
                 format!("NOT converged: {}", r.termination.replace('|', "/"))
             },
-            r.train_rms,
+            sig(r.train_rms),
             match (&r.held_out_rms, &r.held_out_failure) {
-                (Some(h), _) => format!("{h:.4}"),
+                (Some(h), _) => sig(*h),
                 (None, Some(why)) => format!("none: {}", why.replace('|', "/")),
                 (None, None) => "–".into(),
             },
@@ -229,6 +242,17 @@ pub fn models_section(ours: &FitOutcome, classic: &[FitOutcome]) -> String {
     )
 }
 
+/// Five significant digits, as text: a joint's friction in N·m or a lead
+/// screw's in N keeps its digits whatever its scale (0.00071234, not 0.0007).
+pub fn sig(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let e = v.abs().log10().floor() as i32 - 4;
+    let m = 10f64.powi(-e);
+    Num((v * m).round() / m).to_string()
+}
+
 /// Four significant digits.
 fn round4(v: f64) -> f64 {
     if v == 0.0 || !v.is_finite() {
@@ -249,16 +273,16 @@ pub fn fitted_yaml(
     map: &[(String, f64)],
 ) -> String {
     let mut s = format!(
-        "# Fitted by friction-node fit on {}\n# {} — training RMS {:.4} N{}\n",
+        "# Fitted by friction-node fit on {}\n# {} — training RMS {} N{}\n",
         sources.join(", "),
         if o.converged {
             "converged"
         } else {
             "NOT CONVERGED: the best point found"
         },
-        o.train_rms,
+        sig(o.train_rms),
         o.held_out_rms()
-            .map_or(String::new(), |h| format!(", held-out RMS {h:.4} N"))
+            .map_or(String::new(), |h| format!(", held-out RMS {} N", sig(h)))
     );
     for (j, p) in o.params.iter().enumerate() {
         let _ = writeln!(
@@ -570,4 +594,33 @@ pub fn slug(label: &str) -> String {
         .filter(|s| !s.is_empty())
         .collect::<Vec<_>>()
         .join("-")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_standard_error_that_dwarfs_its_value_is_flagged() {
+        // The case: σ = 2.7e-5 ± 6.5e-2 had an empty flag column.
+        assert!(parameter_flag(false, 2.7e-5, 6.5e-2).starts_with("poorly identified"));
+        assert_eq!(parameter_flag(false, 0.3, 0.001), "");
+        assert_eq!(
+            parameter_flag(false, 0.3, f64::INFINITY),
+            "not identifiable"
+        );
+        assert_eq!(parameter_flag(true, 0.3, 1.0), "at a bound");
+        assert_eq!(parameter_flag(false, 0.0, 0.0), "");
+    }
+
+    #[test]
+    fn small_errors_keep_their_significant_digits() {
+        // A joint's friction in N·m (before: "0.0007", "0.0000").
+        assert_eq!(sig(0.000_712_345), "7.1235e-4");
+        assert_eq!(sig(0.002_198_765), "0.0021988");
+        assert_eq!(sig(1.002_345_6), "1.0023");
+        assert_eq!(sig(7_290.123), "7290.1");
+        assert_eq!(sig(0.0), "0");
+        assert_eq!(sig(f64::NAN), "NaN");
+    }
 }

@@ -81,19 +81,19 @@ pub fn gaussian(rng: &mut StdRng, sd: f64) -> f64 {
     sd * (-2.0 * (1.0 - u).ln()).sqrt() * (std::f64::consts::TAU * v).cos()
 }
 
-/// Friction of the transient model configured by `config` along `motion`
-/// (from the steady state of the first sample, as `simulate` does).
+/// Friction of the transient model configured by `config` along `motion`,
+/// as `simulate` runs it: from the steady state at rest at t = 0 (the
+/// motion's first sample is at `dt`), one step per sample.
 pub fn model_friction(config: &Config, motion: &[Sample]) -> Result<Vec<f64>, SetupError> {
     let mut solver = Solver::new(&config.model(), &config.solver_settings())?;
-    let Some(&(_, v0, l0)) = motion.first() else {
+    let Some(&(_, _, l0)) = motion.first() else {
         return Ok(Vec::new());
     };
-    let mut f = Vec::with_capacity(motion.len());
-    f.push(solver.initialize_steady(v0, l0).friction_force);
-    for &(_, v, l) in &motion[1..] {
-        f.push(solver.step(v, l).friction_force);
-    }
-    Ok(f)
+    solver.initialize_steady(0.0, l0);
+    Ok(motion
+        .iter()
+        .map(|&(_, v, l)| solver.step(v, l).friction_force)
+        .collect())
 }
 
 /// `friction` plus white noise of `relative` times its RMS, as CSV text
