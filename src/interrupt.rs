@@ -6,8 +6,11 @@
 //! when dropped, so nothing half-written is left.
 //!
 //! The command line installs [`Stop::install_signal_handlers`]: the first
-//! SIGINT/SIGTERM requests the stop, a second one of either ends the
-//! process at once (exit 130/143; a temporary file may then stay behind).
+//! SIGINT/SIGTERM requests the stop, a second one of either removes the
+//! temporary files still registered ([`crate::output::remove_temporaries`],
+//! microseconds) and ends the process at once (exit 130/143). A stop that
+//! arrives after the work's last check still ends the command with its
+//! exit code (the command line checks once more before it exits 0).
 //! The real-time node has its own handlers (it finalises its recording).
 
 use std::sync::atomic::{AtomicBool, AtomicI32, Ordering};
@@ -68,6 +71,13 @@ impl Stop {
         self.flag.load(Ordering::Acquire)
     }
 
+    /// How a command that returned `Ok` ends: 0, or the stop's exit code
+    /// when a stop was requested after the work's last check (its outputs
+    /// are then complete, but the caller asked it to stop).
+    pub fn exit_code_on_success(&self) -> i32 {
+        self.check().err().map_or(0, |i| i.exit_code())
+    }
+
     /// `Err(Interrupted)` once a stop was requested.
     pub fn check(&self) -> Result<(), Interrupted> {
         if self.requested() {
@@ -79,22 +89,33 @@ impl Stop {
         }
     }
 
-    /// SIGINT and SIGTERM request this stop; a second one ends the process
-    /// at once with 128 + its number.
+    /// SIGINT and SIGTERM request this stop; a second one removes the
+    /// registered temporary files and ends the process at once with 128 +
+    /// its number. The signals are handled on a thread of their own (the
+    /// removal is not async-signal-safe work).
     pub fn install_signal_handlers(&self) -> std::io::Result<()> {
-        for sig in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
-            // A second signal: the stop was already requested, end now.
-            signal_hook::flag::register_conditional_shutdown(sig, 128 + sig, self.flag.clone())?;
-            let (flag, signal) = (self.flag.clone(), self.signal.clone());
-            // SAFETY: the action only stores to atomics (async-signal-safe).
-            unsafe {
-                signal_hook::low_level::register(sig, move || {
-                    signal.store(sig, Ordering::Relaxed);
-                    flag.store(true, Ordering::Release);
-                })?;
-            }
-        }
+        let mut signals = signal_hook::iterator::Signals::new([
+            signal_hook::consts::SIGINT,
+            signal_hook::consts::SIGTERM,
+        ])?;
+        let stop = self.clone();
+        std::thread::Builder::new()
+            .name("signals".into())
+            .spawn(move || {
+                for sig in signals.forever() {
+                    stop.on_signal(sig);
+                }
+            })?;
         Ok(())
+    }
+
+    /// The first signal requests the stop; a second one ends the process.
+    fn on_signal(&self, sig: i32) {
+        if self.requested() {
+            crate::output::remove_temporaries();
+            std::process::exit(128 + sig);
+        }
+        self.request(sig);
     }
 }
 
@@ -112,5 +133,16 @@ mod tests {
         assert_eq!(e.exit_code(), 143);
         assert!(e.to_string().contains("SIGTERM"), "{e}");
         assert_eq!(Interrupted { signal: 0 }.exit_code(), 130);
+    }
+
+    #[test]
+    fn a_stop_after_the_last_check_still_ends_the_command_with_its_code() {
+        let s = Stop::new();
+        assert_eq!(s.exit_code_on_success(), 0);
+        s.request(2);
+        assert_eq!(s.exit_code_on_success(), 130);
+        let t = Stop::new();
+        t.on_signal(15);
+        assert_eq!(t.exit_code_on_success(), 143);
     }
 }

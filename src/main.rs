@@ -94,7 +94,18 @@ fn main() {
         },
     };
     let allocations = || ALLOCATIONS.with(Cell::get);
-    if let Err(e) = cli::dispatch(cli, ros, &allocations) {
+    let result = cli::dispatch(cli, ros, &allocations);
+    let stop = friction_node::interrupt::Stop::process();
+    if result.is_ok() {
+        // A stop in the last moments (writing the outputs) still ends the
+        // command as the signal asked.
+        let code = stop.exit_code_on_success();
+        if code != 0 {
+            eprintln!("{}", stop.check().unwrap_err());
+            std::process::exit(code);
+        }
+    }
+    if let Err(e) = result {
         // Whatever error the stop surfaced as, an interrupted command exits
         // as the signal asked.
         if let Err(i) = friction_node::interrupt::Stop::process().check() {

@@ -17,6 +17,7 @@ use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Mutex;
 
 /// A file could not be written.
 #[derive(Debug, thiserror::Error)]
@@ -45,7 +46,36 @@ impl OutputError {
 
 static COUNTER: AtomicU64 = AtomicU64::new(0);
 
-/// A temporary sibling of `path`, unique within this process.
+/// Every temporary sibling handed out and not yet moved into place or
+/// removed: what [`remove_temporaries`] removes when the process must end
+/// at once (a second SIGINT/SIGTERM).
+static TEMPORARIES: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+fn temporaries() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
+    TEMPORARIES.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// The temporary `tmp` was moved into place or removed: forget it.
+pub fn forget_temporary(tmp: &Path) {
+    let mut t = temporaries();
+    if let Some(i) = t.iter().rposition(|p| p == tmp) {
+        t.swap_remove(i);
+    }
+}
+
+/// Remove every temporary sibling still registered (the names are unique
+/// to this process, so nothing else is touched); how many were removed.
+pub fn remove_temporaries() -> usize {
+    let mut t = temporaries();
+    let removed = t
+        .drain(..)
+        .filter(|p| std::fs::remove_file(p).is_ok())
+        .count();
+    removed
+}
+
+/// A temporary sibling of `path`, unique within this process, registered
+/// until [`forget_temporary`] (so that [`remove_temporaries`] finds it).
 pub fn tmp_sibling(path: &Path) -> PathBuf {
     let mut name = path
         .file_name()
@@ -56,7 +86,9 @@ pub fn tmp_sibling(path: &Path) -> PathBuf {
         std::process::id(),
         COUNTER.fetch_add(1, Ordering::Relaxed)
     ));
-    path.with_file_name(name)
+    let tmp = path.with_file_name(name);
+    temporaries().push(tmp.clone());
+    tmp
 }
 
 /// Whether `path` exists and is something other than a regular file or a
@@ -158,6 +190,7 @@ impl AtomicFile {
                 file.sync_all().map_err(err)?;
                 drop(file);
                 std::fs::rename(tmp, &path).map_err(err)?;
+                forget_temporary(tmp);
                 self.tmp = None;
             }
             None => {
@@ -174,7 +207,8 @@ impl Drop for AtomicFile {
     fn drop(&mut self) {
         if let Some(tmp) = self.tmp.take() {
             self.out = None;
-            let _ = std::fs::remove_file(tmp);
+            let _ = std::fs::remove_file(&tmp);
+            forget_temporary(&tmp);
         }
     }
 }
@@ -260,6 +294,15 @@ pub fn check_room(path: &Path, estimated: f64, what: &str) -> Result<Option<Stri
 
 /// Make sure `dir` exists and is writable (before any computation).
 pub fn prepare_dir(dir: &Path) -> Result<(), OutputError> {
+    prepare_output_dir(dir).map(OutputDir::keep)
+}
+
+/// Make sure `dir` exists and is writable, and remove it again if this
+/// call created it and nothing was written into it: the returned guard
+/// removes the directory when dropped while it is still empty, unless
+/// [`OutputDir::keep`] was called (work that failed or was interrupted
+/// leaves no empty folder behind).
+pub fn prepare_output_dir(dir: &Path) -> Result<OutputDir, OutputError> {
     let err = |source| OutputError::new(dir, source);
     if dir.exists() && !dir.is_dir() {
         return Err(err(std::io::Error::new(
@@ -267,11 +310,39 @@ pub fn prepare_dir(dir: &Path) -> Result<(), OutputError> {
             "exists and is not a directory",
         )));
     }
+    let created = !dir.exists();
     std::fs::create_dir_all(dir).map_err(err)?;
+    let guard = OutputDir {
+        path: created.then(|| dir.to_path_buf()),
+    };
     let probe = tmp_sibling(&dir.join(".write-test"));
     std::fs::write(&probe, b"").map_err(err)?;
     std::fs::remove_file(&probe).map_err(err)?;
-    Ok(())
+    forget_temporary(&probe);
+    Ok(guard)
+}
+
+/// An output directory made by [`prepare_output_dir`].
+#[derive(Debug)]
+pub struct OutputDir {
+    /// The directory when this process created it (removed when dropped empty).
+    path: Option<PathBuf>,
+}
+
+impl OutputDir {
+    /// Keep the directory whatever it holds.
+    pub fn keep(mut self) {
+        self.path = None;
+    }
+}
+
+impl Drop for OutputDir {
+    fn drop(&mut self) {
+        if let Some(p) = &self.path {
+            // remove_dir fails on a directory that is not empty: then it stays.
+            let _ = std::fs::remove_dir(p);
+        }
+    }
 }
 
 #[cfg(test)]

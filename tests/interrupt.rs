@@ -173,3 +173,76 @@ fn sigint_stops_a_fit_before_it_writes_anything() {
     assert_eq!(rc, Some(130), "{err}");
     assert_eq!(files(&d), vec![data], "only the data is there");
 }
+
+#[test]
+fn an_interrupted_fit_says_so_in_words_and_leaves_no_empty_report_folder() {
+    let d = dir("fit-report");
+    let data = d.join("data.csv");
+    let sim = Command::new(bin())
+        .args(["simulate", "--velocity", "sine:0,0.5,1", "--duration", "4"])
+        .args(["--set", "solver.cells=64", "--out"])
+        .arg(&data)
+        .output()
+        .unwrap();
+    assert!(sim.status.success());
+    let report = d.join("report");
+    let (rc, err) = interrupt(
+        &[
+            "fit",
+            data.to_str().unwrap(),
+            "--fit",
+            "contact.boundary_friction,roughness.sigma_m",
+            "--global-points",
+            "0",
+            "--starts",
+            "2",
+            "--out",
+            d.join("fitted.yaml").to_str().unwrap(),
+            "--report",
+            report.to_str().unwrap(),
+            "--set",
+            "solver.cells=2048",
+        ],
+        "parameter(s) on",
+        libc::SIGINT,
+    );
+    assert_eq!(rc, Some(130), "{err}");
+    assert!(!err.contains("User("), "no internal names: {err}");
+    assert!(!report.exists(), "the report folder it made is gone");
+    assert_eq!(files(&d), vec![data], "only the data is there");
+}
+
+#[test]
+fn a_second_signal_ends_at_once_and_still_removes_the_temporary_file() {
+    // Both signals arrive together (held while the process is stopped):
+    // the second ends the process at once, as a second Ctrl-C or
+    // `timeout -s INT` (which signals the whole group) does.
+    let d = dir("double");
+    let out = d.join("run.csv");
+    let mut child = Command::new(bin())
+        .args(["simulate", "--velocity", "const:0.1", "--duration", "300"])
+        .args(["--set", "solver.cells=8192", "--out"])
+        .arg(&out)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut lines = BufReader::new(child.stderr.take().unwrap()).lines();
+    for l in lines.by_ref() {
+        if l.unwrap().contains("simulate: velocity") {
+            break;
+        }
+    }
+    let pid = child.id() as i32;
+    // SAFETY: signalling our own child process.
+    unsafe {
+        assert_eq!(libc::kill(pid, libc::SIGSTOP), 0);
+        assert_eq!(libc::kill(pid, libc::SIGINT), 0);
+        assert_eq!(libc::kill(pid, libc::SIGTERM), 0);
+        assert_eq!(libc::kill(pid, libc::SIGCONT), 0);
+    }
+    let rest: Vec<String> = lines.map(|l| l.unwrap()).collect();
+    let rc = child.wait().unwrap().code();
+    assert!(matches!(rc, Some(130) | Some(143)), "{rc:?}: {rest:?}");
+    assert_eq!(files(&d), Vec::<PathBuf>::new(), "no temporary left behind");
+}

@@ -284,9 +284,13 @@ pub fn run(config: &Config, args: &FitArgs) -> Result<()> {
     // Outputs are checked before any computation.
     let out_probe = friction_node::output::AtomicFile::create(&args.out)?;
     drop(out_probe);
-    if let Some(r) = &args.report {
-        friction_node::output::prepare_dir(r)?;
-    }
+    // A report folder made here is removed again if the fit fails or is
+    // stopped before anything is written into it.
+    let report_dir = args
+        .report
+        .as_deref()
+        .map(friction_node::output::prepare_output_dir)
+        .transpose()?;
     let n_model = p.model.parameters_len();
     eprintln!(
         "fit: {} parameter(s) on {} file(s) ({} validation), {} local run(s), {} global points",
@@ -318,6 +322,9 @@ pub fn run(config: &Config, args: &FitArgs) -> Result<()> {
     if let Some(r) = &args.report {
         let files = report::write_models_report(r, &ours, &classic, &extra)?;
         eprintln!("fit: report in {} ({} files)", r.display(), files.len());
+    }
+    if let Some(d) = report_dir {
+        d.keep();
     }
     eprintln!("fit: wrote {}", args.out.display());
     if !ours.converged {

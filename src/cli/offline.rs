@@ -69,6 +69,8 @@ pub fn simulate(
         Ok(file.line(format_args!("{}", offline::simulate_row(e, t_c)))?)
     })?;
     bar.finish_and_clear();
+    // A stop after the last step: nothing is moved into place.
+    stop.check()?;
     let path = file.commit()?;
     print!("{report}");
     println!("wrote {} ({} rows)", path.display(), report.steps);

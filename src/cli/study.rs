@@ -70,6 +70,7 @@ pub fn run(
     let results = gather(&kinds, done)?;
     let compute_s = started.elapsed().as_secs_f64();
     let failed = write_studies(out, &results)?;
+    stop.check()?;
     write_claims(out, &results, config, &failed)?;
     println!(
         "done in {:.1} s ({:.1} s computing on {} threads)",

@@ -92,11 +92,14 @@ pub fn write(
         .and_then(|_| w.finish());
     match result {
         Ok(bytes) => {
-            std::fs::rename(&tmp, &path)?;
+            let moved = std::fs::rename(&tmp, &path);
+            crate::output::forget_temporary(&tmp);
+            moved?;
             Ok((path, span, bytes))
         }
         Err(e) => {
             let _ = std::fs::remove_file(&tmp);
+            crate::output::forget_temporary(&tmp);
             Err(e)
         }
     }
