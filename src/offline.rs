@@ -199,6 +199,22 @@ pub fn check_signals(
             format!("reaches |v| = {}: {e}", Num(v)),
         )
     })?;
+    // A sine at or above the steps' Nyquist frequency is sampled as a
+    // slower motion (at exactly it, as v = 0 at every step).
+    let nyquist = 0.5 / config.solver.dt_s;
+    for (arg, s) in [("--velocity", velocity), ("--load", load)] {
+        if let Some(f) = s.period().map(|p| 1.0 / p).filter(|&f| f >= nyquist) {
+            return Err(arg_err(
+                arg,
+                s,
+                format!(
+                    "oscillates at {} Hz, at or above the Nyquist frequency 1/(2 solver.dt_s) = {} Hz of the steps, which would sample it as a slower motion (aliasing): lower the frequency or shorten solver.dt_s",
+                    Num(f),
+                    Num(nyquist)
+                ),
+            ));
+        }
+    }
     let (fmin, fmax) = load.range();
     for f in [fmin, fmax] {
         limits.check_load(f).map_err(|e| {

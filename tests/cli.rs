@@ -363,3 +363,63 @@ fn simulate_times_are_whole_steps_without_accumulated_rounding() {
         );
     }
 }
+
+#[test]
+fn a_sine_at_or_above_the_steps_nyquist_frequency_is_refused() {
+    let d = dir("nyquist");
+    let out = d.join("run.csv");
+    // dt = 1 ms: Nyquist at 500 Hz (before: simulated as v ≈ 0, silently).
+    for f in ["500", "990"] {
+        let (ok, _, err) = run(&[
+            "simulate",
+            "--velocity",
+            &format!("sine:0,0.1,{f}"),
+            "--duration",
+            "0.1",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(!ok, "{f} Hz");
+        assert!(
+            err.contains("Nyquist") && err.contains("--velocity"),
+            "{err}"
+        );
+        assert!(!out.exists());
+    }
+    let (ok, _, err) = run(&[
+        "simulate",
+        "--velocity",
+        "sine:0,0.1,400",
+        "--duration",
+        "0.01",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+}
+
+#[test]
+fn an_accuracy_reference_no_finer_than_the_tested_setting_is_refused() {
+    let (ok, _, err) = run(&[
+        "bench-accuracy",
+        "--grids",
+        "64,128",
+        "--steps",
+        "0.001",
+        "--reference-cells",
+        "128",
+    ]);
+    assert!(!ok);
+    assert!(err.contains("--reference-cells 128"), "{err}");
+    let (ok, _, err) = run(&[
+        "bench-cases",
+        "--grids",
+        "64",
+        "--fluxes",
+        "upwind,upwind",
+        "--reference-dt",
+        "0.002",
+    ]);
+    assert!(!ok);
+    assert!(err.contains("--reference-dt 0.002"), "{err}");
+}

@@ -180,6 +180,13 @@ fn several_velocity_topics_are_listed_until_one_is_chosen() {
         m.contains("/joint_states") && m.contains("/cmd_vel") && m.contains("--topic"),
         "{m}"
     );
+    // A joint's name picks the bag's only JointState topic.
+    let p = prepare(FOREIGN_BAG, &opts(None, Some("slider"))).unwrap();
+    assert!(
+        matches!(&p.mode, InputMode::Topics { velocity, .. } if velocity == "/joint_states"),
+        "{:?}",
+        p.mode
+    );
     // TwistStamped: linear.x at 100 Hz, header stamps.
     let p = prepare(FOREIGN_BAG, &opts(Some("/cmd_vel"), None)).unwrap();
     assert!(matches!(
@@ -831,4 +838,40 @@ fn expect_identical_on_a_bag_without_recorded_estimates_exits_5_before_writing()
         "--expect-identical",
     ]);
     assert_eq!(code, 0, "{err}");
+}
+
+#[test]
+fn an_output_whose_extension_contradicts_the_format_is_refused() {
+    let d = dir("format-contradiction");
+    let out = d.join("x.mcap");
+    let (code, _, err) = run(&[
+        "replay",
+        NODE_BAG,
+        "--out",
+        out.to_str().unwrap(),
+        "--format",
+        "csv",
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains(".mcap") && err.contains("--format csv"),
+        "{err}"
+    );
+    assert!(!out.exists());
+}
+
+#[test]
+fn a_bad_override_is_the_configurations_error_not_the_bags() {
+    let d = dir("bad-override");
+    let (code, _, err) = run(&[
+        "replay",
+        NODE_BAG,
+        "--set",
+        "contact.load_n=-1",
+        "--out",
+        d.join("r.csv").to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("contact.load_n"), "{err}");
+    assert!(!err.contains("bag ") && !err.contains("recorded"), "{err}");
 }

@@ -55,7 +55,7 @@
 //! seen (a wrong pointer, a model already freed while its memory still holds
 //! the freed marker), return `FN_ERROR_INVALID_HANDLE`.
 
-use friction_node::config::parameters::{apply_set, declare, Declared};
+use friction_node::config::parameters::{declare, set_from_text, Declared};
 use friction_node::config::{Config, Origin, ResolvedContact, ViscosityLaw};
 use friction_node::msgs::{regime_code, status_code};
 use friction_node::physics::{Estimate, Solver};
@@ -668,17 +668,7 @@ pub unsafe extern "C" fn fn_model_set_parameter(
             (Ok(k), Ok(v)) => (k, v),
             (Err(c), _) | (_, Err(c)) => return c,
         };
-        let parsed: friction_node::msgs::ros_interfaces::ParameterValue =
-            match serde_norway::from_str::<serde_norway::Value>(value) {
-                Ok(v) => friction_node::msgs::ros_interfaces::ParameterValue::from_yaml(&v),
-                Err(e) => {
-                    return fail(
-                        FN_ERROR_PARAMETER,
-                        format!("parameter `{key}`: value `{value}` is not YAML: {e}"),
-                    )
-                }
-            };
-        let new = match apply_set(&m.config, &m.declared, &[(key.to_string(), parsed)]) {
+        let new = match set_from_text(&m.config, &m.declared, key, value) {
             Ok(c) => c,
             Err(e) => return fail(FN_ERROR_PARAMETER, e.to_string()),
         };

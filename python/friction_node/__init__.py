@@ -178,6 +178,18 @@ class Model:
         """Restart from the steady state (the squeeze-film history is forgotten)."""
         return self._core.reset(float(velocity), None if load is None else float(load))
 
+    def set_parameter(self, key: str, value: Any) -> None:
+        """Change a live parameter between steps, as the node's ROS 2
+        parameters and the C API's ``fn_model_set_parameter`` do: ``key`` a
+        dotted configuration key (``contact.boundary_friction``), ``value`` a
+        number, a bool or YAML text. The squeeze-film history and the
+        pre-sliding displacement are kept. An unknown or read-only key, a
+        wrong type, a value out of range or a change of grid
+        (``solver.cells``) raises ``ValueError`` naming the key and value.
+        It rebuilds the model's tables: call it between steps, not inside a
+        real-time loop."""
+        self._core.set_parameter(str(key), value)
+
     def set_temperature(self, temperature_c: float) -> None:
         """The lubricant temperature, degC (with ``lubricant.viscosity_model:
         vogel`` the viscosity follows it). A temperature outside [-60, 300]

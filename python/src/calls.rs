@@ -122,17 +122,22 @@ pub fn replay<'py>(
         out,
         report: report_dir,
     };
-    let in_bag = |e: PyErr| -> PyErr {
-        let message = format!("bag {}: {}", request.bag.display(), e.value(py));
-        if e.is_instance_of::<pyo3::exceptions::PyOSError>(py) {
+    // A configuration error is the configuration's, not the bag's: only
+    // the bag's own errors are prefixed with it.
+    let in_bag = |(e, config): (PyErr, bool)| -> PyErr {
+        if config || e.is_instance_of::<pyo3::exceptions::PyOSError>(py) {
             e
         } else {
-            errors::value(message)
+            errors::value(format!("bag {}: {}", request.bag.display(), e.value(py)))
         }
     };
-    let outcome = crate::interrupts::interruptible(py, |stop| -> PyResult<_> {
-        let ready = request.prepare().map_err(errors::replay)?;
-        ready.run(&mut |_, _| stop.check()).map_err(errors::replay)
+    let to_py = |e: friction_node::replay::ReplayError| {
+        let config = e.is_configuration();
+        (errors::replay(e), config)
+    };
+    let outcome = crate::interrupts::interruptible(py, |stop| {
+        let ready = request.prepare().map_err(to_py)?;
+        ready.run(&mut |_, _| stop.check()).map_err(to_py)
     })?
     .map_err(in_bag)?;
     let d = PyDict::new(py);
@@ -476,15 +481,22 @@ fn calibrate(
                     .map_err(|e| errors::os(e.to_string()))?,
             );
         }
-        if let Some(r) = report_dir {
-            friction_node::output::prepare_dir(r).map_err(|e| errors::os(e.to_string()))?;
-        }
+        // A report folder made here is removed again if the fit fails or
+        // is stopped (the report itself is written by the caller).
+        let dir = report_dir
+            .as_deref()
+            .map(friction_node::output::prepare_output_dir)
+            .transpose()
+            .map_err(|e| errors::os(e.to_string()))?;
         let ours = fit_ours(&p, &req).map_err(errors::fit)?;
         let (classic, skipped) = if req.baselines {
             fit_baselines(&p, &req).map_err(errors::fit)?
         } else {
             (Vec::new(), Vec::new())
         };
+        if let Some(d) = dir {
+            d.keep();
+        }
         Ok((p, ours, classic, skipped))
     })?
 }

@@ -140,6 +140,29 @@ fn check_each(
     Ok(())
 }
 
+/// A Python value as the YAML text of a parameter value: bools, integers
+/// and floats (non-finite ones as YAML's `.nan`, `.inf`), or text as given.
+fn parameter_text(value: &Bound<'_, PyAny>) -> PyResult<String> {
+    if let Ok(b) = value.extract::<bool>() {
+        return Ok(b.to_string());
+    }
+    if let Ok(i) = value.extract::<i64>() {
+        return Ok(i.to_string());
+    }
+    if let Ok(x) = value.extract::<f64>() {
+        return Ok(if x.is_nan() {
+            ".nan".into()
+        } else if x.is_infinite() {
+            if x > 0.0 { ".inf" } else { "-.inf" }.into()
+        } else {
+            format!("{x:?}")
+        });
+    }
+    value
+        .extract::<String>()
+        .map_err(|_| errors::value("a parameter value is a number, a bool or text"))
+}
+
 impl Model {
     fn law(&self) -> ViscosityLaw {
         ViscosityLaw::of(&self.config)
@@ -214,6 +237,40 @@ impl Model {
         Ok(Estimate::from(
             &self.solver.initialize_steady(velocity, load),
         ))
+    }
+
+    /// Change a live parameter between steps (the node's and the C API's
+    /// `set_parameter`): the key's name, and its value as a number, a bool
+    /// or YAML text. The model's tables are rebuilt (this allocates: call it
+    /// between steps, not in a real-time loop); the squeeze-film history
+    /// and the bristle are kept. Refused, naming the key and the value,
+    /// when the key is unknown or read-only, the type is wrong, the value
+    /// is out of range, or the grid would change (`solver.cells`).
+    fn set_parameter(&mut self, key: &str, value: &Bound<'_, PyAny>) -> PyResult<()> {
+        use friction_node::config::parameters::{declare, set_from_text};
+        let text = parameter_text(value)?;
+        let new = set_from_text(&self.config, &declare(&self.config), key, &text)
+            .map_err(|e| errors::value(e.to_string()))?;
+        let law = ViscosityLaw::of(&new);
+        let mu = law.viscosity_at(self.temperature_c).map_err(|e| {
+            errors::value(format!(
+                "parameter `{key}`: the temperature set before no longer holds: {e}"
+            ))
+        })?;
+        let mut prepared = Solver::prepare_model(&new.model(), &new.solver_settings())
+            .map_err(|e| errors::value(format!("parameter `{key}`: {e}")))?;
+        if !self.solver.fits(&prepared) {
+            return Err(errors::value(format!(
+                "parameter `{key}`: {}",
+                friction_node::physics::ModelMismatch
+            )));
+        }
+        let _ = self.solver.swap_model(&mut prepared);
+        self.config = new;
+        if law.follows_temperature() {
+            self.solver.set_liquid_viscosity(mu);
+        }
+        Ok(())
     }
 
     fn set_temperature(&mut self, temperature_c: f64) -> PyResult<()> {

@@ -256,3 +256,34 @@ def test_ctrl_c_stops_a_long_model_run_with_keyboard_interrupt(tmp_path):
     p.send_signal(signal.SIGINT)
     out, _ = p.communicate()
     assert p.returncode == 7 and "interrupted" in out, out
+
+
+def test_set_parameter_changes_a_live_key_and_refuses_what_the_c_api_refuses():
+    m = fn.Model(**{"solver.cells": 32})
+    before = m.step(0.5)
+    m.set_parameter("contact.boundary_friction", 0.15)
+    after = m.step(0.5)
+    # The boundary part of the friction halves; the film is the same state.
+    assert after.friction_force_n < before.friction_force_n
+    assert "boundary_friction: 0.15" in m.config_yaml()
+    m.set_parameter("contact.boundary_friction", "0.3")
+    assert "boundary_friction: 0.3" in m.config_yaml()
+    for key, value, words in [
+        ("contact.nope", 1.0, "contact.nope"),
+        ("contact.boundary_friction", -1.0, "contact.boundary_friction"),
+        ("contact.boundary_friction", float("nan"), "contact.boundary_friction"),
+        ("solver.cells", 64, "solver.cells"),
+    ]:
+        with pytest.raises(ValueError) as e:
+            m.set_parameter(key, value)
+        assert words in str(e.value), str(e.value)
+    # A refused change leaves the model as it was.
+    assert "boundary_friction: 0.3" in m.config_yaml()
+
+
+def test_a_configuration_error_in_replay_is_not_blamed_on_the_bag(repo):
+    bag = repo / "bags/node_lockstep.mcap"
+    with pytest.raises(ValueError) as e:
+        fn.replay(bag, overrides={"contact.load_n": -1})
+    assert "contact.load_n" in str(e.value)
+    assert not str(e.value).startswith("bag "), str(e.value)

@@ -12,6 +12,7 @@
 //! | `accuracy.rs` | `bench-accuracy`: the accuracy guide, answers against N and Δt |
 //! | `cases.rs` | `bench-cases`: the accuracy guide over a family of transient cases, passes per grid and flux |
 //! | `fit.rs` | `bench-fit`: calibration targets on synthetic data (recovery, drivetrain, pre-sliding, transfer) |
+//! | `reference.rs` | the accuracy guides' reference checked finer than what it judges; settings named twice measured once |
 
 use crate::config::Config;
 use crate::offline::{SimulationError, Timing};
@@ -303,5 +304,6 @@ pub mod fit;
 mod latency;
 #[cfg(feature = "mcap")]
 pub mod recorder;
+pub mod reference;
 
 pub use latency::{latency, LatencyReport};

@@ -92,6 +92,12 @@ pub fn accuracy(
     if cfg!(debug_assertions) {
         eprintln!("warning: a debug build; the step costs are not representative (use --release)");
     }
+    use friction_node::bench::reference::{check_reference, without_repeats};
+    let (grids, steps) = (&without_repeats(grids), &without_repeats(steps));
+    // The grids run at the configured step, the steps on the configured grid.
+    let cells: Vec<usize> = grids.iter().copied().chain([config.solver.cells]).collect();
+    let dts: Vec<f64> = steps.iter().copied().chain([config.solver.dt_s]).collect();
+    check_reference(&cells, &dts, reference)?;
     let r = friction_node::bench::accuracy::run(config, grids, steps, reference, cycles, &|m| {
         eprintln!("  {m}")
     })?;
@@ -112,6 +118,9 @@ pub fn cases(
     if cfg!(debug_assertions) {
         eprintln!("warning: a debug build; the cases take much longer (use --release)");
     }
+    use friction_node::bench::reference::{check_reference, without_repeats};
+    let (grids, fluxes) = (&without_repeats(grids), &without_repeats(fluxes));
+    check_reference(grids, &[config.solver.dt_s], reference)?;
     let settings: Vec<_> = fluxes
         .iter()
         .flat_map(|&flux| grids.iter().map(move |&n| (n, config.solver.dt_s, flux)))

@@ -8,11 +8,22 @@ use friction_node::replay::{
 };
 use std::path::{Path, PathBuf};
 
-/// The output's format: `--format`, else the file's extension.
+/// The output's format: `--format`, else the file's extension; the two
+/// must not contradict each other (a `.mcap` file holding CSV).
 fn output_format(out: &Path, format: Option<FormatArg>) -> Result<OutputFormat> {
-    match (format, OutputFormat::from_path(out)) {
-        (Some(FormatArg::Csv), _) => Ok(OutputFormat::Csv),
-        (Some(FormatArg::Mcap), _) => Ok(OutputFormat::Mcap),
+    let asked = format.map(|f| match f {
+        FormatArg::Csv => OutputFormat::Csv,
+        FormatArg::Mcap => OutputFormat::Mcap,
+    });
+    match (asked, OutputFormat::from_path(out)) {
+        (Some(a), Some(e)) if a != e => anyhow::bail!(
+            "--out {} ends in .{} but --format {} was given: name the file .{} or leave --format out",
+            out.display(),
+            e.extension(),
+            a.extension(),
+            a.extension()
+        ),
+        (Some(f), _) => Ok(f),
         (None, Some(f)) => Ok(f),
         (None, None) => anyhow::bail!(
             "--out {}: the output must end in .mcap or .csv, or give --format csv|mcap",
@@ -51,7 +62,7 @@ pub fn run(args: ReplayArgs, config: Option<PathBuf>, overrides: Vec<String>) ->
     let bag = request.bag.display().to_string();
     // The input is validated completely before any output is touched.
     let ready = request.prepare().map_err(|e| {
-        if e.names_the_bag() {
+        if e.names_the_bag() || e.is_configuration() {
             anyhow::Error::new(e)
         } else {
             anyhow::Error::new(e).context(format!("bag {bag}"))

@@ -147,9 +147,10 @@ impl Config {
     fn from_params(mut params: Value) -> Result<Config, ConfigError> {
         default_flux_for_method(&mut params);
         super::contacts::inherit_top_level(&mut params);
-        let cfg: Config = serde_path_to_error::deserialize(params).map_err(|e| {
+        let cfg: Config = serde_path_to_error::deserialize(params.clone()).map_err(|e| {
             let key = e.path().to_string();
             let message = e.inner().to_string();
+            let message = enum_choice_error(&params, &key, &message).unwrap_or(message);
             if message.starts_with("unknown field") {
                 ConfigError::UnknownKey { key, message }
             } else {
@@ -158,6 +159,48 @@ impl Config {
         })?;
         cfg.validate()?;
         Ok(cfg)
+    }
+}
+
+/// `nan`, `inf`, `-inf`, `infinity` (any case; what a shell user or
+/// Python's `str(float("nan"))` writes) as the numbers they name, so that a
+/// numeric key reports them as not finite, as YAML's `.nan` does, rather
+/// than as a string of the wrong type.
+fn non_finite_number(value: Value) -> Value {
+    let Value::String(text) = &value else {
+        return value;
+    };
+    let number = match text.trim().to_ascii_lowercase().as_str() {
+        "nan" | "+nan" | "-nan" => f64::NAN,
+        "inf" | "+inf" | "infinity" | "+infinity" => f64::INFINITY,
+        "-inf" | "-infinity" => f64::NEG_INFINITY,
+        _ => return value,
+    };
+    Value::Number(number.into())
+}
+
+/// A value of the wrong kind where a named choice (an enum) is expected
+/// says "expected a Value::Tagged enum" and lists nothing: read as text, the
+/// same value gets serde's message listing the allowed choices.
+fn enum_choice_error(params: &Value, key: &str, message: &str) -> Option<String> {
+    if !message.contains("Tagged enum") {
+        return None;
+    }
+    let mut tree = params.clone();
+    let mut node = &mut tree;
+    for part in key.split('.') {
+        node = node.get_mut(part)?;
+    }
+    let text = match node {
+        Value::Null => String::new(),
+        Value::Bool(b) => b.to_string(),
+        Value::Number(n) => n.to_string(),
+        _ => return None,
+    };
+    *node = Value::String(text);
+    match serde_path_to_error::deserialize::<_, Config>(tree) {
+        Err(e) if e.path().to_string() == key => Some(e.inner().to_string()),
+        _ => None,
     }
 }
 
@@ -264,6 +307,7 @@ pub fn apply_override(params: &mut Value, arg: &str) -> Result<(), ConfigError> 
     }
     let value: Value = serde_norway::from_str(value.trim())
         .map_err(|e| bad(&format!("value is not a YAML scalar: {e}")))?;
+    let value = non_finite_number(value);
     let mut node = params;
     let parts: Vec<&str> = key.split('.').collect();
     for (i, part) in parts.iter().enumerate() {

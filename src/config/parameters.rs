@@ -251,6 +251,26 @@ pub fn type_name(t: u8) -> &'static str {
     }
 }
 
+/// `config` with `key` set to `value`, given as YAML text (the C API's and
+/// Python's `set_parameter`): [`apply_set`] of the parsed value.
+pub fn set_from_text(
+    config: &Config,
+    declared: &[Declared],
+    key: &str,
+    value: &str,
+) -> Result<Config, SetRefusal> {
+    let yaml: Value = serde_norway::from_str(value).map_err(|e| {
+        SetRefusal::Invalid(format!(
+            "parameter `{key}`: value `{value}` is not YAML: {e}"
+        ))
+    })?;
+    apply_set(
+        config,
+        declared,
+        &[(key.to_string(), ParameterValue::from_yaml(&yaml))],
+    )
+}
+
 /// `config` with `changes` (name, value) applied and validated; refuses
 /// undeclared or read-only names, wrong types (an integer for a double is
 /// accepted, as a number) and values outside their range, naming the key

@@ -288,3 +288,35 @@ fn a_recorded_configuration_without_a_flux_replays_with_the_upwind_flux_it_was_r
         Config::from_recorded_yaml(&old, &origin, &["solver.flux=muscl_minmod".into()]).unwrap();
     assert_eq!(c.solver.flux, FluxKind::MusclMinmod);
 }
+
+#[test]
+fn a_flux_given_as_a_number_a_boolean_or_nothing_lists_the_allowed_values() {
+    for v in ["1", "true", ""] {
+        let e = Config::load(None, &[format!("solver.flux={v}")])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("solver.flux"), "{v}: {e}");
+        assert!(
+            e.contains("upwind") && e.contains("muscl_van_leer"),
+            "{v}: {e}"
+        );
+        assert!(!e.contains("Tagged"), "{v}: {e}");
+    }
+}
+
+#[test]
+fn nan_and_inf_overrides_are_not_finite_numbers_not_strings() {
+    for v in ["nan", "NaN", "inf", "-inf"] {
+        let e = Config::load(None, &[format!("contact.load_n={v}")])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("contact.load_n"), "{v}: {e}");
+        assert!(!e.contains("invalid type"), "{v}: {e}");
+        let yaml = Config::load(None, &["contact.load_n=.nan".to_string()])
+            .unwrap_err()
+            .to_string();
+        if v == "nan" {
+            assert_eq!(e, yaml, "as YAML's .nan");
+        }
+    }
+}

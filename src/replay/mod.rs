@@ -153,6 +153,12 @@ impl ReplayError {
             ReplayError::Bag(BagError::Io { .. } | BagError::NotABag { .. })
         )
     }
+
+    /// Whether the error is the configuration's (a file or the overrides),
+    /// not the bag's: a message about it does not begin with the bag.
+    pub fn is_configuration(&self) -> bool {
+        matches!(self, ReplayError::Config(_))
+    }
 }
 
 fn damage_note(d: &Option<Damage>) -> String {

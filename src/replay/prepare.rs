@@ -83,10 +83,16 @@ fn choose_config(scan: &BagScan, opts: &ReplayOptions) -> Result<(Config, String
         ));
     }
     if let Some(text) = &scan.recorded_config {
-        let c =
-            Config::from_recorded_yaml(text, &Origin::Text("recorded in the bag"), &opts.overrides)
-                .map_err(ReplayError::RecordedConfig)?;
-        return Ok((c, "recorded in the bag".into()));
+        let origin = Origin::Text("recorded in the bag");
+        return match Config::from_recorded_yaml(text, &origin, &opts.overrides) {
+            Ok(c) => Ok((c, "recorded in the bag".into())),
+            // The recorded configuration holds without the overrides: the
+            // error is the overrides', not the bag's.
+            Err(e) if Config::from_recorded_yaml(text, &origin, &[]).is_ok() => {
+                Err(ReplayError::Config(e))
+            }
+            Err(e) => Err(ReplayError::RecordedConfig(e)),
+        };
     }
     Ok((
         Config::load(None, &opts.overrides)?,
@@ -109,6 +115,14 @@ fn velocity_channel(scan: &BagScan, opts: &ReplayOptions) -> Result<ChannelInfo,
                 && !c.topic.ends_with("friction_force")
         })
         .collect();
+    // `--joint` names a joint of a JointState topic: the bag's only one is meant.
+    let joint_states: Vec<&&ChannelInfo> = candidates
+        .iter()
+        .filter(|c| opts.joint.is_some() && c.schema_name == "sensor_msgs/msg/JointState")
+        .collect();
+    if let [one] = joint_states.as_slice() {
+        return Ok((**one).clone());
+    }
     let preferred: Vec<&&ChannelInfo> = candidates
         .iter()
         .filter(|c| c.topic.ends_with("cmd_velocity"))

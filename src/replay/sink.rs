@@ -29,6 +29,14 @@ impl OutputFormat {
             _ => None,
         }
     }
+
+    /// The file extension of this format, without the dot.
+    pub fn extension(self) -> &'static str {
+        match self {
+            Self::Csv => "csv",
+            Self::Mcap => "mcap",
+        }
+    }
 }
 
 /// One contact's step: the estimate, its record and the contact's index.
@@ -153,9 +161,12 @@ impl Sink for McapSink {
         };
         if let Err(e) = finished {
             let _ = std::fs::remove_file(&tmp);
+            crate::output::forget_temporary(&tmp);
             return Err(self.error(e));
         }
-        std::fs::rename(&tmp, &self.path).map_err(|e| OutputError::new(&self.path, e))?;
+        let moved = std::fs::rename(&tmp, &self.path).map_err(|e| OutputError::new(&self.path, e));
+        crate::output::forget_temporary(&tmp);
+        moved?;
         Ok(self.path.clone())
     }
 }
@@ -166,6 +177,7 @@ impl Drop for McapSink {
         if self.w.take().is_some() {
             if let Some(tmp) = &self.tmp {
                 let _ = std::fs::remove_file(tmp);
+                crate::output::forget_temporary(tmp);
             }
         }
     }
@@ -246,6 +258,7 @@ impl OutputStream {
                 .map_err(|e| {
                     if let Some(t) = &tmp {
                         let _ = std::fs::remove_file(t);
+                        crate::output::forget_temporary(t);
                     }
                     out_err(e.to_string())
                 })?;
