@@ -6,8 +6,9 @@
 //! `/parameter_events` are `transport/ros2/params.rs`.
 //!
 //! Keys that can change while running ([`is_runtime`]): the load, the
-//! contact's mass, boundary friction and sign regularisation, every
-//! lubricant, roughness and drivetrain key, and the node's command limits,
+//! contact's mass and film floor, every friction term's key that its term
+//! declares live (`physics::terms`), every lubricant, roughness and
+//! drivetrain key, and the node's command limits,
 //! timeout rule and publication rates. Everything else (geometry, grid,
 //! solver, transports, names, recording) is read-only: changing it needs a
 //! restart. With several contacts the same keys of each contact,
@@ -23,18 +24,11 @@ use serde_norway::Value;
 
 /// Whether `key` may change while the node runs.
 pub fn is_runtime(key: &str) -> bool {
-    const EXACT: [&str; 19] = [
+    // The friction terms' keys say themselves (physics::terms::catalogue).
+    const EXACT: [&str; 11] = [
         "contact.load_n",
         "contact.mass_kg",
-        "contact.boundary_friction",
-        "contact.boundary_friction_rate",
-        "contact.boundary_activation_speed_m_s",
-        "contact.sign_regularization_m_s",
         "contact.min_film_m",
-        "contact.presliding_stiffness_n_m",
-        "contact.presliding_damping_n_s_m",
-        "contact.width_load_exponent",
-        "contact.width_reference_load_n",
         "node.command_timeout_s",
         "node.timeout_behaviour",
         "node.timeout_deceleration_m_s2",
@@ -45,6 +39,7 @@ pub fn is_runtime(key: &str) -> bool {
         "node.statistics_rate_hz",
     ];
     EXACT.contains(&key)
+        || crate::physics::terms::term_key(key).is_some_and(|k| k.live)
         || key == "node.max_catch_up_s"
         || ["lubricant.", "roughness.", "drivetrain."]
             .iter()

@@ -132,7 +132,6 @@ impl Config {
         self.validate_lubricant()?;
         self.validate_roughness()?;
         self.validate_solver()?;
-        self.validate_drivetrain()?;
         self.validate_node()?;
         self.validate_ros()?;
         self.validate_iceoryx2()?;
@@ -147,50 +146,29 @@ impl Config {
         cc("contact.mass_kg", c.mass_kg, 0.0, 1e6)?;
         oc("contact.load_n", c.load_n, 0.0, 1e9)?;
         cc("contact.profile_depth_m", c.profile_depth_m, 0.0, 1e-3)?;
-        cc("contact.boundary_friction", c.boundary_friction, 0.0, 2.0)?;
-        cc(
-            "contact.boundary_friction_rate",
-            c.boundary_friction_rate,
-            0.0,
-            1.0,
-        )?;
-        oc(
-            "contact.boundary_activation_speed_m_s",
-            c.boundary_activation_speed_m_s,
-            1e-12,
-            100.0,
-        )?;
-        oc(
-            "contact.sign_regularization_m_s",
-            c.sign_regularization_m_s,
-            1e-9,
-            1.0,
-        )?;
         cc("contact.min_film_m", c.min_film_m, 0.0, 1e-3)?;
-        cc(
-            "contact.presliding_stiffness_n_m",
-            c.presliding_stiffness_n_m,
-            0.0,
-            1e15,
-        )?;
-        cc(
-            "contact.presliding_damping_n_s_m",
-            c.presliding_damping_n_s_m,
-            0.0,
-            1e9,
-        )?;
-        cc(
-            "contact.width_load_exponent",
-            c.width_load_exponent,
-            0.0,
-            1.0,
-        )?;
-        oc(
-            "contact.width_reference_load_n",
-            c.width_reference_load_n,
-            0.0,
-            1e9,
-        )
+        self.validate_terms()
+    }
+
+    /// Every friction term's key against the range its term declares
+    /// (`physics::terms`: the catalogue is the one list of them).
+    pub(super) fn validate_terms(&self) -> Result<(), ConfigError> {
+        use crate::physics::terms::{catalogue, End as TermEnd};
+        let end = |e: TermEnd| match e {
+            TermEnd::Closed(v) => End::Closed(v),
+            TermEnd::Open(v) => End::Open(v),
+        };
+        let tree = serde_norway::to_value(self).expect("a configuration serializes");
+        for k in catalogue() {
+            let v = k
+                .key
+                .split('.')
+                .try_fold(&tree, |t, part| t.get(part))
+                .and_then(serde_norway::Value::as_f64)
+                .unwrap_or(f64::NAN);
+            check(k.key, v, end(k.lo), end(k.hi))?;
+        }
+        Ok(())
     }
 
     pub(super) fn validate_texture(&self) -> Result<(), ConfigError> {
@@ -281,25 +259,6 @@ impl Config {
             l.vapour_fraction_at_vapour_pressure,
             l.vapour_fraction_at_saturation,
             1.0,
-        )
-    }
-
-    fn validate_drivetrain(&self) -> Result<(), ConfigError> {
-        let d = &self.drivetrain;
-        cc("drivetrain.coulomb_n", d.coulomb_n, 0.0, 1e9)?;
-        cc("drivetrain.viscous_n_s_m", d.viscous_n_s_m, 0.0, 1e9)?;
-        cc("drivetrain.load_coefficient", d.load_coefficient, 0.0, 10.0)?;
-        cc(
-            "drivetrain.quadratic_n_s2_m2",
-            d.quadratic_n_s2_m2,
-            0.0,
-            1e9,
-        )?;
-        cc(
-            "drivetrain.coulomb_asymmetry_n",
-            d.coulomb_asymmetry_n,
-            -1e9,
-            1e9,
         )
     }
 

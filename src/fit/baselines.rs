@@ -27,7 +27,7 @@
 use super::params::{DataScale, FittedParameter};
 use super::problem::Model;
 use super::series::Series;
-use crate::physics::presliding::sgn;
+use crate::physics::sgn;
 use nalgebra::{DMatrix, DVector};
 
 /// The classic friction models fitted beside ours.

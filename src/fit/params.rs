@@ -10,6 +10,7 @@
 
 use super::FitError;
 use crate::config::{Config, ConfigError};
+use crate::physics::terms::FitScale;
 use serde_norway::Value;
 
 /// What the command line asked for one fitted parameter.
@@ -263,25 +264,30 @@ impl ConfigKeys {
                 return Ok((lo, hi));
             }
         }
-        // Terms that are off by default: bounds from the data's scales.
-        let s = scale;
-        let v = s.velocity_m_s.max(1e-9);
-        if key == "drivetrain.coulomb_asymmetry_n" {
-            return Ok((-s.friction_n, s.friction_n));
-        }
-        let hi = match key {
-            "drivetrain.coulomb_n" => Some(2.0 * s.friction_n),
-            "drivetrain.viscous_n_s_m" => Some(2.0 * s.friction_n / v),
-            "drivetrain.quadratic_n_s2_m2" => Some(2.0 * s.friction_n / (v * v)),
-            "drivetrain.load_coefficient" => {
-                Some((2.0 * s.friction_n / s.load_min_n.max(1e-9)).min(10.0))
-            }
-            // μ_r: up to twice the data's friction coefficient per e-fold.
-            "contact.boundary_friction_rate" => {
-                Some((2.0 * s.friction_n / s.load_min_n.max(1e-9)).min(1.0))
-            }
-            k if k.ends_with("presliding_damping_n_s_m") => Some(100.0 * s.friction_n / v),
-            _ => None,
+        // Terms that are off by default: bounds from the data's scales, as
+        // each term declares them (physics::terms).
+        let hi = match crate::physics::terms::term_key(key) {
+            Some(k) => match k.fit {
+                FitScale::Data {
+                    factor,
+                    speed_power,
+                    per_load,
+                    symmetric,
+                } => {
+                    let v = scale.velocity_m_s.max(1e-9);
+                    let mut h = factor * scale.friction_n / v.powi(speed_power);
+                    if per_load {
+                        h /= scale.load_min_n.max(1e-9);
+                    }
+                    let h = h.min(k.hi.value());
+                    if symmetric && h > 0.0 && h.is_finite() {
+                        return Ok((-h, h));
+                    }
+                    Some(h)
+                }
+                FitScale::FromStart => None,
+            },
+            None => None,
         };
         match hi {
             Some(h) if h > 0.0 && h.is_finite() => Ok((0.0, h)),

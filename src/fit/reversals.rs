@@ -6,7 +6,7 @@
 //! largest |v|) followed by a stretch the other way. Through it the
 //! friction moves from the old direction's level F₋ to the new one's F₊.
 //! For a bristle of stiffness σ0 on a level L (LuGre, and our
-//! [`crate::physics::presliding`]) the force after a displacement x from
+//! [`crate::physics::terms::presliding`]) the force after a displacement x from
 //! the reversal is F = L − 2L e^(−σ0 x / L): it passes the middle of the
 //! jump after x½ = (L/σ0) ln 2, so
 //!

@@ -16,9 +16,7 @@
 //! | [`solver`] | discretised Reynolds + load balance, Newton, steady mode, the paper's Algorithm 1 |
 //! | [`estimate`] | per-step output, status and diagnostics |
 //! | [`error`] | the core's setup errors ([`SetupError`]) |
-//! | [`drivetrain`] | losses beside the contact (bearings, seals, gears) |
-//! | [`presliding`] | the contact's elastic displacement before gross sliding |
-//! | [`boundary`] | the boundary film's friction rising with the logarithm of speed (Eyring) |
+//! | [`terms`] | the friction terms beside the film's shear (boundary friction and its rate, pre-sliding, soft width, drivetrain), their keys' catalogue and their composition |
 //! | [`viscosity`] | the liquid's viscosity against temperature (Vogel) |
 //!
 //! ```
@@ -32,8 +30,6 @@
 
 #![warn(clippy::float_cmp)]
 
-pub mod boundary;
-pub mod drivetrain;
 pub mod eos;
 pub mod error;
 pub mod estimate;
@@ -41,19 +37,21 @@ pub mod flow_factors;
 pub mod geometry;
 pub mod gw;
 pub mod params;
-pub mod presliding;
 pub mod scheme;
 pub mod solver;
+pub mod terms;
 pub mod viscosity;
 
-pub use boundary::BoundaryRate;
-pub use drivetrain::Drivetrain;
 pub use error::SetupError;
 pub use estimate::{Diagnostics, Estimate, Regime, Status};
 pub use params::{
     Contact, CouetteFlux, Geometry, Limiter, Lubricant, Method, ModelParams, Pocket, Profile,
-    ReferenceSettings, Roughness, SolverSettings, TimeScheme, WidthLaw,
+    ReferenceSettings, Roughness, SolverSettings, TimeScheme,
 };
-pub use presliding::Presliding;
 pub use solver::{FieldPoint, Isa, ModelMismatch, PreparedModel, Solver, StepBreakdown};
+pub use terms::boundary::BoundaryRate;
+pub use terms::drivetrain::Drivetrain;
+pub use terms::presliding::Presliding;
+pub use terms::soft_width::WidthLaw;
+pub use terms::{sgn, FrictionTerms};
 pub use viscosity::{ViscosityModel, VogelModel};

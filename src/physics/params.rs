@@ -166,63 +166,15 @@ pub struct Contact {
     /// μ_bl, the boundary (asperity) friction coefficient.
     pub boundary_friction: f64,
     /// The boundary friction's dependence on speed (off by default).
-    pub boundary_rate: super::boundary::BoundaryRate,
+    pub boundary_rate: super::terms::boundary::BoundaryRate,
     /// v_reg of the sign's tanh regularisation, m/s.
     pub sign_regularization: f64,
     /// Floor on h0; 0 disables it (the default: with GW it should not bind).
     pub min_film: f64,
     /// Pre-sliding compliance (off by default).
-    pub presliding: super::presliding::Presliding,
+    pub presliding: super::terms::presliding::Presliding,
     /// How the contact's width follows the load (constant by default).
-    pub width_law: WidthLaw,
-}
-
-/// A soft contact's width against the normal load:
-///
-/// ```text
-/// B(F) = B (F / F_ref)^κ
-/// ```
-///
-/// | symbol | meaning | unit |
-/// |---|---|---|
-/// | B | `Geometry::width`, the width at the reference load | m |
-/// | F, F_ref | normal load, the load at which the width is B | N |
-/// | κ | `exponent`: 0 a rigid contact of constant width; 1 a contact whose nominal area grows in proportion to the load (an elastomer conforming at constant mean pressure); ½ Hertz's line contact | – |
-///
-/// The model is one-dimensional: the film problem is per unit width, so a
-/// wider contact carries the same film at the load per unit width
-/// F / B(F), and every force scales with B(F). The solver solves the film
-/// for the load F (B/B(F)) on the width B and scales the forces by
-/// B(F)/B; the squeeze film's history is per unit width and unaffected.
-/// The slider's mass is taken per the reference width (its inertia is a
-/// millionth of the load at the paper's conditions).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct WidthLaw {
-    /// κ, in [0, 1]: 0 rigid, 1 a width proportional to the load.
-    pub exponent: f64,
-    /// F_ref, the load at which the width is the configured B, N.
-    pub reference_load: f64,
-}
-
-impl Default for WidthLaw {
-    fn default() -> Self {
-        Self {
-            exponent: 0.0,
-            reference_load: 20_762.0,
-        }
-    }
-}
-
-impl WidthLaw {
-    /// B(F)/B at load `load` (1 for a rigid contact, or a load that is not
-    /// a positive number: the step's input check reports it).
-    pub fn scale(&self, load: f64) -> f64 {
-        if self.exponent == 0.0 || !(load.is_finite() && load > 0.0) {
-            1.0
-        } else {
-            (load / self.reference_load).powf(self.exponent)
-        }
-    }
+    pub width_law: super::terms::soft_width::WidthLaw,
 }
 
 impl Default for Contact {
@@ -230,11 +182,11 @@ impl Default for Contact {
         Self {
             mass: 1.0,
             boundary_friction: 0.3,
-            boundary_rate: super::boundary::BoundaryRate::default(),
+            boundary_rate: super::terms::boundary::BoundaryRate::default(),
             sign_regularization: 1e-4,
             min_film: 0.0,
-            presliding: super::presliding::Presliding::default(),
-            width_law: WidthLaw::default(),
+            presliding: super::terms::presliding::Presliding::default(),
+            width_law: super::terms::soft_width::WidthLaw::default(),
         }
     }
 }
@@ -251,7 +203,7 @@ pub struct ModelParams {
     /// Mass, boundary friction and the contact's other terms.
     pub contact: Contact,
     /// Losses beside the contact (zero by default).
-    pub drivetrain: super::drivetrain::Drivetrain,
+    pub drivetrain: super::terms::drivetrain::Drivetrain,
 }
 
 /// Which algorithm advances the model.

@@ -106,13 +106,10 @@ pub(crate) struct Disc {
     pub rho_b: f64,
     pub gr_b: f64,
     pub mass: f64,
-    pub mu_bl: f64,
-    pub boundary_rate: crate::physics::boundary::BoundaryRate,
-    pub v_reg: f64,
     pub min_film: f64,
-    pub drivetrain: crate::physics::drivetrain::Drivetrain,
-    pub presliding: crate::physics::presliding::Presliding,
-    pub width_law: crate::physics::params::WidthLaw,
+    /// The friction terms beside the film's shear, composed by
+    /// [`crate::physics::terms`].
+    pub terms: crate::physics::terms::FrictionTerms,
     pub guard: step::PredictionGuard,
 }
 
@@ -275,7 +272,7 @@ pub struct Solver {
     anchor: (f64, f64, f64),
     last: Option<Estimate>,
     /// The contact's pre-sliding displacement z, m (see
-    /// [`crate::physics::presliding`]; 0 while it is off).
+    /// [`crate::physics::terms::presliding`]; 0 while it is off).
     pub(crate) bristle: f64,
     /// B(F)/B of the solve in progress (see [`crate::physics::WidthLaw`]);
     /// the solver works on the load per reference width, F/this.
@@ -341,13 +338,15 @@ impl Solver {
             rho_b: sb.rho,
             gr_b: sb.rho / sb.mu,
             mass: model.contact.mass,
-            mu_bl: model.contact.boundary_friction,
-            boundary_rate: model.contact.boundary_rate,
-            v_reg: model.contact.sign_regularization,
             min_film: model.contact.min_film,
-            drivetrain: model.drivetrain,
-            presliding: model.contact.presliding,
-            width_law: model.contact.width_law,
+            terms: crate::physics::terms::FrictionTerms {
+                boundary_friction: model.contact.boundary_friction,
+                sign_regularization: model.contact.sign_regularization,
+                boundary_rate: model.contact.boundary_rate,
+                presliding: model.contact.presliding,
+                width_law: model.contact.width_law,
+                drivetrain: model.drivetrain,
+            },
             guard: step::PredictionGuard::new(&eos, model.lubricant.saturation_pressure),
         })
     }
@@ -376,13 +375,14 @@ impl Solver {
         if !self.fits(m) {
             return Err(ModelMismatch);
         }
-        let was_rigid = !self.d.presliding.is_on();
+        let was_rigid = !self.d.terms.presliding.is_on();
         std::mem::swap(&mut self.d, &mut m.d);
-        if was_rigid && self.d.presliding.is_on() {
+        if was_rigid && self.d.terms.presliding.is_on() {
             // Compliance switched on: as if it had always been, the
             // displacement of the last state's level.
             self.bristle = self.last.map_or(0.0, |e| {
                 self.d
+                    .terms
                     .presliding
                     .steady_displacement(e.contact_friction_force)
             });
@@ -504,7 +504,7 @@ impl Solver {
     /// The load per reference width of a solve at `load` (N), after
     /// setting the width scale the solve's forces are reported with.
     pub(crate) fn per_reference_width(&mut self, load: f64) -> f64 {
-        self.width_scale = self.d.width_law.scale(load);
+        self.width_scale = self.d.terms.width_law.scale(load);
         load / self.width_scale
     }
 

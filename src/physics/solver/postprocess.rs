@@ -7,6 +7,7 @@ use super::work::CellColumns;
 use super::{Ctx, Disc, H0Mode, Outcome, Solver};
 use crate::physics::estimate::{Diagnostics, Estimate, Regime};
 use crate::physics::scheme::StepCoefficients;
+use crate::physics::terms::BristleMove;
 
 /// The film's forces on the reference width at the solved state.
 struct FilmForces {
@@ -85,42 +86,6 @@ fn shear_per_cell(d: &Disc, h0: f64, v: f64, p: &[f64], rho: &mut [f64], mu: &mu
     }
 }
 
-/// The coefficient of friction: the magnitude of the friction force the
-/// contact transmits, per unit load, and the boundary rate's part of it.
-///
-/// - Rigid contact (the paper's): the contact always slides, so it transmits
-///   its sliding friction (|F_visc| + μ(v) F_asp) / F_ext, with
-///   μ(v) = μ_bl + μ_r asinh(|v|/v_a); the sign's regularisation is a
-///   numerical device and is not applied to it.
-/// - With pre-sliding the contact transmits the bristle's force:
-///   |σ0 z + σ1 ż| / F_ext. In steady sliding that is |L| / F_ext, the rigid
-///   value wherever the shear has the motion's sign; through a reversal it
-///   passes zero with the force, and at rest it is the force held.
-///
-/// The second value is μ_r asinh(|v|/v_a) F_asp / F_ext, the part of the
-/// COF that the boundary rate adds (0 when it is off, or with pre-sliding,
-/// where the bristle filters it): it vanishes at v = 0 with a slope that
-/// is steep at low speed, so the one-sided limits at v = 0 are taken
-/// without it.
-#[inline(always)]
-fn contact_cof(
-    d: &Disc,
-    v: f64,
-    (f_visc, f_asp, f_contact): (f64, f64, f64),
-    load: f64,
-) -> (f64, f64) {
-    if d.presliding.is_on() {
-        return (f_contact.abs() / load, 0.0);
-    }
-    if d.boundary_rate.is_on() {
-        let rate = d.boundary_rate.signed_term(v.abs()) * f_asp / load;
-        let mu = d.mu_bl + d.boundary_rate.signed_term(v.abs());
-        ((f_visc.abs() + mu * f_asp) / load, rate)
-    } else {
-        ((f_visc.abs() + d.mu_bl * f_asp) / load, 0.0)
-    }
-}
-
 impl Solver {
     // ------------------------------------------------------------------
     // Post-processing
@@ -175,41 +140,20 @@ impl Solver {
         }
     }
 
-    /// The contact's friction from its viscous and asperity forces: gross
-    /// sliding's level, through the pre-sliding compliance when it is on
-    /// (its displacement advanced when the step advances time).
+    /// The contact's friction from its viscous and asperity forces
+    /// ([`crate::physics::terms::FrictionTerms::contact`]); the pre-sliding
+    /// displacement advances when the step advances time, takes its steady
+    /// value in a steady state, and is held otherwise.
     #[inline(always)]
     fn contact_friction(&mut self, ctx: &Ctx, f_visc: f64, f_asp: f64, advance: bool) -> f64 {
-        let (d, v) = (&self.d, ctx.v);
-        // The boundary film's rate-dependent part, added only when on (off:
-        // the paper's constant μ_bl, bit for bit, signed zeros included).
-        let with_rate = |f: f64| {
-            if d.boundary_rate.is_on() {
-                f + f_asp * d.boundary_rate.signed_term(v)
-            } else {
-                f
-            }
+        let how = match (advance, ctx.time) {
+            (true, Some((_, dt))) => BristleMove::Step(dt),
+            (_, None) => BristleMove::Steady,
+            _ => BristleMove::Hold,
         };
-        if !d.presliding.is_on() {
-            return with_rate(f_visc + d.mu_bl * f_asp * (v / d.v_reg).tanh());
-        }
-        let level = with_rate(f_visc + d.mu_bl * f_asp * crate::physics::presliding::sgn(v));
-        let p = d.presliding;
-        match (advance, ctx.time) {
-            (true, Some((_, dt))) => {
-                let (z, f) = p.advance(self.bristle, level, v, dt);
-                self.bristle = z;
-                f
-            }
-            // A steady state (or a solve that does not advance time): the
-            // displacement of steady sliding.
-            _ => {
-                if ctx.time.is_none() {
-                    self.bristle = p.steady_displacement(level);
-                }
-                level
-            }
-        }
+        self.d
+            .terms
+            .contact(ctx.v, f_visc, f_asp, &mut self.bristle, how)
     }
 
     /// Make the solved state the newest history level (ρ h from `w.tmp`),
@@ -271,13 +215,8 @@ impl Solver {
         let d = &self.d;
         // The load itself (the film's load is per reference width).
         let load = w * ctx.load;
-        // Zero drivetrain terms leave the contact's force untouched (bit for bit).
-        let friction = if d.drivetrain.is_zero() {
-            contact_friction
-        } else {
-            contact_friction + d.drivetrain.force(v, load, d.v_reg)
-        };
-        let (cof, boundary_rate_cof) = contact_cof(d, v, (f_visc, f_asp, contact_friction), load);
+        let friction = d.terms.total(contact_friction, v, load);
+        let (cof, boundary_rate_cof) = d.terms.cof(v, f_visc, f_asp, contact_friction, load);
         let share = f_asp / load;
         let load_residual = match ctx.gap {
             H0Mode::Balance => load_res,

@@ -30,6 +30,59 @@
 //! level below the Coulomb level) is this term's, not the film's; the film
 //! adds its viscous shear on top.
 
+use super::{End, FitScale, TermKey};
+
+/// The boundary friction's keys: μ_bl and the rigid contact's sign
+/// regularisation, the rate sensitivity and its activation speed.
+pub const KEYS: &[TermKey] = &[
+    TermKey {
+        key: "contact.boundary_friction",
+        symbol: "μ_bl",
+        unit: "–",
+        lo: End::Closed(0.0),
+        hi: End::Closed(2.0),
+        live: true,
+        fit: FitScale::FromStart,
+        meaning: "boundary friction coefficient of the asperity load",
+    },
+    TermKey {
+        key: "contact.sign_regularization_m_s",
+        symbol: "v_reg",
+        unit: "m/s",
+        lo: End::Open(1e-9),
+        hi: End::Closed(1.0),
+        live: true,
+        fit: FitScale::FromStart,
+        meaning: "the rigid contact's (and the drivetrain's) sign tanh(v/v_reg); not used by the pre-sliding bristle",
+    },
+    TermKey {
+        key: "contact.boundary_friction_rate",
+        symbol: "μ_r",
+        unit: "–",
+        lo: End::Closed(0.0),
+        hi: End::Closed(1.0),
+        live: true,
+        // Up to twice the data's friction coefficient per e-fold.
+        fit: FitScale::Data {
+            factor: 2.0,
+            speed_power: 0,
+            per_load: true,
+            symmetric: false,
+        },
+        meaning: "the boundary film's rise per e-fold of speed above v_a (Eyring); 0 = off",
+    },
+    TermKey {
+        key: "contact.boundary_activation_speed_m_s",
+        symbol: "v_a",
+        unit: "m/s",
+        lo: End::Open(1e-12),
+        hi: End::Closed(100.0),
+        live: true,
+        fit: FitScale::FromStart,
+        meaning: "the rate term's activation speed: linear below, logarithmic above",
+    },
+];
+
 /// The rate dependence of the boundary friction (off by default).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BoundaryRate {

@@ -18,6 +18,82 @@
 //!
 //! All zero by default: the estimate is then the contact's alone, bit for bit.
 
+use super::{End, FitScale, TermKey};
+
+/// Bounds up to `factor` times the data's friction over speed^`power`.
+const fn data(factor: f64, speed_power: i32) -> FitScale {
+    FitScale::Data {
+        factor,
+        speed_power,
+        per_load: false,
+        symmetric: false,
+    }
+}
+
+/// The drivetrain's keys.
+pub const KEYS: &[TermKey] = &[
+    TermKey {
+        key: "drivetrain.coulomb_n",
+        symbol: "F_c",
+        unit: "N",
+        lo: End::Closed(0.0),
+        hi: End::Closed(1e9),
+        live: true,
+        fit: data(2.0, 0),
+        meaning: "constant (Coulomb) drivetrain friction",
+    },
+    TermKey {
+        key: "drivetrain.viscous_n_s_m",
+        symbol: "b",
+        unit: "N·s/m",
+        lo: End::Closed(0.0),
+        hi: End::Closed(1e9),
+        live: true,
+        fit: data(2.0, 1),
+        meaning: "viscous drivetrain friction",
+    },
+    TermKey {
+        key: "drivetrain.load_coefficient",
+        symbol: "c_N",
+        unit: "–",
+        lo: End::Closed(0.0),
+        hi: End::Closed(10.0),
+        live: true,
+        fit: FitScale::Data {
+            factor: 2.0,
+            speed_power: 0,
+            per_load: true,
+            symmetric: false,
+        },
+        meaning: "friction proportional to the normal load (rolling elements carrying it)",
+    },
+    TermKey {
+        key: "drivetrain.quadratic_n_s2_m2",
+        symbol: "c_q",
+        unit: "N·s²/m²",
+        lo: End::Closed(0.0),
+        hi: End::Closed(1e9),
+        live: true,
+        fit: data(2.0, 2),
+        meaning: "loss growing with the square of speed (churning, windage, a motor's iron losses)",
+    },
+    TermKey {
+        key: "drivetrain.coulomb_asymmetry_n",
+        symbol: "ΔF_c",
+        unit: "N",
+        lo: End::Closed(-1e9),
+        hi: End::Closed(1e9),
+        live: true,
+        fit: FitScale::Data {
+            factor: 1.0,
+            speed_power: 0,
+            per_load: false,
+            symmetric: true,
+        },
+        meaning: "direction asymmetry: the level is F_c + ΔF_c forward, F_c − ΔF_c backward",
+    },
+];
+
 /// The drivetrain terms.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Drivetrain {

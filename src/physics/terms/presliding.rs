@@ -47,17 +47,38 @@
 //! resolve (a Δt ≫ 1) relaxes within the step, and the rigid model
 //! results. At rest (v = 0) z is held.
 
-/// sgn(v): ±1, and 0 at rest (`f64::signum` gives ±1 at ±0). The sign
-/// of gross sliding in L, and of the classic models' Coulomb terms.
-pub fn sgn(v: f64) -> f64 {
-    if v > 0.0 {
-        1.0
-    } else if v < 0.0 {
-        -1.0
-    } else {
-        0.0
-    }
-}
+use super::{End, FitScale, TermKey};
+
+/// The bristle's keys: stiffness and damping.
+pub const KEYS: &[TermKey] = &[
+    TermKey {
+        key: "contact.presliding_stiffness_n_m",
+        symbol: "σ0",
+        unit: "N/m",
+        lo: End::Closed(0.0),
+        hi: End::Closed(1e15),
+        live: true,
+        // A stiffness that is off starts at the data's stiffness through
+        // its reversals (the fit's own rule), else a decade either side.
+        fit: FitScale::FromStart,
+        meaning: "tangential stiffness before gross sliding (a bristle on the model's own level); 0 = rigid",
+    },
+    TermKey {
+        key: "contact.presliding_damping_n_s_m",
+        symbol: "σ1",
+        unit: "N·s/m",
+        lo: End::Closed(0.0),
+        hi: End::Closed(1e9),
+        live: true,
+        fit: FitScale::Data {
+            factor: 100.0,
+            speed_power: 1,
+            per_load: false,
+            symmetric: false,
+        },
+        meaning: "damping of that displacement; it never carries the force past the sliding level",
+    },
+];
 
 /// The pre-sliding parameters (both zero by default: the contact is rigid
 /// and its estimate bit-identical to a model without this module).
@@ -106,6 +127,7 @@ impl Presliding {
 #[cfg(test)]
 #[allow(clippy::float_cmp)] // the values compared exactly are exact claims (0, 1, representable sums)
 mod tests {
+    use super::super::sgn;
     use super::*;
     use approx::assert_relative_eq;
 

@@ -1,0 +1,368 @@
+//! Friction terms: what the contact's friction is made of besides the
+//! film's shear, each in a file of its own, and composed here in one
+//! documented order ([`FrictionTerms`]). Each term file declares its
+//! configuration keys ([`TermKey`]: unit, valid range, whether it may
+//! change while running, the scale of its default fit bounds); the
+//! catalogue ([`catalogue`]) is what the configuration's validation, the
+//! node's runtime-key list, the fit's default bounds and the README's key
+//! table are derived from.
+//!
+//! | file | term |
+//! |---|---|
+//! | `mod.rs` | the catalogue, the sign functions, the composition |
+//! | `boundary.rs` | boundary friction μ_bl on the asperity load, the rigid contact's sign regularisation, and the boundary film's rise with the logarithm of speed (Eyring) |
+//! | `presliding.rs` | the contact's elastic displacement before gross sliding (a bristle on the model's own level) |
+//! | `soft_width.rs` | a soft contact whose width follows the load |
+//! | `drivetrain.rs` | losses beside the contact (bearings, seals, gears, a motor) |
+//!
+//! Composition, every step, once the film is solved (F_visc, F_asp are the
+//! film's forces on the width B(F) of `soft_width.rs`):
+//!
+//! ```text
+//! 1. level     L   = F_visc + μ_bl F_asp s(v) + F_asp μ_r asinh(v/v_a)
+//!                    s(v) = tanh(v/v_reg) for the rigid contact, sgn(v) with pre-sliding
+//! 2. contact   F_c = L (rigid), or the bristle's σ0 z + σ1 ż on L (pre-sliding)
+//! 3. total     F_f = F_c + F_dt(v, F_ext)
+//! 4. COF           = (|F_visc| + (μ_bl + μ_r asinh(|v|/v_a)) F_asp) / F_ext (rigid)
+//!                    |F_c| / F_ext (pre-sliding)
+//! ```
+//!
+//! | symbol | meaning | unit |
+//! |---|---|---|
+//! | F_visc | the film's shear force | N |
+//! | F_asp | the load the asperities carry | N |
+//! | F_ext | the normal load | N |
+//! | L | the contact's friction in gross sliding | N |
+//! | F_c | the friction the contact transmits | N |
+//! | F_dt | the drivetrain's terms | N |
+//! | F_f | the friction estimate | N |
+//!
+//! Every term is off by default (0) and then leaves every number of the
+//! paper's model unchanged, bit for bit (a term is applied only when on).
+//!
+//! Adding a term: its file (struct, equation, symbol table, `KEYS`), a field
+//! of [`FrictionTerms`] and its place in the composition above, its slice in
+//! [`catalogue`], its configuration fields (`config/model.rs`, `config/mod.rs`)
+//! and its tests. Validation, live-ness, the fit's bounds and the docs'
+//! table follow from `KEYS`.
+
+pub mod boundary;
+pub mod drivetrain;
+pub mod presliding;
+pub mod soft_width;
+
+use boundary::BoundaryRate;
+use drivetrain::Drivetrain;
+use presliding::Presliding;
+use soft_width::WidthLaw;
+
+/// sgn(v): ±1, and 0 at rest (`f64::signum` gives ±1 at ±0). The sign of
+/// gross sliding in the pre-sliding level, and of the classic models'
+/// Coulomb terms.
+pub fn sgn(v: f64) -> f64 {
+    if v > 0.0 {
+        1.0
+    } else if v < 0.0 {
+        -1.0
+    } else {
+        0.0
+    }
+}
+
+/// One end of a key's valid range.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum End {
+    /// The value itself is allowed.
+    Closed(f64),
+    /// The value itself is not allowed.
+    Open(f64),
+}
+
+impl End {
+    /// The number at this end.
+    pub fn value(self) -> f64 {
+        match self {
+            End::Closed(v) | End::Open(v) => v,
+        }
+    }
+}
+
+/// The scale of a key's default fit bounds when its start gives none (a
+/// term that is off starts at 0).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum FitScale {
+    /// Only from its start: a decade either side of a positive start;
+    /// `--bounds` is needed for a start of 0.
+    FromStart,
+    /// [0, factor · F / (v^speed_power · (F_N if per_load))], capped at the
+    /// key's upper bound; `symmetric`: [−hi, hi]. F is the data's largest
+    /// friction, v its largest speed, F_N its smallest load.
+    Data {
+        /// The multiple of the data's friction scale.
+        factor: f64,
+        /// The power of the data's speed the friction is divided by.
+        speed_power: i32,
+        /// Divided by the data's smallest load (a coefficient).
+        per_load: bool,
+        /// Bounds either side of zero (a signed term).
+        symmetric: bool,
+    },
+}
+
+/// One configuration key of a friction term.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TermKey {
+    /// The dotted configuration key.
+    pub key: &'static str,
+    /// Its symbol in the equations.
+    pub symbol: &'static str,
+    /// Its unit ("–" when dimensionless).
+    pub unit: &'static str,
+    /// The lower end of its valid range.
+    pub lo: End,
+    /// The upper end of its valid range.
+    pub hi: End,
+    /// Whether it may change while the node runs.
+    pub live: bool,
+    /// The scale of its default fit bounds.
+    pub fit: FitScale,
+    /// What it is, in a few words.
+    pub meaning: &'static str,
+}
+
+/// Every friction term's keys, term by term, in the composition's order.
+pub fn catalogue() -> impl Iterator<Item = &'static TermKey> {
+    [
+        boundary::KEYS,
+        presliding::KEYS,
+        soft_width::KEYS,
+        drivetrain::KEYS,
+    ]
+    .into_iter()
+    .flatten()
+}
+
+/// The catalogue's entry for `key`.
+pub fn term_key(key: &str) -> Option<&'static TermKey> {
+    catalogue().find(|k| k.key == key)
+}
+
+/// The catalogue as a markdown table (key | symbol | unit | range | live |
+/// meaning): the README's table of the friction terms' keys is this text.
+pub fn keys_table() -> String {
+    let mut s =
+        String::from("| key | symbol | unit | valid range | meaning |\n|---|---|---|---|---|\n");
+    for k in catalogue() {
+        let (l, lv) = match k.lo {
+            End::Closed(v) => ('[', v),
+            End::Open(v) => ('(', v),
+        };
+        let (h, hv) = match k.hi {
+            End::Closed(v) => (']', v),
+            End::Open(v) => (')', v),
+        };
+        s.push_str(&format!(
+            "| `{}` | {} | {} | {l}{}, {}{h} | {} |\n",
+            k.key,
+            k.symbol,
+            k.unit,
+            number(lv),
+            number(hv),
+            k.meaning
+        ));
+    }
+    s
+}
+
+/// A range's end as the configuration's comments write it (1e-9, 0.5, 1e15).
+fn number(v: f64) -> String {
+    let a = v.abs();
+    if a == 0.0 || (1e-3..1e7).contains(&a) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
+/// The friction terms of one contact, composed in the order of the module
+/// documentation. All off by default.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FrictionTerms {
+    /// μ_bl, the boundary friction coefficient.
+    pub boundary_friction: f64,
+    /// v_reg of the rigid contact's (and the drivetrain's) tanh sign, m/s.
+    pub sign_regularization: f64,
+    /// The boundary film's rise with speed.
+    pub boundary_rate: BoundaryRate,
+    /// The pre-sliding bristle.
+    pub presliding: Presliding,
+    /// The soft contact's width against the load.
+    pub width_law: WidthLaw,
+    /// The drivetrain's terms.
+    pub drivetrain: Drivetrain,
+}
+
+impl Default for FrictionTerms {
+    fn default() -> Self {
+        Self {
+            boundary_friction: 0.3,
+            sign_regularization: 1e-4,
+            boundary_rate: BoundaryRate::default(),
+            presliding: Presliding::default(),
+            width_law: WidthLaw::default(),
+            drivetrain: Drivetrain::default(),
+        }
+    }
+}
+
+/// What the composition produced at one state.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Composed {
+    /// F_c, the friction the contact transmits, N.
+    pub contact: f64,
+    /// F_f, with the drivetrain's terms, N.
+    pub total: f64,
+    /// The COF.
+    pub cof: f64,
+    /// The boundary rate's part of the COF (0 with pre-sliding).
+    pub boundary_rate_cof: f64,
+}
+
+/// How the bristle moves in this evaluation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum BristleMove {
+    /// A step of this length, s: the bristle advances.
+    Step(f64),
+    /// A steady state: the bristle takes its steady displacement.
+    Steady,
+    /// Neither (a solve that does not advance time): the bristle is held.
+    Hold,
+}
+
+impl FrictionTerms {
+    /// L with the boundary rate's term added when it is on (off: the
+    /// paper's constant μ_bl, bit for bit, signed zeros included).
+    #[inline(always)]
+    fn with_rate(&self, f: f64, v: f64, f_asp: f64) -> f64 {
+        if self.boundary_rate.is_on() {
+            f + f_asp * self.boundary_rate.signed_term(v)
+        } else {
+            f
+        }
+    }
+
+    /// F_c, the contact's friction from the film's forces (steps 1–2);
+    /// `bristle` is the pre-sliding displacement z, moved as `how` says.
+    #[inline(always)]
+    pub fn contact(
+        &self,
+        v: f64,
+        f_visc: f64,
+        f_asp: f64,
+        bristle: &mut f64,
+        how: BristleMove,
+    ) -> f64 {
+        let mu_bl = self.boundary_friction;
+        if !self.presliding.is_on() {
+            let s = (v / self.sign_regularization).tanh();
+            return self.with_rate(f_visc + mu_bl * f_asp * s, v, f_asp);
+        }
+        let level = self.with_rate(f_visc + mu_bl * f_asp * sgn(v), v, f_asp);
+        let p = self.presliding;
+        match how {
+            BristleMove::Step(dt) => {
+                let (z, f) = p.advance(*bristle, level, v, dt);
+                *bristle = z;
+                f
+            }
+            BristleMove::Steady => {
+                *bristle = p.steady_displacement(level);
+                level
+            }
+            BristleMove::Hold => level,
+        }
+    }
+
+    /// F_f: the contact's friction and the drivetrain's terms at load
+    /// `load` (zero drivetrain terms leave F_c untouched, bit for bit).
+    #[inline(always)]
+    pub fn total(&self, contact: f64, v: f64, load: f64) -> f64 {
+        if self.drivetrain.is_zero() {
+            contact
+        } else {
+            contact + self.drivetrain.force(v, load, self.sign_regularization)
+        }
+    }
+
+    /// The COF and the boundary rate's part of it (step 4): the magnitude
+    /// of the friction the contact transmits per unit load. Rigid contact:
+    /// it always slides, so (|F_visc| + μ(v) F_asp) / F_ext, the sign's
+    /// regularisation not applied; with pre-sliding, |F_c| / F_ext. The
+    /// rate's part μ_r asinh(|v|/v_a) F_asp / F_ext is 0 at v = 0 and steep
+    /// near it: the one-sided limits at v = 0 are taken without it.
+    #[inline(always)]
+    pub fn cof(&self, v: f64, f_visc: f64, f_asp: f64, contact: f64, load: f64) -> (f64, f64) {
+        if self.presliding.is_on() {
+            return (contact.abs() / load, 0.0);
+        }
+        let mu_bl = self.boundary_friction;
+        if self.boundary_rate.is_on() {
+            let rate = self.boundary_rate.signed_term(v.abs()) * f_asp / load;
+            let mu = mu_bl + self.boundary_rate.signed_term(v.abs());
+            ((f_visc.abs() + mu * f_asp) / load, rate)
+        } else {
+            ((f_visc.abs() + mu_bl * f_asp) / load, 0.0)
+        }
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::float_cmp)] // the values compared exactly are exact claims
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_key_of_the_catalogue_is_named_once_with_a_unit_and_an_ordered_range() {
+        let keys: Vec<&str> = catalogue().map(|k| k.key).collect();
+        let mut unique = keys.clone();
+        unique.sort_unstable();
+        unique.dedup();
+        assert_eq!(unique.len(), keys.len(), "{keys:?}");
+        for k in catalogue() {
+            assert!(!k.unit.is_empty() && !k.symbol.is_empty(), "{}", k.key);
+            assert!(k.lo.value() < k.hi.value(), "{}", k.key);
+        }
+        assert_eq!(
+            term_key("contact.boundary_friction").unwrap().symbol,
+            "μ_bl"
+        );
+        assert!(term_key("contact.load_n").is_none());
+    }
+
+    #[test]
+    fn off_terms_leave_the_rigid_contact_as_the_paper_has_it() {
+        let t = FrictionTerms::default();
+        let mut z = 0.0;
+        let (v, f_visc, f_asp, load) = (0.01, 12.0, 5000.0, 20_000.0);
+        let c = t.contact(v, f_visc, f_asp, &mut z, BristleMove::Step(1e-3));
+        assert_eq!(c, f_visc + 0.3 * f_asp * (v / 1e-4).tanh());
+        assert_eq!(t.total(c, v, load), c);
+        assert_eq!(
+            t.cof(v, f_visc, f_asp, c, load),
+            ((12.0 + 0.3 * 5000.0) / load, 0.0)
+        );
+        assert_eq!(z, 0.0);
+        assert_eq!(sgn(-0.0), 0.0);
+        assert_eq!(sgn(-2.0), -1.0);
+    }
+
+    #[test]
+    fn the_readme_lists_the_terms_keys_as_the_catalogue_declares_them() {
+        let readme = include_str!(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md"));
+        let table = keys_table();
+        assert!(
+            readme.contains(&table),
+            "README.md lacks the table:\n{table}"
+        );
+    }
+}
