@@ -422,11 +422,7 @@ fn step_one(s: &mut Solver, config: &Config, v: f64, load: f64, dt_s: f64) -> Es
     if finite && (limits.check_velocity(v).is_err() || limits.check_load(load).is_err()) {
         return s.refuse_step();
     }
-    if dt_s == s.settings().dt {
-        s.step(v, load)
-    } else {
-        s.step_lasting(v, load, dt_s)
-    }
+    s.step_by(v, load, dt_s)
 }
 
 /// Advance every contact by `dt_s`: contact i with velocity

@@ -218,10 +218,8 @@ impl Model {
             .and_then(|_| limits.check_load(load))
             .map_err(|e| errors::value(e.to_string()))?;
         let e = match dt {
-            Some(dt) if dt != self.solver.settings().dt => {
-                self.solver.step_lasting(velocity, load, dt)
-            }
-            _ => self.solver.step(velocity, load),
+            Some(dt) => self.solver.step_by(velocity, load, dt),
+            None => self.solver.step(velocity, load),
         };
         Ok(Estimate::from(&e))
     }
@@ -331,7 +329,6 @@ impl Model {
         }
         let default_load = self.config.contact.load_n;
         let follows = temperature.is_some() && law.follows_temperature();
-        let dt = self.solver.settings().dt;
         let solver = &mut self.solver;
         let t_ref = self.temperature_c;
         let temp = |k: usize| temperature.map_or(t_ref, |s| s[k]);
@@ -353,12 +350,7 @@ impl Model {
                     let e = if k == 0 {
                         solver.initialize_steady(v[0], f(0))
                     } else {
-                        let h = t[k] - t[k - 1];
-                        if (h - dt).abs() <= 1e-9 * dt {
-                            solver.step(v[k], f(k))
-                        } else {
-                            solver.step_lasting(v[k], f(k), h)
-                        }
+                        solver.step_by(v[k], f(k), t[k] - t[k - 1])
                     };
                     c.push(&e, t[k], e.status.as_str(), temp(k));
                 }

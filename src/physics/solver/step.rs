@@ -53,6 +53,20 @@ impl Solver {
         self.step_with_gap(v, load, H0Mode::Balance)
     }
 
+    /// A step of `dt` s, as every entry point that takes a step length
+    /// does it (the C API, Python): the configured step when `dt` is within
+    /// 1e-9 relative of `solver.dt_s` (the second-order history goes on,
+    /// whatever rounding the caller's clock or time column added), else one
+    /// [`Solver::step_lasting`].
+    pub fn step_by(&mut self, v: f64, load: f64, dt: f64) -> Estimate {
+        let configured = self.settings.dt;
+        if (dt - configured).abs() <= 1e-9 * configured {
+            self.step(v, load)
+        } else {
+            self.step_lasting(v, load, dt)
+        }
+    }
+
     /// One backward-Euler step of arbitrary length `dt` (s, in (0,
     /// [`MAX_VARIABLE_STEP_S`]]), for a loop that lost more time than it can catch
     /// up in fixed steps. The history restarts around it: the step and the
@@ -325,6 +339,36 @@ impl PredictionGuard {
         } else {
             predicted
         }
+    }
+}
+
+#[cfg(test)]
+mod step_by_tests {
+    use crate::physics::{ModelParams, Solver, SolverSettings};
+
+    fn solver() -> Solver {
+        let settings = SolverSettings {
+            cells: 32,
+            ..Default::default()
+        };
+        let mut s = Solver::new(&ModelParams::default(), &settings).unwrap();
+        s.initialize_steady(0.0, 20_762.0);
+        s
+    }
+
+    #[test]
+    fn a_step_of_the_configured_length_up_to_rounding_continues_the_history_any_other_lasts() {
+        let (mut a, mut b, mut c) = (solver(), solver(), solver());
+        let dt = a.settings().dt;
+        for k in 1..=20 {
+            let v = 0.01 * k as f64;
+            // A clock's rounding (1e-13 relative) is the configured step.
+            let ea = a.step_by(v, 20_762.0, dt * (1.0 + 1e-13));
+            let eb = b.step(v, 20_762.0);
+            assert_eq!(ea, eb, "step {k}");
+        }
+        let lasting = c.step_by(0.01, 20_762.0, 2.0 * dt);
+        assert_eq!(lasting, solver().step_lasting(0.01, 20_762.0, 2.0 * dt));
     }
 }
 
