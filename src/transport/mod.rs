@@ -11,7 +11,7 @@
 //!
 //! | file | job |
 //! |---|---|
-//! | `mod.rs` | the backend-neutral traits, the loop's ports, profile slots |
+//! | `mod.rs` | the backend-neutral traits and the loop's ports (the film-profile slot they publish from is `crate::link`'s) |
 //! | `memory.rs` | in-memory: bounded lock-free queues between threads of one process |
 //! | `iceoryx/` | iceoryx2: zero-copy shared memory on one host |
 //! | `ros2/` | ROS 2 through ros2-client (pure-Rust DDS) |

@@ -24,7 +24,7 @@
 //! matrix and no pivoting is needed (a zero or non-finite pivot gives None,
 //! as in `bordered.rs`).
 
-use super::bordered::{close_border, Border};
+use super::border::{close_border, Border};
 use super::work::{BandFactor, RowColumns, Work};
 
 /// Row i of the system in solve order (reversed when v < 0), as

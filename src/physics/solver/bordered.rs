@@ -25,6 +25,7 @@
 //! stability is the Thomas algorithm's (diagonally dominant rows: the
 //! spikes are below one in size and 1 − v_last u_first stays away from 0).
 
+use super::border::{close_border, Border};
 use super::work::{Factor, RowColumns, Work};
 
 /// The partition of N rows into two twisted blocks.
@@ -191,45 +192,6 @@ pub(crate) fn factor_solve(w: &mut Work) -> Option<f64> {
         g: w.g,
     };
     close_border(border, y, fs.iter().map(|f| f.z), (sy, sz), &mut w.schur)
-}
-
-/// The load-balance border of the system: its row (c, ∂g/∂h0) and
-/// residual g, and whether the gap is solved for at all.
-pub(super) struct Border {
-    pub(super) balance: bool,
-    pub(super) dgdh: f64,
-    pub(super) c_row: f64,
-    pub(super) g: f64,
-}
-
-/// Close the bordered solve from the block's two solutions y (right-hand
-/// side) and z (border column), given their sums (Σ y, Σ z): Δh0 from the
-/// Schur complement s = ∂g/∂h0 − c Σ z (stored in `schur`), then the
-/// direction −(y + z Δh0) into `y`. Without the border, Δh0 = 0 and the
-/// direction is −y. None when s is zero or non-finite.
-#[inline(always)]
-pub(super) fn close_border(
-    b: Border,
-    y: &mut [f64],
-    z: impl Iterator<Item = f64>,
-    (sy, sz): (f64, f64),
-    schur: &mut f64,
-) -> Option<f64> {
-    if !b.balance {
-        for v in y.iter_mut() {
-            *v = -*v;
-        }
-        return Some(0.0);
-    }
-    *schur = b.dgdh - b.c_row * sz;
-    if !(schur.is_finite() && *schur != 0.0) {
-        return None;
-    }
-    let dh = (-b.g + b.c_row * sy) / *schur;
-    for (v, z) in y.iter_mut().zip(z) {
-        *v = -*v - z * dh;
-    }
-    Some(dh)
 }
 
 /// Back substitution of both blocks outwards from their meeting rows (four

@@ -1,6 +1,6 @@
 //! The second-order (MUSCL) Couette flux: the face density is the upwind
 //! cell's plus half its limited slope (MODEL.md §4 upwinds the density; this
-//! is the `solver.flux: muscl-…` option).
+//! is the `solver.flux: muscl_…` option: `muscl_minmod`, `muscl_van_leer`, `muscl_van_albada`).
 //!
 //! | symbol | meaning | unit |
 //! |---|---|---|

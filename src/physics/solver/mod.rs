@@ -56,6 +56,7 @@
 //! | `flux.rs` | the MUSCL Couette flux: the limited slope's part of each face flux |
 //! | `bordered.rs` | the tridiagonal-plus-border linear solve |
 //! | `banded.rs` | the pentadiagonal-plus-border linear solve (MUSCL flux) |
+//! | `border.rs` | the load-balance border and the Schur-complement close both solves share |
 //! | `lanes.rs` | lane-wise sums and maxima that vectorise |
 //! | `postprocess.rs` | forces, friction and diagnostics of a solved state |
 //! | `reference.rs` | the paper's Algorithm 1 (Picard + secant), the verification reference |
@@ -63,6 +64,7 @@
 
 mod assembly;
 mod banded;
+mod border;
 mod bordered;
 mod breakdown;
 mod cell_pass;

@@ -16,7 +16,7 @@
 //!
 //! | file | job |
 //! |---|---|
-//! | `mod.rs` | the single-contact services: commands in, estimates and profiles out |
+//! | `mod.rs` | the single-contact services: commands in, estimates and loop statistics out (iceoryx2 publishes no film profile) |
 //! | `payloads.rs` | the `#[repr(C)]` payloads and their conversions |
 //! | `joints.rs` | several contacts: JointState velocities in, per-contact estimates out |
 
