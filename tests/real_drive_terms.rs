@@ -406,3 +406,48 @@ fn a_stiff_bristle_is_the_rigid_contact_without_sign_regularisation() {
         "v_reg = 3e-4 smooths a 1 mm/s motion visibly: {worst_smooth}"
     );
 }
+
+#[test]
+fn with_presliding_what_acts_at_zero_speed_rides_on_the_bristle_the_drivetrains_coulomb_level_too()
+{
+    // The level mostly in the drivetrain (μ_bl = 0.01, F_c = 5 kN): before,
+    // the bristle carried the contact's 200 N alone and F_c switched within
+    // ±v_reg, so pre-sliding had almost nothing to act on.
+    let base = [
+        "contact.boundary_friction=0.01",
+        "drivetrain.coulomb_n=5000",
+    ];
+    let rigid = run(&config(&base), 0.01, 700);
+    let mut with = base.to_vec();
+    with.push("contact.presliding_stiffness_n_m=2e8");
+    let c = config(&with);
+    let soft = run(&c, 0.01, 700);
+    let rise = |r: &[(f64, f64)]| {
+        r[480..600]
+            .iter()
+            .filter(|(_, f)| f.abs() < 0.8 * 5000.0)
+            .count()
+    };
+    assert!(rise(&rigid) <= 4, "rigid: {}", rise(&rigid));
+    assert!(
+        rise(&soft) >= 4 * rise(&rigid).max(3),
+        "the whole friction passes zero gradually: {} steps against {}",
+        rise(&soft),
+        rise(&rigid)
+    );
+    // Mid-stroke: the same sliding friction, and the contact's share is the
+    // contact's own friction.
+    assert_relative_eq!(rigid[250].1, soft[250].1, max_relative = 1e-3);
+    let mut s = Solver::new(&c.model(), &c.solver_settings()).unwrap();
+    s.initialize_steady(0.0, c.contact.load_n);
+    let mut e = s.step(0.01, c.contact.load_n);
+    for _ in 0..300 {
+        e = s.step(0.01, c.contact.load_n);
+    }
+    assert_relative_eq!(
+        e.friction_force,
+        e.contact_friction_force + 5000.0,
+        max_relative = 1e-6 // the bristle lags the drifting level by L/(σ0 v) = 2.6 ms
+    );
+    assert!(e.contact_friction_force > 0.0 && e.contact_friction_force < 0.1 * 5000.0);
+}

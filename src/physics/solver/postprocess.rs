@@ -140,12 +140,13 @@ impl Solver {
         }
     }
 
-    /// The contact's friction from its viscous and asperity forces
-    /// ([`crate::physics::terms::FrictionTerms::contact`]); the pre-sliding
+    /// The contact's friction and the total at `load` (N) from the film's
+    /// viscous and asperity forces
+    /// ([`crate::physics::terms::FrictionTerms::friction`]); the pre-sliding
     /// displacement advances when the step advances time, takes its steady
     /// value in a steady state, and is held otherwise.
     #[inline(always)]
-    fn contact_friction(&mut self, ctx: &Ctx, f_visc: f64, f_asp: f64, advance: bool) -> f64 {
+    fn friction(&mut self, ctx: &Ctx, load: f64, forces: (f64, f64), advance: bool) -> (f64, f64) {
         let how = match (advance, ctx.time) {
             (true, Some((_, dt))) => BristleMove::Step(dt),
             (_, None) => BristleMove::Steady,
@@ -153,7 +154,7 @@ impl Solver {
         };
         self.d
             .terms
-            .contact(ctx.v, f_visc, f_asp, &mut self.bristle, how)
+            .friction((ctx.v, load), forces, &mut self.bristle, how)
     }
 
     /// Make the solved state the newest history level (ρ h from `w.tmp`),
@@ -211,11 +212,10 @@ impl Solver {
             w * film.viscous,
             w * inertia,
         );
-        let contact_friction = self.contact_friction(ctx, f_visc, f_asp, advance);
-        let d = &self.d;
         // The load itself (the film's load is per reference width).
         let load = w * ctx.load;
-        let friction = d.terms.total(contact_friction, v, load);
+        let (contact_friction, friction) = self.friction(ctx, load, (f_visc, f_asp), advance);
+        let d = &self.d;
         let (cof, boundary_rate_cof) = d.terms.cof(v, f_visc, f_asp, contact_friction, load);
         let share = f_asp / load;
         let load_residual = match ctx.gap {

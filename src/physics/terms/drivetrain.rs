@@ -17,6 +17,10 @@
 //! | v_reg | the contact's sign regularisation (the same tanh) | m/s |
 //!
 //! All zero by default: the estimate is then the contact's alone, bit for bit.
+//! With pre-sliding on (`presliding.rs`) the terms that act at zero speed,
+//! (F_c + c_N F_ext) sgn v + ΔF_c |sgn v|, are part of the bristle's level
+//! (a reversal's compliance is the whole axis's), and only b v + c_q v|v|
+//! is added beside it.
 
 use super::{End, FitScale, TermKey};
 
@@ -127,6 +131,20 @@ impl Drivetrain {
             + self.coulomb_asymmetry * s.abs()
             + self.viscous * v
             + self.quadratic * v * v.abs()
+    }
+
+    /// The terms that act at zero speed, with the sign `s` of gross sliding
+    /// (−1, 0 or 1): (F_c + c_N F) s + ΔF_c |s|. With pre-sliding on they
+    /// are part of the bristle's level: the compliance at a reversal is the
+    /// whole axis's, not the contact's alone.
+    pub fn level_at_rest(&self, s: f64, load: f64) -> f64 {
+        (self.coulomb + self.load_coefficient * load) * s + self.coulomb_asymmetry * s.abs()
+    }
+
+    /// The terms that vanish with the speed: b v + c_q v |v| (outside the
+    /// bristle, as LuGre's viscous term is).
+    pub fn rate_terms(&self, v: f64) -> f64 {
+        self.viscous * v + self.quadratic * v * v.abs()
     }
 }
 

@@ -19,10 +19,16 @@
 //! film's forces on the width B(F) of `soft_width.rs`):
 //!
 //! ```text
-//! 1. level     L   = F_visc + μ_bl F_asp s(v) + F_asp μ_r asinh(v/v_a)
+//! 1. level     L_c = F_visc + μ_bl F_asp s(v) + F_asp μ_r asinh(v/v_a)
 //!                    s(v) = tanh(v/v_reg) for the rigid contact, sgn(v) with pre-sliding
-//! 2. contact   F_c = L (rigid), or the bristle's σ0 z + σ1 ż on L (pre-sliding)
+//! rigid contact:
+//! 2. contact   F_c = L_c
 //! 3. total     F_f = F_c + F_dt(v, F_ext)
+//! with pre-sliding (the compliance at a reversal is the whole axis's):
+//! 2. level     L   = L_c + (F_c,dt + c_N F_ext) sgn(v) + ΔF_c |sgn(v)|   (what acts at zero speed)
+//!              F_b = σ0 z + σ1 ż on L                                  (the bristle)
+//!              F_c = F_b L_c / L   (the contact's share; F_b when L = 0)
+//! 3. total     F_f = F_b + b v + c_q v |v|
 //! 4. COF           = (|F_visc| + (μ_bl + μ_r asinh(|v|/v_a)) F_asp) / F_ext (rigid)
 //!                    |F_c| / F_ext (pre-sliding)
 //! ```
@@ -251,23 +257,49 @@ impl FrictionTerms {
         }
     }
 
-    /// F_c, the contact's friction from the film's forces (steps 1–2);
-    /// `bristle` is the pre-sliding displacement z, moved as `how` says.
+    /// (F_c, F_f): the contact's friction and the total at load `load`,
+    /// from the film's forces (steps 1–3); `bristle` is the pre-sliding
+    /// displacement z, moved as `how` says. Zero drivetrain terms leave
+    /// F_f = F_c, bit for bit.
     #[inline(always)]
-    pub fn contact(
+    pub fn friction(
         &self,
-        v: f64,
-        f_visc: f64,
-        f_asp: f64,
+        (v, load): (f64, f64),
+        (f_visc, f_asp): (f64, f64),
         bristle: &mut f64,
         how: BristleMove,
-    ) -> f64 {
+    ) -> (f64, f64) {
         let mu_bl = self.boundary_friction;
+        let dt = self.drivetrain;
         if !self.presliding.is_on() {
             let s = (v / self.sign_regularization).tanh();
-            return self.with_rate(f_visc + mu_bl * f_asp * s, v, f_asp);
+            let contact = self.with_rate(f_visc + mu_bl * f_asp * s, v, f_asp);
+            if dt.is_zero() {
+                return (contact, contact);
+            }
+            let total = contact + dt.force(v, load, self.sign_regularization);
+            return (contact, total);
         }
-        let level = self.with_rate(f_visc + mu_bl * f_asp * sgn(v), v, f_asp);
+        let level_c = self.with_rate(f_visc + mu_bl * f_asp * sgn(v), v, f_asp);
+        if dt.is_zero() {
+            let f = self.bristle(level_c, v, bristle, how);
+            return (f, f);
+        }
+        // What acts at zero speed rides on the bristle; the contact's share
+        // of its force is its share of the level.
+        let level = level_c + dt.level_at_rest(sgn(v), load);
+        let f = self.bristle(level, v, bristle, how);
+        let contact = if level == 0.0 {
+            f
+        } else {
+            f * (level_c / level)
+        };
+        (contact, f + dt.rate_terms(v))
+    }
+
+    /// The bristle's force on `level`, z moved as `how` says.
+    #[inline(always)]
+    fn bristle(&self, level: f64, v: f64, bristle: &mut f64, how: BristleMove) -> f64 {
         let p = self.presliding;
         match how {
             BristleMove::Step(dt) => {
@@ -280,17 +312,6 @@ impl FrictionTerms {
                 level
             }
             BristleMove::Hold => level,
-        }
-    }
-
-    /// F_f: the contact's friction and the drivetrain's terms at load
-    /// `load` (zero drivetrain terms leave F_c untouched, bit for bit).
-    #[inline(always)]
-    pub fn total(&self, contact: f64, v: f64, load: f64) -> f64 {
-        if self.drivetrain.is_zero() {
-            contact
-        } else {
-            contact + self.drivetrain.force(v, load, self.sign_regularization)
         }
     }
 
@@ -344,9 +365,9 @@ mod tests {
         let t = FrictionTerms::default();
         let mut z = 0.0;
         let (v, f_visc, f_asp, load) = (0.01, 12.0, 5000.0, 20_000.0);
-        let c = t.contact(v, f_visc, f_asp, &mut z, BristleMove::Step(1e-3));
+        let (c, total) = t.friction((v, load), (f_visc, f_asp), &mut z, BristleMove::Step(1e-3));
         assert_eq!(c, f_visc + 0.3 * f_asp * (v / 1e-4).tanh());
-        assert_eq!(t.total(c, v, load), c);
+        assert_eq!(total, c);
         assert_eq!(
             t.cof(v, f_visc, f_asp, c, load),
             ((12.0 + 0.3 * 5000.0) / load, 0.0)

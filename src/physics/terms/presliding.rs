@@ -4,7 +4,8 @@
 //! own friction in gross sliding as its level.
 //!
 //! ```text
-//! L  = F_visc + μ_bl F_asp sgn(v)              the contact's friction in gross sliding
+//! L  = F_visc + μ_bl F_asp sgn(v) + F_asp μ_r asinh(v/v_a)
+//!      + (F_c + c_N F_ext) sgn(v) + ΔF_c |sgn(v)|   the friction in gross sliding that acts at zero speed
 //! ż  = |v| sgn(L) − σ0 |v| z / |L|  = a (z_ss − z),   a = σ0 |v| / |L|,  z_ss = L / σ0
 //! F  = σ0 z + σ1 ż
 //! ```
@@ -15,7 +16,7 @@
 //! | σ0 | tangential (pre-sliding) stiffness; 0 = off | N/m |
 //! | σ1 | damping of the displacement | N·s/m |
 //! | v | sliding velocity of the slider | m/s |
-//! | L | the rigid model's friction at this state: fluid shear plus boundary friction, signed | N |
+//! | L | the friction of gross sliding at this state that acts at zero speed: fluid shear, boundary friction and its rate, and the drivetrain's Coulomb, load-proportional and asymmetric levels (`drivetrain.rs`), signed; the compliance at a reversal is the whole axis's | N |
 //! | F | the contact's friction force | N |
 //!
 //! With L = g(v) sgn v this is LuGre's ż = v − σ0 |v| z / g(v), but its
