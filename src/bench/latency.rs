@@ -5,6 +5,7 @@
 //! step included.
 
 use crate::config::Config;
+use crate::node::runner::RunError;
 use std::time::Instant;
 
 /// Command → estimate latency through a transport (lockstep node, model step
@@ -31,7 +32,7 @@ pub fn latency(
     spec: crate::transport::BackendSpec,
     samples: usize,
     warmup: usize,
-) -> Result<LatencyReport, crate::node::runner::RunError> {
+) -> Result<LatencyReport, RunError> {
     use crate::link::LiveStatus;
     use crate::msgs::{Command, CommandKind};
     use crate::node::Loop;
@@ -46,18 +47,15 @@ pub fn latency(
     let stop = Arc::new(AtomicBool::new(false));
     let (tx, rx) = std::sync::mpsc::channel();
     let (s2, spec2, cfg2) = (stop.clone(), spec.clone(), cfg.clone());
-    let node = std::thread::spawn(move || -> Result<crate::node::RunSummary, String> {
-        let port = spec2
-            .open_node(Default::default())
-            .map_err(|e| e.to_string())?;
+    let node = std::thread::spawn(move || -> Result<crate::node::RunSummary, RunError> {
+        let port = spec2.open_node(Default::default())?;
         let mut l = Loop::new(
             &cfg2,
             vec![port],
             None,
             None,
             Arc::new(LiveStatus::default()),
-        )
-        .map_err(|e| e.to_string())?;
+        )?;
         let _ = tx.send(());
         Ok(l.run(&s2, None))
     });
@@ -124,8 +122,7 @@ pub fn latency(
     stop.store(true, Ordering::Relaxed);
     let summary = node
         .join()
-        .map_err(|_| crate::node::runner::RunError::Option("the node thread panicked".into()))?
-        .map_err(crate::node::runner::RunError::Option)?;
+        .map_err(|_| RunError::ThreadPanicked("node"))??;
     let mut sorted = times.clone();
     sorted.sort_unstable();
     let q = |p: f64| {

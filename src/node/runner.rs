@@ -41,6 +41,9 @@ pub enum RunError {
     /// An option (`--demo`, `use_sim_time`, recording without `mcap`) that cannot be honoured.
     #[error("invalid option: {0}")]
     Option(String),
+    /// A thread of the run panicked (a defect, not a usage error).
+    #[error("the {0} thread panicked")]
+    ThreadPanicked(&'static str),
     #[cfg(feature = "mcap")]
     /// The recording could not be started.
     #[error(transparent)]
