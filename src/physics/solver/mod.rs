@@ -341,14 +341,7 @@ impl Solver {
             gr_b: sb.rho / sb.mu,
             mass: model.contact.mass,
             min_film: model.contact.min_film,
-            terms: crate::physics::terms::FrictionTerms {
-                boundary_friction: model.contact.boundary_friction,
-                sign_regularization: model.contact.sign_regularization,
-                boundary_rate: model.contact.boundary_rate,
-                presliding: model.contact.presliding,
-                width_law: model.contact.width_law,
-                drivetrain: model.drivetrain,
-            },
+            terms: crate::physics::terms::FrictionTerms::of(model),
             guard: step::PredictionGuard::new(&eos, model.lubricant.saturation_pressure),
         })
     }

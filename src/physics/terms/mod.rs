@@ -172,22 +172,12 @@ pub fn keys_table() -> String {
             k.key,
             k.symbol,
             k.unit,
-            number(lv),
-            number(hv),
+            crate::text::Num(lv),
+            crate::text::Num(hv),
             k.meaning
         ));
     }
     s
-}
-
-/// A range's end as the configuration's comments write it (1e-9, 0.5, 1e15).
-fn number(v: f64) -> String {
-    let a = v.abs();
-    if a == 0.0 || (1e-3..1e7).contains(&a) {
-        format!("{v}")
-    } else {
-        format!("{v:e}")
-    }
 }
 
 /// The friction terms of one contact, composed in the order of the module
@@ -208,15 +198,17 @@ pub struct FrictionTerms {
     pub drivetrain: Drivetrain,
 }
 
-impl Default for FrictionTerms {
-    fn default() -> Self {
+impl FrictionTerms {
+    /// The terms of `model` (its contact's and its drivetrain's keys).
+    pub fn of(model: &crate::physics::ModelParams) -> Self {
+        let c = &model.contact;
         Self {
-            boundary_friction: 0.3,
-            sign_regularization: 1e-4,
-            boundary_rate: BoundaryRate::default(),
-            presliding: Presliding::default(),
-            width_law: WidthLaw::default(),
-            drivetrain: Drivetrain::default(),
+            boundary_friction: c.boundary_friction,
+            sign_regularization: c.sign_regularization,
+            boundary_rate: c.boundary_rate,
+            presliding: c.presliding,
+            width_law: c.width_law,
+            drivetrain: model.drivetrain,
         }
     }
 }
@@ -362,7 +354,7 @@ mod tests {
 
     #[test]
     fn off_terms_leave_the_rigid_contact_as_the_paper_has_it() {
-        let t = FrictionTerms::default();
+        let t = FrictionTerms::of(&crate::physics::ModelParams::default());
         let mut z = 0.0;
         let (v, f_visc, f_asp, load) = (0.01, 12.0, 5000.0, 20_000.0);
         let (c, total) = t.friction((v, load), (f_visc, f_asp), &mut z, BristleMove::Step(1e-3));
