@@ -80,7 +80,8 @@ fn run_timer(cfg: &Config, link: &MemoryLink, ms: u64) -> RunSummary {
 }
 
 #[test]
-fn a_joint_state_drives_each_contact_by_joint_name_and_efforts_are_gain_times_friction() {
+fn a_joint_state_drives_each_contact_by_joint_name_at_gain_times_its_velocity_and_efforts_are_gain_times_friction(
+) {
     let cfg = three();
     let link = MemoryLink::new(1000).with_joints(&joints(&cfg));
     let mut peer = link.peer();
@@ -100,16 +101,20 @@ fn a_joint_state_drives_each_contact_by_joint_name_and_efforts_are_gain_times_fr
         "the unknown joint is not a command of this node"
     );
     let (per, efforts) = outputs(&mut peer);
+    let gains = [1.0, 0.05, 0.02];
     for (k, v) in [0.4, 0.2, -0.3].into_iter().enumerate() {
         assert_eq!(per[k].len(), 10, "contact {k}");
-        assert!(per[k].iter().all(|e| e.velocity_m_s == v), "contact {k}");
+        // The joint's transmission: the contact slides at gain × the joint's velocity.
+        assert!(
+            per[k].iter().all(|e| e.velocity_m_s == gains[k] * v),
+            "contact {k}"
+        );
         assert_eq!(per[k][0].command_status, codes::COMMAND_FRESH);
         assert_eq!(per[k][1].command_status, codes::COMMAND_HELD);
         assert!(per[k].iter().all(|e| e.status == codes::STATUS_CONVERGED));
     }
     assert_eq!(per[0][0].load_n, 4000.0, "left's own load");
     assert_eq!(efforts.len(), 10);
-    let gains = [1.0, 0.05, 0.02];
     for (step, ef) in efforts.iter().enumerate() {
         assert_eq!(ef.as_slice().len(), 3);
         assert_eq!(ef.stamp_ns, per[0][step].stamp_ns);
@@ -148,7 +153,12 @@ fn a_joint_without_a_finite_velocity_is_rejected_alone_and_the_others_apply() {
         ]
     );
     let v: Vec<f64> = per.iter().map(|p| p[0].velocity_m_s).collect();
-    assert_eq!(v, [0.4, 0.1, 0.0], "left keeps its last good velocity");
+    // Contact speeds: gain × the joint's velocity (gains 1, 0.05, 0.02).
+    assert_eq!(
+        v,
+        [0.4, 0.05 * 0.1, 0.0],
+        "left keeps its last good velocity"
+    );
     assert!(per
         .iter()
         .all(|p| p[1].command_status == codes::COMMAND_HELD));
@@ -184,6 +194,7 @@ impl friction_node::transport::NodePort for LeftOnly {
             kind: CommandKind::JointVelocity {
                 contact: 0,
                 last: true,
+                joint: true,
             },
             value: 0.4,
             stamp_ns: self.polls,
@@ -238,7 +249,12 @@ fn a_contact_left_out_of_the_joint_states_is_held_then_times_out_alone() {
     assert_eq!(status(2, 1), codes::COMMAND_HELD);
     assert_eq!(status(1, 79), codes::COMMAND_TIMED_OUT);
     assert_eq!(status(2, 79), codes::COMMAND_TIMED_OUT);
-    assert_eq!(per[2][79].velocity_m_s, 0.1, "hold: the last command");
+    // wrist's last command, 0.1 rad/s at its 0.02 m lever.
+    assert_eq!(
+        per[2][79].velocity_m_s,
+        0.02 * 0.1,
+        "hold: the last command"
+    );
     // The commanded contact is fresh at every step.
     assert!(per[0]
         .iter()
@@ -267,9 +283,11 @@ fn each_contact_of_a_lockstep_loop_equals_a_one_contact_loop_bit_for_bit() {
         let mut peer = link.peer();
         let mut l = new_loop(&one, &link);
         for i in 0..300u64 {
+            // The one-contact loop takes the contact's own speed: gain ×
+            // the joint's velocity.
             l.feed(Command {
                 kind: CommandKind::Velocity,
-                value: profile(k, i),
+                value: r.gain * profile(k, i),
                 stamp_ns: (i + 1) * MS,
             });
         }

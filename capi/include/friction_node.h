@@ -148,8 +148,9 @@ int32_t fn_model_step(struct FnModel *model,
                       double dt_s,
                       struct FnEstimate *out);
 
-// Advance every contact by `dt_s`: contact i with velocity
-// `velocities[i]` (m/s) under `loads[i]` (N; `loads` null: each contact's
+// Advance every contact by `dt_s`: contact i driven by its joint's
+// velocity `velocities[i]` (m/s for a linear joint, rad/s for a rotary
+// one: the contact slides at its `gain` × it) under `loads[i]` (N; `loads` null: each contact's
 // configured `contact.load_n`), in the configuration's contact order, which
 // is the order of its joints. Writes `count` estimates to `out` and, when
 // `efforts` is not null, each contact's feed-forward effort (its `gain` ×

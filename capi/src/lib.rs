@@ -425,8 +425,9 @@ fn step_one(s: &mut Solver, config: &Config, v: f64, load: f64, dt_s: f64) -> Es
     s.step_by(v, load, dt_s)
 }
 
-/// Advance every contact by `dt_s`: contact i with velocity
-/// `velocities[i]` (m/s) under `loads[i]` (N; `loads` null: each contact's
+/// Advance every contact by `dt_s`: contact i driven by its joint's
+/// velocity `velocities[i]` (m/s for a linear joint, rad/s for a rotary
+/// one: the contact slides at its `gain` × it) under `loads[i]` (N; `loads` null: each contact's
 /// configured `contact.load_n`), in the configuration's contact order, which
 /// is the order of its joints. Writes `count` estimates to `out` and, when
 /// `efforts` is not null, each contact's feed-forward effort (its `gain` ×
@@ -477,7 +478,7 @@ pub unsafe extern "C" fn fn_model_step_contacts(
         });
         for (i, (s, c)) in m.solvers.iter_mut().zip(&m.contacts).enumerate() {
             let load = loads.map_or(c.config.contact.load_n, |l| l[i]);
-            let e = FnEstimate::from(&step_one(s, &c.config, v[i], load, dt_s));
+            let e = FnEstimate::from(&step_one(s, &c.config, c.gain * v[i], load, dt_s));
             out[i] = e;
             if !efforts.is_null() {
                 // SAFETY: non-null; `count` values.

@@ -286,8 +286,8 @@ fn one_of_three(name: &str) -> String {
 }
 
 #[test]
-fn one_handle_steps_several_contacts_each_equal_to_its_own_handle_with_gain_times_friction_efforts()
-{
+fn one_handle_steps_several_contacts_each_equal_to_its_own_handle_at_gain_times_the_joint_velocity_with_gain_times_friction_efforts(
+) {
     let m = new_model(THREE).unwrap();
     assert_eq!(unsafe { fn_model_contact_count(m) }, 3);
     let idx = |name: &str| {
@@ -335,7 +335,8 @@ fn one_handle_steps_several_contacts_each_equal_to_its_own_handle_with_gain_time
         alone.clear();
         for (i, &s) in singles.iter().enumerate() {
             let load = [4000.0, 20762.0, 20762.0][i];
-            alone.push(step(s, v[i], load, dt));
+            // The contact slides at gain × its joint's velocity.
+            alone.push(step(s, gains[i] * v[i], load, dt));
         }
         for i in 0..3 {
             assert_eq!(out[i], alone[i], "step {k}, contact {i}");
@@ -344,8 +345,8 @@ fn one_handle_steps_several_contacts_each_equal_to_its_own_handle_with_gain_time
     }
     assert!(out.iter().all(|e| e.status == FN_STATUS_CONVERGED));
     assert_eq!(allocated, 0, "allocations in 500 steps of three contacts");
-    // Loads given per contact.
-    let v = [0.2, 0.2, 0.2];
+    // Loads given per contact (right: 0.2 m/s at its 0.05 m lever).
+    let v = [0.2, 4.0, 0.2];
     let loads = [3000.0, 3000.0, 3000.0];
     assert_eq!(
         unsafe {

@@ -5,7 +5,7 @@
 //! contacts:                 # name → contact; none: the top-level sections are the one contact
 //!   carriage_left:
 //!     joint: axis_x         # the joint whose velocity drives it and whose effort it adds to
-//!     gain: 1.0             # friction force (N) → joint effort: 1 (linear joint, N) or the lever arm in m (rotary, N·m)
+//!     gain: 1.0             # the joint's transmission: contact speed = gain × joint velocity, joint effort = gain × friction force; 1 (linear joint, m/s and N) or the lever arm in m (rotary: rad/s and N·m)
 //!     contact: {load_n: 5000.0}
 //!     solver: {cells: 128}
 //!   carriage_y:
@@ -47,8 +47,10 @@ pub struct ContactEntry {
     pub name: String,
     /// The joint that drives it (its velocity) and takes its effort.
     pub joint: String,
-    /// Friction force (N) → joint effort: 1 for a linear joint (N), the
-    /// lever arm in m for a rotary one (N·m).
+    /// The joint's transmission, m per joint unit: the contact slides at
+    /// `gain` × the joint's velocity and puts `gain` × its friction force
+    /// on the joint (power is kept). 1 for a linear joint (m/s, N), the
+    /// lever arm in m for a rotary one (rad/s, N·m).
     pub gain: f64,
     /// Overrides of the `contact` section.
     pub contact: ContactConfig,

@@ -439,15 +439,20 @@ pub enum CommandKind {
     Load,
     /// Lubricant temperature, °C.
     Temperature,
-    /// One joint's velocity out of a `sensor_msgs/JointState` (m/s of the
-    /// contact's slider), for the configured contact at index `contact`;
-    /// `last` marks the message's last configured joint (lockstep steps
-    /// every contact once per message, on it).
+    /// One joint's velocity out of a `sensor_msgs/JointState` (m/s, or
+    /// rad/s for a rotary joint), for the configured contact at index
+    /// `contact`, which slides at its `gain` × it; `last` marks the
+    /// message's last configured joint (lockstep steps every contact once
+    /// per message, on it).
     JointVelocity {
         /// The contact (configured order).
         contact: u16,
         /// Whether it is the last contact's of the step (the lockstep loop steps after it).
         last: bool,
+        /// The value is the joint's velocity (true), or already the
+        /// contact's own sliding speed in m/s (false: a replay of recorded
+        /// estimates, which hold the contact's speed).
+        joint: bool,
     },
 }
 

@@ -94,7 +94,17 @@ impl Loop {
         }
     }
 
-    /// A velocity command for contact `k`, taken at `now_ns`: applied when
+    /// The sliding speed of contact `k`, m/s, for a velocity command's
+    /// value: a joint's velocity (m/s, or rad/s for a rotary joint) times
+    /// the contact's `gain`; a plain velocity command is the speed itself.
+    pub(super) fn contact_speed(&self, kind: CommandKind, k: usize, value: f64) -> f64 {
+        match kind {
+            CommandKind::JointVelocity { joint: true, .. } => self.contacts.gains()[k] * value,
+            _ => value,
+        }
+    }
+
+    /// A velocity command for contact `k` (m/s), taken at `now_ns`: applied when
     /// within limits, else rejected (that contact only).
     pub(super) fn velocity_command(&mut self, k: usize, value: f64, now_ns: u64) {
         if self.velocity_ok(value) {
@@ -147,7 +157,9 @@ impl Loop {
         match (c.kind, self.velocity_contact(c.kind)) {
             (CommandKind::Load, _) => self.load_command(c.value),
             (CommandKind::Temperature, _) => self.temperature_command(c.value),
-            (_, Some(k)) => self.velocity_command(k, c.value, now_ns),
+            (kind, Some(k)) => {
+                self.velocity_command(k, self.contact_speed(kind, k, c.value), now_ns)
+            }
             (_, None) => self.reject(None),
         }
     }

@@ -67,7 +67,8 @@ impl Loop {
             return;
         }
         let now = self.clock.now_ns();
-        self.velocity_command(k, c.value, now);
+        let v = self.contact_speed(c.kind, k, c.value);
+        self.velocity_command(k, v, now);
         if last {
             self.last_stamp = Some(c.stamp_ns);
             for cmd in &mut self.cmd {

@@ -95,6 +95,7 @@ pub(super) fn joints_as_commands(
             kind: CommandKind::JointVelocity {
                 contact: 0,
                 last: false,
+                joint: true,
             },
             ..c
         });
@@ -108,6 +109,7 @@ pub(super) fn joints_as_commands(
                     kind: CommandKind::JointVelocity {
                         contact: u16::try_from(k + 1).expect("at most MAX_CONTACTS contacts"),
                         last: false,
+                        joint: true,
                     },
                     value: v.value,
                     stamp_ns: c.stamp_ns,
@@ -158,9 +160,11 @@ pub(super) fn contacts_as_commands(
         }
         for (k, r) in recorded.iter().enumerate() {
             commands.push(Command {
+                // The recorded estimates hold each contact's own speed.
                 kind: CommandKind::JointVelocity {
                     contact: u16::try_from(k).expect("at most MAX_CONTACTS contacts"),
                     last: k + 1 == n,
+                    joint: false,
                 },
                 value: r[i].velocity_m_s,
                 stamp_ns: r0.stamp_ns,

@@ -232,6 +232,7 @@ pub fn joint_commands<'a>(
             let kind = crate::msgs::CommandKind::JointVelocity {
                 contact,
                 last: false,
+                joint: true,
             };
             f(
                 Command {
@@ -248,6 +249,7 @@ pub fn joint_commands<'a>(
         let kind = crate::msgs::CommandKind::JointVelocity {
             contact,
             last: true,
+            joint: true,
         };
         f(
             Command {
