@@ -38,7 +38,8 @@ fn data(csv: &str) -> Data {
     Data {
         train: vec![Source::new(table, &Mapping::default()).unwrap()],
         validate: vec![],
-        holdout: 0.0,
+        holdout: Default::default(),
+        units: Default::default(),
         map_names: vec![],
         map_values: vec![],
     }
@@ -737,4 +738,42 @@ fn the_oring_seal_is_calibrated_at_1_and_3_bar_through_mapped_inputs_and_predict
         .and_then(|v| v.parse().ok())
         .unwrap_or_else(|| panic!("f_off in {yaml}"));
     assert!((0.5..1.5).contains(&off), "f_off = {off}");
+}
+
+#[test]
+fn secant_jacobians_reach_the_optimum_of_finite_differences_with_fewer_simulations() {
+    use friction_node::fit::local_run::JacobianRule;
+    let mut truth = coarse();
+    truth.roughness.sigma_m = 3.5e-6;
+    truth.contact.boundary_friction = 0.22;
+    truth.drivetrain.coulomb_n = 300.0;
+    truth.drivetrain.viscous_n_s_m = 800.0;
+    let d = data(&synthetic_csv(&truth, &motion(4.0, 1e-3), 0.02, 2));
+    let keys = [
+        "roughness.sigma_m",
+        "contact.boundary_friction",
+        "drivetrain.coulomb_n",
+        "drivetrain.viscous_n_s_m",
+    ];
+    let model = PhysicsModel::new(&coarse(), &specs(&keys), &scale(&d)).unwrap();
+    let with = |jacobian| {
+        let o = Options {
+            jacobian,
+            starts: 1,
+            ..options(1)
+        };
+        fit(&model, &d, vec![], &o).unwrap()
+    };
+    let (exact, secant) = (with(JacobianRule::Differences), with(JacobianRule::Secant));
+    assert!(exact.converged && secant.converged);
+    approx::assert_relative_eq!(secant.train_rms, exact.train_rms, max_relative = 1e-6);
+    for (s, e) in secant.best.iter().zip(&exact.best) {
+        approx::assert_relative_eq!(*s, *e, max_relative = 1e-3);
+    }
+    assert!(
+        secant.simulations < exact.simulations,
+        "secant {} simulations, differences {}",
+        secant.simulations,
+        exact.simulations
+    );
 }

@@ -246,3 +246,37 @@ fn a_second_signal_ends_at_once_and_still_removes_the_temporary_file() {
     assert!(matches!(rc, Some(130) | Some(143)), "{rc:?}: {rest:?}");
     assert_eq!(files(&d), Vec::<PathBuf>::new(), "no temporary left behind");
 }
+
+#[test]
+fn an_interrupted_term_selection_writes_nothing_and_exits_130() {
+    let d = dir("auto");
+    let data = d.join("data.csv");
+    let sim = Command::new(bin())
+        .args(["simulate", "--velocity", "sine:0,0.5,1", "--duration", "2"])
+        .args(["--set", "solver.cells=32", "--out"])
+        .arg(&data)
+        .output()
+        .unwrap();
+    assert!(sim.status.success());
+    let report = d.join("report");
+    // Stopped while the candidates of the first step are fitted.
+    let (rc, err) = interrupt(
+        &[
+            "fit",
+            data.to_str().unwrap(),
+            "--fit",
+            "auto",
+            "--out",
+            d.join("fitted.yaml").to_str().unwrap(),
+            "--report",
+            report.to_str().unwrap(),
+            "--set",
+            "solver.cells=32",
+        ],
+        "auto: base",
+        libc::SIGINT,
+    );
+    assert_eq!(rc, Some(130), "{err}");
+    assert!(!report.exists(), "the report folder it made is gone");
+    assert_eq!(files(&d), vec![data], "only the data is there");
+}

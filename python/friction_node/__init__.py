@@ -406,13 +406,18 @@ def fit(
     out: Optional[PathLike] = None,
     report: Optional[PathLike] = None,
     progress: bool = False,
+    rotary: bool = False,
 ) -> FitResult:
     """Calibrate configuration keys (and input-map coefficients) to
     recorded friction, as ``friction-node fit`` does (same arguments, same
     defaults, same messages): ``data`` CSV files or bags, ``fit`` the keys
     (e.g. ``["roughness.sigma_m", "contact.boundary_friction"]``), ``bounds``
     ``{key: (lo, hi)}``, ``start`` ``{key: value}``. ``out`` writes the
-    fitted parameter file, ``report`` the summary, tables and plots."""
+    fitted parameter file, ``report`` the summary, tables and plots.
+    ``fit=["auto", ...]`` lets the data choose the physical terms (the
+    names after ``auto`` are fitted as well); ``rotary=True`` takes a
+    joint's velocity in rad/s and friction in N·m (the lever arm and the
+    contact's load are chosen from the data)."""
     if isinstance(data, (str, os.PathLike)):
         data = [data]
     if isinstance(fit, str):
@@ -449,5 +454,6 @@ def fit(
         out=_path(out),
         report_dir=_path(report),
         progress=bool(progress),
+        rotary=bool(rotary),
     )
     return FitResult(raw)

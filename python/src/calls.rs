@@ -7,8 +7,8 @@ use crate::model::load_config;
 use friction_node::analysis::metrics::LOOP_METRIC_COLUMNS;
 use friction_node::fit::report;
 use friction_node::fit::request::{
-    fit_baselines, fit_ours, param_specs, prepare, FitRequest, LabelledProgress, OursFitted,
-    Prepared, TopicChoice,
+    fit_baselines, fit_ours, param_specs, prepare, select_terms, FitRequest, LabelledProgress,
+    OursFitted, Prepared, TopicChoice,
 };
 use friction_node::fit::{Delimiter, FitOutcome, Mapping};
 use friction_node::msgs;
@@ -342,7 +342,7 @@ fn outcome_dict<'py>(py: Python<'py>, o: &FitOutcome) -> PyResult<Bound<'py, PyD
     time=None, velocity="velocity_m_s".to_string(), friction="friction_n".to_string(),
     load=None, temperature=None, smooth=0.05, map=Vec::new(), velocity_topic=None,
     friction_topic=None, joint=None, load_topic=None, temperature_topic=None, out=None,
-    report_dir=None, progress=false))]
+    report_dir=None, progress=false, rotary=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn fit<'py>(
     py: Python<'py>,
@@ -377,6 +377,7 @@ pub fn fit<'py>(
     out: Option<PathBuf>,
     report_dir: Option<PathBuf>,
     progress: bool,
+    rotary: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let config = match &config_path {
         Some(p) => load_config(None, Some(&p.display().to_string()), &overrides)?,
@@ -417,6 +418,8 @@ pub fn fit<'py>(
         seed,
         max_evaluations,
         baselines,
+        rotary,
+        jacobian: Default::default(),
         progress: progress.then(|| {
             Arc::new(|label: &str, l: &str| eprintln!("fit [{label}]: {l}")) as LabelledProgress
         }),
@@ -474,7 +477,7 @@ fn calibrate(
             stop: stop.clone(),
             ..req.clone()
         };
-        let p = prepare(config, &req).map_err(errors::fit)?;
+        let mut p = prepare(config, &req).map_err(errors::fit)?;
         if let Some(o) = out {
             drop(
                 friction_node::output::AtomicFile::create(o)
@@ -488,6 +491,17 @@ fn calibrate(
             .map(friction_node::output::prepare_output_dir)
             .transpose()
             .map_err(|e| errors::os(e.to_string()))?;
+        if p.auto {
+            let progress = req.progress.clone();
+            let say = move |l: &str| {
+                if let Some(f) = &progress {
+                    f("auto", l)
+                }
+            };
+            let s = select_terms(&mut p, &req, &say).map_err(errors::fit)?;
+            p.notes
+                .push(friction_node::fit::auto::report(&s, p.data.units));
+        }
         let ours = fit_ours(&p, &req).map_err(errors::fit)?;
         let (classic, skipped) = if req.baselines {
             fit_baselines(&p, &req).map_err(errors::fit)?

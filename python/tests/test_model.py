@@ -117,6 +117,25 @@ def test_fit_recovers_boundary_friction_and_equals_the_cli(cli, tmp_path):
     assert r.fitted_yaml == out.read_text()
 
 
+def test_a_rotary_fit_takes_rad_s_and_newton_metres_and_equals_the_cli(cli, tmp_path):
+    truth = fn.Model(**{"solver.cells": 32})
+    t = np.arange(2001) * truth.dt
+    v = 0.05 * np.sin(2 * np.pi * t)
+    run = truth.run(t, v)
+    lever = 0.02
+    data = tmp_path / "joint.csv"
+    np.savetxt(data, np.column_stack([t, v / lever, run["friction_n"] * lever]), delimiter=",",
+               header="t_s,w,tau", comments="")
+    r = fn.fit(data, ["contact.boundary_friction"], overrides={"solver.cells": 32}, starts=1,
+               global_points=0, velocity="w", friction="tau", rotary=True)
+    assert "training RMS" in r.summary and " N·m" in r.summary
+    assert "gain:" in r.fitted_yaml
+    out = tmp_path / "cli.yaml"
+    cli("--set", "solver.cells=32", "fit", data, "--fit", "contact.boundary_friction", "--rotary",
+        "--velocity", "w", "--friction", "tau", "--starts", "1", "--global-points", "0", "--out", out)
+    assert r.fitted_yaml == out.read_text()
+
+
 @pytest.mark.parametrize(
     "call, error, words",
     [

@@ -84,9 +84,10 @@ fn data(train: Source, validate: Vec<Source>) -> Data {
     Data {
         train: vec![train],
         validate,
-        holdout: 0.0,
+        holdout: Default::default(),
         map_names: vec![],
         map_values: vec![],
+        units: Default::default(),
     }
 }
 

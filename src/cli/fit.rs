@@ -3,9 +3,11 @@
 
 use anyhow::{bail, Context, Result};
 use friction_node::config::Config;
+use friction_node::fit::local_run::JacobianRule;
 use friction_node::fit::report;
 use friction_node::fit::request::{
-    fit_baselines, fit_ours, param_specs, prepare, FitRequest, OursFitted, TopicChoice,
+    fit_baselines, fit_ours, param_specs, prepare, select_terms, FitRequest, OursFitted,
+    TopicChoice,
 };
 use friction_node::fit::{Delimiter, Mapping, ParamSpec};
 use std::path::PathBuf;
@@ -72,6 +74,17 @@ pub struct FitArgs {
     /// Residual evaluations per local run, in [10, 100000].
     #[arg(long, default_value = "200", value_parser = evaluations)]
     pub max_evaluations: usize,
+    /// The data are a rotary joint's: velocity in rad/s, friction in N·m.
+    /// The lever arm and the contact's load are chosen from the data (or
+    /// taken from the configuration's one contact's `gain`) and written
+    /// into the fitted file as the joint's contact.
+    #[arg(long)]
+    pub rotary: bool,
+    /// Jacobians of the local runs: `secant` (Broyden updates between
+    /// finite differences, polished on differences) or `differences`
+    /// (finite differences at every iteration; slower).
+    #[arg(long, default_value = "secant", value_parser = JacobianRule::parse)]
+    pub jacobian: JacobianRule,
     /// Column names of headerless CSV data (comma-separated).
     #[arg(long, value_name = "NAME,...", value_delimiter = ',')]
     pub columns: Option<Vec<String>>,
@@ -264,7 +277,9 @@ impl FitArgs {
             global_points: self.global_points,
             seed: self.seed,
             max_evaluations: self.max_evaluations,
+            jacobian: self.jacobian,
             baselines: self.baselines,
+            rotary: self.rotary,
             progress: Some(Arc::new(|label: &str, l: &str| {
                 eprintln!("fit [{label}]: {l}")
             })),
@@ -277,7 +292,7 @@ impl FitArgs {
 /// converge.
 pub fn run(config: &Config, args: &FitArgs) -> Result<()> {
     let req = args.request()?;
-    let p = prepare(config, &req)?;
+    let mut p = prepare(config, &req)?;
     for n in &p.notes {
         eprintln!("fit: {n}");
     }
@@ -291,6 +306,15 @@ pub fn run(config: &Config, args: &FitArgs) -> Result<()> {
         .as_deref()
         .map(friction_node::output::prepare_output_dir)
         .transpose()?;
+    let selection = if p.auto {
+        let say = |l: &str| eprintln!("fit: {l}");
+        Some(select_terms(&mut p, &req, &say)?)
+    } else {
+        None
+    };
+    let selection_md = selection.as_ref().map_or(String::new(), |s| {
+        friction_node::fit::auto::report(s, p.data.units)
+    });
     let n_model = p.model.parameters_len();
     eprintln!(
         "fit: {} parameter(s) on {} file(s) ({} validation), {} local run(s), {} global points",
@@ -307,16 +331,17 @@ pub fn run(config: &Config, args: &FitArgs) -> Result<()> {
     } = fit_ours(&p, &req).context("the fitted configuration")?;
     let yaml = report::fitted_yaml(&fitted_config, &ours, &p.names, &map);
     friction_node::output::write_file(&args.out, yaml.as_bytes())?;
-    println!("{}", report::summary(&ours, ""));
-    let mut extra = String::new();
+    println!("{}", report::summary(&ours, &selection_md));
+    let mut extra = selection_md.clone();
     let mut classic = Vec::new();
     if args.baselines {
         let (baselines, skipped) = fit_baselines(&p, &req)?;
         for s in skipped {
             eprintln!("fit: {s}");
         }
-        extra = report::models_section(&ours, &baselines);
-        println!("{extra}");
+        let models = report::models_section(&ours, &baselines);
+        println!("{models}");
+        extra.push_str(&models);
         classic = baselines;
     }
     if let Some(r) = &args.report {

@@ -27,6 +27,8 @@ pub struct BagTopics {
     /// `sensor_msgs/msg/Temperature`, °C (default: as replay, a Temperature
     /// topic ending in `temperature`, if the bag has one).
     pub temperature: Option<String>,
+    /// A rotary joint's data (rad/s): a velocity in m/s is refused.
+    pub rotary: bool,
 }
 
 fn friction_kind(schema: &str, joint: Option<&str>) -> Option<SampleKind> {
@@ -72,6 +74,12 @@ pub fn read(
             expected: crate::bag::decode::VELOCITY_TYPES.into(),
         }
     })?;
+    if topics.rotary && vc.schema_name == "geometry_msgs/msg/TwistStamped" {
+        return Err(FitError::Data {
+            what: format!("--rotary, topic {}", vc.topic),
+            message: "is a geometry_msgs/msg/TwistStamped, a linear velocity in m/s; a rotary joint's velocity is in rad/s (a sensor_msgs/msg/JointState topic with --joint): drop --rotary to fit it as a linear axis".into(),
+        });
+    }
     let fc = scan.require(&topics.friction)?;
     let fkind = friction_kind(&fc.schema_name, joint).ok_or_else(|| BagError::UnsupportedType {
         topic: fc.topic.clone(),

@@ -15,6 +15,8 @@ use std::time::Instant;
 pub struct FitOutcome {
     /// The model's name.
     pub label: String,
+    /// The data's units.
+    pub units: super::Units,
     /// The fitted parameters with their bounds.
     pub params: Vec<FittedParameter>,
     /// The best point, one value per parameter.
@@ -25,6 +27,9 @@ pub struct FitOutcome {
     pub converged: bool,
     /// Standard errors, intervals and correlations at the best point.
     pub statistics: super::stats::Statistics,
+    /// One-step blocked cross-validation: each block's mean squared
+    /// held-out residual (`Options::cv_blocks` > 0).
+    pub block_mse: Option<Vec<f64>>,
     /// The training sources with the prediction.
     pub train: Vec<SeriesFit>,
     /// The validation sources with the prediction.
@@ -82,7 +87,12 @@ pub fn fit(
     let optima = super::search::search(&problem, options);
     options.stop.check()?;
     let best = optima[0].clone();
-    let statistics = super::stats::at_optimum(&problem, &best.x);
+    let (r0, jac) = super::stats::jacobian(&problem, &best.x);
+    let statistics = super::stats::from_jacobian(&problem, &best.x, &r0, &jac);
+    let block_mse = (options.cv_blocks > 0).then(|| {
+        let blocks = problem.residual_blocks(options.cv_blocks);
+        super::stats::block_cv(&r0, &jac, &blocks, options.cv_blocks)
+    });
     let collect = |v: Vec<Result<SeriesFit, String>>| -> Result<Vec<SeriesFit>, super::FitError> {
         v.into_iter()
             .map(|r| {
@@ -105,11 +115,13 @@ pub fn fit(
     let ns = problem.simulation_ns.load(Ordering::Relaxed);
     Ok(FitOutcome {
         label: model.label(),
+        units: data.units,
         params: problem.params.clone(),
         best: best.x.clone(),
         converged: best.converged,
         optima,
         statistics,
+        block_mse,
         train,
         validate,
         train_rms,

@@ -17,6 +17,7 @@ pub(super) enum Var {
 }
 
 /// One compiled expression and the identifiers it reads.
+#[derive(Clone)]
 pub(super) struct Expr {
     pub(super) text: String,
     pub(super) node: Node<DefaultNumericTypes>,
@@ -32,6 +33,7 @@ pub(super) struct Expr {
 }
 
 /// An expression's values as an affine function of the coefficients.
+#[derive(Clone)]
 pub(super) struct Affine {
     pub(super) c0: Vec<f64>,
     pub(super) base: Vec<f64>,

@@ -1,12 +1,30 @@
 //! One Levenberg–Marquardt run (MINPACK's, from the `levenberg-marquardt`
-//! crate) on the problem's unbounded variables, the Jacobian by forward
-//! differences of whole simulations run in parallel; on a budget stop, the
+//! crate) on the problem's unbounded variables; on a budget stop, the
 //! parameters that were still moving.
+//!
+//! The Jacobian is taken by forward differences of whole simulations (one
+//! per parameter, run in parallel) or — the default — kept up to date
+//! between them by Broyden's secant update (Dennis & Schnabel 1996, §8.1;
+//! MINPACK's `hybrd` does the same): after an accepted step du with
+//! residual change dr, J ← J + (dr − J du) duᵀ / (duᵀ du), at no
+//! simulation's cost. Differences are taken again when the secant model
+//! failed (the step before it needed more than one trial) and after as
+//! many secant updates as there are parameters; and a run that ended on
+//! secant Jacobians is polished by a run on differences from its end
+//! point, so the convergence test and the optimum are the exact method's.
+//!
+//! A run that enters the 95 % joint confidence region of an optimum an
+//! earlier run found (within it by that optimum's curvature JᵀJ, and its
+//! cost within ½ s² χ²₀.₉₅(n) of that optimum's) stops there: going on could only find that optimum again, or a point
+//! the data cannot tell from it (kept among the distinct optima when it
+//! lies apart).
 
 use super::problem::Problem;
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt, TerminationReason};
 use nalgebra::{storage::Owned, DMatrix, DVector, Dyn};
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
 
 /// The result of one local run.
 #[derive(Debug, Clone, PartialEq)]
@@ -21,10 +39,79 @@ pub struct LocalRun {
     pub termination: String,
     /// Residual evaluations it used.
     pub evaluations: usize,
+    /// Simulations its Jacobians took (columns of differences).
+    pub jacobian_evaluations: usize,
+    /// JᵀJ in the optimiser's variables at (or one step before) its end
+    /// point, when its last Jacobian was taken by differences: the
+    /// curvature of the cost that defines the optimum's confidence region.
+    pub curvature: Option<DMatrix<f64>>,
+}
+
+/// An optimum found by an earlier run: its point in the optimiser's
+/// variables, its cost and the curvature JᵀJ there.
+#[derive(Debug, Clone)]
+pub struct Found {
+    /// The point, unbounded variables.
+    pub u: Vec<f64>,
+    /// ½Σr² there.
+    pub cost: f64,
+    /// JᵀJ there.
+    pub curvature: DMatrix<f64>,
+}
+
+/// How a local run gets its Jacobian.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum JacobianRule {
+    /// Forward differences at every iteration.
+    Differences,
+    /// Broyden's secant update between differences, polished on
+    /// differences at the end.
+    #[default]
+    Secant,
+}
+
+impl JacobianRule {
+    /// The rules by name (the command line's values).
+    pub const NAMES: [(&'static str, JacobianRule); 2] = [
+        ("secant", JacobianRule::Secant),
+        ("differences", JacobianRule::Differences),
+    ];
+
+    /// The rule named `s`.
+    pub fn parse(s: &str) -> Result<Self, String> {
+        Self::NAMES
+            .iter()
+            .find(|(n, _)| *n == s)
+            .map(|(_, r)| *r)
+            .ok_or_else(|| format!("`{s}` is not a Jacobian rule: secant or differences"))
+    }
+}
+
+/// The secant model is kept while the accepted step's actual reduction
+/// of the cost is at least this fraction of the reduction it predicted.
+const SECANT_TRUST: f64 = 0.25;
+/// Secant updates between differences, per parameter.
+const SECANT_SPAN: usize = 2;
+
+/// The 95 % quantile of χ² with `n` degrees of freedom (Wilson–Hilferty:
+/// 2.5 % low at n = 1, within 1 % from n = 3).
+pub fn chi_square_95(n: usize) -> f64 {
+    let n = n.max(1) as f64;
+    let a = 2.0 / (9.0 * n);
+    n * (1.0 - a + 1.644_853_626_951_472_6 * a.sqrt()).powi(3)
 }
 
 /// Forward-difference step in the unbounded variable.
 const FD_STEP: f64 = 1e-4;
+
+/// The last Jacobian: the accepted point it belongs to, the matrix, and
+/// the secant updates since differences were taken.
+struct LastJacobian {
+    u: DVector<f64>,
+    r: DVector<f64>,
+    j: DMatrix<f64>,
+    secant_updates: usize,
+}
 
 struct Lm<'p, 'a> {
     problem: &'p Problem<'a>,
@@ -33,34 +120,20 @@ struct Lm<'p, 'a> {
     /// Every point evaluated: (cost, u), for what was still moving when a
     /// run stops on its budget.
     trail: Vec<(f64, Vec<f64>)>,
+    rule: JacobianRule,
+    last: Mutex<Option<LastJacobian>>,
+    /// Residual evaluations since the last Jacobian.
+    trials: AtomicUsize,
+    /// Simulations the differences took.
+    jacobian_evaluations: AtomicUsize,
+    /// Optima of earlier runs.
+    earlier: &'p [Found],
+    /// The earlier optimum this run came to.
+    joined: Option<usize>,
 }
 
-impl LeastSquaresProblem<f64, Dyn, Dyn> for Lm<'_, '_> {
-    type ResidualStorage = Owned<f64, Dyn>;
-    type JacobianStorage = Owned<f64, Dyn, Dyn>;
-    type ParameterStorage = Owned<f64, Dyn>;
-
-    fn set_params(&mut self, u: &DVector<f64>) {
-        self.u.copy_from(u);
-        let x = self.problem.from_internal(u.as_slice());
-        self.r = DVector::from_vec(self.problem.residuals(&x));
-        self.trail
-            .push((0.5 * self.r.norm_squared(), u.as_slice().to_vec()));
-    }
-
-    fn params(&self) -> DVector<f64> {
-        self.u.clone()
-    }
-
-    fn residuals(&self) -> Option<DVector<f64>> {
-        // None ends the run (TerminationReason::User) when a stop is asked.
-        (!self.problem.stop.requested()).then(|| self.r.clone())
-    }
-
-    fn jacobian(&self) -> Option<DMatrix<f64>> {
-        if self.problem.stop.requested() {
-            return None;
-        }
+impl Lm<'_, '_> {
+    fn differences(&self) -> DMatrix<f64> {
         let n = self.u.len();
         let columns: Vec<Vec<f64>> = (0..n)
             .into_par_iter()
@@ -76,13 +149,145 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Lm<'_, '_> {
                     .collect()
             })
             .collect();
+        self.jacobian_evaluations.fetch_add(n, Ordering::Relaxed);
         let m = self.r.len();
-        Some(DMatrix::from_fn(m, n, |i, j| columns[j][i]))
+        DMatrix::from_fn(m, n, |i, j| columns[j][i])
+    }
+
+    /// The earlier optimum whose 95 % joint confidence region this point
+    /// (u, its cost) has entered: dᵀ JᵀJ d ≤ s² χ²₀.₉₅(n), d = u − u₁ and
+    /// s² = 2c₁/(m − n) the residual variance at that optimum (the region
+    /// of the linearised model), with the cost itself within ½ s² χ²₀.₉₅(n)
+    /// of c₁. The data cannot tell such a point from that optimum; going
+    /// on could only find it again, or a point that fits as well.
+    fn joins(&self, u: &[f64], cost: f64) -> Option<usize> {
+        let n = self.problem.params.len();
+        let dof = self.problem.fitted_samples().saturating_sub(n).max(1) as f64;
+        let chi2 = chi_square_95(n);
+        self.earlier.iter().position(|f| {
+            let s2 = 2.0 * f.cost / dof;
+            let d = DVector::from_iterator(n, u.iter().zip(&f.u).map(|(a, b)| a - b));
+            let q = (d.transpose() * &f.curvature * &d)[(0, 0)];
+            q <= s2 * chi2 && cost <= f.cost + 0.5 * s2 * chi2
+        })
     }
 }
 
-/// One Levenberg–Marquardt run from `x0`.
-pub fn local_run(problem: &Problem<'_>, x0: &[f64], max_evaluations: usize) -> LocalRun {
+impl LeastSquaresProblem<f64, Dyn, Dyn> for Lm<'_, '_> {
+    type ResidualStorage = Owned<f64, Dyn>;
+    type JacobianStorage = Owned<f64, Dyn, Dyn>;
+    type ParameterStorage = Owned<f64, Dyn>;
+
+    fn set_params(&mut self, u: &DVector<f64>) {
+        // After a rejected last trial the optimiser goes back to the last
+        // accepted point: the point of the last Jacobian, whose residuals
+        // are kept.
+        let back = self
+            .last
+            .get_mut()
+            .unwrap_or_else(|p| p.into_inner())
+            .as_ref()
+            .filter(|l| l.u == *u)
+            .map(|l| l.r.clone());
+        self.u.copy_from(u);
+        if let Some(r) = back {
+            self.r = r;
+            return;
+        }
+        let x = self.problem.from_internal(u.as_slice());
+        self.r = DVector::from_vec(self.problem.residuals(&x));
+        let cost = 0.5 * self.r.norm_squared();
+        self.trail.push((cost, u.as_slice().to_vec()));
+        self.trials.fetch_add(1, Ordering::Relaxed);
+        if self.joined.is_none() {
+            self.joined = self.joins(u.as_slice(), cost);
+        }
+    }
+
+    fn params(&self) -> DVector<f64> {
+        self.u.clone()
+    }
+
+    fn residuals(&self) -> Option<DVector<f64>> {
+        // None ends the run (TerminationReason::User) when a stop is asked
+        // or the run came to an earlier optimum.
+        (!self.problem.stop.requested() && self.joined.is_none()).then(|| self.r.clone())
+    }
+
+    fn jacobian(&self) -> Option<DMatrix<f64>> {
+        if self.problem.stop.requested() || self.joined.is_some() {
+            return None;
+        }
+        let trials = self.trials.swap(0, Ordering::Relaxed);
+        let mut last = self.last.lock().unwrap_or_else(|p| p.into_inner());
+        let n = self.u.len();
+        if let (JacobianRule::Secant, Some(l)) = (self.rule, last.as_mut()) {
+            let du = &self.u - &l.u;
+            let dd = du.norm_squared();
+            let predicted = &l.r + &l.j * &du;
+            let (old, now) = (l.r.norm_squared(), self.r.norm_squared());
+            let ratio = (old - now) / (old - predicted.norm_squared());
+            let _ = trials;
+            if ratio >= SECANT_TRUST && l.secant_updates < SECANT_SPAN * n && dd > 0.0 {
+                let miss = &self.r - predicted;
+                l.j += miss * du.transpose() / dd;
+                l.secant_updates += 1;
+                l.u.copy_from(&self.u);
+                l.r.copy_from(&self.r);
+                return Some(l.j.clone());
+            }
+        }
+        let j = self.differences();
+        *last = Some(LastJacobian {
+            u: self.u.clone(),
+            r: self.r.clone(),
+            j: j.clone(),
+            secant_updates: 0,
+        });
+        Some(j)
+    }
+}
+
+/// One Levenberg–Marquardt run from `x0` with `rule`'s Jacobians (a
+/// secant run is polished on differences); it stops early when it comes
+/// to one of the `earlier` optima.
+pub fn local_run(
+    problem: &Problem<'_>,
+    x0: &[f64],
+    max_evaluations: usize,
+    rule: JacobianRule,
+    earlier: &[Found],
+    tolerance: (f64, f64),
+) -> LocalRun {
+    let one_run = |x: &[f64], budget: usize, rule: JacobianRule, earlier: &[Found]| {
+        one_run(problem, x, budget, rule, earlier, tolerance)
+    };
+    let (first, ended_early) = one_run(x0, max_evaluations, rule, earlier);
+    // The budget bounds the whole run: a secant run that spent it is not
+    // polished (it did not converge).
+    let left = max_evaluations.saturating_sub(first.evaluations);
+    if rule == JacobianRule::Differences || ended_early || !first.converged || left < 2 {
+        return first;
+    }
+    // The polish: the exact method from where the secant run ended, on
+    // the budget that is left.
+    let (polish, _) = one_run(&first.x, left, JacobianRule::Differences, earlier);
+    LocalRun {
+        evaluations: first.evaluations + polish.evaluations,
+        jacobian_evaluations: first.jacobian_evaluations + polish.jacobian_evaluations,
+        ..polish
+    }
+}
+
+/// One run; true when it ended early (a stop, or an earlier optimum).
+fn one_run(
+    problem: &Problem<'_>,
+    x0: &[f64],
+    max_evaluations: usize,
+    rule: JacobianRule,
+    earlier: &[Found],
+    (ftol, xtol): (f64, f64),
+) -> (LocalRun, bool) {
     let u0 = DVector::from_vec(problem.to_internal(x0));
     let n = u0.len();
     let mut lm = Lm {
@@ -90,15 +295,46 @@ pub fn local_run(problem: &Problem<'_>, x0: &[f64], max_evaluations: usize) -> L
         u: u0.clone(),
         r: DVector::zeros(0),
         trail: Vec::new(),
+        rule,
+        last: Mutex::new(None),
+        trials: AtomicUsize::new(0),
+        jacobian_evaluations: AtomicUsize::new(0),
+        earlier,
+        joined: None,
     };
     lm.set_params(&u0);
     let patience = max_evaluations.div_ceil(n + 1).max(1);
     let (lm, report) = LevenbergMarquardt::new()
-        .with_ftol(1e-10)
-        .with_xtol(1e-8)
+        .with_ftol(ftol)
+        .with_xtol(xtol)
         .with_gtol(1e-10)
         .with_patience(patience)
         .minimize(lm);
+    let jacobian_evaluations = lm.jacobian_evaluations.load(Ordering::Relaxed);
+    // The last Jacobian by differences: at the end point, or at the
+    // accepted point before it when the last step met the convergence
+    // test (the curvature hardly changes over that step).
+    let curvature = lm
+        .last
+        .into_inner()
+        .unwrap_or_else(|p| p.into_inner())
+        .filter(|l| l.secant_updates == 0)
+        .map(|l| l.j.transpose() * &l.j);
+    if let Some(k) = lm.joined {
+        // Where it stopped: the point that came to optimum k.
+        let x = problem.from_internal(lm.u.as_slice());
+        let cost = 0.5 * lm.r.norm_squared();
+        let run = LocalRun {
+            x,
+            cost,
+            converged: true,
+            termination: format!("came to optimum {} of an earlier run", k + 1),
+            evaluations: report.number_of_evaluations,
+            jacobian_evaluations,
+            curvature: None,
+        };
+        return (run, true);
+    }
     let converged = report.termination.was_successful()
         || matches!(
             report.termination,
@@ -113,13 +349,16 @@ pub fn local_run(problem: &Problem<'_>, x0: &[f64], max_evaluations: usize) -> L
             termination.push_str(&format!("; still moving: {}", moving.join(", ")));
         }
     }
-    LocalRun {
+    let run = LocalRun {
         x,
         cost,
         converged,
         termination,
         evaluations: report.number_of_evaluations,
-    }
+        jacobian_evaluations,
+        curvature,
+    };
+    (run, problem.stop.requested())
 }
 
 /// The parameters that moved by more than 0.1 % of their scaled range
@@ -161,5 +400,32 @@ fn termination_text(t: &TerminationReason) -> String {
         // Our residuals and Jacobian return None only when a stop is asked.
         TerminationReason::User(_) => "stopped on request".into(),
         other => format!("not converged: {other:?}"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    #[test]
+    fn the_chi_square_quantile_matches_the_tables() {
+        // χ²₀.₉₅: 3.841 (1), 11.070 (5), 18.307 (10), 31.410 (20).
+        assert_relative_eq!(chi_square_95(1), 3.841, max_relative = 0.03);
+        for (n, q) in [(3, 7.815), (5, 11.070), (10, 18.307), (20, 31.410)] {
+            assert_relative_eq!(chi_square_95(n), q, max_relative = 0.01);
+        }
+    }
+
+    #[test]
+    fn a_jacobian_rule_is_named_on_the_command_line() {
+        assert_eq!(JacobianRule::parse("secant"), Ok(JacobianRule::Secant));
+        assert_eq!(
+            JacobianRule::parse("differences"),
+            Ok(JacobianRule::Differences)
+        );
+        assert!(JacobianRule::parse("broyden")
+            .unwrap_err()
+            .contains("secant or differences"));
     }
 }

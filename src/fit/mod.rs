@@ -20,6 +20,7 @@
 //!
 //! | file | content |
 //! |---|---|
+//! | `auto.rs` | `--fit auto`: the terms chosen by blocked cross-validation |
 //! | `series.rs` | a table and its mapping → the model's inputs |
 //! | `expr.rs` | column expressions: compiling, affine fast path, `ddt` |
 //! | `bag_input.rs` | topics of a bag → a table |
@@ -36,8 +37,10 @@
 //! | `report.rs` | the summary, the tables, plots, the fitted YAML |
 //! | `by_direction.rs` | the residual by direction of motion: level and offset errors |
 //! | `synthetic.rs` | synthetic data: the model along a motion, with noise |
+//! | `rotary.rs` | a rotary joint (rad/s, N·m): the lever arm and load chosen from the data |
 //! | `reversals.rs` | velocity reversals in the data and the stiffness through them (pre-sliding starts) |
 
+pub mod auto;
 #[cfg(feature = "mcap")]
 pub mod bag_input;
 pub mod baselines;
@@ -52,6 +55,7 @@ pub mod problem;
 pub mod report;
 pub mod request;
 pub mod reversals;
+pub mod rotary;
 pub mod search;
 pub mod series;
 pub mod stats;
@@ -67,6 +71,51 @@ pub use problem::{Data, Model};
 pub use series::{Mapping, Series, Source};
 
 use std::path::PathBuf;
+
+/// The units of a fit's data: a linear axis (velocity m/s, friction N) or
+/// a rotary joint (rad/s, N·m; `fit --rotary`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Units {
+    /// m/s and N.
+    #[default]
+    Linear,
+    /// rad/s and N·m.
+    Rotary,
+}
+
+impl Units {
+    /// The friction's unit.
+    pub fn force(self) -> &'static str {
+        match self {
+            Self::Linear => "N",
+            Self::Rotary => "N·m",
+        }
+    }
+
+    /// The velocity's unit.
+    pub fn speed(self) -> &'static str {
+        match self {
+            Self::Linear => "m/s",
+            Self::Rotary => "rad/s",
+        }
+    }
+
+    /// The friction's unit in a column name (`measured_n`, `measured_n_m`).
+    pub fn force_column(self) -> &'static str {
+        match self {
+            Self::Linear => "n",
+            Self::Rotary => "n_m",
+        }
+    }
+
+    /// The velocity's unit in a column name.
+    pub fn speed_column(self) -> &'static str {
+        match self {
+            Self::Linear => "m_s",
+            Self::Rotary => "rad_s",
+        }
+    }
+}
 
 /// Errors of calibration: inputs, keys, bounds and data. A fit that does
 /// not converge is not an error (it is an outcome with a status).

@@ -24,6 +24,15 @@ pub struct Options {
     /// fitted map coefficients), run besides the given start and the global
     /// points: e.g. a nested model's optimum.
     pub extra_starts: Vec<Vec<f64>>,
+    /// How the local runs get their Jacobians.
+    pub jacobian: super::local_run::JacobianRule,
+    /// Convergence: relative change of the cost, and of the step.
+    pub ftol: f64,
+    /// See `ftol`.
+    pub xtol: f64,
+    /// Blocks of the one-step blocked cross-validation computed at the
+    /// optimum (0: none; see [`super::stats::block_cv`]).
+    pub cv_blocks: usize,
 }
 
 impl Default for Options {
@@ -36,6 +45,10 @@ impl Default for Options {
             progress: None,
             stop: crate::interrupt::Stop::new(),
             extra_starts: Vec::new(),
+            jacobian: Default::default(),
+            ftol: 1e-10,
+            xtol: 1e-8,
+            cv_blocks: 0,
         }
     }
 }

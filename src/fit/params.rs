@@ -45,6 +45,16 @@ pub struct FittedParameter {
 const START_MARGIN: f64 = 0.02;
 
 impl FittedParameter {
+    /// This parameter started at `v`, kept inside its bounds (clear of
+    /// them by the start margin, where the sine transform is stationary);
+    /// the bounds do not move.
+    pub fn warm(&mut self, v: f64) {
+        if v.is_finite() {
+            let f = self.fraction(v.clamp(self.lo, self.hi));
+            self.start = self.from_fraction(f.clamp(START_MARGIN, 1.0 - START_MARGIN));
+        }
+    }
+
     /// A parameter on `[lo, hi]`, on the log scale when `lo > 0`.
     pub fn new(name: &str, start: f64, lo: f64, hi: f64) -> Self {
         Self {
@@ -125,6 +135,20 @@ pub struct DataScale {
     /// The contact's stiffness through the data's reversals, N/m (None:
     /// no reversal; see [`super::reversals`]).
     pub reversal_stiffness_n_m: Option<f64>,
+}
+
+impl DataScale {
+    /// The scales of a rotary joint's data (rad/s, N·m) on the contact
+    /// behind lever arm `lever_m` (m/s, N), whose smallest load is
+    /// `load_min_n`: v = r ω, F = τ / r, k = k_joint / r².
+    pub fn through_lever(&self, lever_m: f64, load_min_n: f64) -> Self {
+        Self {
+            friction_n: self.friction_n / lever_m,
+            velocity_m_s: self.velocity_m_s * lever_m,
+            load_min_n,
+            reversal_stiffness_n_m: self.reversal_stiffness_n_m.map(|k| k / (lever_m * lever_m)),
+        }
+    }
 }
 
 /// The configuration as a tree of keys, to read and set numeric keys by

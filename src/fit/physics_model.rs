@@ -27,6 +27,10 @@ pub struct PhysicsModel {
     keys: ConfigKeys,
     names: Vec<String>,
     params: Vec<FittedParameter>,
+    /// The joint's lever arm r, m: the data's velocity (rad/s) times r is
+    /// the contact's speed, and the contact's friction times r is the
+    /// data's (N·m). 1 for data in m/s and N.
+    lever_m: f64,
 }
 
 impl PhysicsModel {
@@ -41,7 +45,29 @@ impl PhysicsModel {
             names: params.iter().map(|p| p.name.clone()).collect(),
             keys,
             params,
+            lever_m: 1.0,
         })
+    }
+
+    /// The model of a rotary joint through lever arm `lever_m` (m): data
+    /// in rad/s and N·m (see `rotary.rs`).
+    pub fn with_lever(self, lever_m: f64) -> Self {
+        Self { lever_m, ..self }
+    }
+
+    /// Start every fitted key named in `values` at its value there (kept
+    /// inside its bounds, which do not move).
+    pub fn warm(&mut self, values: &[(String, f64)]) {
+        for q in &mut self.params {
+            if let Some((_, v)) = values.iter().find(|(n, _)| *n == q.name) {
+                q.warm(*v);
+            }
+        }
+    }
+
+    /// The lever arm, m (1: data in m/s and N).
+    pub fn lever_m(&self) -> f64 {
+        self.lever_m
     }
 
     /// Number of fitted configuration keys.
@@ -66,11 +92,22 @@ impl Model for PhysicsModel {
 
     fn predict(&self, x: &[f64], series: &Series) -> Result<Vec<f64>, String> {
         let config = self.config(x).map_err(|e| e.to_string())?;
-        if series.steady {
-            steady(&config, series)
-        } else {
-            transient(&config, series)
+        let run = |s: &Series| {
+            if s.steady {
+                steady(&config, s)
+            } else {
+                transient(&config, s)
+            }
+        };
+        if self.lever_m == 1.0 {
+            return run(series);
         }
+        let r = self.lever_m;
+        let contact = Series {
+            velocity: series.velocity.iter().map(|w| r * w).collect(),
+            ..series.clone()
+        };
+        Ok(run(&contact)?.into_iter().map(|f| r * f).collect())
     }
 }
 

@@ -16,7 +16,10 @@ pub trait Model: Sync {
     /// Its fitted parameters (values are passed in this order).
     fn parameters(&self) -> &[FittedParameter];
     /// Friction, N, at every sample of `series` for parameter values `x`;
-    /// `Err` says why these values give no prediction.
+    /// `Err` says why these values give no prediction. It reads only the
+    /// series' inputs (time, velocity, load, temperature, steady), not the
+    /// measured friction or which samples are fitted: a prediction is
+    /// reused when only those change (a map coefficient of the friction).
     fn predict(&self, x: &[f64], series: &Series) -> Result<Vec<f64>, String>;
 }
 
@@ -27,12 +30,56 @@ pub struct Data {
     pub train: Vec<Source>,
     /// Validation sources (not fitted).
     pub validate: Vec<Source>,
-    /// Fraction of each training source held out (see [`Series::hold_out`]).
-    pub holdout: f64,
+    /// What of each training source is held out.
+    pub holdout: HoldOut,
     /// Map coefficient names and their values (fixed or starts).
     pub map_names: Vec<String>,
     /// Their values.
     pub map_values: Vec<f64>,
+    /// The units of velocity and friction.
+    pub units: super::Units,
+}
+
+/// What of each training source is held out of the fit (scored, not
+/// fitted).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum HoldOut {
+    /// Nothing.
+    #[default]
+    None,
+    /// The last fraction of a time series, or every k-th point of a steady
+    /// curve (see [`Series::hold_out`]).
+    Fraction(f64),
+    /// Block `index` of `count` contiguous blocks of a time series (of a
+    /// steady curve: the points whose index is `index` modulo `count`):
+    /// a fold of blocked cross-validation.
+    Block {
+        /// Which block, from 0.
+        index: usize,
+        /// How many.
+        count: usize,
+    },
+}
+
+impl HoldOut {
+    /// Mark the held-out samples of `s`.
+    pub fn apply(self, s: &mut Series) {
+        match self {
+            Self::None => {}
+            Self::Fraction(f) => s.hold_out(f),
+            Self::Block { index, count } => {
+                let n = s.len();
+                let steady = s.steady;
+                for (k, f) in s.fit.iter_mut().enumerate() {
+                    *f = if steady {
+                        k % count != index
+                    } else {
+                        k * count / n.max(1) != index
+                    };
+                }
+            }
+        }
+    }
 }
 
 /// A model's prediction beside the measurement, for one source.
@@ -70,6 +117,33 @@ type SeriesEntry = (bool, Vec<u64>, Arc<Vec<Result<Series, String>>>);
 /// Map-coefficient values whose series are kept.
 const RECENT_SERIES: usize = 8;
 
+/// A prediction kept for reuse: (training?, source index, the model
+/// parameters' bits, the fingerprint of the series' inputs, the
+/// prediction).
+type PredictionEntry = (bool, usize, Vec<u64>, u64, Arc<Vec<f64>>);
+
+/// Predictions kept: enough for one Jacobian's columns and its base point.
+fn predictions_kept(params: usize, sources: usize) -> usize {
+    2 * (params + 2) * sources.max(1)
+}
+
+/// A fingerprint (SipHash) of the series' model inputs: time, velocity,
+/// load, temperature and whether it is steady.
+fn inputs_fingerprint(s: &Series) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    s.steady.hash(&mut h);
+    let mut column = |v: &[f64]| {
+        v.len().hash(&mut h);
+        v.iter().for_each(|x| x.to_bits().hash(&mut h));
+    };
+    column(&s.t);
+    column(&s.velocity);
+    column(s.load.as_deref().unwrap_or(&[]));
+    column(s.temperature.as_deref().unwrap_or(&[]));
+    h.finish()
+}
+
 /// A model on data, with the map coefficients that are fitted.
 pub struct Problem<'a> {
     /// The model fitted.
@@ -89,6 +163,10 @@ pub struct Problem<'a> {
     /// validation): a Jacobian column that moves only a model parameter
     /// reuses them instead of evaluating the column expressions again.
     recent: Mutex<Vec<SeriesEntry>>,
+    /// Predictions of the last model parameters, per source: a Jacobian
+    /// column of a map coefficient that moves only the measured friction
+    /// reuses them instead of simulating again.
+    predictions: Mutex<Vec<PredictionEntry>>,
     /// A stop requested from outside ends the local runs at once.
     pub stop: crate::interrupt::Stop,
     /// Model evaluations so far.
@@ -110,7 +188,7 @@ impl<'a> Problem<'a> {
         let mut scale = 0.0f64;
         for s in &data.train {
             let mut series = s.series(&data.map_values)?;
-            series.hold_out(data.holdout);
+            data.holdout.apply(&mut series);
             fitted_samples += series.fit.iter().filter(|f| **f).count();
             scale = series.friction.iter().fold(scale, |m, f| m.max(f.abs()));
         }
@@ -130,17 +208,20 @@ impl<'a> Problem<'a> {
             });
         }
         let fixed = if map_fit.is_empty() {
-            let all = |sources: &[Source], holdout: f64| {
+            let all = |sources: &[Source], holdout: HoldOut| {
                 sources
                     .iter()
                     .map(|s| {
                         let mut se = s.series(&data.map_values)?;
-                        se.hold_out(holdout);
+                        holdout.apply(&mut se);
                         Ok(se)
                     })
                     .collect::<Result<Vec<_>, super::FitError>>()
             };
-            Some((all(&data.train, data.holdout)?, all(&data.validate, 0.0)?))
+            Some((
+                all(&data.train, data.holdout)?,
+                all(&data.validate, HoldOut::None)?,
+            ))
         } else {
             None
         };
@@ -153,6 +234,7 @@ impl<'a> Problem<'a> {
             friction_scale: scale,
             fixed,
             recent: Mutex::new(Vec::new()),
+            predictions: Mutex::new(Vec::new()),
             stop: crate::interrupt::Stop::new(),
             simulations: AtomicUsize::new(0),
             simulation_ns: AtomicU64::new(0),
@@ -180,7 +262,7 @@ impl<'a> Problem<'a> {
         let (sources, holdout) = if train {
             (&self.data.train, self.data.holdout)
         } else {
-            (&self.data.validate, 0.0)
+            (&self.data.validate, HoldOut::None)
         };
         let map = self.map_values(x);
         let computed = if self.fixed.is_none() {
@@ -196,19 +278,51 @@ impl<'a> Problem<'a> {
                     (None, Some(c)) => c[i].clone()?,
                     (None, None) => unreachable!("computed when not fixed"),
                 };
-                let start = Instant::now();
-                let predicted = self.model.predict(&x[..n], &series);
-                self.simulations.fetch_add(1, Ordering::Relaxed);
-                self.simulation_ns.fetch_add(
-                    u64::try_from(start.elapsed().as_nanos()).unwrap_or(u64::MAX),
-                    Ordering::Relaxed,
-                );
-                Ok(SeriesFit {
-                    series,
-                    predicted: predicted?,
-                })
+                let predicted = self.predict_one(&x[..n], train, i, &series)?;
+                Ok(SeriesFit { series, predicted })
             })
             .collect()
+    }
+
+    /// The model on one source: a kept prediction when the parameters and
+    /// the series' inputs are those of one, else a simulation (kept when
+    /// map coefficients are fitted, the only case where it is reused).
+    fn predict_one(
+        &self,
+        x: &[f64],
+        train: bool,
+        source: usize,
+        series: &Series,
+    ) -> Result<Vec<f64>, String> {
+        let bits: Vec<u64> = x.iter().map(|v| v.to_bits()).collect();
+        let lock = || self.predictions.lock().unwrap_or_else(|p| p.into_inner());
+        let keep = self.fixed.is_none();
+        let print = if keep { inputs_fingerprint(series) } else { 0 };
+        if keep {
+            if let Some(e) = lock()
+                .iter()
+                .find(|e| e.0 == train && e.1 == source && e.2 == bits && e.3 == print)
+            {
+                return Ok(e.4.as_ref().clone());
+            }
+        }
+        let start = Instant::now();
+        let predicted = self.model.predict(x, series);
+        self.simulations.fetch_add(1, Ordering::Relaxed);
+        self.simulation_ns.fetch_add(
+            u64::try_from(start.elapsed().as_nanos()).unwrap_or(u64::MAX),
+            Ordering::Relaxed,
+        );
+        let predicted = predicted?;
+        if keep {
+            let mut kept = lock();
+            let most = predictions_kept(self.params.len(), self.data.train.len());
+            if kept.len() >= most {
+                kept.remove(0);
+            }
+            kept.push((train, source, bits, print, Arc::new(predicted.clone())));
+        }
+        Ok(predicted)
     }
 
     /// The series of `sources` for map values `map`, from the recent ones
@@ -218,7 +332,7 @@ impl<'a> Problem<'a> {
         map: &[f64],
         train: bool,
         sources: &[Source],
-        holdout: f64,
+        holdout: HoldOut,
     ) -> Arc<Vec<Result<Series, String>>> {
         let key: Vec<u64> = map.iter().map(|v| v.to_bits()).collect();
         let lock = || self.recent.lock().unwrap_or_else(|p| p.into_inner());
@@ -230,7 +344,7 @@ impl<'a> Problem<'a> {
                 .par_iter()
                 .map(|s| {
                     let mut se = s.series(map).map_err(|e| e.to_string())?;
-                    se.hold_out(holdout);
+                    holdout.apply(&mut se);
                     Ok(se)
                 })
                 .collect(),
@@ -272,6 +386,24 @@ impl<'a> Problem<'a> {
         0.5 * self.residuals(x).iter().map(|r| r * r).sum::<f64>()
     }
 
+    /// The block (0..count) of every residual row: contiguous blocks of
+    /// each training time series (a steady curve: interleaved points), as
+    /// [`HoldOut::Block`] cuts them.
+    pub fn residual_blocks(&self, count: usize) -> Vec<usize> {
+        let mut out = Vec::with_capacity(self.fitted_samples);
+        for s in &self.data.train {
+            let Ok(mut se) = s.series(&self.data.map_values) else {
+                continue;
+            };
+            self.data.holdout.apply(&mut se);
+            let n = se.len().max(1);
+            for k in (0..se.len()).filter(|&k| se.fit[k]) {
+                out.push(if se.steady { k % count } else { k * count / n });
+            }
+        }
+        out
+    }
+
     /// Samples the cost sums over.
     pub fn fitted_samples(&self) -> usize {
         self.fitted_samples
@@ -293,5 +425,76 @@ impl<'a> Problem<'a> {
             .zip(u)
             .map(|(p, v)| p.from_internal(*v))
             .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fit::series::Mapping;
+    use crate::table::{Delimiter, Table};
+    use std::path::Path;
+
+    /// Friction = c · velocity, one parameter c.
+    struct Linear(Vec<FittedParameter>);
+
+    impl Model for Linear {
+        fn label(&self) -> String {
+            "linear".into()
+        }
+        fn parameters(&self) -> &[FittedParameter] {
+            &self.0
+        }
+        fn predict(&self, x: &[f64], s: &Series) -> Result<Vec<f64>, String> {
+            Ok(s.velocity.iter().map(|v| x[0] * v).collect())
+        }
+    }
+
+    fn data(friction: &str, coefficients: Vec<(String, f64)>) -> Data {
+        let mut text = String::from("t_s,v,f\n");
+        for k in 0..50 {
+            text += &format!("{},{},{}\n", k as f64 * 0.01, (k as f64 * 0.3).sin(), k);
+        }
+        let table = Table::parse(&text, Path::new("d.csv"), Delimiter::Auto, None, 0).unwrap();
+        let mapping = Mapping {
+            velocity: "v * g".into(),
+            friction: friction.into(),
+            coefficients: coefficients.clone(),
+            ..Default::default()
+        };
+        Data {
+            train: vec![Source::new(table, &mapping).unwrap()],
+            validate: vec![],
+            holdout: HoldOut::None,
+            map_names: coefficients.iter().map(|c| c.0.clone()).collect(),
+            map_values: coefficients.iter().map(|c| c.1).collect(),
+            units: Default::default(),
+        }
+    }
+
+    #[test]
+    fn a_map_coefficient_that_moves_only_the_measured_friction_reuses_the_prediction() {
+        let d = data("f - b", vec![("g".into(), 1.0), ("b".into(), 0.0)]);
+        let model = Linear(vec![FittedParameter::new("c", 1.0, 0.1, 10.0)]);
+        let fit_b = (1, FittedParameter::new("b", 0.0, -5.0, 5.0));
+        let fit_g = (0, FittedParameter::new("g", 1.0, 0.5, 2.0));
+        let p = Problem::new(&model, &d, vec![fit_g, fit_b]).unwrap();
+        let count = || p.simulations.load(Ordering::Relaxed);
+        let base = p.residuals(&[2.0, 1.0, 0.0]);
+        assert_eq!(count(), 1);
+        // The friction's offset: the same prediction, residuals shifted.
+        let shifted = p.residuals(&[2.0, 1.0, 0.5]);
+        assert_eq!(count(), 1);
+        for (a, b) in shifted.iter().zip(&base) {
+            approx::assert_relative_eq!(*a, b + 0.5, epsilon = 1e-12);
+        }
+        // The velocity's gain and the model's parameter: simulated again.
+        p.residuals(&[2.0, 1.5, 0.5]);
+        assert_eq!(count(), 2);
+        p.residuals(&[3.0, 1.5, 0.5]);
+        assert_eq!(count(), 3);
+        // Back at the first point: kept.
+        p.residuals(&[2.0, 1.0, 0.0]);
+        assert_eq!(count(), 3);
     }
 }

@@ -115,8 +115,9 @@ pub fn optima_table(o: &FitOutcome) -> String {
 
 /// Residual summary lines.
 pub fn residual_lines(o: &FitOutcome) -> String {
+    let u = o.units.force();
     let mut s = format!(
-        "training RMS {} N, max |residual| {} N (σ = {} N)\n",
+        "training RMS {} {u}, max |residual| {} {u} (σ = {} {u})\n",
         sig(o.train_rms),
         sig(o.train_max),
         sig(o.statistics.sigma)
@@ -124,12 +125,12 @@ pub fn residual_lines(o: &FitOutcome) -> String {
     if let Some(h) = o.holdout_rms {
         let _ = writeln!(
             s,
-            "held-out RMS {} N (held-out part of the training data)",
+            "held-out RMS {} {u} (held-out part of the training data)",
             sig(h)
         );
     }
     if let Some(v) = o.validate_rms {
-        let _ = writeln!(s, "validation RMS {} N (--validate data)", sig(v));
+        let _ = writeln!(s, "validation RMS {} {u} (--validate data)", sig(v));
     }
     if let Some(why) = &o.validate_failure {
         let _ = writeln!(s, "no prediction on the --validate data: {why}");
@@ -151,6 +152,8 @@ pub struct ModelRow {
     pub label: String,
     /// Its fitted parameters.
     pub parameters: Vec<(String, f64)>,
+    /// The data's units.
+    pub units: super::Units,
     /// RMS residual on the training samples, N.
     pub train_rms: f64,
     /// RMS residual on the held-out samples, N.
@@ -169,6 +172,7 @@ impl From<&FitOutcome> for ModelRow {
     fn from(o: &FitOutcome) -> Self {
         Self {
             label: o.label.clone(),
+            units: o.units,
             parameters: o
                 .params
                 .iter()
@@ -191,8 +195,9 @@ impl From<&FitOutcome> for ModelRow {
 /// Model | parameters | training RMS | held-out RMS (relative to `floor_n`
 /// when given).
 pub fn models_table(rows: &[ModelRow], scale_n: f64) -> String {
-    let mut s = String::from(
-        "| model | n | parameters | fit | training RMS (N) | held-out RMS (N) | held-out / friction scale |\n|---|---|---|---|---|---|---|\n",
+    let u = rows.first().map_or("N", |r| r.units.force());
+    let mut s = format!(
+        "| model | n | parameters | fit | training RMS ({u}) | held-out RMS ({u}) | held-out / friction scale |\n|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         let params: Vec<String> = r
@@ -273,7 +278,7 @@ pub fn fitted_yaml(
     map: &[(String, f64)],
 ) -> String {
     let mut s = format!(
-        "# Fitted by friction-node fit on {}\n# {} — training RMS {} N{}\n",
+        "# Fitted by friction-node fit on {}\n# {} — training RMS {} {u}{}\n",
         sources.join(", "),
         if o.converged {
             "converged"
@@ -281,8 +286,12 @@ pub fn fitted_yaml(
             "NOT CONVERGED: the best point found"
         },
         sig(o.train_rms),
-        o.held_out_rms()
-            .map_or(String::new(), |h| format!(", held-out RMS {} N", sig(h)))
+        o.held_out_rms().map_or(String::new(), |h| format!(
+            ", held-out RMS {} {}",
+            sig(h),
+            o.units.force()
+        )),
+        u = o.units.force(),
     );
     for (j, p) in o.params.iter().enumerate() {
         let _ = writeln!(
@@ -306,12 +315,14 @@ pub fn fitted_yaml(
 /// `fit.csv`: every sample of every source with the prediction.
 fn write_samples(
     path: &Path,
+    units: super::Units,
     train: &[SeriesFit],
     validate: &[SeriesFit],
 ) -> Result<PathBuf, OutputError> {
     let mut f = AtomicFile::create(path)?;
+    let (v, n) = (units.speed_column(), units.force_column());
     f.line(format_args!(
-        "source,role,t_s,velocity_m_s,load_n,measured_n,predicted_n,residual_n"
+        "source,role,t_s,velocity_{v},load_n,measured_{n},predicted_{n},residual_{n}"
     ))?;
     for (fits, train) in [(train, true), (validate, false)] {
         for sf in fits {
@@ -355,7 +366,7 @@ pub fn summary(o: &FitOutcome, extra: &str) -> String {
 pub fn write_report(dir: &Path, o: &FitOutcome, extra: &str) -> Result<Vec<PathBuf>, OutputError> {
     let files = vec![
         crate::output::write_file(&dir.join("summary.md"), summary(o, extra).as_bytes())?,
-        write_samples(&dir.join("fit.csv"), &o.train, &o.validate)?,
+        write_samples(&dir.join("fit.csv"), o.units, &o.train, &o.validate)?,
     ];
     #[cfg(feature = "plots")]
     let files = [files, plots::write(dir, o)?].concat();
@@ -507,9 +518,14 @@ mod plots {
         if panels.is_empty() {
             return Ok(Vec::new());
         }
+        let u = models[0].units;
+        let (x, y) = (
+            format!("velocity ({})", u.speed()),
+            format!("mean residual, model − measured ({})", u.force()),
+        );
         let ax = Axes {
-            x: "velocity (m/s)",
-            y: "mean residual, model − measured (N)",
+            x: &x,
+            y: &y,
             log_x: false,
             log_y: false,
             legend: SeriesLabelPosition::UpperLeft,
@@ -524,14 +540,22 @@ mod plots {
     }
 
     pub fn write(dir: &Path, o: &FitOutcome) -> Result<Vec<PathBuf>, OutputError> {
-        let ax = |x: &'static str, y: &'static str| Axes {
-            x,
-            y,
-            log_x: false,
-            log_y: false,
-            legend: SeriesLabelPosition::UpperRight,
-            legend_everywhere: true,
-        };
+        let (f, v) = (o.units.force(), o.units.speed());
+        let (friction, velocity, residual) = (
+            format!("friction ({f})"),
+            format!("velocity ({v})"),
+            format!("residual ({f})"),
+        );
+        fn ax<'a>(x: &'a str, y: &'a str) -> Axes<'a> {
+            Axes {
+                x,
+                y,
+                log_x: false,
+                log_y: false,
+                legend: SeriesLabelPosition::UpperRight,
+                legend_everywhere: true,
+            }
+        }
         let mut all = panels(&o.train, "training", |f, k| f.series.t[k], false);
         all.extend(panels(
             &o.validate,
@@ -560,19 +584,19 @@ mod plots {
                 &dir.join("friction_time.svg"),
                 &format!("{}: measured and fitted friction", o.label),
                 &all,
-                &ax(tx, "friction (N)"),
+                &ax(tx, &friction),
             )?,
             figure(
                 &dir.join("friction_velocity.svg"),
                 &format!("{}: friction against velocity", o.label),
                 &vel,
-                &ax("velocity (m/s)", "friction (N)"),
+                &ax(&velocity, &friction),
             )?,
             figure(
                 &dir.join("residual.svg"),
                 &format!("{}: residual (model − measured)", o.label),
                 &res,
-                &ax(tx, "residual (N)"),
+                &ax(tx, &residual),
             )?,
         ])
     }

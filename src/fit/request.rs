@@ -64,8 +64,14 @@ pub struct FitRequest {
     pub seed: u64,
     /// Residual evaluations per local run.
     pub max_evaluations: usize,
+    /// How the local runs get their Jacobians.
+    pub jacobian: super::local_run::JacobianRule,
     /// Also fit Coulomb + viscous, Stribeck and LuGre.
     pub baselines: bool,
+    /// The data are a rotary joint's: velocity in rad/s, friction in N·m
+    /// (the lever arm and the contact's load are chosen from the data, see
+    /// `rotary.rs`, unless the configuration's one contact has a gain).
+    pub rotary: bool,
     /// Progress lines, with the model's label.
     pub progress: Option<LabelledProgress>,
     /// Requested from outside (SIGINT, Ctrl-C): the fit ends with
@@ -90,7 +96,9 @@ impl Default for FitRequest {
             global_points: 16,
             seed: 1,
             max_evaluations: 200,
+            jacobian: Default::default(),
             baselines: false,
+            rotary: false,
             progress: None,
             stop: crate::interrupt::Stop::new(),
         }
@@ -171,6 +179,8 @@ impl FitRequest {
             progress,
             stop: self.stop.clone(),
             extra_starts: Vec::new(),
+            jacobian: self.jacobian,
+            ..Default::default()
         }
     }
 
@@ -193,6 +203,7 @@ impl FitRequest {
                     joint: self.topics.joint.clone(),
                     load: self.topics.load.clone(),
                     temperature: self.topics.temperature.clone(),
+                    rotary: self.rotary,
                 };
                 let (table, note, used) = super::bag_input::read(path, &topics)?;
                 let mut line = format!(
@@ -323,6 +334,79 @@ pub fn data_scale(
     Ok((scale, sum_abs / n.max(1) as f64, lmax > 1.01 * lmin))
 }
 
+/// A rotary joint's model configuration and lever: the configuration's
+/// one contact with its gain, or a lever arm and load chosen from the data
+/// (their start values); a bound on the boundary friction that excludes the
+/// value the chosen load rests on is an error naming both.
+fn rotary_setup(
+    config: &Config,
+    train: &[Source],
+    map: &[f64],
+    specs: &[ParamSpec],
+) -> Result<(Config, super::rotary::Lever), FitError> {
+    let contacts = config.resolved_contacts();
+    if config.contacts.0.len() > 1 {
+        return Err(FitError::Data {
+            what: "--rotary".into(),
+            message: format!(
+                "the configuration has {} contacts; a joint's fit needs one (or none: the top level)",
+                contacts.len()
+            ),
+        });
+    }
+    let one = &contacts[0];
+    if !config.contacts.is_empty() && one.gain != 1.0 {
+        return Ok((
+            one.config.clone(),
+            super::rotary::Lever {
+                lever_m: one.gain,
+                load_n: one.config.contact.load_n,
+                how: format!("configured: contacts.{}.gain", one.name),
+            },
+        ));
+    }
+    let (mut top, mut sum, mut n) = (0.0f64, 0.0, 0usize);
+    let mut all = Vec::new();
+    for s in train {
+        all.push(s.series(map)?);
+    }
+    for se in &all {
+        top = se.velocity.iter().fold(top, |m, v| m.max(v.abs()));
+    }
+    for se in &all {
+        for k in (0..se.len()).filter(|&k| se.velocity[k].abs() > 0.1 * top) {
+            sum += se.friction[k].abs();
+            n += 1;
+        }
+    }
+    let level = sum / n.max(1) as f64;
+    let lever = super::rotary::choose(&one.config, top, level)?;
+    let mut c = one.config.clone();
+    if all.iter().all(|s| s.load.is_none()) {
+        c.contact.load_n = lever.load_n;
+    }
+    let mu = c.contact.boundary_friction;
+    for s in specs
+        .iter()
+        .filter(|s| s.name == "contact.boundary_friction")
+    {
+        if let Some((lo, hi)) = s.bounds {
+            if !(lo..=hi).contains(&mu) {
+                return Err(FitError::Bounds {
+                    key: s.name.clone(),
+                    message: format!(
+                        "{lo}:{hi} excludes {mu}, the boundary friction on which the chosen scale rests (load {} N and lever arm {} m give the data's sliding level {} N·m with it): widen the bounds, or set contact.boundary_friction inside them in the configuration (the load is then chosen from that value)",
+                        crate::text::Num(lever.load_n),
+                        crate::text::Num(lever.lever_m),
+                        crate::text::Num(level)
+                    ),
+                });
+            }
+        }
+    }
+    Ok((c, lever))
+}
+
 /// Data, the physics model's parameters and the fitted map coefficients.
 pub struct Prepared {
     /// The sources.
@@ -343,6 +427,69 @@ pub struct Prepared {
     pub names: Vec<String>,
     /// What was read from each bag (topics used, warnings).
     pub notes: Vec<String>,
+    /// A rotary joint's lever arm and load (`--rotary`).
+    pub lever: Option<super::rotary::Lever>,
+    /// The joint's name in the fitted file (`--joint`, else `joint`).
+    pub joint: String,
+    /// The configuration our model runs on (a rotary joint's contact with
+    /// its chosen load).
+    pub model_config: Config,
+    /// The data's scales as our model sees them (through the lever).
+    pub model_scale: DataScale,
+    /// The names given to `--fit` (besides `auto`).
+    pub given: Vec<ParamSpec>,
+    /// `--fit auto`: the data choose the terms.
+    pub auto: bool,
+}
+
+/// Fitted map coefficients: index into the data's maps and bounds.
+pub type MapFit = Vec<(usize, FittedParameter)>;
+
+/// Split specs into configuration keys and map coefficients (with their
+/// bounds resolved).
+fn split_specs(
+    specs: &[ParamSpec],
+    map_names: &[String],
+    map_values: &[f64],
+) -> Result<(Vec<ParamSpec>, MapFit), FitError> {
+    let mut key_specs = Vec::new();
+    let mut map_fit = Vec::new();
+    for s in specs {
+        if s.name.contains('.') {
+            key_specs.push(s.clone());
+        } else if let Some(i) = map_names.iter().position(|n| *n == s.name) {
+            map_fit.push((i, map_parameter(s, map_values[i])?));
+        } else {
+            return Err(FitError::Key {
+                key: s.name.clone(),
+                message:
+                    "neither a configuration key (dotted, e.g. roughness.sigma_m) nor a --map coefficient"
+                        .into(),
+            });
+        }
+    }
+    Ok((key_specs, map_fit))
+}
+
+/// Our model for `specs` on `p`'s data (a rotary joint's lever included)
+/// and its fitted map coefficients, every parameter started at its value
+/// in `warm` when it has one (the bounds stay those of `specs`).
+pub fn model_for(
+    p: &Prepared,
+    specs: &[ParamSpec],
+    warm: &[(String, f64)],
+) -> Result<(PhysicsModel, MapFit), FitError> {
+    let (key_specs, mut map_fit) = split_specs(specs, &p.data.map_names, &p.data.map_values)?;
+    let lever_m = p.lever.as_ref().map_or(1.0, |l| l.lever_m);
+    let mut model =
+        PhysicsModel::new(&p.model_config, &key_specs, &p.model_scale)?.with_lever(lever_m);
+    model.warm(warm);
+    for (_, q) in &mut map_fit {
+        if let Some((_, v)) = warm.iter().find(|(n, _)| *n == q.name) {
+            q.warm(*v);
+        }
+    }
+    Ok((model, map_fit))
 }
 
 fn load_range(sources: &[Source], map: &[f64], load_n: f64) -> Result<(f64, f64), FitError> {
@@ -390,22 +537,31 @@ pub fn prepare(config: &Config, req: &FitRequest) -> Result<Prepared, FitError> 
         let (vl, vh) = load_range(&validate, &map_values, load_n)?;
         vl < 0.99 * tl || vh > 1.01 * th
     };
-    let mut key_specs = Vec::new();
-    let mut map_fit = Vec::new();
-    for s in &req.params {
-        if s.name.contains('.') {
-            key_specs.push(s.clone());
-        } else if let Some(i) = map_names.iter().position(|n| *n == s.name) {
-            map_fit.push((i, map_parameter(s, map_values[i])?));
-        } else {
-            return Err(FitError::Key {
-                key: s.name.clone(),
-                message:
-                    "neither a configuration key (dotted, e.g. roughness.sigma_m) nor a --map coefficient"
-                        .into(),
-            });
-        }
+    let (auto, _) = super::auto::split(
+        &req.params
+            .iter()
+            .map(|s| s.name.clone())
+            .collect::<Vec<_>>(),
+    );
+    let given: Vec<ParamSpec> = req
+        .params
+        .iter()
+        .filter(|s| s.name != super::auto::AUTO)
+        .cloned()
+        .collect();
+    // With `auto` the model starts with the base key; the selection
+    // chooses the rest.
+    let mut specs = given.clone();
+    if auto && !specs.iter().any(|s| s.name == super::auto::BASE_KEY) {
+        specs.insert(
+            0,
+            ParamSpec {
+                name: super::auto::BASE_KEY.into(),
+                ..Default::default()
+            },
+        );
     }
+    let (key_specs, map_fit) = split_specs(&specs, &map_names, &map_values)?;
     if scale.reversal_stiffness_n_m.is_none() {
         for s in key_specs.iter().filter(|s| s.name.contains("presliding_")) {
             notes.push(format!(
@@ -414,15 +570,50 @@ pub fn prepare(config: &Config, req: &FitRequest) -> Result<Prepared, FitError> 
             ));
         }
     }
-    let model = PhysicsModel::new(config, &key_specs, &scale)?;
+    let (model_config, lever) = if req.rotary {
+        let (c, l) = rotary_setup(config, &train, &map_values, &key_specs)?;
+        notes.push(format!(
+            "rotary joint: lever arm {} m, contact load {} N ({})",
+            crate::text::Num(l.lever_m),
+            crate::text::Num(l.load_n),
+            l.how
+        ));
+        (c, Some(l))
+    } else {
+        (config.clone(), None)
+    };
+    let model_scale = match &lever {
+        Some(l) => {
+            let load_min = load_range(&train, &map_values, model_config.contact.load_n)?.0;
+            scale.through_lever(l.lever_m, load_min)
+        }
+        None => scale,
+    };
+    let lever_m = lever.as_ref().map_or(1.0, |l| l.lever_m);
+    let model = PhysicsModel::new(&model_config, &key_specs, &model_scale)?.with_lever(lever_m);
     Ok(Prepared {
+        model_config,
+        model_scale,
+        given,
+        auto,
+        lever,
+        joint: req.topics.joint.clone().unwrap_or_else(|| "joint".into()),
         names: req.data.iter().map(|p| p.display().to_string()).collect(),
         data: Data {
             train,
             validate,
-            holdout: req.holdout,
+            holdout: if req.holdout > 0.0 {
+                super::problem::HoldOut::Fraction(req.holdout)
+            } else {
+                super::problem::HoldOut::None
+            },
             map_names,
             map_values,
+            units: if req.rotary {
+                super::Units::Rotary
+            } else {
+                super::Units::Linear
+            },
         },
         model,
         map_fit,
@@ -432,6 +623,35 @@ pub fn prepare(config: &Config, req: &FitRequest) -> Result<Prepared, FitError> 
         other_loads,
         notes,
     })
+}
+
+/// `--fit auto`: choose the terms (see `auto.rs`) and set `p`'s model to
+/// the chosen keys; `say` receives a line per set tried.
+pub fn select_terms(
+    p: &mut Prepared,
+    req: &FitRequest,
+    say: &(dyn Fn(&str) + Sync),
+) -> Result<super::auto::Selection, FitError> {
+    let given = p.given.clone();
+    let s = super::auto::select(p, req, &given, say)?;
+    let specs: Vec<ParamSpec> = s
+        .keys
+        .iter()
+        .map(|k| {
+            given
+                .iter()
+                .find(|g| g.name == *k)
+                .cloned()
+                .unwrap_or(ParamSpec {
+                    name: k.clone(),
+                    ..Default::default()
+                })
+        })
+        .collect();
+    let (model, map_fit) = model_for(p, &specs, &[])?;
+    p.model = model;
+    p.map_fit = map_fit;
+    Ok(s)
 }
 
 /// Our model's fit: the outcome, the fitted configuration and the map
@@ -454,7 +674,10 @@ pub fn fit_ours(p: &Prepared, req: &FitRequest) -> Result<OursFitted, FitError> 
         &req.options("friction-node"),
     )?;
     let n_model = p.model.parameters_len();
-    let config = p.model.config(&outcome.best[..n_model])?;
+    let mut config = p.model.config(&outcome.best[..n_model])?;
+    if let Some(l) = &p.lever {
+        config = super::rotary::on_joint(config, &p.joint, l.lever_m);
+    }
     let mut map = p
         .data
         .map_names
@@ -523,7 +746,7 @@ pub fn fit_baselines(
         .iter()
         .map(|s| {
             let mut se = s.series(&p.data.map_values)?;
-            se.hold_out(p.data.holdout);
+            p.data.holdout.apply(&mut se);
             Ok(se)
         })
         .collect::<Result<Vec<_>, FitError>>()?;
@@ -546,6 +769,10 @@ pub fn fit_baselines(
         // budget's fault.
         let mut opts = req.options(kind.label());
         opts.max_evaluations = req.max_evaluations.saturating_mul(10);
+        // The secant update saves simulations; a classic model costs
+        // microseconds, so it keeps the exact Jacobian (whose path the
+        // classic models' optima were checked on against SciPy).
+        opts.jacobian = super::local_run::JacobianRule::Differences;
         // Each model contains the one before it: it also starts from that
         // one's optimum, so it never ends worse than the simpler model; and
         // from generic starts that ignore the data (mean level, static

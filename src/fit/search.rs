@@ -7,7 +7,7 @@
 //! start already taken; their end points, sorted by cost and with
 //! near-duplicates merged, are the distinct optima.
 
-use super::local_run::{local_run, LocalRun};
+use super::local_run::{local_run, Found, LocalRun};
 use super::options::Options;
 use super::problem::Problem;
 use rand::rngs::StdRng;
@@ -103,27 +103,64 @@ pub fn search(problem: &Problem<'_>, options: &Options) -> Vec<LocalRun> {
         }
     }
     let total = starts.len();
-    let mut runs: Vec<LocalRun> = starts
+    let say = |k: usize, run: &LocalRun| {
+        options.say(&format!(
+            "local run {}/{total} ({}): cost {:.4e}, {} evaluations + {} for Jacobians, {}",
+            k + 1,
+            if k == 0 {
+                "given start"
+            } else {
+                "global point"
+            },
+            run.cost,
+            run.evaluations,
+            run.jacobian_evaluations,
+            run.termination
+        ));
+    };
+    let run_from = |x: &Vec<f64>, earlier: &[Found]| {
+        local_run(
+            problem,
+            x,
+            options.max_evaluations,
+            options.jacobian,
+            earlier,
+            (options.ftol, options.xtol),
+        )
+    };
+    // The given start first; then the other starts side by side, each
+    // stopping when it comes to the first one's optimum (the same for
+    // every run, so the outcome does not depend on which ends first).
+    let mut runs: Vec<LocalRun> = Vec::new();
+    if !problem.stop.requested() {
+        let first = run_from(&starts[0], &[]);
+        say(0, &first);
+        runs.push(first);
+    }
+    let found: Vec<Found> = runs
         .iter()
-        .enumerate()
-        .take_while(|_| !problem.stop.requested())
-        .map(|(k, x)| {
-            let run = local_run(problem, x, options.max_evaluations);
-            options.say(&format!(
-                "local run {}/{total} ({}): cost {:.4e}, {} evaluations, {}",
-                k + 1,
-                if k == 0 {
-                    "given start"
-                } else {
-                    "global point"
-                },
-                run.cost,
-                run.evaluations,
-                run.termination
-            ));
-            run
+        .filter_map(|r| {
+            r.curvature.clone().map(|curvature| Found {
+                u: problem.to_internal(&r.x),
+                cost: r.cost,
+                curvature,
+            })
         })
         .collect();
+    let others: Vec<Option<LocalRun>> = starts
+        .par_iter()
+        .enumerate()
+        .skip(1)
+        .map(|(k, x)| {
+            if problem.stop.requested() || runs.is_empty() {
+                return None;
+            }
+            let run = run_from(x, &found);
+            say(k, &run);
+            Some(run)
+        })
+        .collect();
+    runs.extend(others.into_iter().flatten());
     runs.sort_by(|a, b| a.cost.total_cmp(&b.cost));
     let mut distinct: Vec<LocalRun> = Vec::new();
     for r in runs {
@@ -143,6 +180,8 @@ pub fn search(problem: &Problem<'_>, options: &Options) -> Vec<LocalRun> {
             converged: false,
             termination: "stopped before any local run".into(),
             evaluations: 1,
+            jacobian_evaluations: 0,
+            curvature: None,
         });
     }
     distinct

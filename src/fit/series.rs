@@ -108,6 +108,7 @@ impl Series {
 }
 
 /// A table with its mapping, ready to give series for any coefficients.
+#[derive(Clone)]
 pub struct Source {
     pub(super) table: Table,
     name: String,

@@ -1,0 +1,220 @@
+//! Calibration without an expert: a rotary joint's recording in its own
+//! units (`fit --rotary`) and the terms chosen by the data (`--fit auto`),
+//! through the command line as a user runs them.
+
+use friction_node::config::Config;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_friction-node"))
+}
+
+fn dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("fn-joint-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn run(args: &[&str]) -> (i32, String, String) {
+    let o = bin().args(args).output().unwrap();
+    (
+        o.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+/// `simulate`'s columns t_s, velocity_m_s, friction_n of `csv`.
+fn simulated(csv: &Path) -> Vec<(f64, f64, f64)> {
+    let text = std::fs::read_to_string(csv).unwrap();
+    let mut lines = text.lines();
+    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |n: &str| head.iter().position(|h| *h == n).unwrap();
+    let (t, v, f) = (col("t_s"), col("velocity_m_s"), col("friction_n"));
+    lines
+        .map(|l| {
+            let c: Vec<&str> = l.split(',').collect();
+            (
+                c[t].parse().unwrap(),
+                c[v].parse().unwrap(),
+                c[f].parse().unwrap(),
+            )
+        })
+        .collect()
+}
+
+/// Deterministic noise in [-1, 1].
+fn noise(k: usize) -> f64 {
+    ((k as f64 * 12.9898).sin() * 43758.5453).fract() * 2.0 - 1.0
+}
+
+#[test]
+fn a_rotary_joint_is_fitted_in_rad_s_and_newton_metres_and_its_file_drives_the_contact_through_the_chosen_lever(
+) {
+    let d = dir("rotary");
+    let c = d.join("contact.csv");
+    let (code, _, err) = run(&[
+        "simulate",
+        "--velocity",
+        "sine:0,0.05,1",
+        "--duration",
+        "2",
+        "--set",
+        "solver.cells=32",
+        "--out",
+        c.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    // The same motion seen at a joint through a 20 mm lever: rad/s, N·m.
+    let r = 0.02;
+    let rows = simulated(&c);
+    let mut text = String::from("t,omega_rad_s,torque_n_m\n");
+    for (t, v, f) in &rows {
+        text += &format!("{t},{},{}\n", v / r, f * r);
+    }
+    let joint = d.join("joint.csv");
+    std::fs::write(&joint, text).unwrap();
+    let out = d.join("fitted.yaml");
+    let (code, stdout, err) = run(&[
+        "fit",
+        joint.to_str().unwrap(),
+        "--rotary",
+        "--joint",
+        "elbow",
+        "--time",
+        "t",
+        "--velocity",
+        "omega_rad_s",
+        "--friction",
+        "torque_n_m",
+        "--set",
+        "solver.cells=32",
+        "--fit",
+        "contact.boundary_friction,lubricant.viscosity_pa_s",
+        "--starts",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("rotary joint: lever arm"), "{err}");
+    assert!(
+        stdout.contains("training RMS") && stdout.contains(" N·m"),
+        "{stdout}"
+    );
+    // The fitted file: one contact on joint `elbow` with the lever as gain.
+    let fitted = Config::load(Some(&out), &[]).unwrap();
+    let contacts = fitted.resolved_contacts();
+    assert_eq!(contacts.len(), 1);
+    assert_eq!(contacts[0].joint, "elbow");
+    let gain = contacts[0].gain;
+    assert!(gain > 0.0 && gain < 1.0, "lever arm {gain} m");
+    // Driven by the joint's velocity through that gain, the contact gives
+    // the joint's torque: simulate the contact at gain × ω, effort = gain × F.
+    let mut v = String::from("t_s,v\n");
+    for (t, w, _) in rows.iter().map(|(t, vv, f)| (t, vv / r, f)) {
+        v += &format!("{t},{}\n", gain * w);
+    }
+    let vcsv = d.join("v.csv");
+    std::fs::write(&vcsv, v).unwrap();
+    let contact_yaml = d.join("contact.yaml");
+    std::fs::write(&contact_yaml, contacts[0].config.to_yaml()).unwrap();
+    let back = d.join("back.csv");
+    let (code, _, err) = run(&[
+        "simulate",
+        "--config",
+        contact_yaml.to_str().unwrap(),
+        "--velocity",
+        &format!("csv:{}@v", vcsv.display()),
+        "--duration",
+        "2",
+        "--out",
+        back.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let again = simulated(&back);
+    let (mut ss, mut scale) = (0.0, 0.0f64);
+    for ((_, _, f_joint), (_, _, f)) in rows.iter().zip(&again) {
+        let torque = f_joint * r;
+        ss += (gain * f - torque).powi(2);
+        scale = scale.max(torque.abs());
+    }
+    let rms = (ss / again.len() as f64).sqrt();
+    assert!(rms < 0.02 * scale, "torque RMS {rms} N·m of {scale}");
+}
+
+#[test]
+fn rotary_refuses_a_twist_stamped_velocity_naming_its_unit() {
+    let bag = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/bags/foreign_joint_states.mcap"
+    );
+    let d = dir("twist");
+    let (code, _, err) = run(&[
+        "fit",
+        bag,
+        "--rotary",
+        "--velocity-topic",
+        "/cmd_vel",
+        "--friction-topic",
+        "/joint_states",
+        "--joint",
+        "slider",
+        "--fit",
+        "contact.boundary_friction",
+        "--out",
+        d.join("x.yaml").to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("TwistStamped") && err.contains("m/s") && err.contains("rad/s"),
+        "{err}"
+    );
+    assert!(!d.join("x.yaml").exists());
+}
+
+#[test]
+fn auto_on_data_of_one_speed_without_a_reversal_keeps_the_smallest_set_and_says_why() {
+    let d = dir("auto-one-speed");
+    let c = d.join("c.csv");
+    let (code, _, err) = run(&[
+        "simulate",
+        "--velocity",
+        "const:0.05",
+        "--duration",
+        "1",
+        "--set",
+        "solver.cells=32",
+        "--out",
+        c.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let mut text = String::from("t_s,velocity_m_s,friction_n\n");
+    for (k, (t, v, f)) in simulated(&c).into_iter().enumerate() {
+        text += &format!("{t},{v},{}\n", f + 20.0 * noise(k));
+    }
+    let data = d.join("d.csv");
+    std::fs::write(&data, text).unwrap();
+    let (code, stdout, err) = run(&[
+        "fit",
+        data.to_str().unwrap(),
+        "--set",
+        "solver.cells=32",
+        "--fit",
+        "auto",
+        "--out",
+        d.join("f.yaml").to_str().unwrap(),
+    ]);
+    assert!(code == 0 || code == 4, "{err}");
+    assert!(
+        stdout.contains("Chosen: boundary friction. Stopped:")
+            && stdout.contains("does not pay for itself"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("Keys fitted: contact.boundary_friction."),
+        "{stdout}"
+    );
+}
