@@ -218,3 +218,42 @@ fn auto_on_data_of_one_speed_without_a_reversal_keeps_the_smallest_set_and_says_
         "{stdout}"
     );
 }
+
+#[test]
+fn a_bound_that_excludes_the_value_the_chosen_scale_rests_on_is_an_error_naming_both() {
+    let d = dir("bounds");
+    let mut text = String::from("t,w,tau\n");
+    for k in 0..2000 {
+        let t = k as f64 * 1e-3;
+        let w = 2.0 * (2.0 * std::f64::consts::PI * t).sin();
+        text += &format!("{t},{w},{}\n", 5.0 * (w / 0.1).tanh());
+    }
+    let data = d.join("joint.csv");
+    std::fs::write(&data, text).unwrap();
+    let (code, _, err) = run(&[
+        "fit",
+        data.to_str().unwrap(),
+        "--rotary",
+        "--time",
+        "t",
+        "--velocity",
+        "w",
+        "--friction",
+        "tau",
+        "--set",
+        "solver.cells=32",
+        "--fit",
+        "contact.boundary_friction",
+        "--bounds",
+        "contact.boundary_friction=0.5:1",
+        "--out",
+        d.join("x.yaml").to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    // The bound, the configured boundary friction 0.3 and the chosen scale.
+    assert!(
+        err.contains("0.5:1 excludes 0.3") && err.contains("lever arm"),
+        "{err}"
+    );
+    assert!(!d.join("x.yaml").exists());
+}

@@ -23,11 +23,12 @@
 //!    (whose prerequisite is chosen), warm-started from the current set's
 //!    optimum with the new keys at their starts, and keeps the candidate
 //!    with the lowest CV error.
-//! 3. The cost of a term: it is kept only if it lowers the CV error by more
-//!    than the standard error of that lowering over the folds (the
-//!    one-standard-error rule, on the folds' paired differences of mean
-//!    squared error). A term must pay for itself beyond what the folds'
-//!    spread could give by chance; otherwise the selection stops.
+//! 3. The cost of a term: it is kept only if it lowers the CV mean squared
+//!    error by more than [`TERM_COST`] (1 %) of it **and** by more than
+//!    the standard error of that lowering over the blocks (the
+//!    one-standard-error rule, on the blocks' paired differences). A term
+//!    must pay for itself beyond what the blocks' spread could give by
+//!    chance, and by a margin that matters; otherwise the selection stops.
 //! 4. The chosen set is fitted on all the training data with the usual
 //!    search (global phase, local runs).
 //!
@@ -48,6 +49,14 @@ pub const AUTO: &str = "auto";
 
 /// Blocks of the blocked cross-validation.
 pub const FOLDS: usize = 4;
+
+/// The cost of a term: the smallest fraction of the cross-validated mean
+/// squared error it must remove to be kept (1 %: about half a percent of
+/// the RMS). Below it, a term fits the data's fine structure — a noise
+/// floor's texture, a systematic residue of another effect — consistently
+/// enough to beat the blocks' spread while predicting no better in any
+/// sense a controller would notice.
+pub const TERM_COST: f64 = 0.01;
 
 /// A term the selection may add.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -358,11 +367,14 @@ pub fn select(
             .expect("a candidate was open");
         let (gain, se) = paired(&current.fold_mse, &best.fold_mse);
         let name = best.terms.last().copied().unwrap_or_default();
-        if !(gain.is_finite() && gain > se) {
+        let mse = current.cv_rms * current.cv_rms;
+        if !(gain.is_finite() && gain > se && gain > TERM_COST * mse) {
             break format!(
-                "the best next term, {name}, lowers the blocks' mean squared error by {} ± {} (standard error): not more than its standard error, so it does not pay for itself",
+                "the best next term, {name}, lowers the blocks' mean squared error by {} ± {} (standard error), {:.2} % of it: a term must lower it by more than its standard error and by more than {:.0} % (the cost of a term), so it does not pay for itself",
                 super::report::sig(gain),
-                super::report::sig(se)
+                super::report::sig(se),
+                100.0 * gain / mse,
+                100.0 * TERM_COST
             );
         }
         current = best;
@@ -396,7 +408,8 @@ fn cv(t: &Tried, p: &Prepared) -> String {
 pub fn report(s: &Selection, units: super::Units) -> String {
     let u = units.force();
     let mut md = format!(
-        "## Terms chosen by the data (`--fit auto`)\n\nRule: forward selection on blocked cross-validation of the training data ({FOLDS} contiguous time blocks per record, each predicted by the parameters refitted without it in one Gauss–Newton step); a term is kept only if it lowers the blocks' mean squared error by more than the standard error of that lowering. The --validate data are not used.\n\n| set (boundary friction +) | CV RMS ({u}) | RMS per block ({u}) | simulations |\n|---|---|---|---|\n"
+        "## Terms chosen by the data (`--fit auto`)\n\nRule: forward selection on blocked cross-validation of the training data ({FOLDS} contiguous time blocks per record, each predicted by the parameters refitted without it in one Gauss–Newton step); a term is kept only if it lowers the blocks' mean squared error by more than the standard error of that lowering and by more than {:.0} % of it (the cost of a term). The --validate data are not used.\n\n| set (boundary friction +) | CV RMS ({u}) | RMS per block ({u}) | simulations |\n|---|---|---|---|\n",
+        100.0 * TERM_COST
     );
     for t in &s.tried {
         let folds: Vec<String> = t

@@ -1,0 +1,69 @@
+#!/usr/bin/env bash
+# Fit speed, side by side in one run: the shape of issue 42's target (a
+# 25 s record at 1 kHz, 8 configuration keys + 2 input maps, contact.load_n
+# set), synthetic: point-to-point moves made by `simulate` with every fitted
+# term on, 1 % noise, the velocity read 5 % fast and the force offset by
+# 5 N (the two maps). Fits it with `--jacobian differences` (finite
+# differences at every iteration) and the default `--jacobian secant`, and
+# prints simulations, wall time and training RMS of each.
+#
+# Usage: docs/bench-fit-speed.sh [OUT_DIR] [BINARY]   (default: out/bench-fit-speed)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+OUT=${1:-out/bench-fit-speed}
+mkdir -p "$OUT"
+if [ -z "${2:-}" ]; then cargo build --release --quiet; fi
+BIN=${2:-target/release/friction-node}
+python3 - "$OUT" <<'PY'
+import random, sys
+out = sys.argv[1]
+random.seed(3)
+dt, T = 1e-3, 25.0
+segs, t = [], 0.0
+while t < T:
+    vmax = random.choice([0.005, 0.02, 0.05, 0.1, 0.2]) * random.choice([1, -1])
+    ramp = abs(vmax) / 2.0
+    flat, dwell = random.uniform(0.2, 1.0), random.uniform(0.1, 0.4)
+    segs.append((t, ramp, flat, vmax, dwell))
+    t += 2 * ramp + flat + dwell
+def v(t):
+    for (t0, r, f, vm, d) in segs:
+        if t0 <= t < t0 + 2 * r + f + d:
+            s = t - t0
+            if s < r: return vm * s / r
+            if s < r + f: return vm
+            if s < 2 * r + f: return vm * (2 * r + f - s) / r
+            return 0.0
+    return 0.0
+with open(f"{out}/vel.csv", "w") as fh:
+    fh.write("t_s,v\n")
+    for k in range(int(T / dt) + 1):
+        fh.write(f"{k*dt:.6f},{v(k*dt):.9f}\n")
+PY
+"$BIN" simulate --velocity "csv:$OUT/vel.csv@v" --duration 25 --out "$OUT/sim.csv" \
+  --set solver.cells=64 --set contact.load_n=2000 \
+  --set contact.boundary_friction=0.12 --set lubricant.viscosity_pa_s=0.08 \
+  --set drivetrain.coulomb_n=40 --set drivetrain.viscous_n_s_m=300 \
+  --set contact.presliding_stiffness_n_m=2e6 --set contact.presliding_damping_n_s_m=3e3 \
+  --set drivetrain.quadratic_n_s2_m2=800 --set contact.boundary_friction_rate=0.01 > /dev/null
+python3 - "$OUT" <<'PY'
+import csv, random, sys
+out = sys.argv[1]
+random.seed(5)
+rows = list(csv.DictReader(open(f"{out}/sim.csv")))
+f = [float(x["friction_n"]) for x in rows]
+scale = max(abs(x) for x in f)
+with open(f"{out}/meas.csv", "w") as fh:
+    fh.write("t,v,f\n")
+    for x, y in zip(rows, f):
+        fh.write(f"{x['t_s']},{float(x['velocity_m_s']) * 1.05},{y + 5 + random.gauss(0, 0.01 * scale)}\n")
+PY
+for rule in differences secant; do
+  start=$(date +%s.%N)
+  "$BIN" fit "$OUT/meas.csv" --time t --velocity 'v / c' --friction 'f - b' --map c=1 --map b=0 \
+    --bounds c=0.5:2 --bounds b=-50:50 --set solver.cells=64 --set contact.load_n=2000 \
+    --fit contact.boundary_friction,lubricant.viscosity_pa_s,drivetrain.coulomb_n,drivetrain.viscous_n_s_m,contact.presliding_stiffness_n_m,contact.presliding_damping_n_s_m,drivetrain.quadratic_n_s2_m2,contact.boundary_friction_rate,c,b \
+    --jacobian "$rule" --out "$OUT/fitted-$rule.yaml" > "$OUT/$rule.log" 2>&1 || true
+  end=$(date +%s.%N)
+  echo "$rule: $(grep -E '^[0-9]+ simulations' "$OUT/$rule.log"); $(grep -E '^training RMS' "$OUT/$rule.log" | cut -d, -f1); wall $(python3 -c "print(round($end - $start, 1))") s"
+done
