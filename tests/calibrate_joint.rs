@@ -145,6 +145,7 @@ fn a_rotary_joint_is_fitted_in_rad_s_and_newton_metres_and_its_file_drives_the_c
     assert!(rms < 0.02 * scale, "torque RMS {rms} N·m of {scale}");
 }
 
+#[cfg(feature = "mcap")]
 #[test]
 fn rotary_refuses_a_twist_stamped_velocity_naming_its_unit() {
     let bag = concat!(

@@ -299,19 +299,13 @@ fn paired(a: &[f64], b: &[f64]) -> (f64, f64) {
     (mean, (var / n).sqrt())
 }
 
-/// Choose the terms (see the module's rule). `given` are the specs of the
-/// names after `auto`; `say` receives a line per set tried.
-pub fn select(
-    p: &Prepared,
-    req: &FitRequest,
-    given: &[ParamSpec],
-    say: &(dyn Fn(&str) + Sync),
-) -> Result<Selection, FitError> {
-    let wall = std::time::Instant::now();
-    // A candidate whose keys cannot be set up on these data (no bounds to
-    // derive: pre-sliding without a reversal) is not one here.
+/// The candidates on `p`'s data: those whose keys can be set up (a
+/// candidate without bounds to derive, pre-sliding without a reversal, is
+/// not one here, and is returned with why), that the loads allow and that
+/// no given name already fits.
+fn candidates_here(p: &Prepared, given: &[ParamSpec]) -> (Vec<&'static Candidate>, Vec<String>) {
     let mut excluded: Vec<String> = Vec::new();
-    let candidates: Vec<&Candidate> = CANDIDATES
+    let candidates = CANDIDATES
         .iter()
         .filter(|c| !c.needs_varying_load || p.loads_vary)
         .filter(|c| !c.keys.iter().any(|k| given.iter().any(|g| g.name == *k)))
@@ -328,6 +322,19 @@ pub fn select(
             }
         })
         .collect();
+    (candidates, excluded)
+}
+
+/// Choose the terms (see the module's rule). `given` are the specs of the
+/// names after `auto`; `say` receives a line per set tried.
+pub fn select(
+    p: &Prepared,
+    req: &FitRequest,
+    given: &[ParamSpec],
+    say: &(dyn Fn(&str) + Sync),
+) -> Result<Selection, FitError> {
+    let wall = std::time::Instant::now();
+    let (candidates, excluded) = candidates_here(p, given);
     for e in &excluded {
         say(&format!("auto: not a candidate on these data: {e}"));
     }

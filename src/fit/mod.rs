@@ -31,6 +31,7 @@
 //! | `options.rs` | how a fit searches: starts, global points, budget, progress, stop |
 //! | `local_run.rs` | one Levenberg–Marquardt run, the parallel Jacobian, what was still moving |
 //! | `driver.rs` | the whole fit: global phase, local runs, statistics, predictions |
+//! | `prepare.rs` | data → our model: scales, keys, maps, a rotary joint's lever, `--fit auto`'s base set |
 //! | `request.rs` | a calibration as data (the command line's and Python's) and its steps |
 //! | `search.rs` | the global phase and the distinct optima |
 //! | `stats.rs` | standard errors, correlations, flags |
@@ -51,6 +52,7 @@ pub mod local_run;
 pub mod options;
 pub mod params;
 pub mod physics_model;
+pub mod prepare;
 pub mod problem;
 pub mod report;
 pub mod request;

@@ -32,6 +32,8 @@
 //! | v_t | transition speed: half the load on the film | m/s |
 //! | μ_bl | boundary friction (`contact.boundary_friction`) | – |
 
+use super::params::ParamSpec;
+use super::series::Source;
 use super::FitError;
 use crate::config::Config;
 use crate::physics::Solver;
@@ -165,6 +167,79 @@ pub fn choose(config: &Config, omega_top: f64, tau_level: f64) -> Result<Lever, 
             crate::text::Num(tau_level)
         ),
     })
+}
+
+/// A rotary joint's model configuration and lever: the configuration's
+/// one contact with its gain, or a lever arm and load chosen from the data
+/// (their start values); a bound on the boundary friction that excludes the
+/// value the chosen load rests on is an error naming both.
+pub fn setup(
+    config: &Config,
+    train: &[Source],
+    map: &[f64],
+    specs: &[ParamSpec],
+) -> Result<(Config, Lever), FitError> {
+    let contacts = config.resolved_contacts();
+    if config.contacts.0.len() > 1 {
+        return Err(FitError::Data {
+            what: "--rotary".into(),
+            message: format!(
+                "the configuration has {} contacts; a joint's fit needs one (or none: the top level)",
+                contacts.len()
+            ),
+        });
+    }
+    let one = &contacts[0];
+    if !config.contacts.is_empty() && one.gain != 1.0 {
+        return Ok((
+            one.config.clone(),
+            Lever {
+                lever_m: one.gain,
+                load_n: one.config.contact.load_n,
+                how: format!("configured: contacts.{}.gain", one.name),
+            },
+        ));
+    }
+    let (mut top, mut sum, mut n) = (0.0f64, 0.0, 0usize);
+    let mut all = Vec::new();
+    for s in train {
+        all.push(s.series(map)?);
+    }
+    for se in &all {
+        top = se.velocity.iter().fold(top, |m, v| m.max(v.abs()));
+    }
+    for se in &all {
+        for k in (0..se.len()).filter(|&k| se.velocity[k].abs() > 0.1 * top) {
+            sum += se.friction[k].abs();
+            n += 1;
+        }
+    }
+    let level = sum / n.max(1) as f64;
+    let lever = choose(&one.config, top, level)?;
+    let mut c = one.config.clone();
+    if all.iter().all(|s| s.load.is_none()) {
+        c.contact.load_n = lever.load_n;
+    }
+    let mu = c.contact.boundary_friction;
+    for s in specs
+        .iter()
+        .filter(|s| s.name == "contact.boundary_friction")
+    {
+        if let Some((lo, hi)) = s.bounds {
+            if !(lo..=hi).contains(&mu) {
+                return Err(FitError::Bounds {
+                    key: s.name.clone(),
+                    message: format!(
+                        "{lo}:{hi} excludes {mu}, the boundary friction on which the chosen scale rests (load {} N and lever arm {} m give the data's sliding level {} N·m with it): widen the bounds, or set contact.boundary_friction inside them in the configuration (the load is then chosen from that value)",
+                        crate::text::Num(lever.load_n),
+                        crate::text::Num(lever.lever_m),
+                        crate::text::Num(level)
+                    ),
+                });
+            }
+        }
+    }
+    Ok((c, lever))
 }
 
 /// `config` as the one contact of joint `joint` with lever arm `lever_m`

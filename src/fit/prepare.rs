@@ -1,0 +1,311 @@
+//! Data → our model: read the sources, the data's scales, the fitted
+//! keys and map coefficients (`--fit auto`'s base set, a rotary joint's
+//! lever), everything checked before any simulation; and `--fit auto`'s
+//! choice of keys applied to it. The request itself is `request.rs`.
+
+use super::params::{map_parameter, DataScale};
+use super::request::FitRequest;
+use super::{Data, FitError, FittedParameter, ParamSpec, PhysicsModel, Source};
+use crate::config::Config;
+use std::path::PathBuf;
+
+/// Scales of the training data at the maps' start values: the scale, the
+/// mean |F| and whether the load varies.
+pub fn data_scale(
+    sources: &[Source],
+    map: &[f64],
+    load_n: f64,
+) -> Result<(DataScale, f64, bool), FitError> {
+    let (mut f, mut v, mut lmin, mut lmax) = (0.0f64, 0.0f64, f64::INFINITY, 0.0f64);
+    let (mut sum_abs, mut n) = (0.0, 0usize);
+    let mut all = Vec::with_capacity(sources.len());
+    for s in sources {
+        let se = s.series(map)?;
+        for k in 0..se.len() {
+            f = f.max(se.friction[k].abs());
+            v = v.max(se.velocity[k].abs());
+            let l = se.load_at(k, load_n);
+            lmin = lmin.min(l);
+            lmax = lmax.max(l);
+            sum_abs += se.friction[k].abs();
+            n += 1;
+        }
+        all.push(se);
+    }
+    if v == 0.0 {
+        return Err(FitError::Data {
+            what: "data".into(),
+            message: "the velocity is zero in every sample: there is no sliding to fit".into(),
+        });
+    }
+    let scale = DataScale {
+        friction_n: f,
+        velocity_m_s: v,
+        load_min_n: lmin,
+        reversal_stiffness_n_m: super::reversals::stiffness(&all).stiffness_n_m,
+    };
+    Ok((scale, sum_abs / n.max(1) as f64, lmax > 1.01 * lmin))
+}
+
+/// `--fit` as `auto`, the names given besides it, and the specs our model
+/// starts with (with `auto`: the base key first; the selection chooses the
+/// rest).
+fn auto_specs(params: &[ParamSpec]) -> (bool, Vec<ParamSpec>, Vec<ParamSpec>) {
+    let auto = params.iter().any(|s| s.name == super::auto::AUTO);
+    let given: Vec<ParamSpec> = params
+        .iter()
+        .filter(|s| s.name != super::auto::AUTO)
+        .cloned()
+        .collect();
+    let mut specs = given.clone();
+    if auto && !specs.iter().any(|s| s.name == super::auto::BASE_KEY) {
+        specs.insert(
+            0,
+            ParamSpec {
+                name: super::auto::BASE_KEY.into(),
+                ..Default::default()
+            },
+        );
+    }
+    (auto, given, specs)
+}
+
+/// The configuration our model runs on, a rotary joint's lever, and the
+/// data's scales as the model sees them (through the lever).
+fn model_setup(
+    config: &Config,
+    rotary: bool,
+    train: &[Source],
+    map_values: &[f64],
+    key_specs: &[ParamSpec],
+    scale: DataScale,
+    notes: &mut Vec<String>,
+) -> Result<(Config, Option<super::rotary::Lever>, DataScale), FitError> {
+    if !rotary {
+        return Ok((config.clone(), None, scale));
+    }
+    let (c, l) = super::rotary::setup(config, train, map_values, key_specs)?;
+    notes.push(format!(
+        "rotary joint: lever arm {} m, contact load {} N ({})",
+        crate::text::Num(l.lever_m),
+        crate::text::Num(l.load_n),
+        l.how
+    ));
+    let load_min = load_range(train, map_values, c.contact.load_n)?.0;
+    let contact_scale = scale.through_lever(l.lever_m, load_min);
+    Ok((c, Some(l), contact_scale))
+}
+
+/// Data, the physics model's parameters and the fitted map coefficients.
+pub struct Prepared {
+    /// The sources.
+    pub data: Data,
+    /// Our model with its fitted keys.
+    pub model: PhysicsModel,
+    /// Fitted map coefficients (index, bounds).
+    pub map_fit: Vec<(usize, FittedParameter)>,
+    /// The data's velocity and friction scales (for the baselines' starts and bounds).
+    pub scale: DataScale,
+    /// Mean |friction| of the training data, N.
+    pub mean_abs_n: f64,
+    /// Whether the training loads differ by more than 1 %.
+    pub loads_vary: bool,
+    /// The validation data hold loads outside the training data's range.
+    pub other_loads: bool,
+    /// The training files, as given.
+    pub names: Vec<String>,
+    /// What was read from each bag (topics used, warnings).
+    pub notes: Vec<String>,
+    /// A rotary joint's lever arm and load (`--rotary`).
+    pub lever: Option<super::rotary::Lever>,
+    /// The joint's name in the fitted file (`--joint`, else `joint`).
+    pub joint: String,
+    /// The configuration our model runs on (a rotary joint's contact with
+    /// its chosen load).
+    pub model_config: Config,
+    /// The data's scales as our model sees them (through the lever).
+    pub model_scale: DataScale,
+    /// The names given to `--fit` (besides `auto`).
+    pub given: Vec<ParamSpec>,
+    /// `--fit auto`: the data choose the terms.
+    pub auto: bool,
+}
+
+/// Fitted map coefficients: index into the data's maps and bounds.
+pub type MapFit = Vec<(usize, FittedParameter)>;
+
+/// Split specs into configuration keys and map coefficients (with their
+/// bounds resolved).
+fn split_specs(
+    specs: &[ParamSpec],
+    map_names: &[String],
+    map_values: &[f64],
+) -> Result<(Vec<ParamSpec>, MapFit), FitError> {
+    let mut key_specs = Vec::new();
+    let mut map_fit = Vec::new();
+    for s in specs {
+        if s.name.contains('.') {
+            key_specs.push(s.clone());
+        } else if let Some(i) = map_names.iter().position(|n| *n == s.name) {
+            map_fit.push((i, map_parameter(s, map_values[i])?));
+        } else {
+            return Err(FitError::Key {
+                key: s.name.clone(),
+                message:
+                    "neither a configuration key (dotted, e.g. roughness.sigma_m) nor a --map coefficient"
+                        .into(),
+            });
+        }
+    }
+    Ok((key_specs, map_fit))
+}
+
+/// Our model for `specs` on `p`'s data (a rotary joint's lever included)
+/// and its fitted map coefficients, every parameter started at its value
+/// in `warm` when it has one (the bounds stay those of `specs`).
+pub fn model_for(
+    p: &Prepared,
+    specs: &[ParamSpec],
+    warm: &[(String, f64)],
+) -> Result<(PhysicsModel, MapFit), FitError> {
+    let (key_specs, mut map_fit) = split_specs(specs, &p.data.map_names, &p.data.map_values)?;
+    let lever_m = p.lever.as_ref().map_or(1.0, |l| l.lever_m);
+    let mut model =
+        PhysicsModel::new(&p.model_config, &key_specs, &p.model_scale)?.with_lever(lever_m);
+    model.warm(warm);
+    for (_, q) in &mut map_fit {
+        if let Some((_, v)) = warm.iter().find(|(n, _)| *n == q.name) {
+            q.warm(*v);
+        }
+    }
+    Ok((model, map_fit))
+}
+
+fn load_range(sources: &[Source], map: &[f64], load_n: f64) -> Result<(f64, f64), FitError> {
+    let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+    for s in sources {
+        let se = s.series(map)?;
+        for k in 0..se.len() {
+            let l = se.load_at(k, load_n);
+            lo = lo.min(l);
+            hi = hi.max(l);
+        }
+    }
+    Ok((lo, hi))
+}
+
+/// Read the data and set up the parameters (everything checked before any
+/// simulation).
+pub fn prepare(config: &Config, req: &FitRequest) -> Result<Prepared, FitError> {
+    req.check()?;
+    let mut notes = Vec::new();
+    let mut source = |p: &PathBuf| -> Result<Source, FitError> {
+        let (table, note) = req.table(p)?;
+        notes.extend(note);
+        Source::new(table, &req.mapping)
+    };
+    let train = req
+        .data
+        .iter()
+        .map(&mut source)
+        .collect::<Result<Vec<_>, _>>()?;
+    let validate = req
+        .validate
+        .iter()
+        .map(&mut source)
+        .collect::<Result<Vec<_>, _>>()?;
+    let mapping = &req.mapping;
+    let map_names: Vec<String> = mapping.coefficients.iter().map(|c| c.0.clone()).collect();
+    let map_values: Vec<f64> = mapping.coefficients.iter().map(|c| c.1).collect();
+    let load_n = config.contact.load_n;
+    let (scale, mean_abs_n, loads_vary) = data_scale(&train, &map_values, load_n)?;
+    let other_loads = if validate.is_empty() {
+        false
+    } else {
+        let (tl, th) = load_range(&train, &map_values, load_n)?;
+        let (vl, vh) = load_range(&validate, &map_values, load_n)?;
+        vl < 0.99 * tl || vh > 1.01 * th
+    };
+    let (auto, given, specs) = auto_specs(&req.params);
+    let (key_specs, map_fit) = split_specs(&specs, &map_names, &map_values)?;
+    if scale.reversal_stiffness_n_m.is_none() {
+        for s in key_specs.iter().filter(|s| s.name.contains("presliding_")) {
+            notes.push(format!(
+                "warning: {} is fitted, but the training data hold no usable velocity reversal: pre-sliding shows only through a reversal, so these data cannot identify it (its estimate will follow its start and bounds)",
+                s.name
+            ));
+        }
+    }
+    let (model_config, lever, model_scale) = model_setup(
+        config,
+        req.rotary,
+        &train,
+        &map_values,
+        &key_specs,
+        scale,
+        &mut notes,
+    )?;
+    let lever_m = lever.as_ref().map_or(1.0, |l| l.lever_m);
+    let model = PhysicsModel::new(&model_config, &key_specs, &model_scale)?.with_lever(lever_m);
+    Ok(Prepared {
+        model_config,
+        model_scale,
+        given,
+        auto,
+        lever,
+        joint: req.topics.joint.clone().unwrap_or_else(|| "joint".into()),
+        names: req.data.iter().map(|p| p.display().to_string()).collect(),
+        data: Data {
+            train,
+            validate,
+            holdout: if req.holdout > 0.0 {
+                super::problem::HoldOut::Fraction(req.holdout)
+            } else {
+                super::problem::HoldOut::None
+            },
+            map_names,
+            map_values,
+            units: if req.rotary {
+                super::Units::Rotary
+            } else {
+                super::Units::Linear
+            },
+        },
+        model,
+        map_fit,
+        scale,
+        mean_abs_n,
+        loads_vary,
+        other_loads,
+        notes,
+    })
+}
+
+/// `--fit auto`: choose the terms (see `auto.rs`) and set `p`'s model to
+/// the chosen keys; `say` receives a line per set tried.
+pub fn select_terms(
+    p: &mut Prepared,
+    req: &FitRequest,
+    say: &(dyn Fn(&str) + Sync),
+) -> Result<super::auto::Selection, FitError> {
+    let given = p.given.clone();
+    let s = super::auto::select(p, req, &given, say)?;
+    let specs: Vec<ParamSpec> = s
+        .keys
+        .iter()
+        .map(|k| {
+            given
+                .iter()
+                .find(|g| g.name == *k)
+                .cloned()
+                .unwrap_or(ParamSpec {
+                    name: k.clone(),
+                    ..Default::default()
+                })
+        })
+        .collect();
+    let (model, map_fit) = model_for(p, &specs, &[])?;
+    p.model = model;
+    p.map_fit = map_fit;
+    Ok(s)
+}
