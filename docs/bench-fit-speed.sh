@@ -3,9 +3,11 @@
 # 25 s record at 1 kHz, 8 configuration keys + 2 input maps, contact.load_n
 # set), synthetic: point-to-point moves made by `simulate` with every fitted
 # term on, 1 % noise, the velocity read 5 % fast and the force offset by
-# 5 N (the two maps). Fits it with `--jacobian differences` (finite
-# differences at every iteration) and the default `--jacobian secant`, and
-# prints simulations, wall time and training RMS of each.
+# 5 N (the two maps). Fits it three ways: `--jacobian differences
+# --later-runs full` (finite differences at every iteration, every local
+# run walked to its end), `--jacobian secant --later-runs full`, and the
+# defaults (`secant`, `valley`: later runs stop in the first optimum's
+# valley); prints simulations, wall time and training RMS of each.
 #
 # Usage: docs/bench-fit-speed.sh [OUT_DIR] [BINARY]   (default: out/bench-fit-speed)
 set -euo pipefail
@@ -58,12 +60,14 @@ with open(f"{out}/meas.csv", "w") as fh:
     for x, y in zip(rows, f):
         fh.write(f"{x['t_s']},{float(x['velocity_m_s']) * 1.05},{y + 5 + random.gauss(0, 0.01 * scale)}\n")
 PY
-for rule in differences secant; do
+for way in ${WAYS:-differences/full secant/full secant/valley}; do
+  rule=${way%/*}
+  later=${way#*/}
   start=$(date +%s.%N)
   "$BIN" fit "$OUT/meas.csv" --time t --velocity 'v / c' --friction 'f - b' --map c=1 --map b=0 \
     --bounds c=0.5:2 --bounds b=-50:50 --set solver.cells=64 --set contact.load_n=2000 \
     --fit contact.boundary_friction,lubricant.viscosity_pa_s,drivetrain.coulomb_n,drivetrain.viscous_n_s_m,contact.presliding_stiffness_n_m,contact.presliding_damping_n_s_m,drivetrain.quadratic_n_s2_m2,contact.boundary_friction_rate,c,b \
-    --jacobian "$rule" --out "$OUT/fitted-$rule.yaml" > "$OUT/$rule.log" 2>&1 || true
+    --jacobian "$rule" --later-runs "$later" --out "$OUT/fitted-$rule-$later.yaml" > "$OUT/$rule-$later.log" 2>&1 || true
   end=$(date +%s.%N)
-  echo "$rule: $(grep -E '^[0-9]+ simulations' "$OUT/$rule.log"); $(grep -E '^training RMS' "$OUT/$rule.log" | cut -d, -f1); wall $(python3 -c "print(round($end - $start, 1))") s"
+  echo "$rule, later runs $later: $(grep -E '^[0-9]+ simulations' "$OUT/$rule-$later.log"); $(grep -E '^training RMS' "$OUT/$rule-$later.log" | cut -d, -f1); wall $(python3 -c "print(round($end - $start, 1))") s"
 done

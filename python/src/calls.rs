@@ -420,6 +420,7 @@ pub fn fit<'py>(
         baselines,
         rotary,
         jacobian: Default::default(),
+        later_runs: Default::default(),
         progress: progress.then(|| {
             Arc::new(|label: &str, l: &str| eprintln!("fit [{label}]: {l}")) as LabelledProgress
         }),

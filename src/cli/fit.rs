@@ -3,7 +3,7 @@
 
 use anyhow::{bail, Context, Result};
 use friction_node::config::Config;
-use friction_node::fit::local_run::JacobianRule;
+use friction_node::fit::local_run::{JacobianRule, LaterRuns};
 use friction_node::fit::report;
 use friction_node::fit::request::{
     fit_baselines, fit_ours, param_specs, prepare, select_terms, FitRequest, OursFitted,
@@ -85,6 +85,12 @@ pub struct FitArgs {
     /// (finite differences at every iteration; slower).
     #[arg(long, default_value = "secant", value_parser = JacobianRule::parse)]
     pub jacobian: JacobianRule,
+    /// How the local runs after the first end: `valley` (a run whose
+    /// straight line to an earlier optimum falls all the way stops there)
+    /// or `full` (every run walks to its end; slower). The classic models
+    /// always walk to the end.
+    #[arg(long, default_value = "valley", value_parser = LaterRuns::parse)]
+    pub later_runs: LaterRuns,
     /// Column names of headerless CSV data (comma-separated).
     #[arg(long, value_name = "NAME,...", value_delimiter = ',')]
     pub columns: Option<Vec<String>>,
@@ -278,6 +284,7 @@ impl FitArgs {
             seed: self.seed,
             max_evaluations: self.max_evaluations,
             jacobian: self.jacobian,
+            later_runs: self.later_runs,
             baselines: self.baselines,
             rotary: self.rotary,
             progress: Some(Arc::new(|label: &str, l: &str| {

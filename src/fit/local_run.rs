@@ -18,6 +18,23 @@
 //! cost within ½ s² χ²₀.₉₅(n) of that optimum's) stops there: going on could only find that optimum again, or a point
 //! the data cannot tell from it (kept among the distinct optima when it
 //! lies apart).
+//!
+//! With the valley test on (our model's fits; `--later-runs valley`, the
+//! default), a run that is not the first also asks, before it takes
+//! differences, whether it already sits in the valley of an earlier
+//! optimum u₁ (the hill–valley test of Ursem 2000, made monotone): the
+//! cost at `VALLEY_POINTS` evenly spaced points of the straight line from
+//! its point u to u₁ (in the unbounded variables) falls at every point,
+//! c(u) ≥ c(u + ⅕(u₁ − u)) ≥ … ≥ c₁. Then a descent from u has a straight
+//! way down to u₁ with no hill on it, and the run stops there ("in the
+//! valley of optimum 1") for a few simulations instead of the dozens of
+//! Jacobians it would take to walk down. A line with a rise on it
+//! (another valley between) lets the run go on; it asks again once its
+//! cost has fallen tenfold since the last time. The test is evidence, not
+//! proof: from a start far up the slopes most straight lines fall, and a
+//! better optimum whose basin holds such a start would be missed;
+//! `--later-runs full` walks every run to its end. The first run (no
+//! earlier optimum) is the same either way.
 
 use super::problem::Problem;
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt, TerminationReason};
@@ -47,8 +64,19 @@ pub struct LocalRun {
     pub curvature: Option<DMatrix<f64>>,
 }
 
+/// The optimiser's variables u on their canonical fold: the variables are
+/// periodic (x = x(sin u)), so a run that went over a bound stands at
+/// the same point as asin(sin u) + 2π; distances between runs' points
+/// are taken there.
+pub fn canonical(u: &[f64]) -> Vec<f64> {
+    u.iter()
+        .map(|v| v.sin().asin() + std::f64::consts::TAU)
+        .collect()
+}
+
 /// An optimum found by an earlier run: its point in the optimiser's
-/// variables, its cost and the curvature JᵀJ there.
+/// variables (canonical), its cost and the curvature JᵀJ there (in the
+/// canonical variables).
 #[derive(Debug, Clone)]
 pub struct Found {
     /// The point, unbounded variables.
@@ -101,6 +129,48 @@ pub fn chi_square_95(n: usize) -> f64 {
     n * (1.0 - a + 1.644_853_626_951_472_6 * a.sqrt()).powi(3)
 }
 
+/// Interior points of the valley test's line.
+pub const VALLEY_POINTS: usize = 4;
+/// A run asks the valley test again once its cost has fallen by this
+/// factor since the last time.
+const VALLEY_RETEST: f64 = 10.0;
+
+/// How the runs after the first end.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum LaterRuns {
+    /// Each stops when a straight line from its point falls all the way
+    /// to an earlier optimum (the valley test), or inside that optimum's
+    /// confidence region.
+    #[default]
+    Valley,
+    /// Each stops only inside an earlier optimum's confidence region.
+    Full,
+}
+
+impl LaterRuns {
+    /// The rules by name (the command line's values).
+    pub const NAMES: [(&'static str, LaterRuns); 2] =
+        [("valley", LaterRuns::Valley), ("full", LaterRuns::Full)];
+
+    /// The rule named `s`.
+    pub fn parse(s: &str) -> Result<Self, String> {
+        Self::NAMES
+            .iter()
+            .find(|(n, _)| *n == s)
+            .map(|(_, r)| *r)
+            .ok_or_else(|| format!("`{s}` is not a rule for later runs: valley or full"))
+    }
+}
+
+/// How a run came to an earlier optimum.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Joined {
+    /// Inside its 95 % confidence region.
+    Region(usize),
+    /// On a straight line down to it with no rise (the valley test).
+    Valley(usize),
+}
+
 /// Forward-difference step in the unbounded variable.
 const FD_STEP: f64 = 1e-4;
 
@@ -129,10 +199,20 @@ struct Lm<'p, 'a> {
     /// Optima of earlier runs.
     earlier: &'p [Found],
     /// The earlier optimum this run came to.
-    joined: Option<usize>,
+    joined: Mutex<Option<Joined>>,
+    /// Whether the valley test is asked.
+    later: LaterRuns,
+    /// The cost at the last valley test (none yet: infinite).
+    valley_cost: Mutex<f64>,
+    /// Simulations the valley tests took.
+    valley_evaluations: AtomicUsize,
 }
 
 impl Lm<'_, '_> {
+    fn joined(&self) -> Option<Joined> {
+        *self.joined.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
     fn differences(&self) -> DMatrix<f64> {
         let n = self.u.len();
         let columns: Vec<Vec<f64>> = (0..n)
@@ -166,10 +246,58 @@ impl Lm<'_, '_> {
         let chi2 = chi_square_95(n);
         self.earlier.iter().position(|f| {
             let s2 = 2.0 * f.cost / dof;
+            let u = canonical(u);
             let d = DVector::from_iterator(n, u.iter().zip(&f.u).map(|(a, b)| a - b));
             let q = (d.transpose() * &f.curvature * &d)[(0, 0)];
             q <= s2 * chi2 && cost <= f.cost + 0.5 * s2 * chi2
         })
+    }
+
+    /// The earlier optimum whose valley the current point is in: the cost
+    /// falls at every one of `VALLEY_POINTS` evenly spaced points of the
+    /// straight line to it. Asked once the cost has fallen `VALLEY_RETEST`
+    /// times since the last asking (the first time always).
+    fn valley(&self) -> Option<usize> {
+        let cost = 0.5 * self.r.norm_squared();
+        {
+            let mut last = self.valley_cost.lock().unwrap_or_else(|p| p.into_inner());
+            if self.later != LaterRuns::Valley
+                || self.earlier.is_empty()
+                || !cost.is_finite()
+                || cost * VALLEY_RETEST > *last
+            {
+                return None;
+            }
+            *last = cost;
+        }
+        self.earlier
+            .iter()
+            .position(|f| f.cost <= cost && self.falls_to(cost, f))
+    }
+
+    /// Whether the cost falls at every interior point of the straight
+    /// line from the current point (cost `cost`) to `f`, and on to `f`.
+    fn falls_to(&self, cost: f64, f: &Found) -> bool {
+        let from = canonical(self.u.as_slice());
+        let costs: Vec<f64> = (1..=VALLEY_POINTS)
+            .into_par_iter()
+            .map(|k| {
+                let t = k as f64 / (VALLEY_POINTS + 1) as f64;
+                let u: Vec<f64> = from
+                    .iter()
+                    .zip(&f.u)
+                    .map(|(a, b)| a + t * (b - a))
+                    .collect();
+                self.problem.cost(&self.problem.from_internal(&u))
+            })
+            .collect();
+        self.valley_evaluations
+            .fetch_add(VALLEY_POINTS, Ordering::Relaxed);
+        let line: Vec<f64> = std::iter::once(cost)
+            .chain(costs)
+            .chain(std::iter::once(f.cost))
+            .collect();
+        line.windows(2).all(|w| w[1].is_finite() && w[1] <= w[0])
     }
 }
 
@@ -199,8 +327,10 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Lm<'_, '_> {
         let cost = 0.5 * self.r.norm_squared();
         self.trail.push((cost, u.as_slice().to_vec()));
         self.trials.fetch_add(1, Ordering::Relaxed);
-        if self.joined.is_none() {
-            self.joined = self.joins(u.as_slice(), cost);
+        let joins = self.joins(u.as_slice(), cost);
+        let joined = self.joined.get_mut().unwrap_or_else(|p| p.into_inner());
+        if joined.is_none() {
+            *joined = joins.map(Joined::Region);
         }
     }
 
@@ -211,11 +341,11 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Lm<'_, '_> {
     fn residuals(&self) -> Option<DVector<f64>> {
         // None ends the run (TerminationReason::User) when a stop is asked
         // or the run came to an earlier optimum.
-        (!self.problem.stop.requested() && self.joined.is_none()).then(|| self.r.clone())
+        (!self.problem.stop.requested() && self.joined().is_none()).then(|| self.r.clone())
     }
 
     fn jacobian(&self) -> Option<DMatrix<f64>> {
-        if self.problem.stop.requested() || self.joined.is_some() {
+        if self.problem.stop.requested() || self.joined().is_some() {
             return None;
         }
         let trials = self.trials.swap(0, Ordering::Relaxed);
@@ -237,6 +367,10 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Lm<'_, '_> {
                 return Some(l.j.clone());
             }
         }
+        if let Some(k) = self.valley() {
+            *self.joined.lock().unwrap_or_else(|p| p.into_inner()) = Some(Joined::Valley(k));
+            return None;
+        }
         let j = self.differences();
         *last = Some(LastJacobian {
             u: self.u.clone(),
@@ -250,17 +384,19 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Lm<'_, '_> {
 
 /// One Levenberg–Marquardt run from `x0` with `rule`'s Jacobians (a
 /// secant run is polished on differences); it stops early when it comes
-/// to one of the `earlier` optima.
+/// to one of the `earlier` optima (inside its confidence region, or,
+/// with `later` = [`LaterRuns::Valley`], in its valley).
 pub fn local_run(
     problem: &Problem<'_>,
     x0: &[f64],
     max_evaluations: usize,
     rule: JacobianRule,
     earlier: &[Found],
+    later: LaterRuns,
     tolerance: (f64, f64),
 ) -> LocalRun {
     let one_run = |x: &[f64], budget: usize, rule: JacobianRule, earlier: &[Found]| {
-        one_run(problem, x, budget, rule, earlier, tolerance)
+        one_run(problem, x, budget, (rule, later), earlier, tolerance)
     };
     let (first, ended_early) = one_run(x0, max_evaluations, rule, earlier);
     // The budget bounds the whole run: a secant run that spent it is not
@@ -284,7 +420,7 @@ fn one_run(
     problem: &Problem<'_>,
     x0: &[f64],
     max_evaluations: usize,
-    rule: JacobianRule,
+    (rule, later): (JacobianRule, LaterRuns),
     earlier: &[Found],
     (ftol, xtol): (f64, f64),
 ) -> (LocalRun, bool) {
@@ -300,7 +436,10 @@ fn one_run(
         trials: AtomicUsize::new(0),
         jacobian_evaluations: AtomicUsize::new(0),
         earlier,
-        joined: None,
+        joined: Mutex::new(None),
+        later,
+        valley_cost: Mutex::new(f64::INFINITY),
+        valley_evaluations: AtomicUsize::new(0),
     };
     lm.set_params(&u0);
     let patience = max_evaluations.div_ceil(n + 1).max(1);
@@ -310,7 +449,10 @@ fn one_run(
         .with_gtol(1e-10)
         .with_patience(patience)
         .minimize(lm);
-    let jacobian_evaluations = lm.jacobian_evaluations.load(Ordering::Relaxed);
+    // Valley tests are counted with the Jacobians' simulations: both are
+    // simulations besides the optimiser's own evaluations.
+    let jacobian_evaluations = lm.jacobian_evaluations.load(Ordering::Relaxed)
+        + lm.valley_evaluations.load(Ordering::Relaxed);
     // The last Jacobian by differences: at the end point, or at the
     // accepted point before it when the last step met the convergence
     // test (the curvature hardly changes over that step).
@@ -319,16 +461,43 @@ fn one_run(
         .into_inner()
         .unwrap_or_else(|p| p.into_inner())
         .filter(|l| l.secant_updates == 0)
-        .map(|l| l.j.transpose() * &l.j);
-    if let Some(k) = lm.joined {
-        // Where it stopped: the point that came to optimum k.
-        let x = problem.from_internal(lm.u.as_slice());
-        let cost = 0.5 * lm.r.norm_squared();
+        .map(|l| {
+            // In the canonical variables: a column taken on a fold where
+            // cos u < 0 changes sign.
+            let mut j = l.j;
+            for (k, u) in l.u.iter().enumerate() {
+                if u.cos() < 0.0 {
+                    j.column_mut(k).neg_mut();
+                }
+            }
+            j.transpose() * &j
+        });
+    let joined = lm.joined.into_inner().unwrap_or_else(|p| p.into_inner());
+    if let Some(how) = joined {
+        let (x, cost, termination) = match how {
+            // Where it stopped: the point that came to optimum k.
+            Joined::Region(k) => (
+                problem.from_internal(lm.u.as_slice()),
+                0.5 * lm.r.norm_squared(),
+                format!("came to optimum {} of an earlier run", k + 1),
+            ),
+            // Its end is that optimum: a straight way down leads there.
+            Joined::Valley(k) => (
+                problem.from_internal(&earlier[k].u),
+                earlier[k].cost,
+                format!(
+                    "in the valley of optimum {} of an earlier run (from cost {:.4e} the cost \
+                     falls at every one of {VALLEY_POINTS} points on the straight line to it)",
+                    k + 1,
+                    0.5 * lm.r.norm_squared()
+                ),
+            ),
+        };
         let run = LocalRun {
             x,
             cost,
             converged: true,
-            termination: format!("came to optimum {} of an earlier run", k + 1),
+            termination,
             evaluations: report.number_of_evaluations,
             jacobian_evaluations,
             curvature: None,

@@ -10,7 +10,7 @@
 //! |---|---|
 //! | scaling | each parameter on its log scale (positive bounds) or linear scale, mapped to an unbounded variable by the sine transform s = lo + (hi − lo)(1 + sin u)/2 |
 //! | global phase | a seeded Latin-hypercube set of starts over the scaled bounds, each scored by one simulation |
-//! | local phase | Levenberg–Marquardt (MINPACK, `levenberg-marquardt` on nalgebra) from the given start, then the best distinct global starts side by side, each stopped inside the first optimum's 95 % confidence region; Jacobian by forward differences of whole simulations run in parallel, kept up to date between them by Broyden's secant update and polished on differences at the end |
+//! | local phase | Levenberg–Marquardt (MINPACK, `levenberg-marquardt` on nalgebra) from the given start, then the best distinct global starts side by side, each stopped inside the first optimum's 95 % confidence region or, with `--later-runs valley` (the default), as soon as a straight line from it falls all the way to that optimum (the valley test); Jacobian by forward differences of whole simulations run in parallel, kept up to date between them by Broyden's secant update and polished on differences at the end |
 //! | statistics | standard errors s²(JᵀJ)⁻¹ and correlations from the Jacobian in scaled coordinates at the optimum; flags at bounds and for |corr| > 0.95 |
 //!
 //! Transient data are simulated from the steady state of the first sample
@@ -29,7 +29,7 @@
 //! | `baselines.rs` | Coulomb + viscous, Stribeck, LuGre |
 //! | `problem.rs` | the problem: model, data, map coefficients, residuals, predictions |
 //! | `options.rs` | how a fit searches: starts, global points, budget, progress, stop |
-//! | `local_run.rs` | one Levenberg–Marquardt run: secant or difference Jacobians, the stop inside an earlier optimum's confidence region, what was still moving |
+//! | `local_run.rs` | one Levenberg–Marquardt run: secant or difference Jacobians, the stop inside an earlier optimum's confidence region or valley, what was still moving |
 //! | `driver.rs` | the whole fit: global phase, local runs, statistics, predictions |
 //! | `prepare.rs` | data → our model: scales, keys, maps, a rotary joint's lever, `--fit auto`'s base set |
 //! | `request.rs` | a calibration as data (the command line's and Python's) and its steps |

@@ -26,6 +26,8 @@ pub struct Options {
     pub extra_starts: Vec<Vec<f64>>,
     /// How the local runs get their Jacobians.
     pub jacobian: super::local_run::JacobianRule,
+    /// How the runs after the first end (the valley test or not).
+    pub later_runs: super::local_run::LaterRuns,
     /// Convergence: relative change of the cost, and of the step.
     pub ftol: f64,
     /// See `ftol`.
@@ -46,6 +48,7 @@ impl Default for Options {
             stop: crate::interrupt::Stop::new(),
             extra_starts: Vec::new(),
             jacobian: Default::default(),
+            later_runs: Default::default(),
             ftol: 1e-10,
             xtol: 1e-8,
             cv_blocks: 0,

@@ -111,6 +111,13 @@ impl FittedParameter {
         (2.0 * f - 1.0).asin() + std::f64::consts::TAU
     }
 
+    /// The unbounded variable of `p` on its canonical fold (in
+    /// [2π − π/2, 2π + π/2]), a value at a bound kept there: where the
+    /// point of a run's end is compared with other runs' points.
+    pub fn to_canonical(&self, p: f64) -> f64 {
+        (2.0 * self.fraction(p) - 1.0).asin() + std::f64::consts::TAU
+    }
+
     /// The value of the optimiser's unbounded variable `u` (see `to_internal`).
     pub fn from_internal(&self, u: f64) -> f64 {
         self.from_fraction(0.5 * (1.0 + u.sin()))

@@ -65,6 +65,8 @@ pub struct FitRequest {
     pub max_evaluations: usize,
     /// How the local runs get their Jacobians.
     pub jacobian: super::local_run::JacobianRule,
+    /// How the runs after the first end.
+    pub later_runs: super::local_run::LaterRuns,
     /// Also fit Coulomb + viscous, Stribeck and LuGre.
     pub baselines: bool,
     /// The data are a rotary joint's: velocity in rad/s, friction in N·m
@@ -96,6 +98,7 @@ impl Default for FitRequest {
             seed: 1,
             max_evaluations: 200,
             jacobian: Default::default(),
+            later_runs: Default::default(),
             baselines: false,
             rotary: false,
             progress: None,
@@ -179,6 +182,7 @@ impl FitRequest {
             stop: self.stop.clone(),
             extra_starts: Vec::new(),
             jacobian: self.jacobian,
+            later_runs: self.later_runs,
             ..Default::default()
         }
     }
@@ -416,6 +420,10 @@ pub fn fit_baselines(
         // microseconds, so it keeps the exact Jacobian (whose path the
         // classic models' optima were checked on against SciPy).
         opts.jacobian = super::local_run::JacobianRule::Differences;
+        // For the same reason every later run walks to its end: the valley
+        // test saves simulations at the risk of missing a better optimum,
+        // a risk the baselines need not take.
+        opts.later_runs = super::local_run::LaterRuns::Full;
         // Each model contains the one before it: it also starts from that
         // one's optimum, so it never ends worse than the simpler model; and
         // from generic starts that ignore the data (mean level, static

@@ -47,9 +47,39 @@ const DISTINCT_OPTIMUM: f64 = 0.02;
 
 /// Global phase, local runs, distinct optima (best first; never empty).
 pub fn search(problem: &Problem<'_>, options: &Options) -> Vec<LocalRun> {
-    let x0 = problem.start();
-    let mut starts = vec![x0.clone()];
-    // Extra starts (a nested model's optimum) run whatever the count.
+    let starts = starts(problem, options);
+    let runs = local_runs(problem, options, &starts);
+    let mut distinct: Vec<LocalRun> = Vec::new();
+    for r in runs {
+        if distinct
+            .iter()
+            .all(|d| distance(problem, &d.x, &r.x) > DISTINCT_OPTIMUM)
+        {
+            distinct.push(r);
+        }
+    }
+    if distinct.is_empty() {
+        // Stopped before any local run: the start, unrefined.
+        let x0 = problem.start();
+        let cost = problem.cost(&x0);
+        distinct.push(LocalRun {
+            x: x0,
+            cost,
+            converged: false,
+            termination: "stopped before any local run".into(),
+            evaluations: 1,
+            jacobian_evaluations: 0,
+            curvature: None,
+        });
+    }
+    distinct
+}
+
+/// The local runs' starts: the given start, the extra starts (a nested
+/// model's optimum, whatever the count), then the best points of the
+/// global phase that are not close to a start already taken.
+fn starts(problem: &Problem<'_>, options: &Options) -> Vec<Vec<f64>> {
+    let mut starts = vec![problem.start()];
     let clamp = |x: &[f64]| -> Vec<f64> {
         problem
             .params
@@ -66,42 +96,51 @@ pub fn search(problem: &Problem<'_>, options: &Options) -> Vec<LocalRun> {
         .collect();
     let wanted = options.starts + extra.len();
     starts.extend(extra);
-    if options.global_points > 0 && options.starts > 1 {
-        let cube = latin_hypercube(options.global_points, problem.params.len(), options.seed);
-        let mut scored: Vec<(f64, Vec<f64>)> = cube
-            .par_iter()
-            .map(|f| {
-                if problem.stop.requested() {
-                    return (f64::INFINITY, Vec::new());
-                }
-                let x: Vec<f64> = problem
-                    .params
-                    .iter()
-                    .zip(f)
-                    .map(|(p, v)| p.from_fraction(*v))
-                    .collect();
-                (problem.cost(&x), x)
-            })
-            .collect();
-        scored.sort_by(|a, b| a.0.total_cmp(&b.0));
-        options.say(&format!(
-            "global phase: {} points (seed {}), best cost {:.4e}",
-            scored.len(),
-            options.seed,
-            scored[0].0
-        ));
-        for (_, x) in scored {
-            if starts.len() >= wanted || x.is_empty() {
-                break;
+    if options.global_points == 0 || options.starts <= 1 {
+        return starts;
+    }
+    let cube = latin_hypercube(options.global_points, problem.params.len(), options.seed);
+    let mut scored: Vec<(f64, Vec<f64>)> = cube
+        .par_iter()
+        .map(|f| {
+            if problem.stop.requested() {
+                return (f64::INFINITY, Vec::new());
             }
-            if starts
+            let x: Vec<f64> = problem
+                .params
                 .iter()
-                .all(|s| distance(problem, s, &x) > DISTINCT_START)
-            {
-                starts.push(x);
-            }
+                .zip(f)
+                .map(|(p, v)| p.from_fraction(*v))
+                .collect();
+            (problem.cost(&x), x)
+        })
+        .collect();
+    scored.sort_by(|a, b| a.0.total_cmp(&b.0));
+    options.say(&format!(
+        "global phase: {} points (seed {}), best cost {:.4e}",
+        scored.len(),
+        options.seed,
+        scored[0].0
+    ));
+    for (_, x) in scored {
+        if starts.len() >= wanted || x.is_empty() {
+            break;
+        }
+        if starts
+            .iter()
+            .all(|s| distance(problem, s, &x) > DISTINCT_START)
+        {
+            starts.push(x);
         }
     }
+    starts
+}
+
+/// The local runs from `starts`, best first: the given start first; then
+/// the other starts side by side, each stopping when it comes to the
+/// first one's optimum (the same for every run, so the outcome does not
+/// depend on which ends first).
+fn local_runs(problem: &Problem<'_>, options: &Options, starts: &[Vec<f64>]) -> Vec<LocalRun> {
     let total = starts.len();
     let say = |k: usize, run: &LocalRun| {
         options.say(&format!(
@@ -125,34 +164,38 @@ pub fn search(problem: &Problem<'_>, options: &Options) -> Vec<LocalRun> {
             options.max_evaluations,
             options.jacobian,
             earlier,
+            options.later_runs,
             (options.ftol, options.xtol),
         )
     };
-    // The given start first; then the other starts side by side, each
-    // stopping when it comes to the first one's optimum (the same for
-    // every run, so the outcome does not depend on which ends first).
     let mut runs: Vec<LocalRun> = Vec::new();
-    if !problem.stop.requested() {
-        let first = run_from(&starts[0], &[]);
-        say(0, &first);
-        runs.push(first);
+    if problem.stop.requested() {
+        return runs;
     }
-    let found: Vec<Found> = runs
-        .iter()
-        .filter_map(|r| {
-            r.curvature.clone().map(|curvature| Found {
-                u: problem.to_internal(&r.x),
-                cost: r.cost,
-                curvature,
-            })
+    let first = run_from(&starts[0], &[]);
+    say(0, &first);
+    let found: Vec<Found> = first
+        .curvature
+        .clone()
+        .map(|curvature| Found {
+            u: problem
+                .params
+                .iter()
+                .zip(&first.x)
+                .map(|(p, v)| p.to_canonical(*v))
+                .collect(),
+            cost: first.cost,
+            curvature,
         })
+        .into_iter()
         .collect();
+    runs.push(first);
     let others: Vec<Option<LocalRun>> = starts
         .par_iter()
         .enumerate()
         .skip(1)
         .map(|(k, x)| {
-            if problem.stop.requested() || runs.is_empty() {
+            if problem.stop.requested() {
                 return None;
             }
             let run = run_from(x, &found);
@@ -162,34 +205,108 @@ pub fn search(problem: &Problem<'_>, options: &Options) -> Vec<LocalRun> {
         .collect();
     runs.extend(others.into_iter().flatten());
     runs.sort_by(|a, b| a.cost.total_cmp(&b.cost));
-    let mut distinct: Vec<LocalRun> = Vec::new();
-    for r in runs {
-        if distinct
-            .iter()
-            .all(|d| distance(problem, &d.x, &r.x) > DISTINCT_OPTIMUM)
-        {
-            distinct.push(r);
-        }
-    }
-    if distinct.is_empty() {
-        // Stopped before any local run: the start, unrefined.
-        let cost = problem.cost(&x0);
-        distinct.push(LocalRun {
-            x: x0,
-            cost,
-            converged: false,
-            termination: "stopped before any local run".into(),
-            evaluations: 1,
-            jacobian_evaluations: 0,
-            curvature: None,
-        });
-    }
-    distinct
+    runs
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fit::local_run::LaterRuns;
+    use crate::fit::params::FittedParameter;
+    use crate::fit::problem::{Data, HoldOut, Model};
+    use crate::fit::series::{Mapping, Series, Source};
+    use crate::table::{Delimiter, Table};
+    use std::path::Path;
+
+    /// Two valleys in one parameter a ∈ [−3, 3]: residuals a² − 1 and
+    /// 0.3 (a + 1), so ½Σr² has its best optimum at a = −1 (cost 0), a
+    /// worse one at a = 0.953 (cost 0.176) and a hill between them at
+    /// a = 0.047 (cost 0.547).
+    struct TwoValleys(Vec<FittedParameter>);
+
+    impl Model for TwoValleys {
+        fn label(&self) -> String {
+            "two valleys".into()
+        }
+        fn parameters(&self) -> &[FittedParameter] {
+            &self.0
+        }
+        fn predict(&self, x: &[f64], s: &Series) -> Result<Vec<f64>, String> {
+            let a = x[0];
+            let mut out = s.friction.clone();
+            out[0] -= a * a - 1.0;
+            out[1] -= 0.3 * (a + 1.0);
+            Ok(out)
+        }
+    }
+
+    fn two_valleys() -> (TwoValleys, Data) {
+        let mut text = String::from("t_s,velocity_m_s,friction_n\n");
+        for k in 0..8 {
+            text += &format!("{},0.1,1\n", k as f64 * 0.01);
+        }
+        let table = Table::parse(&text, Path::new("d.csv"), Delimiter::Auto, None, 0).unwrap();
+        let data = Data {
+            train: vec![Source::new(table, &Mapping::default()).unwrap()],
+            validate: vec![],
+            holdout: HoldOut::None,
+            map_names: vec![],
+            map_values: vec![],
+            units: Default::default(),
+        };
+        // The given start, a = 2, lies in the worse valley.
+        let model = TwoValleys(vec![FittedParameter::new("a", 2.0, -3.0, 3.0)]);
+        (model, data)
+    }
+
+    /// The distinct optima and the simulations of a search from a = 2
+    /// with `other` as a second start.
+    fn runs_from(other: Option<f64>, later_runs: LaterRuns) -> (Vec<LocalRun>, usize) {
+        let (model, data) = two_valleys();
+        let problem = Problem::new(&model, &data, vec![]).unwrap();
+        let options = Options {
+            starts: 1,
+            global_points: 0,
+            extra_starts: other.map(|a| vec![a]).into_iter().collect(),
+            later_runs,
+            ..Default::default()
+        };
+        let runs = search(&problem, &options);
+        let simulations = problem
+            .simulations
+            .load(std::sync::atomic::Ordering::Relaxed);
+        (runs, simulations)
+    }
+
+    #[test]
+    fn a_later_run_in_the_valley_of_the_first_optimum_stops_there_for_a_few_simulations() {
+        let (alone, first_run) = runs_from(None, LaterRuns::Valley);
+        let (valley, with_valley) = runs_from(Some(2.5), LaterRuns::Valley);
+        let (full, _) = runs_from(Some(2.5), LaterRuns::Full);
+        // One distinct optimum every way: the first run's, a = 0.953.
+        assert_eq!((alone.len(), valley.len(), full.len()), (1, 1, 1));
+        approx::assert_relative_eq!(valley[0].x[0], 0.9528, epsilon = 1e-3);
+        approx::assert_relative_eq!(valley[0].x[0], full[0].x[0], epsilon = 1e-9);
+        // The later run cost its start and the valley test's points, and
+        // nothing more: it stopped there.
+        assert_eq!(
+            with_valley,
+            first_run + 1 + crate::fit::local_run::VALLEY_POINTS
+        );
+    }
+
+    #[test]
+    fn a_later_run_with_a_hill_on_its_line_to_the_first_optimum_walks_to_the_better_one() {
+        // From a = −2.5 the straight line to a = 0.953 crosses a = −1 and
+        // the hill at 0.047: the valley test sees the rise, the run goes
+        // on and finds the better optimum.
+        let (runs, _) = runs_from(Some(-2.5), LaterRuns::Valley);
+        assert_eq!(runs.len(), 2, "{runs:?}");
+        approx::assert_relative_eq!(runs[0].x[0], -1.0, epsilon = 1e-4);
+        assert!(runs[0].cost < 1e-8, "{}", runs[0].cost);
+        assert!(!runs[0].termination.contains("valley"));
+        approx::assert_relative_eq!(runs[1].x[0], 0.9528, epsilon = 1e-3);
+    }
 
     #[test]
     fn a_latin_hypercube_puts_one_point_in_every_stratum_and_repeats_with_its_seed() {
