@@ -64,7 +64,39 @@ pub fn read(
     if topics.temperature.is_none() {
         topics.temperature = crate::bag::decode::default_temperature_topic(&scan);
     }
-    let topics = &topics;
+    let mut decoders = decoders(&scan, &topics)?;
+    let mut read = read_topics(&bag, &mut decoders)?;
+    for s in &mut read.samples {
+        s.sort_by_key(|x| x.0);
+    }
+    // The samples of every given topic, in the order velocity, friction,
+    // load, temperature (absent topics left out).
+    let named = [
+        ("velocity", Some(&topics.velocity)),
+        ("friction", Some(&topics.friction)),
+        ("load", topics.load.as_ref()),
+        ("temperature", topics.temperature.as_ref()),
+    ];
+    let given = named.iter().filter_map(|(name, t)| t.map(|t| (*name, t)));
+    for ((name, t), samples) in given.zip(&read.samples) {
+        if samples.is_empty() {
+            return Err(FitError::Data {
+                what: format!("{} ({name} topic `{t}`)", path.display()),
+                message: "no message could be read".into(),
+            });
+        }
+    }
+    let (names, columns) = on_friction_grid(path, &topics, &read.samples)?;
+    let note = read
+        .damage
+        .map(|d| format!("{}: reading stopped {d}", path.display()));
+    Ok((Table::from_columns(path, names, columns), note, topics))
+}
+
+/// Decoders of the given topics: velocity, friction, then load and
+/// temperature when given. A TwistStamped velocity with `--rotary` is
+/// refused (m/s is not a joint's rad/s).
+fn decoders(scan: &crate::bag::BagScan, topics: &BagTopics) -> Result<Vec<TopicDecoder>, FitError> {
     let joint = topics.joint.as_deref();
     let vc = scan.require(&topics.velocity)?;
     let vkind = SampleKind::velocity_for(&vc.schema_name, joint).ok_or_else(|| {
@@ -96,32 +128,20 @@ pub fn read(
             SampleKind::Temperature,
         )?);
     }
-    let mut read = read_topics(&bag, &mut decoders)?;
-    for s in &mut read.samples {
-        s.sort_by_key(|x| x.0);
-    }
-    let names = ["velocity", "friction", "load", "temperature"];
-    let given = [
-        Some(&topics.velocity),
-        Some(&topics.friction),
-        topics.load.as_ref(),
-        topics.temperature.as_ref(),
-    ];
-    let mut k = 0;
-    for (name, topic) in names.iter().zip(given) {
-        if let Some(t) = topic {
-            if read.samples[k].is_empty() {
-                return Err(FitError::Data {
-                    what: format!("{} ({name} topic `{t}`)", path.display()),
-                    message: "no message could be read".into(),
-                });
-            }
-            k += 1;
-        }
-    }
-    let vel = &read.samples[0];
+    Ok(decoders)
+}
+
+/// The columns on the friction samples' stamps (within the velocity's
+/// span): time from the first, the velocity interpolated, the friction,
+/// the load and temperature held. `samples` as `read` orders them.
+fn on_friction_grid(
+    path: &Path,
+    topics: &BagTopics,
+    samples: &[Vec<(u64, f64)>],
+) -> Result<(Vec<String>, Vec<Vec<f64>>), FitError> {
+    let vel = &samples[0];
     let (v_first, v_last) = (vel[0].0, vel[vel.len() - 1].0);
-    let grid: Vec<(u64, f64)> = read.samples[1]
+    let grid: Vec<(u64, f64)> = samples[1]
         .iter()
         .copied()
         .filter(|(s, _)| (v_first..=v_last).contains(s))
@@ -161,30 +181,16 @@ pub fn read(
         "velocity_m_s".into(),
         "friction_n".into(),
     ];
-    for (k, name) in [(2usize, "load_n"), (3, "temperature_c")] {
-        let present = if k == 2 {
-            topics.load.is_some()
-        } else {
-            topics.temperature.is_some()
-        };
-        if present {
-            let idx = if k == 3 && topics.load.is_none() {
-                2
-            } else {
-                k
-            };
-            let s = &read.samples[idx];
-            let mut j = 0;
-            columns.push(grid.iter().map(|(st, _)| held(s, *st, &mut j)).collect());
-            names.push(name.into());
-        }
+    // The held columns: the samples after velocity and friction, in order.
+    let held_topics = [
+        ("load_n", topics.load.is_some()),
+        ("temperature_c", topics.temperature.is_some()),
+    ];
+    let present = held_topics.iter().filter(|(_, given)| *given);
+    for ((name, _), s) in present.zip(&samples[2..]) {
+        let mut j = 0;
+        columns.push(grid.iter().map(|(st, _)| held(s, *st, &mut j)).collect());
+        names.push((*name).into());
     }
-    let note = read
-        .damage
-        .map(|d| format!("{}: reading stopped {d}", path.display()));
-    Ok((
-        Table::from_columns(path, names, columns),
-        note,
-        topics.clone(),
-    ))
+    Ok((names, columns))
 }

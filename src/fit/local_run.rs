@@ -208,7 +208,31 @@ struct Lm<'p, 'a> {
     valley_evaluations: AtomicUsize,
 }
 
-impl Lm<'_, '_> {
+impl<'p, 'a> Lm<'p, 'a> {
+    /// A run from `u0` (its residuals not yet taken).
+    fn new(
+        problem: &'p Problem<'a>,
+        u0: &DVector<f64>,
+        (rule, later): (JacobianRule, LaterRuns),
+        earlier: &'p [Found],
+    ) -> Self {
+        Lm {
+            problem,
+            u: u0.clone(),
+            r: DVector::zeros(0),
+            trail: Vec::new(),
+            rule,
+            last: Mutex::new(None),
+            trials: AtomicUsize::new(0),
+            jacobian_evaluations: AtomicUsize::new(0),
+            earlier,
+            joined: Mutex::new(None),
+            later,
+            valley_cost: Mutex::new(f64::INFINITY),
+            valley_evaluations: AtomicUsize::new(0),
+        }
+    }
+
     fn joined(&self) -> Option<Joined> {
         *self.joined.lock().unwrap_or_else(|p| p.into_inner())
     }
@@ -420,27 +444,13 @@ fn one_run(
     problem: &Problem<'_>,
     x0: &[f64],
     max_evaluations: usize,
-    (rule, later): (JacobianRule, LaterRuns),
+    rules: (JacobianRule, LaterRuns),
     earlier: &[Found],
     (ftol, xtol): (f64, f64),
 ) -> (LocalRun, bool) {
     let u0 = DVector::from_vec(problem.to_internal(x0));
     let n = u0.len();
-    let mut lm = Lm {
-        problem,
-        u: u0.clone(),
-        r: DVector::zeros(0),
-        trail: Vec::new(),
-        rule,
-        last: Mutex::new(None),
-        trials: AtomicUsize::new(0),
-        jacobian_evaluations: AtomicUsize::new(0),
-        earlier,
-        joined: Mutex::new(None),
-        later,
-        valley_cost: Mutex::new(f64::INFINITY),
-        valley_evaluations: AtomicUsize::new(0),
-    };
+    let mut lm = Lm::new(problem, &u0, rules, earlier);
     lm.set_params(&u0);
     let patience = max_evaluations.div_ceil(n + 1).max(1);
     let (lm, report) = LevenbergMarquardt::new()
@@ -453,64 +463,20 @@ fn one_run(
     // simulations besides the optimiser's own evaluations.
     let jacobian_evaluations = lm.jacobian_evaluations.load(Ordering::Relaxed)
         + lm.valley_evaluations.load(Ordering::Relaxed);
-    // The last Jacobian by differences: at the end point, or at the
-    // accepted point before it when the last step met the convergence
-    // test (the curvature hardly changes over that step).
-    let curvature = lm
-        .last
-        .into_inner()
-        .unwrap_or_else(|p| p.into_inner())
-        .filter(|l| l.secant_updates == 0)
-        .map(|l| {
-            // In the canonical variables: a column taken on a fold where
-            // cos u < 0 changes sign.
-            let mut j = l.j;
-            for (k, u) in l.u.iter().enumerate() {
-                if u.cos() < 0.0 {
-                    j.column_mut(k).neg_mut();
-                }
-            }
-            j.transpose() * &j
-        });
+    let evaluations = (report.number_of_evaluations, jacobian_evaluations);
+    let curvature = curvature(lm.last.into_inner().unwrap_or_else(|p| p.into_inner()));
     let joined = lm.joined.into_inner().unwrap_or_else(|p| p.into_inner());
     if let Some(how) = joined {
-        let (x, cost, termination) = match how {
-            // Where it stopped: the point that came to optimum k.
-            Joined::Region(k) => (
-                problem.from_internal(lm.u.as_slice()),
-                0.5 * lm.r.norm_squared(),
-                format!("came to optimum {} of an earlier run", k + 1),
-            ),
-            // Its end is that optimum: a straight way down leads there.
-            Joined::Valley(k) => (
-                problem.from_internal(&earlier[k].u),
-                earlier[k].cost,
-                format!(
-                    "in the valley of optimum {} of an earlier run (from cost {:.4e} the cost \
-                     falls at every one of {VALLEY_POINTS} points on the straight line to it)",
-                    k + 1,
-                    0.5 * lm.r.norm_squared()
-                ),
-            ),
-        };
-        let run = LocalRun {
-            x,
-            cost,
-            converged: true,
-            termination,
-            evaluations: report.number_of_evaluations,
-            jacobian_evaluations,
-            curvature: None,
-        };
-        return (run, true);
+        return (
+            joined_run(problem, earlier, how, &lm.u, &lm.r, evaluations),
+            true,
+        );
     }
     let converged = report.termination.was_successful()
         || matches!(
             report.termination,
             TerminationReason::NoImprovementPossible(_)
         );
-    let x = problem.from_internal(lm.u.as_slice());
-    let cost = 0.5 * lm.r.norm_squared();
     let mut termination = termination_text(&report.termination);
     if matches!(report.termination, TerminationReason::LostPatience) {
         let moving = still_moving(problem, &lm.trail);
@@ -519,15 +485,71 @@ fn one_run(
         }
     }
     let run = LocalRun {
-        x,
-        cost,
+        x: problem.from_internal(lm.u.as_slice()),
+        cost: 0.5 * lm.r.norm_squared(),
         converged,
         termination,
-        evaluations: report.number_of_evaluations,
+        evaluations: evaluations.0,
         jacobian_evaluations,
         curvature,
     };
     (run, problem.stop.requested())
+}
+
+/// JᵀJ of the last Jacobian by differences, in the canonical variables:
+/// at the end point, or at the accepted point before it when the last
+/// step met the convergence test (the curvature hardly changes over that
+/// step). None when the last Jacobian was a secant update.
+fn curvature(last: Option<LastJacobian>) -> Option<DMatrix<f64>> {
+    let l = last.filter(|l| l.secant_updates == 0)?;
+    // A column taken on a fold where cos u < 0 changes sign.
+    let mut j = l.j;
+    for (k, u) in l.u.iter().enumerate() {
+        if u.cos() < 0.0 {
+            j.column_mut(k).neg_mut();
+        }
+    }
+    Some(j.transpose() * &j)
+}
+
+/// A run that came to an earlier optimum (`how`), standing at `u` with
+/// residuals `r` after `(evaluations, jacobian_evaluations)`.
+fn joined_run(
+    problem: &Problem<'_>,
+    earlier: &[Found],
+    how: Joined,
+    u: &DVector<f64>,
+    r: &DVector<f64>,
+    (evaluations, jacobian_evaluations): (usize, usize),
+) -> LocalRun {
+    let (x, cost, termination) = match how {
+        // Where it stopped: the point that came to optimum k.
+        Joined::Region(k) => (
+            problem.from_internal(u.as_slice()),
+            0.5 * r.norm_squared(),
+            format!("came to optimum {} of an earlier run", k + 1),
+        ),
+        // Its end is that optimum: a straight way down leads there.
+        Joined::Valley(k) => (
+            problem.from_internal(&earlier[k].u),
+            earlier[k].cost,
+            format!(
+                "in the valley of optimum {} of an earlier run (from cost {:.4e} the cost \
+                 falls at every one of {VALLEY_POINTS} points on the straight line to it)",
+                k + 1,
+                0.5 * r.norm_squared()
+            ),
+        ),
+    };
+    LocalRun {
+        x,
+        cost,
+        converged: true,
+        termination,
+        evaluations,
+        jacobian_evaluations,
+        curvature: None,
+    }
 }
 
 /// The parameters that moved by more than 0.1 % of their scaled range

@@ -52,12 +52,7 @@ struct Entities {
     velocity: RawReader,
     load: RawReader,
     temperature: RawReader,
-    friction: Publisher<FrictionEstimate>,
-    force: Publisher<Float64>,
-    film: Publisher<FilmProfile>,
-    stats: Publisher<LoopStatistics>,
-    rosout: Publisher<msgs::ros_interfaces::Log>,
-    diagnostics: Publisher<msgs::ros_interfaces::DiagnosticArray>,
+    out: Publishers,
     snapshot: Option<ros2_client::Subscription<msgs::Empty>>,
     clock: Option<ros2_client::Subscription<msgs::ros_interfaces::Clock>>,
     poll: Poll,
@@ -66,12 +61,24 @@ struct Entities {
     joints: Option<super::joints::JointTopics>,
 }
 
-fn setup(spec: &Ros2Spec, snapshots: bool, sim_time: bool) -> Result<Entities, TransportError> {
-    let ctx = context(spec)?;
-    let mut node = ros_node(&ctx, &spec.namespace, &spec.node_name)?;
+/// The node's publishers (one contact's; several contacts' are in
+/// `joints`).
+struct Publishers {
+    friction: Publisher<FrictionEstimate>,
+    force: Publisher<Float64>,
+    film: Publisher<FilmProfile>,
+    stats: Publisher<LoopStatistics>,
+    rosout: Publisher<msgs::ros_interfaces::Log>,
+    diagnostics: Publisher<msgs::ros_interfaces::DiagnosticArray>,
+}
+
+/// The three command readers: velocity, load, temperature.
+fn command_readers(
+    ctx: &ros2_client::Context,
+    n: &mut ros2_client::Node,
+    spec: &Ros2Spec,
+) -> Result<[RawReader; 3], TransportError> {
     let cq = qos(&spec.command_qos);
-    let eq = qos(&spec.estimate_qos);
-    let n = &mut node;
     let velocity_type = match spec.command_type {
         CommandType::Float64 => &FLOAT64,
         CommandType::TwistStamped => &TWIST_STAMPED,
@@ -80,130 +87,113 @@ fn setup(spec: &Ros2Spec, snapshots: bool, sim_time: bool) -> Result<Entities, T
         .domain_participant()
         .create_subscriber(&QosPolicies::from(&cq))
         .map_err(|e| err("create a DDS subscriber", e))?;
-    let raw_reader = |n: &mut ros2_client::Node, name: &str, ty: &msgs::MsgType, what: &str| {
+    let mut raw_reader = |name: &str, ty: &msgs::MsgType, what: &str| {
         let t = topic(n, name, ty.package, ty.name, &cq)?;
         subscriber
             .create_simple_datareader_no_key::<RawCdr, RawAdapter>(&t, Some(QosPolicies::from(&cq)))
             .map_err(|e| err(format!("subscribe to {what}"), e))
     };
-    let mut velocity = raw_reader(n, &spec.topics.cmd_velocity, velocity_type, "the velocity")?;
-    let mut load = raw_reader(n, &spec.topics.normal_load, &FLOAT64, "the load")?;
-    let mut temperature = raw_reader(
-        n,
-        &spec.topics.temperature,
-        &msgs::TEMPERATURE,
-        "the temperature",
-    )?;
-    let friction = advertise(
-        n,
-        &spec.topics.friction,
-        &FRICTION_ESTIMATE,
-        &eq,
-        "the estimate",
-    )?;
-    let force = advertise(
-        n,
-        &spec.topics.friction_force,
-        &FLOAT64,
-        &eq,
-        "the friction force",
-    )?;
-    let film = advertise(
-        n,
-        &spec.topics.film_profile,
-        &FILM_PROFILE,
-        &eq,
-        "the film profile",
-    )?;
-    let stats = advertise(
-        n,
-        &spec.topics.loop_statistics,
-        &LOOP_STATISTICS,
-        &eq,
-        "the statistics",
-    )?;
-    // /rosout as rcl offers it: reliable, transient local, keep last 1000.
-    let rosout_qos = ros2_client::QosProfile::publisher_default()
-        .durability(ros2_client::qos::Durability::TransientLocal)
-        .history(ros2_client::qos::History::KeepLast { depth: 1000 });
-    let rosout = advertise(
-        n,
-        "/rosout",
-        &msgs::ros_interfaces::LOG,
-        &rosout_qos,
-        "/rosout",
-    )?;
-    let diagnostics = advertise(
-        n,
-        "/diagnostics",
-        &msgs::ros_interfaces::DIAGNOSTIC_ARRAY,
-        &ros2_client::QosProfile::publisher_default()
-            .history(ros2_client::qos::History::KeepLast { depth: 10 }),
-        "/diagnostics",
-    )?;
-    let snapshot = if snapshots {
-        Some(super::subscribe(
-            n,
-            &spec.topics.snapshot,
-            &msgs::EMPTY,
-            &cq,
-            "the snapshot request",
-        )?)
-    } else {
-        None
-    };
-    let poll = Poll::new().map_err(|e| err("create a poll", e))?;
-    poll.registry()
-        .register(&mut velocity, VELOCITY, Interest::READABLE)
-        .map_err(|e| err("register the velocity reader", e))?;
-    poll.registry()
-        .register(&mut load, LOAD, Interest::READABLE)
-        .map_err(|e| err("register the load reader", e))?;
-    poll.registry()
-        .register(&mut temperature, TEMPERATURE, Interest::READABLE)
-        .map_err(|e| err("register the temperature reader", e))?;
+    Ok([
+        raw_reader(&spec.topics.cmd_velocity, velocity_type, "the velocity")?,
+        raw_reader(&spec.topics.normal_load, &FLOAT64, "the load")?,
+        raw_reader(
+            &spec.topics.temperature,
+            &msgs::TEMPERATURE,
+            "the temperature",
+        )?,
+    ])
+}
+
+impl Publishers {
+    fn open(n: &mut ros2_client::Node, spec: &Ros2Spec) -> Result<Self, TransportError> {
+        let eq = qos(&spec.estimate_qos);
+        let t = &spec.topics;
+        // /rosout as rcl offers it: reliable, transient local, keep last 1000.
+        let rosout_qos = ros2_client::QosProfile::publisher_default()
+            .durability(ros2_client::qos::Durability::TransientLocal)
+            .history(ros2_client::qos::History::KeepLast { depth: 1000 });
+        let diagnostics_qos = ros2_client::QosProfile::publisher_default()
+            .history(ros2_client::qos::History::KeepLast { depth: 10 });
+        Ok(Self {
+            friction: advertise(n, &t.friction, &FRICTION_ESTIMATE, &eq, "the estimate")?,
+            force: advertise(n, &t.friction_force, &FLOAT64, &eq, "the friction force")?,
+            film: advertise(n, &t.film_profile, &FILM_PROFILE, &eq, "the film profile")?,
+            stats: advertise(
+                n,
+                &t.loop_statistics,
+                &LOOP_STATISTICS,
+                &eq,
+                "the statistics",
+            )?,
+            rosout: advertise(
+                n,
+                "/rosout",
+                &msgs::ros_interfaces::LOG,
+                &rosout_qos,
+                "/rosout",
+            )?,
+            diagnostics: advertise(
+                n,
+                "/diagnostics",
+                &msgs::ros_interfaces::DIAGNOSTIC_ARRAY,
+                &diagnostics_qos,
+                "/diagnostics",
+            )?,
+        })
+    }
+}
+
+fn setup(spec: &Ros2Spec, snapshots: bool, sim_time: bool) -> Result<Entities, TransportError> {
+    let ctx = context(spec)?;
+    let mut node = ros_node(&ctx, &spec.namespace, &spec.node_name)?;
+    let cq = qos(&spec.command_qos);
+    let eq = qos(&spec.estimate_qos);
+    let n = &mut node;
+    let [mut velocity, mut load, mut temperature] = command_readers(&ctx, n, spec)?;
+    let out = Publishers::open(n, spec)?;
+    let snapshot = snapshots
+        .then(|| {
+            let what = "the snapshot request";
+            super::subscribe(n, &spec.topics.snapshot, &msgs::EMPTY, &cq, what)
+        })
+        .transpose()?;
     // /clock for use_sim_time: keep last 1, best effort (matches every
     // publisher), polled with the commands so that time moves at once.
-    let mut clock = if sim_time {
-        let q = ros2_client::QosProfile::subscription_default();
-        Some(super::subscribe(
-            n,
-            "/clock",
-            &msgs::ros_interfaces::CLOCK,
-            &q,
-            "/clock",
-        )?)
-    } else {
-        None
+    let mut clock = sim_time
+        .then(|| {
+            let q = ros2_client::QosProfile::subscription_default();
+            super::subscribe(n, "/clock", &msgs::ros_interfaces::CLOCK, &q, "/clock")
+        })
+        .transpose()?;
+    let mut joints = (!spec.joints.is_empty())
+        .then(|| super::joints::JointTopics::open(n, spec, &cq, &eq))
+        .transpose()?;
+    let poll = Poll::new().map_err(|e| err("create a poll", e))?;
+    let registry = poll.registry();
+    let register = |source: &mut dyn ros2_client::dds::rustdds::mio1::event::Source,
+                    token: Token,
+                    what: &str| {
+        registry
+            .register(source, token, Interest::READABLE)
+            .map_err(|e| err(format!("register {what}"), e))
     };
+    register(&mut velocity, VELOCITY, "the velocity reader")?;
+    register(&mut load, LOAD, "the load reader")?;
+    register(&mut temperature, TEMPERATURE, "the temperature reader")?;
     if let Some(c) = clock.as_mut() {
-        poll.registry()
-            .register(c, CLOCK, Interest::READABLE)
-            .map_err(|e| err("register /clock", e))?;
+        register(c, CLOCK, "/clock")?;
     }
-    let mut joints = if spec.joints.is_empty() {
-        None
-    } else {
-        Some(super::joints::JointTopics::open(n, spec, &cq, &eq)?)
-    };
     if let Some(j) = joints.as_mut() {
-        poll.registry()
-            .register(&mut j.commands, JOINTS, Interest::READABLE)
-            .map_err(|e| err("register the joint commands", e))?;
+        register(&mut j.commands, JOINTS, "the joint commands")?;
     }
-    let waker = Arc::new(Waker::new(poll.registry(), WAKE).map_err(|e| err("create a waker", e))?);
+    let waker = Arc::new(Waker::new(registry, WAKE).map_err(|e| err("create a waker", e))?);
     Ok(Entities {
         ctx,
         _node: node,
         velocity,
         load,
         temperature,
-        friction,
-        force,
-        film,
-        stats,
-        rosout,
-        diagnostics,
+        out,
         snapshot,
         clock,
         poll,
@@ -300,106 +290,157 @@ pub(super) fn run(
     };
     let _ = ready.send(Ok((e.waker.clone(), e.ctx.clone())));
     let mut events = Events::with_capacity(16);
-    let mut seen_profile = 0u64;
-    let frame = sh.spec.frame_id.clone();
-    let fqn = sh.spec.fully_qualified_name();
-    // rcl's logger name: the node's name with `.` between namespace tokens.
-    let logger = fqn.trim_start_matches('/').replace('/', ".");
-    let mut diagnostics = super::diagnostics::HealthReporter::default();
-    let mut last_diagnostics: Option<std::time::Instant> = None;
-    let counters = &sh.counters;
-    let count = |ok: bool, which: &std::sync::atomic::AtomicU64| {
-        if !ok {
-            SharedCounters::bump(which);
-        }
-    };
+    let mut outgoing = Outgoing::new(&sh.spec);
     while !sh.stop.load(Ordering::Acquire) {
         // Wake on commands, on outputs (the waker), or every 20 ms for profiles.
         let _ = e.poll.poll(&mut events, Some(Duration::from_millis(20)));
-        if let (Some(sub), Some(clock)) = (&e.clock, &sh.sim_time) {
-            while let Ok(Some((m, _))) = sub.take() {
-                clock.set(m.clock.to_ns());
-            }
-        }
-        take_all(&sh, &e.velocity, CommandKind::Velocity);
-        take_all(&sh, &e.load, CommandKind::Load);
-        take_all(&sh, &e.temperature, CommandKind::Temperature);
-        if let Some(j) = e.joints.as_mut() {
-            j.take(&sh.commands, &sh.counters);
-        }
-        if let (Some(sub), Some(flag)) = (&e.snapshot, &sh.snapshot) {
-            while let Ok(Some(_)) = sub.take() {
-                flag.store(true, Ordering::Release);
-            }
-        }
+        take_inputs(&sh, &mut e);
         while let Some(o) = sh.outputs.pop() {
-            match o {
-                Out::Estimate(r) => {
+            outgoing.publish(&e, o, &sh.counters);
+        }
+        outgoing.rosout(&e.out);
+        if let Some(slot) = &sh.profile {
+            outgoing.film_profile(&e.out, slot, &sh.counters);
+        }
+    }
+    drop(e);
+}
+
+/// Everything that came in: the clock, the commands, the snapshot request.
+fn take_inputs(sh: &Shared, e: &mut Entities) {
+    if let (Some(sub), Some(clock)) = (&e.clock, &sh.sim_time) {
+        while let Ok(Some((m, _))) = sub.take() {
+            clock.set(m.clock.to_ns());
+        }
+    }
+    take_all(sh, &e.velocity, CommandKind::Velocity);
+    take_all(sh, &e.load, CommandKind::Load);
+    take_all(sh, &e.temperature, CommandKind::Temperature);
+    if let Some(j) = e.joints.as_mut() {
+        j.take(&sh.commands, &sh.counters);
+    }
+    if let (Some(sub), Some(flag)) = (&e.snapshot, &sh.snapshot) {
+        while let Ok(Some(_)) = sub.take() {
+            flag.store(true, Ordering::Release);
+        }
+    }
+}
+
+/// Counts a failed publish in `which`.
+fn count(ok: bool, which: &std::sync::atomic::AtomicU64) {
+    if !ok {
+        SharedCounters::bump(which);
+    }
+}
+
+/// What goes out, and what publishing remembers between turns.
+struct Outgoing {
+    frame: String,
+    fqn: String,
+    /// rcl's logger name: the node's name with `.` between namespace tokens.
+    logger: String,
+    diagnostics: super::diagnostics::HealthReporter,
+    last_diagnostics: Option<std::time::Instant>,
+    seen_profile: u64,
+}
+
+impl Outgoing {
+    fn new(spec: &Ros2Spec) -> Self {
+        let fqn = spec.fully_qualified_name();
+        Self {
+            frame: spec.frame_id.clone(),
+            logger: fqn.trim_start_matches('/').replace('/', "."),
+            fqn,
+            diagnostics: Default::default(),
+            last_diagnostics: None,
+            seen_profile: 0,
+        }
+    }
+
+    /// One output of the loop.
+    fn publish(&mut self, e: &Entities, o: Out, counters: &SharedCounters) {
+        let frame = &self.frame;
+        match o {
+            Out::Estimate(r) => {
+                count(
+                    e.out.friction.publish(r.to_wire(frame)).is_ok(),
+                    &counters.publish_failures,
+                );
+                let force = Float64 {
+                    data: r.friction_force_n,
+                };
+                count(
+                    e.out.force.publish(force).is_ok(),
+                    &counters.publish_failures,
+                );
+            }
+            Out::ContactEstimate(k, r) => count(
+                e.joints
+                    .as_ref()
+                    .is_some_and(|j| j.publish_estimate(k, &r, frame)),
+                &counters.publish_failures,
+            ),
+            Out::Efforts(x) => count(
+                e.joints
+                    .as_ref()
+                    .is_some_and(|j| j.publish_efforts(&x, frame)),
+                &counters.publish_failures,
+            ),
+            Out::Statistics(s) => {
+                count(
+                    e.out.stats.publish(s.to_wire(frame)).is_ok(),
+                    &counters.statistics_failures,
+                );
+                // /diagnostics at most once a second.
+                let a = self.diagnostics.update(&s, &self.fqn, frame);
+                if self
+                    .last_diagnostics
+                    .is_none_or(|t| t.elapsed() >= Duration::from_millis(990))
+                {
+                    self.last_diagnostics = Some(std::time::Instant::now());
                     count(
-                        e.friction.publish(r.to_wire(&frame)).is_ok(),
+                        e.out.diagnostics.publish(a).is_ok(),
                         &counters.publish_failures,
                     );
-                    count(
-                        e.force
-                            .publish(Float64 {
-                                data: r.friction_force_n,
-                            })
-                            .is_ok(),
-                        &counters.publish_failures,
-                    );
-                }
-                Out::ContactEstimate(k, r) => count(
-                    e.joints
-                        .as_ref()
-                        .is_some_and(|j| j.publish_estimate(k, &r, &frame)),
-                    &counters.publish_failures,
-                ),
-                Out::Efforts(x) => count(
-                    e.joints
-                        .as_ref()
-                        .is_some_and(|j| j.publish_efforts(&x, &frame)),
-                    &counters.publish_failures,
-                ),
-                Out::Statistics(s) => {
-                    count(
-                        e.stats.publish(s.to_wire(&frame)).is_ok(),
-                        &counters.statistics_failures,
-                    );
-                    // /diagnostics at most once a second.
-                    let a = diagnostics.update(&s, &fqn, &frame);
-                    if last_diagnostics.is_none_or(|t| t.elapsed() >= Duration::from_millis(990)) {
-                        last_diagnostics = Some(std::time::Instant::now());
-                        count(e.diagnostics.publish(a).is_ok(), &counters.publish_failures);
-                    }
                 }
             }
         }
+    }
+
+    /// The log lines waiting for /rosout.
+    fn rosout(&self, out: &Publishers) {
         super::rosout::drain(|l| {
             let m = msgs::ros_interfaces::Log {
                 stamp: Time::from_ns(l.stamp_ns),
                 level: l.level,
-                name: logger.clone(),
+                name: self.logger.clone(),
                 msg: l.message,
                 file: l.file,
                 function: l.target,
                 line: l.line,
             };
-            let _ = e.rosout.publish(m);
+            let _ = out.rosout.publish(m);
         });
-        if let Some(slot) = &sh.profile {
-            if let Some(p) = slot.read_if_newer(&mut seen_profile) {
-                let m = FilmProfile {
-                    header: Header {
-                        stamp: Time::from_ns(p.stamp_ns),
-                        frame_id: frame.clone(),
-                    },
-                    dx_m: p.dx_m,
-                    h_m: p.h_m,
-                    p_pa: p.p_pa,
-                };
-                count(e.film.publish(m).is_ok(), &counters.publish_failures);
-            }
+    }
+
+    /// The film profile, when the slot holds a newer one.
+    fn film_profile(
+        &mut self,
+        out: &Publishers,
+        slot: &FilmProfileSlot,
+        counters: &SharedCounters,
+    ) {
+        if let Some(p) = slot.read_if_newer(&mut self.seen_profile) {
+            let m = FilmProfile {
+                header: Header {
+                    stamp: Time::from_ns(p.stamp_ns),
+                    frame_id: self.frame.clone(),
+                },
+                dx_m: p.dx_m,
+                h_m: p.h_m,
+                p_pa: p.p_pa,
+            };
+            count(out.film.publish(m).is_ok(), &counters.publish_failures);
         }
     }
-    drop(e);
 }
