@@ -6,19 +6,15 @@
 //! naming it (exit 2); never a panic, never a half-written output.
 #![cfg(feature = "mcap")]
 
+mod common;
+use common::cli::fresh_dir;
+
 use friction_node::msgs;
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
 const NODE_BAG: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/bags/node_lockstep.mcap");
-
-fn dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("fn-badbag-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 struct Outcome {
     code: i32,
@@ -82,7 +78,7 @@ fn sane(o: &Outcome, out: &Path, what: &str) {
 #[test]
 fn a_bag_truncated_at_any_of_60_offsets_replays_its_prefix_or_is_refused() {
     let bytes = std::fs::read(NODE_BAG).unwrap();
-    let d = dir("trunc");
+    let d = fresh_dir("badbag", "trunc");
     let (mut replayed, mut refused) = (0, 0);
     let offsets: Vec<usize> = [0, 1, 7, 8, 9, 17, 30, 100, 500]
         .into_iter()
@@ -119,7 +115,7 @@ fn a_bag_truncated_at_any_of_60_offsets_replays_its_prefix_or_is_refused() {
 #[test]
 fn single_bit_flips_anywhere_never_panic_or_leave_half_an_output() {
     let bytes = std::fs::read(NODE_BAG).unwrap();
-    let d = dir("flip");
+    let d = fresh_dir("badbag", "flip");
     for k in 0..60 {
         let pos = 3 + k * (bytes.len() - 4) / 60;
         let mut b = bytes.clone();
@@ -155,7 +151,7 @@ fn absurd_record_lengths_bad_chunk_crcs_and_corrupt_compression_are_damage() {
     let recs = records(&bytes);
     let chunks: Vec<&(usize, u8, u64)> = recs.iter().filter(|r| r.1 == 0x06).collect();
     assert!(chunks.len() >= 2, "the fixture has chunks");
-    let d = dir("records");
+    let d = fresh_dir("badbag", "records");
     let mut cases: Vec<(&str, Vec<u8>)> = Vec::new();
     // The header record claims 2^64 − 1 bytes.
     let mut b = bytes.clone();
@@ -234,7 +230,7 @@ fn f64_cdr(v: f64) -> Vec<u8> {
 
 #[test]
 fn a_joint_state_declaring_2_pow_31_names_is_a_decode_error_not_an_allocation() {
-    let d = dir("cdr");
+    let d = fresh_dir("badbag", "cdr");
     // Header: stamp (8), frame_id "" (4 + 1 + pad 3), then name count 2^31.
     let mut bad = vec![0x00, 0x01, 0x00, 0x00];
     bad.extend_from_slice(&[0; 8]);
@@ -260,7 +256,7 @@ fn a_joint_state_declaring_2_pow_31_names_is_a_decode_error_not_an_allocation() 
 
 #[test]
 fn a_schema_that_lies_about_its_type_is_named() {
-    let d = dir("lie");
+    let d = fresh_dir("badbag", "lie");
     let bag = d.join("lie.mcap");
     write_bag(
         &bag,
@@ -276,7 +272,7 @@ fn a_schema_that_lies_about_its_type_is_named() {
 
 #[test]
 fn a_bag_of_60000_channels_is_listed_briefly() {
-    let d = dir("channels");
+    let d = fresh_dir("badbag", "channels");
     let bag = d.join("many.mcap");
     // MCAP channel ids are 16 bits: one file holds at most 65 535.
     let channels: Vec<(String, &str, &str)> = (0..60_000)
@@ -304,7 +300,7 @@ fn a_bag_of_60000_channels_is_listed_briefly() {
 
 #[test]
 fn time_going_backwards_in_the_bag_is_sorted_onto_the_step_grid() {
-    let d = dir("backwards");
+    let d = fresh_dir("badbag", "backwards");
     let bag = d.join("back.mcap");
     let msgs: Vec<(usize, u64, Vec<u8>)> = (0..100u64)
         .map(|k| {
@@ -333,7 +329,7 @@ fn time_going_backwards_in_the_bag_is_sorted_onto_the_step_grid() {
 
 #[test]
 fn things_that_are_not_bags_are_named() {
-    let d = dir("notbags");
+    let d = fresh_dir("badbag", "notbags");
     let out = d.join("o.csv");
     let cases: Vec<(&str, Vec<u8>, &str)> = vec![
         ("empty.mcap", vec![], "MCAP magic"),
@@ -380,7 +376,7 @@ fn things_that_are_not_bags_are_named() {
 
 #[test]
 fn a_stamp_years_away_is_refused_instead_of_a_grid_of_10_to_the_13_steps() {
-    let d = dir("years");
+    let d = fresh_dir("badbag", "years");
     let bag = d.join("years.mcap");
     let msgs = vec![
         (0, 1_000_000_000, f64_cdr(0.1)),

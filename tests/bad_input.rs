@@ -3,19 +3,9 @@
 //! message names what is wrong, and that nothing half-written is left (no
 //! output file, no temporary sibling). No input may panic (exit 101).
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod common;
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_friction-node"))
-}
-
-fn dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("fn-bad-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+use std::path::Path;
 
 struct Outcome {
     code: i32,
@@ -23,12 +13,17 @@ struct Outcome {
     stderr: String,
 }
 
+/// A fresh directory for test `name`.
+fn dir(name: &str) -> std::path::PathBuf {
+    common::cli::fresh_dir("bad", name)
+}
+
 fn run(args: &[&str]) -> Outcome {
-    let o = bin().args(args).output().unwrap();
+    let (code, stdout, stderr) = common::cli::run(args);
     Outcome {
-        code: o.status.code().unwrap_or(-1),
-        stdout: String::from_utf8_lossy(&o.stdout).into_owned(),
-        stderr: String::from_utf8_lossy(&o.stderr).into_owned(),
+        code,
+        stdout,
+        stderr,
     }
 }
 

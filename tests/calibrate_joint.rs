@@ -2,28 +2,15 @@
 //! units (`fit --rotary`) and the terms chosen by the data (`--fit auto`),
 //! through the command line as a user runs them.
 
+mod common;
+use common::cli::run;
+
 use friction_node::config::Config;
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::Path;
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_friction-node"))
-}
-
-fn dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("fn-joint-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn run(args: &[&str]) -> (i32, String, String) {
-    let o = bin().args(args).output().unwrap();
-    (
-        o.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&o.stdout).into_owned(),
-        String::from_utf8_lossy(&o.stderr).into_owned(),
-    )
+/// A fresh directory for test `name`.
+fn dir(name: &str) -> std::path::PathBuf {
+    common::cli::fresh_dir("joint", name)
 }
 
 /// `simulate`'s columns t_s, velocity_m_s, friction_n of `csv`.

@@ -1,25 +1,16 @@
 //! The command line, end to end (the real binary).
 
-use std::path::PathBuf;
-use std::process::Command;
+mod common;
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_friction-node"))
+/// A fresh directory for test `name`.
+fn dir(name: &str) -> std::path::PathBuf {
+    common::cli::fresh_dir("cli", name)
 }
 
-fn dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("fn-cli-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
+/// Runs the binary: (success, stdout, stderr).
 fn run(args: &[&str]) -> (bool, String, String) {
-    let o = bin().args(args).output().unwrap();
-    (
-        o.status.success(),
-        String::from_utf8_lossy(&o.stdout).into_owned(),
-        String::from_utf8_lossy(&o.stderr).into_owned(),
-    )
+    let (code, stdout, stderr) = common::cli::run(args);
+    (code == 0, stdout, stderr)
 }
 
 #[test]
@@ -317,7 +308,7 @@ fn a_study_writes_case_csvs_a_summary_plots_and_the_claims() {
 #[cfg(feature = "iceoryx2")]
 fn log_lines_on_a_redirected_stderr_carry_no_colour_codes() {
     let svc = format!("fn-cli-colour-{}", std::process::id());
-    let mut c = bin();
+    let mut c = common::cli::bin();
     c.args(["run", "--demo", "0.2", "--transport", "iceoryx2", "--quiet"]);
     for (key, suffix) in [
         ("cmd_velocity_service", "v"),

@@ -6,6 +6,9 @@
 
 #![cfg(all(feature = "mcap", feature = "iceoryx2"))]
 
+mod common;
+use common::cli::fresh_dir;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -21,13 +24,6 @@ friction_node:
       right: {joint: x_right, contact: {load_n: 4000.0}}
       wrist: {joint: wrist, gain: 0.03, contact: {load_n: 800.0}, solver: {cells: 32}}
 ";
-
-fn dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("fn-contacts-replay-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 fn node(d: &Path, args: &[&str]) -> Output {
     let svc = format!(
@@ -83,7 +79,7 @@ fn recording(d: &Path) -> PathBuf {
 
 #[test]
 fn a_recording_of_three_contacts_replays_bit_identical_for_each_contact() {
-    let d = dir("identical");
+    let d = fresh_dir("contacts-replay", "identical");
     let bag = recording(&d);
     // The bag: each contact's estimates and the joint commands, readable alone.
     let reader = friction_node::bag::Bag::open(&bag).unwrap();
@@ -156,7 +152,7 @@ fn a_recording_of_three_contacts_replays_bit_identical_for_each_contact() {
 
 #[test]
 fn a_changed_contact_is_the_only_one_the_oracle_flags() {
-    let d = dir("changed");
+    let d = fresh_dir("contacts-replay", "changed");
     let bag = recording(&d);
     let o = node(
         &d,
@@ -219,7 +215,7 @@ fn a_changed_contact_is_the_only_one_the_oracle_flags() {
 
 #[test]
 fn a_joint_state_bag_drives_every_configured_joint_each_as_its_one_joint_replay() {
-    let d = dir("joints");
+    let d = fresh_dir("contacts-replay", "joints");
     std::fs::write(
         d.join("two.yaml"),
         "friction_node:\n  ros__parameters:\n    contacts:\n      slide: {joint: slider}\n      \

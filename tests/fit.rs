@@ -4,6 +4,9 @@
 //! reproducible; steady curves and mapped inputs (the O-ring seal's real
 //! data, read from ../shared/data) fit too; bad input gets a clear message.
 
+mod common;
+use common::cli::run;
+
 use friction_node::config::Config;
 use friction_node::fit::driver::{fit, FitOutcome};
 use friction_node::fit::options::Options;
@@ -20,7 +23,6 @@ use friction_node::physics::Solver;
 use rand::rngs::StdRng;
 use rand::SeedableRng;
 use std::path::Path;
-use std::process::Command;
 
 /// A reciprocating motion: two amplitudes and two loads, one quarter each.
 fn motion(duration: f64, dt: f64) -> Vec<(f64, f64, f64)> {
@@ -219,24 +221,9 @@ fn each_classic_model_recovers_its_own_parameters() {
 
 // ---- the command line ----
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_friction-node"))
-}
-
+/// A fresh directory for test `name`.
 fn dir(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("fn-fit-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn run(args: &[&str]) -> (i32, String, String) {
-    let o = bin().args(args).output().unwrap();
-    (
-        o.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&o.stdout).into_owned(),
-        String::from_utf8_lossy(&o.stderr).into_owned(),
-    )
+    common::cli::fresh_dir("fit", name)
 }
 
 fn small_data(d: &Path) -> std::path::PathBuf {

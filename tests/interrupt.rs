@@ -4,20 +4,12 @@
 //! has printed the line it prints just before the long part (an event, not
 //! a delay), with work sized to take far longer than that.
 
+mod common;
+use common::cli::{bin, fresh_dir};
+
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
-
-fn bin() -> &'static str {
-    env!("CARGO_BIN_EXE_friction-node")
-}
-
-fn dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("fn-interrupt-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+use std::process::Stdio;
 
 /// Every file under `d`, recursively.
 fn files(d: &Path) -> Vec<PathBuf> {
@@ -36,7 +28,7 @@ fn files(d: &Path) -> Vec<PathBuf> {
 /// Start `args`, send `signal` once a stderr line contains `ready`, and
 /// return the exit code and the whole stderr.
 fn interrupt(args: &[&str], ready: &str, signal: i32) -> (Option<i32>, String) {
-    let mut child = Command::new(bin())
+    let mut child = bin()
         .args(args)
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
@@ -67,7 +59,7 @@ fn interrupt(args: &[&str], ready: &str, signal: i32) -> (Option<i32>, String) {
 #[test]
 fn sigint_and_sigterm_stop_simulate_and_remove_its_temporary_file() {
     for (signal, code) in [(libc::SIGINT, 130), (libc::SIGTERM, 143)] {
-        let d = dir(&format!("simulate-{signal}"));
+        let d = fresh_dir("interrupt", &format!("simulate-{signal}"));
         let out = d.join("run.csv");
         let (rc, err) = interrupt(
             &[
@@ -92,7 +84,7 @@ fn sigint_and_sigterm_stop_simulate_and_remove_its_temporary_file() {
 
 #[test]
 fn sigint_stops_a_study_before_anything_is_written() {
-    let d = dir("study");
+    let d = fresh_dir("interrupt", "study");
     let (rc, err) = interrupt(
         &[
             "study",
@@ -112,7 +104,7 @@ fn sigint_stops_a_study_before_anything_is_written() {
 #[test]
 #[cfg(feature = "mcap")]
 fn sigterm_stops_a_replay_and_removes_its_temporary_output() {
-    let d = dir("replay");
+    let d = fresh_dir("interrupt", "replay");
     let bag = concat!(env!("CARGO_MANIFEST_DIR"), "/bags/node_lockstep.mcap");
     let out = d.join("replay.csv");
     // 2 s of bag at 10 µs steps on 8192 cells: far longer than the signal.
@@ -136,9 +128,9 @@ fn sigterm_stops_a_replay_and_removes_its_temporary_output() {
 
 #[test]
 fn sigint_stops_a_fit_before_it_writes_anything() {
-    let d = dir("fit");
+    let d = fresh_dir("interrupt", "fit");
     let data = d.join("data.csv");
-    let sim = Command::new(bin())
+    let sim = bin()
         .args([
             "simulate",
             "--velocity",
@@ -176,9 +168,9 @@ fn sigint_stops_a_fit_before_it_writes_anything() {
 
 #[test]
 fn an_interrupted_fit_says_so_in_words_and_leaves_no_empty_report_folder() {
-    let d = dir("fit-report");
+    let d = fresh_dir("interrupt", "fit-report");
     let data = d.join("data.csv");
-    let sim = Command::new(bin())
+    let sim = bin()
         .args(["simulate", "--velocity", "sine:0,0.5,1", "--duration", "4"])
         .args(["--set", "solver.cells=64", "--out"])
         .arg(&data)
@@ -217,9 +209,9 @@ fn a_second_signal_ends_at_once_and_still_removes_the_temporary_file() {
     // Both signals arrive together (held while the process is stopped):
     // the second ends the process at once, as a second Ctrl-C or
     // `timeout -s INT` (which signals the whole group) does.
-    let d = dir("double");
+    let d = fresh_dir("interrupt", "double");
     let out = d.join("run.csv");
-    let mut child = Command::new(bin())
+    let mut child = bin()
         .args(["simulate", "--velocity", "const:0.1", "--duration", "300"])
         .args(["--set", "solver.cells=8192", "--out"])
         .arg(&out)
@@ -249,9 +241,9 @@ fn a_second_signal_ends_at_once_and_still_removes_the_temporary_file() {
 
 #[test]
 fn an_interrupted_term_selection_writes_nothing_and_exits_130() {
-    let d = dir("auto");
+    let d = fresh_dir("interrupt", "auto");
     let data = d.join("data.csv");
-    let sim = Command::new(bin())
+    let sim = bin()
         .args(["simulate", "--velocity", "sine:0,0.5,1", "--duration", "2"])
         .args(["--set", "solver.cells=32", "--out"])
         .arg(&data)

@@ -5,21 +5,12 @@
 //! asymmetry. Off by default (every other test checks that the estimates
 //! are then unchanged); here they are on.
 
+mod common;
+use common::cli::{bin, fresh_dir};
+
 use approx::assert_relative_eq;
 use friction_node::config::Config;
 use friction_node::physics::{Solver, Status};
-use std::process::Command;
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_friction-node"))
-}
-
-fn dir(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("fn-drive-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 fn config(sets: &[&str]) -> Config {
     let mut all = vec!["solver.cells=32".to_string()];
@@ -174,7 +165,7 @@ fn simulate_the_python_columns_and_a_recorded_node_carry_the_new_terms_bit_for_b
         "contact.boundary_activation_speed_m_s=1e-3",
     ];
     let c = config(&sets);
-    let d = dir("simulate");
+    let d = fresh_dir("drive", "simulate");
     let out = d.join("run.csv");
     let mut args = vec![
         "simulate",
@@ -210,7 +201,7 @@ fn simulate_the_python_columns_and_a_recorded_node_carry_the_new_terms_bit_for_b
 #[test]
 #[cfg(all(feature = "mcap", feature = "iceoryx2"))]
 fn a_node_recording_with_the_new_terms_replays_bit_identically() {
-    let d = dir("node");
+    let d = fresh_dir("drive", "node");
     let bag = d.join("lockstep.mcap");
     let base = format!("fn_drive_{}", std::process::id());
     let mut args: Vec<String> = vec![
@@ -331,7 +322,7 @@ fn negative_or_non_finite_terms_are_refused_naming_the_key() {
 
 #[test]
 fn fitting_a_presliding_key_on_data_without_a_reversal_warns_that_it_cannot_be_identified() {
-    let d = dir("no-reversal");
+    let d = fresh_dir("drive", "no-reversal");
     let data = d.join("oneway.csv");
     let mut csv = String::from("t_s,velocity_m_s,friction_n\n");
     for k in 0..400 {

@@ -5,6 +5,7 @@
 #![cfg(feature = "mcap")]
 
 mod common;
+use common::cli::fresh_dir;
 
 use friction_node::bag::{rosbag2, Bag};
 use friction_node::clock::SimClock;
@@ -19,19 +20,12 @@ use friction_node::replay::{self, ReplayOptions};
 use friction_node::transport::memory::MemoryLink;
 use friction_node::transport::PeerPort;
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
 
 const WALL0: u64 = 1_763_900_000_000_000_000;
-
-fn dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("fn-rec-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 fn config() -> Config {
     let mut c = Config::default();
@@ -139,7 +133,7 @@ fn read_file(path: &Path) -> Vec<(String, u64, u64, Vec<u8>)> {
 fn a_60_s_run_split_every_5_s_loses_and_repeats_no_message_and_replays_as_one_bag() {
     let mut cfg = config();
     cfg.recording.split.max_duration_s = 5;
-    let d = dir("split");
+    let d = fresh_dir("rec", "split");
     let bag = d.join("run");
     let (s, report) = record(
         &cfg,
@@ -208,7 +202,7 @@ fn a_60_s_run_split_every_5_s_loses_and_repeats_no_message_and_replays_as_one_ba
 fn a_disk_budget_deletes_the_oldest_split_files_and_metadata_forgets_them() {
     let mut cfg = config();
     cfg.recording.split.max_duration_s = 5;
-    let d = dir("budget");
+    let d = fresh_dir("rec", "budget");
     let bag = d.join("run");
     // First, how big is one 5 s file?
     let (_, probe) = record(
@@ -261,7 +255,7 @@ fn a_disk_budget_deletes_the_oldest_split_files_and_metadata_forgets_them() {
 fn a_snapshot_holds_the_last_seconds_of_every_topic() {
     let mut cfg = config();
     cfg.recording.snapshot_s = 2;
-    let d = dir("snapshot");
+    let d = fresh_dir("rec", "snapshot");
     let (_, report) = record(
         &cfg,
         RecordPlan {
@@ -293,7 +287,7 @@ fn a_snapshot_holds_the_last_seconds_of_every_topic() {
 fn a_split_recording_refuses_a_directory_that_is_not_empty() {
     let mut cfg = config();
     cfg.recording.split.max_duration_s = 5;
-    let d = dir("nonempty");
+    let d = fresh_dir("rec", "nonempty");
     std::fs::write(d.join("something"), "x").unwrap();
     let e = Recorder::start(
         RecordPlan {
@@ -319,7 +313,7 @@ fn a_run_whose_parameters_changed_midway_replays_bit_identically() {
     use friction_node::link::{ParameterChannel, ParameterUpdate};
     use friction_node::msgs::ros_interfaces::{parameter_type, ParameterValue};
     use friction_node::transport::ros2::params::record_applied;
-    let d = dir("params");
+    let d = fresh_dir("rec", "params");
     let bag = d.join("params.mcap");
     let mut cfg = config();
     cfg.lubricant.viscosity_model = friction_node::config::ViscosityModelKind::Vogel;

@@ -3,12 +3,14 @@
 //! Python mcap-ros2-support writer. Bad bags are made here from them.
 #![cfg(feature = "mcap")]
 
+mod common;
+use common::cli::run;
+
 use friction_node::bag::{Bag, BagError, SampleKind};
 use friction_node::msgs::{self, CommandKind};
 use friction_node::replay::{self, InputMode, ReplayError, ReplayOptions};
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::Path;
 
 const NODE_BAG: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/bags/node_lockstep.mcap");
 const FOREIGN_BAG: &str = concat!(
@@ -16,24 +18,9 @@ const FOREIGN_BAG: &str = concat!(
     "/bags/foreign_joint_states.mcap"
 );
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_friction-node"))
-}
-
-fn dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("fn-replay-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn run(args: &[&str]) -> (i32, String, String) {
-    let o = bin().args(args).output().unwrap();
-    (
-        o.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&o.stdout).into_owned(),
-        String::from_utf8_lossy(&o.stderr).into_owned(),
-    )
+/// A fresh directory for test `name`.
+fn dir(name: &str) -> std::path::PathBuf {
+    common::cli::fresh_dir("replay", name)
 }
 
 fn opts(topic: Option<&str>, joint: Option<&str>) -> ReplayOptions {

@@ -1,5 +1,9 @@
-//! Helpers shared by the loop's tests (`tests/node.rs`) and the recording
-//! tests (`tests/recording.rs`).
+//! Helpers shared by the integration tests: the loop's (`tests/node.rs`,
+//! `tests/recording.rs`) and running the binary (`cli`). Each test file
+//! uses some of them.
+#![allow(dead_code)]
+
+pub mod cli;
 
 use friction_node::config::{Config, StepMode};
 use friction_node::msgs::EstimateRecord;

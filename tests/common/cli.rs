@@ -1,0 +1,30 @@
+//! Running the binary from a test: the command, a fresh directory per
+//! test, and a run's exit code and output.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+/// The `friction-node` binary this test suite was built with.
+pub fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_friction-node"))
+}
+
+/// An empty directory of its own for test `name` of `suite`:
+/// `<temp>/fn-<suite>-<pid>-<name>`, emptied if it was there.
+pub fn fresh_dir(suite: &str, name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("fn-{suite}-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Runs the binary with `args`: (exit code, stdout, stderr); the code is
+/// −1 when a signal ended it.
+pub fn run(args: &[&str]) -> (i32, String, String) {
+    let o = bin().args(args).output().unwrap();
+    (
+        o.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
