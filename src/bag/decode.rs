@@ -7,7 +7,7 @@
 //! that declares more elements than the bytes hold is a decode error).
 
 use super::{BagError, BagMessage, ChannelInfo};
-use crate::msgs::{self, MsgType};
+use crate::msgs::{self, command_codec, MsgType};
 
 /// What to read from a topic.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -158,16 +158,11 @@ pub fn decode_cdr<T: serde::de::DeserializeOwned>(
     })
 }
 
-/// The stamp of a sample: the header's when set, else the publish time,
-/// else the log time.
-pub fn stamp_or(header: u64, publish: u64, log: u64) -> u64 {
-    if header != 0 {
-        header
-    } else if publish != 0 {
-        publish
-    } else {
-        log
-    }
+/// The stamp of a sample by the stamp rule
+/// ([`crate::msgs::command_codec::stamp_or`]): the header's when set,
+/// else the publish time, else the log time.
+fn stamp_or(header: u64, publish: u64, log: u64) -> u64 {
+    command_codec::stamp_or(header, || if publish != 0 { publish } else { log })
 }
 
 /// Turns one topic's messages into `(stamp_ns, value)` samples.
@@ -222,23 +217,19 @@ impl TopicDecoder {
         let idx = self.index;
         let c = &self.channel;
         match &mut self.kind {
-            SampleKind::Float64 => {
-                let f: msgs::Float64 = decode_cdr(c, idx, m.data)?;
-                Ok((stamp_or(0, m.publish_time, m.log_time), f.data))
-            }
-            SampleKind::TwistLinearX => {
-                let t: msgs::TwistStamped = decode_cdr(c, idx, m.data)?;
-                Ok((
-                    stamp_or(t.header.stamp.to_ns(), m.publish_time, m.log_time),
-                    t.twist.linear.x,
-                ))
-            }
-            SampleKind::Temperature => {
-                let t: msgs::Temperature = decode_cdr(c, idx, m.data)?;
-                Ok((
-                    stamp_or(t.header.stamp.to_ns(), m.publish_time, m.log_time),
-                    t.temperature,
-                ))
+            SampleKind::Float64 | SampleKind::TwistLinearX | SampleKind::Temperature => {
+                let read = match self.kind {
+                    SampleKind::Float64 => command_codec::float64,
+                    SampleKind::TwistLinearX => command_codec::twist_linear_x,
+                    _ => command_codec::temperature,
+                };
+                let (value, header) = read(m.data).map_err(|message| BagError::Decode {
+                    topic: c.topic.clone(),
+                    type_name: c.schema_name.clone(),
+                    index: idx,
+                    message,
+                })?;
+                Ok((stamp_or(header, m.publish_time, m.log_time), value))
             }
             SampleKind::JointVelocity(joint)
             | SampleKind::JointEffort(joint)

@@ -13,10 +13,12 @@
 //! | `types.rs` | [`MsgType`]: package, name, definition, `ros2msg` schema |
 //! | `records.rs` | heap-free records of the loop and their conversions |
 //! | `cdr.rs` | CDR with its encapsulation header |
+//! | `command_codec.rs` | a command as its message and back (Float64, TwistStamped, Temperature, JointState), the stamp rule |
 //! | `ros_interfaces.rs` | standard interfaces: parameters, `/rosout`, diagnostics, `/clock`, Trigger |
 //! | `tests.rs` | round trips of every message through CDR and the records |
 
 mod cdr;
+pub mod command_codec;
 mod records;
 pub mod ros_interfaces;
 mod types;

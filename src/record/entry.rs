@@ -6,7 +6,8 @@ use super::WriteError;
 use crate::config::CommandType;
 use crate::link::FilmProfileData;
 use crate::link::RecordItem;
-use crate::msgs::{self, Command, CommandKind, Float64, Header, Time, TwistStamped};
+use crate::msgs::command_codec::CommandMessage;
+use crate::msgs::{self, Command, CommandKind, Float64, Header, Time};
 
 /// The node's recorded topics.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -112,63 +113,39 @@ fn cdr<T: serde::Serialize>(topic: TopicId, m: &T) -> Result<Vec<u8>, WriteError
     msgs::to_cdr(m).map_err(|message| WriteError::Encode { topic, message })
 }
 
+/// The topic a command of `kind` is recorded on.
+fn command_topic(kind: CommandKind) -> TopicId {
+    match kind {
+        CommandKind::Velocity => TopicId::Velocity,
+        CommandKind::JointVelocity { .. } => TopicId::JointCommands,
+        CommandKind::Load => TopicId::Load,
+        CommandKind::Temperature => TopicId::Temperature,
+    }
+}
+
 impl Encoder {
     fn command(&self, c: &Command, received_ns: u64) -> Result<Entry, WriteError> {
-        let (topic, data) = match (c.kind, self.command_type) {
-            (CommandKind::Load, _) => (
-                TopicId::Load,
-                cdr(TopicId::Load, &Float64 { data: c.value })?,
-            ),
-            (CommandKind::Temperature, _) => (
-                TopicId::Temperature,
-                cdr(
-                    TopicId::Temperature,
-                    &msgs::Temperature {
-                        header: Header {
-                            stamp: Time::from_ns(c.stamp_ns),
-                            frame_id: self.frame_id.clone(),
-                        },
-                        temperature: c.value,
-                        variance: 0.0,
-                    },
-                )?,
-            ),
-            (CommandKind::Velocity, CommandType::Float64) => (
-                TopicId::Velocity,
-                cdr(TopicId::Velocity, &Float64 { data: c.value })?,
-            ),
-            (CommandKind::JointVelocity { contact, .. }, _) => {
-                let Some(joint) = self.joints.get(usize::from(contact)) else {
-                    return Err(WriteError::NoSuchContact {
+        let joint = match c.kind {
+            CommandKind::JointVelocity { contact, .. } => Some(
+                self.joints
+                    .get(usize::from(contact))
+                    .ok_or(WriteError::NoSuchContact {
                         what: "a joint velocity",
                         contact,
                         contacts: self.joints.len(),
-                    });
-                };
-                let m = msgs::JointState {
-                    header: Header {
-                        stamp: Time::from_ns(c.stamp_ns),
-                        frame_id: self.frame_id.clone(),
-                    },
-                    name: vec![joint.clone()],
-                    position: Vec::new(),
-                    velocity: vec![c.value],
-                    effort: Vec::new(),
-                };
-                (TopicId::JointCommands, cdr(TopicId::JointCommands, &m)?)
-            }
-            (CommandKind::Velocity, CommandType::TwistStamped) => {
-                let mut m = TwistStamped {
-                    header: Header {
-                        stamp: Time::from_ns(c.stamp_ns),
-                        frame_id: self.frame_id.clone(),
-                    },
-                    ..Default::default()
-                };
-                m.twist.linear.x = c.value;
-                (TopicId::Velocity, cdr(TopicId::Velocity, &m)?)
-            }
+                    })?
+                    .as_str(),
+            ),
+            _ => None,
         };
+        let topic = command_topic(c.kind);
+        let data = CommandMessage::of(c, self.command_type, &self.frame_id, joint)
+            .ok_or(WriteError::Encode {
+                topic,
+                message: "a joint velocity without its joint's name".into(),
+            })?
+            .to_cdr()
+            .map_err(|message| WriteError::Encode { topic, message })?;
         Ok(Entry {
             topic,
             log_ns: received_ns,
@@ -187,12 +164,7 @@ impl Encoder {
                 received_ns,
             } => out.push(self.command(command, *received_ns)?),
             RecordItem::Raw(r) => out.push(Entry {
-                topic: match r.kind {
-                    CommandKind::Velocity => TopicId::Velocity,
-                    CommandKind::JointVelocity { .. } => TopicId::JointCommands,
-                    CommandKind::Load => TopicId::Load,
-                    CommandKind::Temperature => TopicId::Temperature,
-                },
+                topic: command_topic(r.kind),
                 log_ns: r.received_ns,
                 publish_ns: r.publish_ns,
                 data: r.cdr.clone(),

@@ -8,8 +8,8 @@ use crate::config::CommandType;
 use crate::link::FilmProfileSlot;
 use crate::link::RecordItem;
 use crate::msgs::{
-    self, Command, CommandKind, FilmProfile, Float64, FrictionEstimate, Header, LoopStatistics,
-    RawSample, Time, TwistStamped, FILM_PROFILE, FLOAT64, FRICTION_ESTIMATE, LOOP_STATISTICS,
+    self, command_codec, Command, CommandKind, FilmProfile, Float64, FrictionEstimate, Header,
+    LoopStatistics, RawSample, Time, FILM_PROFILE, FLOAT64, FRICTION_ESTIMATE, LOOP_STATISTICS,
     TWIST_STAMPED,
 };
 use crate::transport::{record_input, RecordQueue, SharedCounters, TransportError};
@@ -202,31 +202,14 @@ fn setup(spec: &Ros2Spec, snapshots: bool, sim_time: bool) -> Result<Entities, T
     })
 }
 
-/// Decode a raw command sample: (value, sender's stamp). An undecodable
-/// sample becomes a NaN command, which the loop rejects and counts.
+/// Decode a raw command sample: (value, stamp by the stamp rule, the
+/// sender's publish time, else now). An undecodable sample becomes a NaN
+/// command, which the loop rejects and counts.
 fn decode(kind: CommandKind, ty: CommandType, raw: &[u8], source_ns: Option<u64>) -> (f64, u64) {
-    let now = || source_ns.unwrap_or_else(system_wall_ns);
-    match (kind, ty) {
-        (CommandKind::Temperature, _) => match msgs::from_cdr::<msgs::Temperature>(raw) {
-            Ok(m) => {
-                let stamp = m.header.stamp.to_ns();
-                (m.temperature, if stamp != 0 { stamp } else { now() })
-            }
-            Err(_) => (f64::NAN, now()),
-        },
-        (CommandKind::Velocity, CommandType::TwistStamped) => {
-            match msgs::from_cdr::<TwistStamped>(raw) {
-                Ok(m) => {
-                    let stamp = m.header.stamp.to_ns();
-                    (m.twist.linear.x, if stamp != 0 { stamp } else { now() })
-                }
-                Err(_) => (f64::NAN, now()),
-            }
-        }
-        _ => match msgs::from_cdr::<Float64>(raw) {
-            Ok(m) => (m.data, now()),
-            Err(_) => (f64::NAN, now()),
-        },
+    let fallback = || source_ns.unwrap_or_else(system_wall_ns);
+    match command_codec::decode(kind, ty, raw) {
+        Ok((value, header_ns)) => (value, command_codec::stamp_or(header_ns, fallback)),
+        Err(_) => (f64::NAN, fallback()),
     }
 }
 

@@ -3,10 +3,10 @@
 
 use super::{advertise, context, err, qos, ros_node, subscribe, Ros2Spec, NAME};
 use crate::config::CommandType;
+use crate::msgs::command_codec::CommandMessage;
 use crate::msgs::{
-    self, Command, CommandKind, EstimateRecord, Float64, FrictionEstimate, Header, LoopStatistics,
-    StatisticsRecord, Time, TwistStamped, FLOAT64, FRICTION_ESTIMATE, LOOP_STATISTICS,
-    TWIST_STAMPED,
+    self, Command, CommandKind, EstimateRecord, Float64, FrictionEstimate, LoopStatistics,
+    StatisticsRecord, TwistStamped, FLOAT64, FRICTION_ESTIMATE, LOOP_STATISTICS, TWIST_STAMPED,
 };
 use crate::transport::{JointEfforts, JointStateCommand, PeerPort, TransportError};
 use ros2_client::{Context, Node, Publisher, Subscription};
@@ -134,43 +134,29 @@ impl PeerPort for Ros2Peer {
     }
 
     fn send(&mut self, c: &Command) -> Result<(), TransportError> {
-        let r = match (c.kind, &self.velocity_f64, &self.velocity_twist) {
-            (CommandKind::JointVelocity { .. }, _, _) => {
-                return Err(err(
-                    "send a joint velocity",
-                    "send a JointState (send_joint_state) instead",
-                ))
+        let velocity = if self.velocity_f64.is_some() {
+            CommandType::Float64
+        } else {
+            CommandType::TwistStamped
+        };
+        // A joint velocity has no joint's name here: None.
+        let Some(message) = CommandMessage::of(c, velocity, &self.frame_id, None) else {
+            return Err(err(
+                "send a joint velocity",
+                "send a JointState (send_joint_state) instead",
+            ));
+        };
+        let show = |e: &dyn std::fmt::Debug| format!("{e:?}");
+        let r = match (c.kind, message, &self.velocity_f64, &self.velocity_twist) {
+            (CommandKind::Load, CommandMessage::Float64(m), _, _) => {
+                self.load.publish(m).map_err(|e| show(&e))
             }
-            (CommandKind::Temperature, _, _) => self
-                .temperature
-                .publish(msgs::Temperature {
-                    header: Header {
-                        stamp: Time::from_ns(c.stamp_ns),
-                        frame_id: self.frame_id.clone(),
-                    },
-                    temperature: c.value,
-                    variance: 0.0,
-                })
-                .map_err(|e| format!("{e:?}")),
-            (CommandKind::Load, _, _) => self
-                .load
-                .publish(Float64 { data: c.value })
-                .map_err(|e| format!("{e:?}")),
-            (CommandKind::Velocity, Some(p), _) => p
-                .publish(Float64 { data: c.value })
-                .map_err(|e| format!("{e:?}")),
-            (CommandKind::Velocity, None, Some(p)) => {
-                let mut m = TwistStamped {
-                    header: Header {
-                        stamp: Time::from_ns(c.stamp_ns),
-                        frame_id: self.frame_id.clone(),
-                    },
-                    ..Default::default()
-                };
-                m.twist.linear.x = c.value;
-                p.publish(m).map_err(|e| format!("{e:?}"))
+            (_, CommandMessage::Float64(m), Some(p), _) => p.publish(m).map_err(|e| show(&e)),
+            (_, CommandMessage::Twist(m), _, Some(p)) => p.publish(m).map_err(|e| show(&e)),
+            (_, CommandMessage::Temperature(m), _, _) => {
+                self.temperature.publish(m).map_err(|e| show(&e))
             }
-            (CommandKind::Velocity, None, None) => Err("no velocity publisher".into()),
+            _ => Err("no publisher for this command".into()),
         };
         r.map_err(|e| err("publish a command", e))
     }
