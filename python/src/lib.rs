@@ -13,7 +13,7 @@
 //! |---|---|
 //! | `lib.rs` | the module `friction_node._core` and what it exports |
 //! | `model.rs` | `Model`: one contact stepped from Python, `Model.run` over arrays |
-//! | `calls.rs` | `stribeck`, `replay` and `fit`: the command line's jobs returning arrays |
+//! | `calls/` | `stribeck`, `replay` and `fit`: the command line's jobs returning arrays |
 //! | `columns.rs` | estimates → named numpy columns |
 //! | `errors.rs` | library errors → Python exceptions, CLI flags → keywords |
 //! | `interrupts.rs` | Ctrl-C during long calls (checked between chunks) |
@@ -30,9 +30,9 @@ use pyo3::prelude::*;
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<model::Model>()?;
     m.add_class::<model::Estimate>()?;
-    m.add_function(wrap_pyfunction!(calls::stribeck, m)?)?;
-    m.add_function(wrap_pyfunction!(calls::replay, m)?)?;
-    m.add_function(wrap_pyfunction!(calls::fit, m)?)?;
+    m.add_function(wrap_pyfunction!(calls::stribeck::stribeck, m)?)?;
+    m.add_function(wrap_pyfunction!(calls::replay::replay, m)?)?;
+    m.add_function(wrap_pyfunction!(calls::fit::fit, m)?)?;
     m.add_function(wrap_pyfunction!(calls::default_config_yaml, m)?)?;
     m.add("SIMULATE_COLUMNS", friction_node::offline::SIMULATE_COLUMNS)?;
     m.add(
