@@ -7,7 +7,8 @@
 //!
 //! | module | content |
 //! |---|---|
-//! | [`params`] | parameters and their defaults (paper Tables A2–A4) |
+//! | [`params`] | physical parameters and their defaults (paper Tables A2–A4) |
+//! | [`settings`] | the solver's numerical settings: method, time scheme, grid, tolerances, flux |
 //! | [`geometry`] | film shape h = h0 + hg + ht, finite-volume grid |
 //! | [`eos`] | mixture cavitation equation of state |
 //! | [`gw`] | Greenwood–Williamson contact, exact F_n tables |
@@ -38,16 +39,15 @@ pub mod geometry;
 pub mod gw;
 pub mod params;
 pub mod scheme;
+pub mod settings;
 pub mod solver;
 pub mod terms;
 pub mod viscosity;
 
 pub use error::SetupError;
 pub use estimate::{Diagnostics, Estimate, Regime, Status};
-pub use params::{
-    Contact, CouetteFlux, Geometry, Limiter, Lubricant, Method, ModelParams, Pocket, Profile,
-    ReferenceSettings, Roughness, SolverSettings, TimeScheme,
-};
+pub use params::{Contact, Geometry, Lubricant, ModelParams, Pocket, Profile, Roughness};
+pub use settings::{CouetteFlux, Limiter, Method, ReferenceSettings, SolverSettings, TimeScheme};
 pub use solver::{FieldPoint, Isa, ModelMismatch, PreparedModel, Solver, StepBreakdown};
 pub use terms::boundary::BoundaryRate;
 pub use terms::drivetrain::Drivetrain;

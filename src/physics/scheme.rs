@@ -16,7 +16,7 @@
 //! at level n; it only enters through the inertia term, which is 1e-6 % of
 //! the load at the paper's settings (see the inertia study).
 
-use super::params::TimeScheme;
+use super::settings::TimeScheme;
 
 /// Coefficients of one step: `u' ≈ Σ a_k u^(n−k) / Δt`, forces `Σ w_k F^(n−k)`.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -11,8 +11,8 @@ use super::flux::muscl_pass;
 use super::lanes::{all_finite, lane_sum};
 use super::work::{CellColumns, CellProps, FaceColumns, FaceFlux, RowColumns, Work};
 use super::{Ctx, Disc, H0Mode, Level};
-use crate::physics::params::CouetteFlux;
 use crate::physics::scheme::StepCoefficients;
+use crate::physics::settings::CouetteFlux;
 
 /// What a face flux needs besides the two neighbouring states.
 struct FluxCtx<'a> {
@@ -341,9 +341,7 @@ mod jacobian_tests {
     //! residual, for random states (property test).
     use super::super::Solver;
     use super::*;
-    use crate::physics::params::{
-        Limiter, ModelParams, Pocket, Profile, SolverSettings, TimeScheme,
-    };
+    use crate::physics::{Limiter, ModelParams, Pocket, Profile, SolverSettings, TimeScheme};
     use proptest::prelude::*;
 
     fn residual(s: &mut Solver, p: &[f64], h0: f64, ctx: &Ctx) -> (Vec<f64>, f64) {

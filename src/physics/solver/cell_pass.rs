@@ -78,7 +78,7 @@ mod cell_pass_tests {
     //! The chunked cell pass equals the EOS evaluated cell by cell.
     use super::super::Solver;
     use super::*;
-    use crate::physics::params::{ModelParams, SolverSettings};
+    use crate::physics::{ModelParams, SolverSettings};
     use proptest::prelude::*;
 
     fn bits(x: f64) -> u64 {

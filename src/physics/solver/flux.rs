@@ -28,7 +28,7 @@
 
 use super::work::Work;
 use super::{Ctx, Disc};
-use crate::physics::params::Limiter;
+use crate::physics::settings::Limiter;
 
 /// The limited slope s(dm = Δ−, dp = Δ+) and its derivatives ∂s/∂Δ−,
 /// ∂s/∂Δ+ (branch-free, so that the loop over faces vectorises).

@@ -87,8 +87,9 @@ use super::estimate::{Estimate, Status};
 use super::flow_factors::FlowFactors;
 use super::geometry::Grid;
 use super::gw::{Greenwood, SummedContact};
-use super::params::{Method, ModelParams, SolverSettings};
+use super::params::ModelParams;
 use super::scheme::StepCoefficients;
+use super::settings::{Method, SolverSettings};
 use newton::CONTRACTION_MAX;
 
 /// Immutable discretisation data.
@@ -101,7 +102,7 @@ pub(crate) struct Disc {
     pub contact: SummedContact,
     pub ff: Option<FlowFactors>,
     /// The Couette flux's face density.
-    pub flux: super::params::CouetteFlux,
+    pub flux: super::settings::CouetteFlux,
     pub sigma: f64,
     pub p_amb: f64,
     /// ρ, ρ/μ at the boundary pressure.

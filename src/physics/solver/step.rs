@@ -34,8 +34,9 @@ use super::newton::MAX_SUBSTEPS;
 use super::{Ctx, H0Mode, Isa, Solver};
 use crate::physics::eos::MixtureEos;
 use crate::physics::estimate::{Diagnostics, Estimate, Regime, Status};
-use crate::physics::params::{Method, MAX_ABS_VELOCITY, MAX_LOAD, MAX_VARIABLE_STEP_S};
+use crate::physics::params::{MAX_ABS_VELOCITY, MAX_LOAD, MAX_VARIABLE_STEP_S};
 use crate::physics::scheme::StepCoefficients;
+use crate::physics::settings::Method;
 
 impl Solver {
     // ------------------------------------------------------------------
@@ -415,8 +416,8 @@ mod guard_tests {
 #[cfg(test)]
 mod isa_tests {
     use super::super::Isa;
-    use crate::physics::params::{ModelParams, SolverSettings};
     use crate::physics::Solver;
+    use crate::physics::{ModelParams, SolverSettings};
 
     /// Every instruction-set version of the step this CPU runs gives the
     /// baseline's estimates bit for bit (reciprocating motion through
