@@ -12,32 +12,7 @@ OUT=${1:-out/auto-selection}
 mkdir -p "$OUT"
 cargo build --release --quiet
 BIN=target/release/friction-node
-python3 - "$OUT" <<'PY'
-import random, sys
-out = sys.argv[1]
-random.seed(3)
-dt, T = 1e-3, 10.0
-segs, t = [], 0.0
-while t < T:
-    vmax = random.choice([0.005, 0.02, 0.05, 0.1, 0.2]) * random.choice([1, -1])
-    ramp = abs(vmax) / 2.0
-    flat, dwell = random.uniform(0.2, 1.0), random.uniform(0.1, 0.4)
-    segs.append((t, ramp, flat, vmax, dwell))
-    t += 2 * ramp + flat + dwell
-def v(t):
-    for (t0, r, f, vm, d) in segs:
-        if t0 <= t < t0 + 2 * r + f + d:
-            s = t - t0
-            if s < r: return vm * s / r
-            if s < r + f: return vm
-            if s < 2 * r + f: return vm * (2 * r + f - s) / r
-            return 0.0
-    return 0.0
-with open(f"{out}/motion.csv", "w") as fh:
-    fh.write("t_s,v\n")
-    for k in range(int(T / dt) + 1):
-        fh.write(f"{k*dt:.6f},{v(k*dt):.9f}\n")
-PY
+python3 docs/point-to-point-motion.py "$OUT/motion.csv" 10
 COMMON=(--set solver.cells=32 --set contact.load_n=2000)
 case_run() {
     local name=$1 truth=$2; shift 2

@@ -16,32 +16,7 @@ OUT=${1:-out/bench-fit-speed}
 mkdir -p "$OUT"
 if [ -z "${2:-}" ]; then cargo build --release --quiet; fi
 BIN=${2:-target/release/friction-node}
-python3 - "$OUT" <<'PY'
-import random, sys
-out = sys.argv[1]
-random.seed(3)
-dt, T = 1e-3, 25.0
-segs, t = [], 0.0
-while t < T:
-    vmax = random.choice([0.005, 0.02, 0.05, 0.1, 0.2]) * random.choice([1, -1])
-    ramp = abs(vmax) / 2.0
-    flat, dwell = random.uniform(0.2, 1.0), random.uniform(0.1, 0.4)
-    segs.append((t, ramp, flat, vmax, dwell))
-    t += 2 * ramp + flat + dwell
-def v(t):
-    for (t0, r, f, vm, d) in segs:
-        if t0 <= t < t0 + 2 * r + f + d:
-            s = t - t0
-            if s < r: return vm * s / r
-            if s < r + f: return vm
-            if s < 2 * r + f: return vm * (2 * r + f - s) / r
-            return 0.0
-    return 0.0
-with open(f"{out}/vel.csv", "w") as fh:
-    fh.write("t_s,v\n")
-    for k in range(int(T / dt) + 1):
-        fh.write(f"{k*dt:.6f},{v(k*dt):.9f}\n")
-PY
+python3 docs/point-to-point-motion.py "$OUT/vel.csv" 25
 "$BIN" simulate --velocity "csv:$OUT/vel.csv@v" --duration 25 --out "$OUT/sim.csv" \
   --set solver.cells=64 --set contact.load_n=2000 \
   --set contact.boundary_friction=0.12 --set lubricant.viscosity_pa_s=0.08 \
