@@ -503,3 +503,34 @@ fn with_several_contacts_each_contacts_model_keys_are_runtime_and_the_defaults_r
         .unwrap();
     assert!(!lub.read_only);
 }
+
+#[test]
+fn a_configuration_with_one_listed_contact_publishes_its_joint_effort_as_several_do() {
+    // The shape `fit --rotary` writes: the joint as the one listed contact,
+    // driven by its JointState and answered with its effort (gain × friction).
+    let cfg = Config::from_yaml(
+        "/**:
+  ros__parameters:
+    solver: {cells: 32}
+    node: {step_mode: timer, statistics_rate_hz: 100.0, command_timeout_s: 0.05}
+    contacts:
+      elbow: {joint: elbow, gain: 0.04}
+",
+        &Origin::Embedded,
+        &[],
+    )
+    .unwrap();
+    let link = MemoryLink::new(1000).with_joints(&joints(&cfg));
+    let mut peer = link.peer();
+    peer.send_joint_state(&js(1, &["elbow"], &[2.0])).unwrap();
+    let s = run_timer(&cfg, &link, 5);
+    assert_eq!((s.steps, s.contacts), (5, 1));
+    let (per, efforts) = outputs(&mut peer);
+    assert_eq!(per[0].len(), 5);
+    assert!(per[0].iter().all(|e| e.velocity_m_s == 0.04 * 2.0));
+    assert_eq!(efforts.len(), 5, "one effort array per step");
+    for (ef, e) in efforts.iter().zip(&per[0]) {
+        assert_eq!(ef.as_slice(), [0.04 * e.friction_force_n]);
+        assert_eq!(ef.stamp_ns, e.stamp_ns);
+    }
+}

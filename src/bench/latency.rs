@@ -66,12 +66,13 @@ pub fn latency(
     let mut times = Vec::with_capacity(samples);
     let mut lost = 0;
     let stamp0 = crate::clock::system_wall_ns();
+    let plan = cfg.output_plan();
+    let several = plan.by_joint();
     let joints: Vec<String> = cfg
         .resolved_contacts()
         .into_iter()
         .map(|c| c.joint)
         .collect();
-    let several = joints.len() > 1;
     let mut js = crate::transport::JointStateCommand {
         stamp_ns: 0,
         velocity: vec![0.0; joints.len()],

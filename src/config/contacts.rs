@@ -230,7 +230,50 @@ pub struct ResolvedContact {
 /// The name of the one contact of a configuration without `contacts`.
 pub const SINGLE_CONTACT_NAME: &str = "contact";
 
+/// How the node meets the world, decided once from the configuration:
+/// the loop, the transports, the recorder, replay and the topic names all
+/// ask this, never the number of contacts.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum OutputPlan {
+    /// No `contacts` list: the one contact of the top-level sections,
+    /// driven by velocity commands (Float64 or TwistStamped), its estimate
+    /// on `ros.topics.friction` and its force alone (Float64) on
+    /// `ros.topics.friction_force`.
+    OneContact,
+    /// Listed contacts (one or more), each driven by its joint's velocity
+    /// in a JointState: each estimate on its contact's own topic, and the
+    /// joints' efforts (gain × friction) as one array per step. The joints
+    /// in the configured order.
+    Joints(Vec<String>),
+}
+
+impl OutputPlan {
+    /// The joints, in the configured order (none for one contact).
+    pub fn joints(&self) -> &[String] {
+        match self {
+            Self::OneContact => &[],
+            Self::Joints(j) => j,
+        }
+    }
+
+    /// Whether the contacts are driven by joints.
+    pub fn by_joint(&self) -> bool {
+        matches!(self, Self::Joints(_))
+    }
+}
+
 impl Config {
+    /// The output plan: [`OutputPlan::Joints`] whenever `contacts` lists
+    /// any (a rotary joint fitted by `fit --rotary` is one listed
+    /// contact), else [`OutputPlan::OneContact`].
+    pub fn output_plan(&self) -> OutputPlan {
+        if self.contacts.0.is_empty() {
+            OutputPlan::OneContact
+        } else {
+            OutputPlan::Joints(self.contacts.0.iter().map(|c| c.joint.clone()).collect())
+        }
+    }
+
     /// Every contact with its own configuration; a configuration without
     /// `contacts` is one contact named `contact` on joint `""`, gain 1.
     pub fn resolved_contacts(&self) -> Vec<ResolvedContact> {
@@ -383,6 +426,27 @@ mod tests {
     }
 
     const TWO: &str = "friction_node:\n  ros__parameters:\n    contact: {load_n: 8000.0, boundary_friction: 0.2}\n    solver: {cells: 64}\n    contacts:\n      right:\n        joint: axis_y\n        gain: 0.05\n        contact: {load_n: 3000.0}\n        solver: {cells: 32}\n      left:\n        lubricant: {viscosity_pa_s: 0.1}\n";
+
+    #[test]
+    fn listed_contacts_are_driven_by_joints_even_one_and_a_plain_configuration_is_one_contact() {
+        assert_eq!(Config::default().output_plan(), OutputPlan::OneContact);
+        let one = load(
+            "/**:\n  ros__parameters:\n    contacts:\n      elbow: {joint: elbow_joint, gain: 0.04}\n",
+            &[],
+        )
+        .unwrap();
+        let plan = one.output_plan();
+        assert_eq!(plan, OutputPlan::Joints(vec!["elbow_joint".into()]));
+        assert!(plan.by_joint());
+        // The node's topics follow the plan: the contact's own estimate topic.
+        let topics = crate::config::topics::TopicNames::from_config(&one);
+        assert_eq!(topics.contact_friction.len(), 1);
+        assert!(topics.contact_friction[0].ends_with("/elbow/friction"));
+        assert_eq!(
+            load(TWO, &[]).unwrap().output_plan().joints(),
+            ["axis_y", "left"]
+        );
+    }
 
     #[test]
     fn a_contact_overrides_the_top_level_key_by_key_and_keeps_the_file_order() {

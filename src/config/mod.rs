@@ -49,7 +49,7 @@ mod validate;
 mod validate_node;
 
 pub use contacts::{
-    ContactEntry, ContactList, ContactSolverConfig, ResolvedContact, CONTACT_SECTIONS,
+    ContactEntry, ContactList, ContactSolverConfig, OutputPlan, ResolvedContact, CONTACT_SECTIONS,
     MAX_CONTACTS, MAX_JOINT_NAME_BYTES, SINGLE_CONTACT_NAME,
 };
 pub use envelope::{

@@ -89,7 +89,7 @@ impl TopicNames {
             joint_commands: t(&r.topics.joint_commands),
             joint_efforts: t(&r.topics.joint_efforts),
             joint_friction: t(&r.topics.joint_friction),
-            contact_friction: if cfg.contacts.0.len() > 1 {
+            contact_friction: if cfg.output_plan().by_joint() {
                 let prefix = r.topics.contact_friction.trim_end_matches('/');
                 cfg.contacts
                     .0

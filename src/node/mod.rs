@@ -144,6 +144,9 @@ pub struct Loop {
     velocities: Vec<f64>,
     loads: Vec<f64>,
     efforts: Vec<f64>,
+    /// The contacts are driven by joints (the output plan): efforts go out
+    /// every step.
+    by_joint: bool,
     /// What the loop takes from the configuration (replaced by a live
     /// parameter update).
     settings: LoopSettings,
@@ -223,6 +226,7 @@ impl Loop {
             velocities: vec![v0; n],
             loads: resolved.iter().map(|c| c.config.contact.load_n).collect(),
             efforts: vec![0.0; n],
+            by_joint: config.output_plan().by_joint(),
             ports,
             record,
             profile,

@@ -43,7 +43,7 @@ impl Loop {
             self.publish(k, &e, stamp_ns, own, late_ns);
             self.efforts[k] = self.contacts.effort(k);
         }
-        if several {
+        if self.by_joint {
             for p in self.ports.iter_mut() {
                 if !p.publish_efforts(stamp_ns, &self.efforts) {
                     self.summary.publish_drops += 1;

@@ -123,12 +123,10 @@ pub fn backend_specs(
         #[cfg(feature = "iceoryx2")]
         {
             let spec = transport::iceoryx::IceoryxSpec::from(&config.iceoryx2);
-            let contacts = config.resolved_contacts();
-            out.push(BackendSpec::Iceoryx2(if contacts.len() > 1 {
-                spec.with_joints(contacts.into_iter().map(|c| c.joint).collect())
-            } else {
-                spec
-            }));
+            let plan = config.output_plan();
+            out.push(BackendSpec::Iceoryx2(
+                spec.with_joints(plan.joints().to_vec()),
+            ));
         }
         #[cfg(not(feature = "iceoryx2"))]
         return Err(TransportError::NotBuiltIn("iceoryx2"));
@@ -343,11 +341,7 @@ fn start_demo(
         dt_s: config.solver.dt_s,
         seconds,
         motion: opts.motion,
-        joints: if config.contacts.0.len() > 1 {
-            config.contacts.0.iter().map(|c| c.joint.clone()).collect()
-        } else {
-            Vec::new()
-        },
+        joints: config.output_plan().joints().to_vec(),
     };
     let driver = std::thread::spawn(move || super::driver::drive(spec, plan, tx, driver_stop));
     match rx.recv_timeout(Duration::from_secs(30)) {

@@ -102,7 +102,7 @@ impl TopicTable {
                 ),
             ],
         };
-        if config.contacts.0.len() > 1 {
+        if config.output_plan().by_joint() {
             // Several contacts: the JointState input and each contact's
             // estimate on its own topic (the node's published names).
             table.topics.push((

@@ -67,11 +67,7 @@ impl Encoder {
         Self {
             frame_id: config.node.frame_id.clone(),
             command_type: config.ros.command_type,
-            joints: if config.contacts.0.len() > 1 {
-                config.contacts.0.iter().map(|c| c.joint.clone()).collect()
-            } else {
-                Vec::new()
-            },
+            joints: config.output_plan().joints().to_vec(),
         }
     }
 }

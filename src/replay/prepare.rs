@@ -263,7 +263,7 @@ fn input_mode(
     opts: &ReplayOptions,
 ) -> Result<InputMode, ReplayError> {
     let n_contacts = config.contacts.0.len();
-    if n_contacts <= 1 {
+    if !config.output_plan().by_joint() {
         let estimates = scan
             .channels
             .iter()

@@ -153,8 +153,9 @@ pub fn run(
 ) -> Result<ReplayResult, ReplayError> {
     let mut cfg = p.config.clone();
     cfg.node.step_mode = crate::config::StepMode::Lockstep;
-    let joints: Vec<String> = cfg.contacts.0.iter().map(|c| c.joint.clone()).collect();
-    let several = joints.len() > 1;
+    let plan = cfg.output_plan();
+    let joints = plan.joints();
+    let several = plan.by_joint();
     let link = if several {
         MemoryLink::new(16).with_joints(&joints)
     } else {

@@ -212,7 +212,7 @@ impl OutputStream {
         let sink: Box<dyn Sink> = match format {
             OutputFormat::Csv => {
                 let mut file = crate::output::AtomicFile::create(path)?;
-                let contacts: Vec<String> = if p.config.contacts.0.len() > 1 {
+                let contacts: Vec<String> = if p.config.output_plan().by_joint() {
                     p.config.contacts.0.iter().map(|c| c.name.clone()).collect()
                 } else {
                     Vec::new()

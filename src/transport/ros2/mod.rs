@@ -150,11 +150,7 @@ impl Ros2Spec {
             estimate_qos: r.qos.estimates.clone(),
             frame_id: cfg.node.frame_id.clone(),
             queue_capacity: cfg.node.queue_capacity,
-            joints: if cfg.contacts.0.len() > 1 {
-                cfg.contacts.0.iter().map(|c| c.joint.clone()).collect()
-            } else {
-                Vec::new()
-            },
+            joints: cfg.output_plan().joints().to_vec(),
         })
     }
 }
