@@ -157,7 +157,7 @@ pub fn run(
     let joints = plan.joints();
     let several = plan.by_joint();
     let link = if several {
-        MemoryLink::new(16).with_joints(&joints)
+        MemoryLink::new(16).with_joints(joints)
     } else {
         MemoryLink::new(16)
     };
