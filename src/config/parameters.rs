@@ -20,6 +20,8 @@
 
 use super::{key_ranges, Config, ConfigError, KeyRange};
 use crate::msgs::ros_interfaces::{parameter_type as ty, ParameterValue};
+use crate::physics::terms::{catalogue, End};
+use crate::text::Num;
 use serde_norway::Value;
 
 /// Whether `key` may change while the node runs.
@@ -308,9 +310,46 @@ pub fn apply_set(
     Ok(new)
 }
 
+/// The catalogue as a markdown table (key | symbol | unit | range | live |
+/// meaning): the README's table of the friction terms' keys is this text.
+pub fn term_keys_table() -> String {
+    let mut s =
+        String::from("| key | symbol | unit | valid range | meaning |\n|---|---|---|---|---|\n");
+    for k in catalogue() {
+        let (l, lv) = match k.lo {
+            End::Closed(v) => ('[', v),
+            End::Open(v) => ('(', v),
+        };
+        let (h, hv) = match k.hi {
+            End::Closed(v) => (']', v),
+            End::Open(v) => (')', v),
+        };
+        s.push_str(&format!(
+            "| `{}` | {} | {} | {l}{}, {}{h} | {} |\n",
+            k.key,
+            k.symbol,
+            k.unit,
+            Num(lv),
+            Num(hv),
+            k.meaning
+        ));
+    }
+    s
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_readme_lists_the_terms_keys_as_the_catalogue_declares_them() {
+        let readme = include_str!(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md"));
+        let table = term_keys_table();
+        assert!(
+            readme.contains(&table),
+            "README.md lacks the table:\n{table}"
+        );
+    }
 
     fn value(text: &str) -> ParameterValue {
         ParameterValue::from_yaml(&serde_norway::from_str(text).unwrap())

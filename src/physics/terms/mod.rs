@@ -153,33 +153,6 @@ pub fn term_key(key: &str) -> Option<&'static TermKey> {
     catalogue().find(|k| k.key == key)
 }
 
-/// The catalogue as a markdown table (key | symbol | unit | range | live |
-/// meaning): the README's table of the friction terms' keys is this text.
-pub fn keys_table() -> String {
-    let mut s =
-        String::from("| key | symbol | unit | valid range | meaning |\n|---|---|---|---|---|\n");
-    for k in catalogue() {
-        let (l, lv) = match k.lo {
-            End::Closed(v) => ('[', v),
-            End::Open(v) => ('(', v),
-        };
-        let (h, hv) = match k.hi {
-            End::Closed(v) => (']', v),
-            End::Open(v) => (')', v),
-        };
-        s.push_str(&format!(
-            "| `{}` | {} | {} | {l}{}, {}{h} | {} |\n",
-            k.key,
-            k.symbol,
-            k.unit,
-            crate::text::Num(lv),
-            crate::text::Num(hv),
-            k.meaning
-        ));
-    }
-    s
-}
-
 /// The friction terms of one contact, composed in the order of the module
 /// documentation. All off by default.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -367,15 +340,5 @@ mod tests {
         assert_eq!(z, 0.0);
         assert_eq!(sgn(-0.0), 0.0);
         assert_eq!(sgn(-2.0), -1.0);
-    }
-
-    #[test]
-    fn the_readme_lists_the_terms_keys_as_the_catalogue_declares_them() {
-        let readme = include_str!(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md"));
-        let table = keys_table();
-        assert!(
-            readme.contains(&table),
-            "README.md lacks the table:\n{table}"
-        );
     }
 }
