@@ -18,7 +18,7 @@ use friction_node::msgs::{
 use friction_node::node::{Loop, RunSummary};
 use friction_node::offline;
 use friction_node::signal::Signal;
-use friction_node::transport::{self, BackendSpec};
+use friction_node::transport::{self, BackendSpec, JointStateCommand, TransportError};
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
@@ -139,6 +139,22 @@ fn conformance(spec: BackendSpec, cfg: Config) {
             .unwrap_or_else(|| panic!("{}: no estimate for {what}", spec.name()))
     };
     let stamped = cfg.ros.command_type == CommandType::TwistStamped || spec.name() != "ros2";
+    // A side opened for one contact has no joints: asking for them is the
+    // same typed error on every backend.
+    let no_joints = peer.send_joint_state(&JointStateCommand {
+        stamp_ns: STAMP0,
+        name: vec!["elbow".into()],
+        velocity: vec![0.1],
+    });
+    assert!(
+        matches!(no_joints, Err(TransportError::NotJoints { .. })),
+        "{}: {no_joints:?}",
+        spec.name()
+    );
+    assert!(matches!(
+        peer.try_recv_efforts(),
+        Err(TransportError::NotJoints { .. })
+    ));
     for (k, want) in reference.iter().enumerate() {
         let t = (k + 1) as f64 * cfg.solver.dt_s;
         let stamp = STAMP0 + k as u64 * 1_000_000;

@@ -150,11 +150,11 @@ pub fn decode_cdr<T: serde::de::DeserializeOwned>(
     index: u64,
     data: &[u8],
 ) -> Result<T, BagError> {
-    msgs::from_cdr(data).map_err(|message| BagError::Decode {
+    msgs::from_cdr(data).map_err(|e| BagError::Decode {
         topic: c.topic.clone(),
         type_name: c.schema_name.clone(),
         index,
-        message,
+        message: e.to_string(),
     })
 }
 
@@ -223,11 +223,11 @@ impl TopicDecoder {
                     SampleKind::TwistLinearX => command_codec::twist_linear_x,
                     _ => command_codec::temperature,
                 };
-                let (value, header) = read(m.data).map_err(|message| BagError::Decode {
+                let (value, header) = read(m.data).map_err(|e| BagError::Decode {
                     topic: c.topic.clone(),
                     type_name: c.schema_name.clone(),
                     index: idx,
-                    message,
+                    message: e.to_string(),
                 })?;
                 Ok((stamp_or(header, m.publish_time, m.log_time), value))
             }

@@ -15,7 +15,9 @@
 //! zero), else the fallback: the sender's publish time, then the time the
 //! sample was logged or received.
 
-use super::{Command, CommandKind, Float64, Header, JointState, Temperature, Time, TwistStamped};
+use super::{
+    CdrError, Command, CommandKind, Float64, Header, JointState, Temperature, Time, TwistStamped,
+};
 use crate::config::CommandType;
 
 /// A command as the message it travels in.
@@ -74,7 +76,7 @@ impl CommandMessage {
     }
 
     /// The message in CDR.
-    pub fn to_cdr(&self) -> Result<Vec<u8>, String> {
+    pub fn to_cdr(&self) -> Result<Vec<u8>, CdrError> {
         match self {
             Self::Float64(m) => super::to_cdr(m),
             Self::Twist(m) => super::to_cdr(m),
@@ -94,33 +96,35 @@ pub fn stamp_or(header_ns: u64, fallback: impl FnOnce() -> u64) -> u64 {
 }
 
 /// The value of a `std_msgs/msg/Float64` (no header: stamp 0).
-pub fn float64(cdr: &[u8]) -> Result<(f64, u64), String> {
+pub fn float64(cdr: &[u8]) -> Result<(f64, u64), CdrError> {
     super::from_cdr::<Float64>(cdr).map(|m| (m.data, 0))
 }
 
 /// `twist.linear.x` of a `geometry_msgs/msg/TwistStamped` and its header's
 /// stamp.
-pub fn twist_linear_x(cdr: &[u8]) -> Result<(f64, u64), String> {
+pub fn twist_linear_x(cdr: &[u8]) -> Result<(f64, u64), CdrError> {
     super::from_cdr::<TwistStamped>(cdr).map(|m| (m.twist.linear.x, m.header.stamp.to_ns()))
 }
 
 /// The temperature of a `sensor_msgs/msg/Temperature` and its header's
 /// stamp.
-pub fn temperature(cdr: &[u8]) -> Result<(f64, u64), String> {
+pub fn temperature(cdr: &[u8]) -> Result<(f64, u64), CdrError> {
     super::from_cdr::<Temperature>(cdr).map(|m| (m.temperature, m.header.stamp.to_ns()))
 }
 
 /// The value and header stamp (0: none) of a command of `kind` sent with
 /// velocities as `velocity`. A joint's velocity comes in a JointState of
 /// several joints, read by name where the joints are known (not here).
-pub fn decode(kind: CommandKind, velocity: CommandType, cdr: &[u8]) -> Result<(f64, u64), String> {
+pub fn decode(
+    kind: CommandKind,
+    velocity: CommandType,
+    cdr: &[u8],
+) -> Result<(f64, u64), CdrError> {
     match (kind, velocity) {
         (CommandKind::Temperature, _) => temperature(cdr),
         (CommandKind::Velocity, CommandType::TwistStamped) => twist_linear_x(cdr),
         (CommandKind::Velocity, CommandType::Float64) | (CommandKind::Load, _) => float64(cdr),
-        (CommandKind::JointVelocity { .. }, _) => {
-            Err("a joint's velocity is read by its joint's name from a JointState".into())
-        }
+        (CommandKind::JointVelocity { .. }, _) => Err(CdrError::JointByName),
     }
 }
 

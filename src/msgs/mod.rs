@@ -24,7 +24,7 @@ pub mod ros_interfaces;
 mod types;
 mod wire;
 
-pub use cdr::{from_cdr, to_cdr};
+pub use cdr::{from_cdr, to_cdr, CdrError};
 pub use records::*;
 pub use types::*;
 pub use wire::*;

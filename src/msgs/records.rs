@@ -231,7 +231,7 @@ pub fn is_legacy_estimate_schema(schema_text: &str) -> bool {
 }
 
 /// Decode a recorded `FrictionEstimate` of either layout.
-pub fn decode_estimate(bytes: &[u8], legacy: bool) -> Result<EstimateRecord, String> {
+pub fn decode_estimate(bytes: &[u8], legacy: bool) -> Result<EstimateRecord, super::CdrError> {
     if legacy {
         super::from_cdr::<FrictionEstimateV1>(bytes).map(|m| EstimateRecord::from_wire_v1(&m))
     } else {

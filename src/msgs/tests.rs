@@ -156,5 +156,18 @@ fn cdr_round_trips_with_the_encapsulation_header() {
     let back: FrictionEstimate = from_cdr(&bytes).unwrap();
     assert_eq!(EstimateRecord::from_wire(&back), r);
     assert_eq!(back.header.frame_id, "slider");
-    assert!(from_cdr::<FrictionEstimate>(&bytes[..10]).is_err());
+    assert!(matches!(
+        from_cdr::<FrictionEstimate>(&bytes[..10]),
+        Err(CdrError::Body { .. })
+    ));
+    assert_eq!(
+        from_cdr::<FrictionEstimate>(&bytes[..2]),
+        Err(CdrError::TooShort { len: 2 })
+    );
+    let mut xcdr = bytes.clone();
+    xcdr[1] = 0x07;
+    assert_eq!(
+        from_cdr::<FrictionEstimate>(&xcdr),
+        Err(CdrError::Encapsulation { header: [0, 7] })
+    );
 }

@@ -106,7 +106,7 @@ pub struct Encoder {
 }
 
 fn cdr<T: serde::Serialize>(topic: TopicId, m: &T) -> Result<Vec<u8>, WriteError> {
-    msgs::to_cdr(m).map_err(|message| WriteError::Encode { topic, message })
+    msgs::to_cdr(m).map_err(|error| WriteError::Encode { topic, error })
 }
 
 /// The topic a command of `kind` is recorded on.
@@ -136,12 +136,9 @@ impl Encoder {
         };
         let topic = command_topic(c.kind);
         let data = CommandMessage::of(c, self.command_type, &self.frame_id, joint)
-            .ok_or(WriteError::Encode {
-                topic,
-                message: "a joint velocity without its joint's name".into(),
-            })?
-            .to_cdr()
-            .map_err(|message| WriteError::Encode { topic, message })?;
+            .ok_or(msgs::CdrError::JointByName)
+            .and_then(|m| m.to_cdr())
+            .map_err(|error| WriteError::Encode { topic, error })?;
         Ok(Entry {
             topic,
             log_ns: received_ns,

@@ -96,12 +96,13 @@ pub enum WriteError {
     #[error(transparent)]
     Io(#[from] std::io::Error),
     /// A message did not serialize as CDR.
-    #[error("cannot encode {topic:?} as CDR: {message}")]
+    #[error("cannot encode {topic:?} as CDR: {error}")]
     Encode {
         /// The topic the message was for.
         topic: TopicId,
-        /// The serializer's error.
-        message: String,
+        /// The codec's error.
+        #[source]
+        error: crate::msgs::CdrError,
     },
     /// An item for a contact the recording does not have.
     #[error("{what} of contact {contact}, but the recording has {contacts} contacts")]

@@ -182,12 +182,13 @@ impl<'s> Readers<'s> {
 
     /// Decode one message into `s` if it is on one of the topics.
     fn take(&mut self, view: &BagMessage<'_>, s: &mut Samples) -> Result<(), BagError> {
-        let estimate_error = |topic: &str, type_name: &str, index, message| BagError::Decode {
-            topic: topic.to_string(),
-            type_name: type_name.to_string(),
-            index,
-            message,
-        };
+        let estimate_error =
+            |topic: &str, type_name: &str, index, e: msgs::CdrError| BagError::Decode {
+                topic: topic.to_string(),
+                type_name: type_name.to_string(),
+                index,
+                message: e.to_string(),
+            };
         if let Some(c) = self.events.filter(|c| c.topic == view.topic) {
             self.take_event(c, view.data, s)
         } else if let Some(k) = self.contact_topics.iter().position(|t| *t == view.topic) {
@@ -240,15 +241,14 @@ impl<'s> Readers<'s> {
 
     /// A parameter event: kept when it is this node's and changed something.
     fn take_event(&self, c: &ChannelInfo, data: &[u8], s: &mut Samples) -> Result<(), BagError> {
-        let ev =
-            msgs::from_cdr::<msgs::ros_interfaces::ParameterEvent>(data).map_err(|message| {
-                BagError::Decode {
-                    topic: c.topic.clone(),
-                    type_name: c.schema_name.clone(),
-                    index: s.parameter_changes.len() as u64 + 1,
-                    message,
-                }
-            })?;
+        let ev = msgs::from_cdr::<msgs::ros_interfaces::ParameterEvent>(data).map_err(|e| {
+            BagError::Decode {
+                topic: c.topic.clone(),
+                type_name: c.schema_name.clone(),
+                index: s.parameter_changes.len() as u64 + 1,
+                message: e.to_string(),
+            }
+        })?;
         if ev.node == self.node_fqn && !ev.changed_parameters.is_empty() {
             s.parameter_changes.push(ParameterChange {
                 stamp_ns: ev.stamp.to_ns(),

@@ -170,15 +170,33 @@ pub struct MemoryPeer {
     link: MemoryLink,
 }
 
+impl MemoryPeer {
+    /// Ok when the link was opened for joints (a configuration with
+    /// `contacts`), else the error of `operation`.
+    fn joints(&self, operation: &'static str) -> Result<(), TransportError> {
+        if self.link.joints.is_empty() {
+            return Err(TransportError::NotJoints {
+                backend: "memory",
+                operation,
+            });
+        }
+        Ok(())
+    }
+}
+
 impl PeerPort for MemoryPeer {
     fn name(&self) -> &'static str {
         "memory"
     }
 
     fn send(&mut self, c: &Command) -> Result<(), TransportError> {
-        self.link.commands.push(*c).map_err(|_| {
-            TransportError::backend("memory", "send a command", "the command queue is full")
-        })
+        self.link
+            .commands
+            .push(*c)
+            .map_err(|_| TransportError::Full {
+                backend: "memory",
+                operation: "send a command",
+            })
     }
 
     fn try_recv(&mut self) -> Result<Option<EstimateRecord>, TransportError> {
@@ -190,6 +208,7 @@ impl PeerPort for MemoryPeer {
     }
 
     fn send_joint_state(&mut self, js: &JointStateCommand) -> Result<(), TransportError> {
+        self.joints("send a JointState")?;
         let mut full = false;
         let names = js.name.iter().map(String::as_str);
         joint_commands(
@@ -202,20 +221,21 @@ impl PeerPort for MemoryPeer {
             },
         );
         if full {
-            return Err(TransportError::backend(
-                "memory",
-                "send a JointState",
-                "the command queue is full",
-            ));
+            return Err(TransportError::Full {
+                backend: "memory",
+                operation: "send a JointState",
+            });
         }
         Ok(())
     }
 
     fn try_recv_efforts(&mut self) -> Result<Option<JointEfforts>, TransportError> {
+        self.joints("receive joint efforts")?;
         Ok(self.link.efforts.pop())
     }
 
     fn try_recv_contact(&mut self) -> Result<Option<(usize, EstimateRecord)>, TransportError> {
+        self.joints("receive a contact estimate")?;
         Ok(self.link.contact_estimates.pop())
     }
 

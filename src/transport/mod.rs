@@ -31,19 +31,68 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-/// Errors of the transport layer.
+/// Errors of the transport layer, by the operation that failed. The
+/// middleware's errors arrive formatted: the backends' error types stay out
+/// of this crate's API.
 #[derive(Debug, thiserror::Error)]
 pub enum TransportError {
-    /// The middleware refused an operation (its error, formatted: the
-    /// backends' error types stay out of this crate's API).
+    /// Opening a side failed: a node, context, topic, service, publisher,
+    /// subscriber, poll or thread.
     #[error("{backend}: cannot {operation}: {message}")]
-    Backend {
-        /// `ros2` or `iceoryx2`.
+    Open {
+        /// `memory`, `ros2` or `iceoryx2`.
         backend: &'static str,
-        /// What was being done.
+        /// What was being opened, as a phrase ("create topic `x`").
         operation: String,
         /// The middleware's error.
         message: String,
+    },
+    /// Sending failed: a command, a joint state, an event, a notification.
+    #[error("{backend}: cannot {operation}: {message}")]
+    Send {
+        /// `memory`, `ros2` or `iceoryx2`.
+        backend: &'static str,
+        /// What was being sent, as a phrase.
+        operation: String,
+        /// The middleware's error.
+        message: String,
+    },
+    /// Receiving failed: an estimate, statistics, efforts, a command event.
+    #[error("{backend}: cannot {operation}: {message}")]
+    Receive {
+        /// `memory`, `ros2` or `iceoryx2`.
+        backend: &'static str,
+        /// What was being received, as a phrase.
+        operation: String,
+        /// The middleware's error.
+        message: String,
+    },
+    /// A bounded queue had no room: the other side does not keep up.
+    #[error("{backend}: cannot {operation}: the queue is full")]
+    Full {
+        /// `memory`, `ros2` or `iceoryx2`.
+        backend: &'static str,
+        /// What was being sent.
+        operation: &'static str,
+    },
+    /// A message the wire cannot carry (a name longer than its slot, more
+    /// joints than a sample holds).
+    #[error("{backend}: cannot {operation}: {reason}")]
+    TooLarge {
+        /// `memory`, `ros2` or `iceoryx2`.
+        backend: &'static str,
+        /// What was being sent.
+        operation: &'static str,
+        /// What does not fit.
+        reason: String,
+    },
+    /// A joint operation on a side opened for one contact.
+    #[error("{backend}: cannot {operation}: this side was opened for one contact (a configuration with `contacts` opens the joints)")]
+    NotJoints {
+        /// `memory`, `ros2` or `iceoryx2`.
+        backend: &'static str,
+        /// What was asked.
+        operation: &'static str,
     },
     /// The transport's feature was not compiled in.
     #[error("the {0} transport is not built in (rebuild with the `{0}` feature)")]
@@ -60,16 +109,42 @@ pub enum TransportError {
     },
 }
 
+/// The kind of operation a middleware error came from (each backend's
+/// helpers build [`TransportError`] from it).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[allow(dead_code)] // a backend may not use every kind
+pub(crate) enum Operation {
+    Open,
+    Send,
+    Receive,
+}
+
 impl TransportError {
-    pub(crate) fn backend(
+    /// The error of a middleware operation of `kind`.
+    #[allow(dead_code)] // the in-memory backend has no middleware
+    pub(crate) fn middleware(
         backend: &'static str,
+        kind: Operation,
         operation: impl Into<String>,
-        message: impl ToString,
+        error: impl std::fmt::Debug,
     ) -> Self {
-        TransportError::Backend {
-            backend,
-            operation: operation.into(),
-            message: message.to_string(),
+        let (operation, message) = (operation.into(), format!("{error:?}"));
+        match kind {
+            Operation::Open => TransportError::Open {
+                backend,
+                operation,
+                message,
+            },
+            Operation::Send => TransportError::Send {
+                backend,
+                operation,
+                message,
+            },
+            Operation::Receive => TransportError::Receive {
+                backend,
+                operation,
+                message,
+            },
         }
     }
 }

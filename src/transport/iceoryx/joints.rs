@@ -14,6 +14,7 @@ use super::{IceoryxSpec, JointStatePayload, Sequences, JOINT_NAME_BYTES};
 use crate::clock::system_wall_ns;
 use crate::link::RecordItem;
 use crate::msgs::{Command, EstimateRecord};
+use crate::transport::Operation;
 use crate::transport::{
     joint_commands, record_input, JointEfforts, JointStateCommand, RecordQueue, SharedCounters,
     TransportError, MAX_CONTACTS,
@@ -52,15 +53,15 @@ impl JointNode {
                 .subscriber_builder()
                 .buffer_size(JOINT_BUFFER)
                 .create()
-                .map_err(|e| err("create the joint-state subscriber", e))?,
+                .map_err(|e| err(Operation::Open, "create the joint-state subscriber", e))?,
             efforts: ef
                 .publisher_builder()
                 .create()
-                .map_err(|e| err("create the efforts publisher", e))?,
+                .map_err(|e| err(Operation::Open, "create the efforts publisher", e))?,
             contact_estimate: ce
                 .publisher_builder()
                 .create()
-                .map_err(|e| err("create the contact estimate publisher", e))?,
+                .map_err(|e| err(Operation::Open, "create the contact estimate publisher", e))?,
             sequences: Sequences::new(),
             pending: [None; MAX_CONTACTS],
             next: MAX_CONTACTS,
@@ -86,7 +87,7 @@ impl JointNode {
             let Some(s) = self
                 .joint_state
                 .receive()
-                .map_err(|e| err("receive a joint state", e))?
+                .map_err(|e| err(Operation::Receive, "receive a joint state", e))?
             else {
                 return Ok(None);
             };
@@ -188,17 +189,17 @@ impl JointPeer {
             joint_state: js
                 .publisher_builder()
                 .create()
-                .map_err(|e| err("create the joint-state publisher", e))?,
+                .map_err(|e| err(Operation::Open, "create the joint-state publisher", e))?,
             efforts: ef
                 .subscriber_builder()
                 .buffer_size(OUTPUT_BUFFER)
                 .create()
-                .map_err(|e| err("create the efforts subscriber", e))?,
+                .map_err(|e| err(Operation::Open, "create the efforts subscriber", e))?,
             contact_estimate: ce
                 .subscriber_builder()
                 .buffer_size(OUTPUT_BUFFER)
                 .create()
-                .map_err(|e| err("create the contact estimate subscriber", e))?,
+                .map_err(|e| err(Operation::Open, "create the contact estimate subscriber", e))?,
             sequence: 0,
         })
     }
@@ -208,28 +209,28 @@ impl JointPeer {
     pub fn send(&mut self, js: &JointStateCommand) -> Result<(), TransportError> {
         let too_many = js.name.len().max(js.velocity.len()) > MAX_CONTACTS;
         if too_many {
-            return Err(TransportError::backend(
-                super::NAME,
-                "send a JointState",
-                format!(
+            return Err(TransportError::TooLarge {
+                backend: super::NAME,
+                operation: "send a JointState",
+                reason: format!(
                     "{} names and {} velocities: at most {MAX_CONTACTS} joints",
                     js.name.len(),
                     js.velocity.len()
                 ),
-            ));
+            });
         }
         if let Some(long) = js.name.iter().find(|n| n.len() > JOINT_NAME_BYTES) {
-            return Err(TransportError::backend(
-                super::NAME,
-                "send a JointState",
-                format!("joint name `{long}` is longer than {JOINT_NAME_BYTES} bytes"),
-            ));
+            return Err(TransportError::TooLarge {
+                backend: super::NAME,
+                operation: "send a JointState",
+                reason: format!("joint name `{long}` is longer than {JOINT_NAME_BYTES} bytes"),
+            });
         }
         self.sequence += 1;
         let sample = self
             .joint_state
             .loan_uninit()
-            .map_err(|e| err("loan a joint-state sample", e))?;
+            .map_err(|e| err(Operation::Send, "loan a joint-state sample", e))?;
         let mut p = JointStatePayload {
             stamp_ns: js.stamp_ns,
             sequence: self.sequence,
@@ -247,7 +248,7 @@ impl JointPeer {
         sample
             .write_payload(p)
             .send()
-            .map_err(|e| err("send a joint state", e))?;
+            .map_err(|e| err(Operation::Send, "send a joint state", e))?;
         Ok(())
     }
 
@@ -255,7 +256,7 @@ impl JointPeer {
         Ok(self
             .efforts
             .receive()
-            .map_err(|e| err("receive joint efforts", e))?
+            .map_err(|e| err(Operation::Receive, "receive joint efforts", e))?
             .map(|s| {
                 let n = (s.len as usize).min(MAX_CONTACTS);
                 JointEfforts::new(s.stamp_ns, &s.effort[..n])
@@ -266,7 +267,7 @@ impl JointPeer {
         Ok(self
             .contact_estimate
             .receive()
-            .map_err(|e| err("receive a contact estimate", e))?
+            .map_err(|e| err(Operation::Receive, "receive a contact estimate", e))?
             .map(|s| (s.contact as usize, EstimateRecord::from(&s.estimate))))
     }
 }

@@ -29,6 +29,7 @@ mod peer;
 
 use super::TransportError;
 use crate::config::Iceoryx2Config;
+use crate::transport::Operation;
 use iceoryx2::identifiers::UniquePublisherId;
 use iceoryx2::prelude::*;
 pub use node::IceoryxNode;
@@ -96,8 +97,8 @@ const ESTIMATE_BUFFER: usize = 1024;
 /// Depth of the statistics buffers.
 const STATISTICS_BUFFER: usize = 64;
 
-fn err(op: &str, e: impl std::fmt::Debug) -> TransportError {
-    TransportError::backend(NAME, op.to_string(), format!("{e:?}"))
+fn err(kind: Operation, op: &str, e: impl std::fmt::Debug) -> TransportError {
+    TransportError::middleware(NAME, kind, op, e)
 }
 
 fn node() -> Result<Node<ipc::Service>, TransportError> {
@@ -106,7 +107,7 @@ fn node() -> Result<Node<ipc::Service>, TransportError> {
         // The node handles SIGINT/SIGTERM itself (to finalise recordings).
         .signal_handling_mode(SignalHandlingMode::Disabled)
         .create::<ipc::Service>()
-        .map_err(|e| err("create an iceoryx2 node", e))
+        .map_err(|e| err(Operation::Open, "create an iceoryx2 node", e))
 }
 
 type PubSub<T> =
@@ -120,7 +121,7 @@ fn service<T: std::fmt::Debug + ZeroCopySend>(
 ) -> Result<PubSub<T>, TransportError> {
     let sn: ServiceName = name
         .try_into()
-        .map_err(|e| err(&format!("use service name `{name}`"), e))?;
+        .map_err(|e| err(Operation::Open, &format!("use service name `{name}`"), e))?;
     n.service_builder(&sn)
         .publish_subscribe::<T>()
         .enable_safe_overflow(true)
@@ -129,17 +130,17 @@ fn service<T: std::fmt::Debug + ZeroCopySend>(
         .max_publishers(8)
         .max_subscribers(8)
         .open_or_create()
-        .map_err(|e| err(&format!("open service `{name}`"), e))
+        .map_err(|e| err(Operation::Open, &format!("open service `{name}`"), e))
 }
 
 fn event(n: &Node<ipc::Service>, name: &str) -> Result<EventService, TransportError> {
     let sn: ServiceName = name
         .try_into()
-        .map_err(|e| err(&format!("use service name `{name}`"), e))?;
+        .map_err(|e| err(Operation::Open, &format!("use service name `{name}`"), e))?;
     n.service_builder(&sn)
         .event()
         .open_or_create()
-        .map_err(|e| err(&format!("open event service `{name}`"), e))
+        .map_err(|e| err(Operation::Open, &format!("open event service `{name}`"), e))
 }
 
 /// Sequence numbers seen per publisher (fixed size: no allocation).

@@ -7,6 +7,7 @@ use super::*;
 use crate::clock::system_wall_ns;
 use crate::link::RecordItem;
 use crate::msgs::{Command, CommandKind, EstimateRecord, StatisticsRecord};
+use crate::transport::Operation;
 use crate::transport::{
     record_input, NodePort, PortCounters, RecordQueue, SharedCounters, TransportError,
 };
@@ -49,30 +50,30 @@ impl IceoryxNode {
                 .subscriber_builder()
                 .buffer_size(COMMAND_BUFFER)
                 .create()
-                .map_err(|e| err("create the temperature subscriber", e))?,
+                .map_err(|e| err(Operation::Open, "create the temperature subscriber", e))?,
             temperature_sequences: Sequences::new(),
             velocity: v
                 .subscriber_builder()
                 .buffer_size(COMMAND_BUFFER)
                 .create()
-                .map_err(|e| err("create the velocity subscriber", e))?,
+                .map_err(|e| err(Operation::Open, "create the velocity subscriber", e))?,
             load: l
                 .subscriber_builder()
                 .buffer_size(COMMAND_BUFFER)
                 .create()
-                .map_err(|e| err("create the load subscriber", e))?,
+                .map_err(|e| err(Operation::Open, "create the load subscriber", e))?,
             estimate: e
                 .publisher_builder()
                 .create()
-                .map_err(|e| err("create the estimate publisher", e))?,
+                .map_err(|e| err(Operation::Open, "create the estimate publisher", e))?,
             statistics: st
                 .publisher_builder()
                 .create()
-                .map_err(|e| err("create the statistics publisher", e))?,
+                .map_err(|e| err(Operation::Open, "create the statistics publisher", e))?,
             listener: ev
                 .listener_builder()
                 .create()
-                .map_err(|e| err("create the command event listener", e))?,
+                .map_err(|e| err(Operation::Open, "create the command event listener", e))?,
             velocity_sequences: Sequences::new(),
             load_sequences: Sequences::new(),
             joints: if spec.joints.is_empty() {
@@ -102,7 +103,7 @@ impl IceoryxNode {
         };
         let Some(s) = sub
             .receive()
-            .map_err(|e| err(&format!("receive {what}"), e))?
+            .map_err(|e| err(Operation::Receive, &format!("receive {what}"), e))?
         else {
             return Ok(None);
         };
@@ -187,7 +188,7 @@ impl NodePort for IceoryxNode {
         self.listener
             .timed_wait(|_| {}, timeout)
             .map(|_| ())
-            .map_err(|e| err("wait for a command event", e))
+            .map_err(|e| err(Operation::Receive, "wait for a command event", e))
     }
 
     fn counters(&self) -> PortCounters {

@@ -5,6 +5,7 @@
 use super::joints::JointPeer;
 use super::*;
 use crate::msgs::{Command, CommandKind, EstimateRecord, StatisticsRecord};
+use crate::transport::Operation;
 use crate::transport::{JointEfforts, JointStateCommand, PeerPort, TransportError};
 use iceoryx2::prelude::*;
 use iceoryx2::service::port_factory::PortFactory;
@@ -42,31 +43,31 @@ impl IceoryxPeer {
                 .subscriber_builder()
                 .buffer_size(STATISTICS_BUFFER)
                 .create()
-                .map_err(|e| err("create the statistics subscriber", e))?,
+                .map_err(|e| err(Operation::Open, "create the statistics subscriber", e))?,
             velocity_sequence: 0,
             load_sequence: 0,
             temperature_sequence: 0,
             temperature: service::<CommandPayload>(&n, &spec.temperature, COMMAND_BUFFER)?
                 .publisher_builder()
                 .create()
-                .map_err(|e| err("create the temperature publisher", e))?,
+                .map_err(|e| err(Operation::Open, "create the temperature publisher", e))?,
             velocity: v
                 .publisher_builder()
                 .create()
-                .map_err(|e| err("create the velocity publisher", e))?,
+                .map_err(|e| err(Operation::Open, "create the velocity publisher", e))?,
             load: l
                 .publisher_builder()
                 .create()
-                .map_err(|e| err("create the load publisher", e))?,
+                .map_err(|e| err(Operation::Open, "create the load publisher", e))?,
             estimate: e
                 .subscriber_builder()
                 .buffer_size(ESTIMATE_BUFFER)
                 .create()
-                .map_err(|e| err("create the estimate subscriber", e))?,
+                .map_err(|e| err(Operation::Open, "create the estimate subscriber", e))?,
             notifier: ev
                 .notifier_builder()
                 .create()
-                .map_err(|e| err("create the command notifier", e))?,
+                .map_err(|e| err(Operation::Open, "create the command notifier", e))?,
             joints: if spec.joints.is_empty() {
                 None
             } else {
@@ -81,12 +82,9 @@ impl IceoryxPeer {
 
 impl IceoryxPeer {
     fn joint_peer(&mut self) -> Result<&mut JointPeer, TransportError> {
-        self.joints.as_mut().ok_or_else(|| {
-            TransportError::backend(
-                NAME,
-                "use the joint services",
-                "this peer was opened for one contact (IceoryxSpec::with_joints opens them)",
-            )
+        self.joints.as_mut().ok_or(TransportError::NotJoints {
+            backend: NAME,
+            operation: "use the joint services",
         })
     }
 }
@@ -110,10 +108,11 @@ impl PeerPort for IceoryxPeer {
             value: c.value,
             sequence: *sequence,
         };
-        port.send_copy(p).map_err(|e| err("send a command", e))?;
+        port.send_copy(p)
+            .map_err(|e| err(Operation::Send, "send a command", e))?;
         self.notifier
             .notify()
-            .map_err(|e| err("notify the node", e))?;
+            .map_err(|e| err(Operation::Send, "notify the node", e))?;
         Ok(())
     }
 
@@ -121,7 +120,7 @@ impl PeerPort for IceoryxPeer {
         Ok(self
             .estimate
             .receive()
-            .map_err(|e| err("receive an estimate", e))?
+            .map_err(|e| err(Operation::Receive, "receive an estimate", e))?
             .map(|s| EstimateRecord::from(&*s)))
     }
 
@@ -129,7 +128,7 @@ impl PeerPort for IceoryxPeer {
         Ok(self
             .statistics
             .receive()
-            .map_err(|e| err("receive loop statistics", e))?
+            .map_err(|e| err(Operation::Receive, "receive loop statistics", e))?
             .map(|s| StatisticsRecord::from(&*s)))
     }
 
@@ -137,7 +136,7 @@ impl PeerPort for IceoryxPeer {
         self.joint_peer()?.send(js)?;
         self.notifier
             .notify()
-            .map_err(|e| err("notify the node", e))?;
+            .map_err(|e| err(Operation::Send, "notify the node", e))?;
         Ok(())
     }
 

@@ -12,6 +12,7 @@ use crate::msgs::{
     LoopStatistics, RawSample, Time, FILM_PROFILE, FLOAT64, FRICTION_ESTIMATE, LOOP_STATISTICS,
     TWIST_STAMPED,
 };
+use crate::transport::Operation;
 use crate::transport::{record_input, RecordQueue, SharedCounters, TransportError};
 use crossbeam_queue::ArrayQueue;
 use ros2_client::dds::rustdds::mio1::{Events, Interest, Poll, Token, Waker};
@@ -86,12 +87,12 @@ fn command_readers(
     let subscriber = ctx
         .domain_participant()
         .create_subscriber(&QosPolicies::from(&cq))
-        .map_err(|e| err("create a DDS subscriber", e))?;
+        .map_err(|e| err(Operation::Open, "create a DDS subscriber", e))?;
     let mut raw_reader = |name: &str, ty: &msgs::MsgType, what: &str| {
         let t = topic(n, name, ty.package, ty.name, &cq)?;
         subscriber
             .create_simple_datareader_no_key::<RawCdr, RawAdapter>(&t, Some(QosPolicies::from(&cq)))
-            .map_err(|e| err(format!("subscribe to {what}"), e))
+            .map_err(|e| err(Operation::Open, format!("subscribe to {what}"), e))
     };
     Ok([
         raw_reader(&spec.topics.cmd_velocity, velocity_type, "the velocity")?,
@@ -168,14 +169,14 @@ fn setup(spec: &Ros2Spec, snapshots: bool, sim_time: bool) -> Result<Entities, T
     let mut joints = (!spec.joints.is_empty())
         .then(|| super::joints::JointTopics::open(n, spec, &cq, &eq))
         .transpose()?;
-    let poll = Poll::new().map_err(|e| err("create a poll", e))?;
+    let poll = Poll::new().map_err(|e| err(Operation::Open, "create a poll", e))?;
     let registry = poll.registry();
     let register = |source: &mut dyn ros2_client::dds::rustdds::mio1::event::Source,
                     token: Token,
                     what: &str| {
         registry
             .register(source, token, Interest::READABLE)
-            .map_err(|e| err(format!("register {what}"), e))
+            .map_err(|e| err(Operation::Open, format!("register {what}"), e))
     };
     register(&mut velocity, VELOCITY, "the velocity reader")?;
     register(&mut load, LOAD, "the load reader")?;
@@ -186,7 +187,9 @@ fn setup(spec: &Ros2Spec, snapshots: bool, sim_time: bool) -> Result<Entities, T
     if let Some(j) = joints.as_mut() {
         register(&mut j.commands, JOINTS, "the joint commands")?;
     }
-    let waker = Arc::new(Waker::new(registry, WAKE).map_err(|e| err("create a waker", e))?);
+    let waker = Arc::new(
+        Waker::new(registry, WAKE).map_err(|e| err(Operation::Open, "create a waker", e))?,
+    );
     Ok(Entities {
         ctx,
         _node: node,

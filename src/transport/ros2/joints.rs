@@ -18,6 +18,7 @@ use crate::msgs::{
     EstimateRecord, Float64MultiArray, FrictionEstimate, Header, JointState, MultiArrayDimension,
     MultiArrayLayout, Time, FLOAT64_MULTI_ARRAY, FRICTION_ESTIMATE, JOINT_STATE,
 };
+use crate::transport::Operation;
 use crate::transport::{
     joint_commands, JointEfforts, JointStateCommand, SharedCounters, TransportError,
 };
@@ -207,14 +208,14 @@ impl JointPeer {
         };
         self.commands
             .publish(m)
-            .map_err(|e| err("publish a JointState", e))
+            .map_err(|e| err(Operation::Send, "publish a JointState", e))
     }
 
     pub fn try_recv_efforts(&mut self) -> Result<Option<JointEfforts>, TransportError> {
         match self.efforts.take() {
             // The stamp travels in the JointState twin; the array has none.
             Ok(m) => Ok(m.map(|(m, _)| JointEfforts::new(0, &m.data))),
-            Err(e) => Err(err("take joint efforts", e)),
+            Err(e) => Err(err(Operation::Receive, "take joint efforts", e)),
         }
     }
 
@@ -229,7 +230,7 @@ impl JointPeer {
                     return Ok(Some((k, EstimateRecord::from_wire(&m))));
                 }
                 Ok(None) => {}
-                Err(e) => return Err(err("take a contact estimate", e)),
+                Err(e) => return Err(err(Operation::Receive, "take a contact estimate", e)),
             }
         }
         Ok(None)

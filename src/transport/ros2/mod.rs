@@ -46,6 +46,7 @@ use super::{NodePort, PortCounters, PortIo, SharedCounters, TransportError};
 use crate::config::topics::TopicNames;
 use crate::config::{self, CommandType, Config, DiscoveryRange, QosConfig, Reliability};
 use crate::msgs::{Command, EstimateRecord, MsgType, StatisticsRecord};
+use crate::transport::Operation;
 use crossbeam_queue::ArrayQueue;
 use ros2_client::dds::rustdds::mio1::Waker;
 use ros2_client::dds::rustdds::DomainParticipantBuilder;
@@ -61,8 +62,12 @@ use std::time::{Duration, Instant};
 
 pub(super) const NAME: &str = "ros2";
 
-pub(super) fn err(op: impl Into<String>, e: impl std::fmt::Debug) -> TransportError {
-    TransportError::backend(NAME, op, format!("{e:?}"))
+pub(super) fn err(
+    kind: Operation,
+    op: impl Into<String>,
+    e: impl std::fmt::Debug,
+) -> TransportError {
+    TransportError::middleware(NAME, kind, op, e)
 }
 
 /// Everything needed to open either side (Send).
@@ -103,11 +108,10 @@ pub fn domain_id(cfg: &Config) -> Result<u16, TransportError> {
             .parse::<u16>()
             .ok()
             .filter(|d| *d <= 232)
-            .ok_or_else(|| {
-                err(
-                    "read ROS_DOMAIN_ID",
-                    format!("`{v}` is not a domain id in 0..=232"),
-                )
+            .ok_or_else(|| TransportError::Open {
+                backend: NAME,
+                operation: "read ROS_DOMAIN_ID".into(),
+                message: format!("`{v}` is not a domain id in 0..=232"),
             }),
         _ => Ok(0),
     }
@@ -178,16 +182,23 @@ pub(super) fn context(spec: &Ros2Spec) -> Result<Context, TransportError> {
     }
     let dp = b.build().map_err(|e| {
         err(
+            Operation::Open,
             format!("create a DDS participant on domain {}", spec.domain_id),
             e,
         )
     })?;
-    Context::from_domain_participant(dp).map_err(|e| err("create a ROS 2 context", e))
+    Context::from_domain_participant(dp)
+        .map_err(|e| err(Operation::Open, "create a ROS 2 context", e))
 }
 
 pub(super) fn ros_node(ctx: &Context, namespace: &str, name: &str) -> Result<Node, TransportError> {
-    let nn = NodeName::new(namespace, name)
-        .map_err(|e| err(format!("use node name `{namespace}` `{name}`"), e))?;
+    let nn = NodeName::new(namespace, name).map_err(|e| {
+        err(
+            Operation::Open,
+            format!("use node name `{namespace}` `{name}`"),
+            e,
+        )
+    })?;
     let mut node = ctx
         .new_node(
             nn,
@@ -196,18 +207,18 @@ pub(super) fn ros_node(ctx: &Context, namespace: &str, name: &str) -> Result<Nod
                 // Parameters are served by `params.rs`, in both DDS layouts.
                 .start_parameter_services(false),
         )
-        .map_err(|e| err("create the ROS 2 node", e))?;
+        .map_err(|e| err(Operation::Open, "create the ROS 2 node", e))?;
     // The spinner maintains the matched-endpoint counts (and answers
     // parameter services); it runs until the node is dropped.
     let spinner = node
         .spinner()
-        .map_err(|e| err("create the node's spinner", e))?;
+        .map_err(|e| err(Operation::Open, "create the node's spinner", e))?;
     std::thread::Builder::new()
         .name("ros2-spinner".into())
         .spawn(move || {
             let _ = futures::executor::block_on(spinner.spin());
         })
-        .map_err(|e| err("start the spinner thread", e))?;
+        .map_err(|e| err(Operation::Open, "start the spinner thread", e))?;
     Ok(node)
 }
 
@@ -218,9 +229,10 @@ pub(super) fn topic(
     ty: &str,
     q: &QosProfile,
 ) -> Result<ros2_client::dds::rustdds::Topic, TransportError> {
-    let n = Name::parse(name).map_err(|e| err(format!("use topic name `{name}`"), e))?;
+    let n = Name::parse(name)
+        .map_err(|e| err(Operation::Open, format!("use topic name `{name}`"), e))?;
     node.create_topic(&n, MessageTypeName::new(package, ty), q)
-        .map_err(|e| err(format!("create topic `{name}`"), e))
+        .map_err(|e| err(Operation::Open, format!("create topic `{name}`"), e))
 }
 
 /// Create the topic and a publisher on it; `what` names it in errors.
@@ -233,7 +245,7 @@ pub(super) fn advertise<M: serde::Serialize>(
 ) -> Result<Publisher<M>, TransportError> {
     let t = topic(node, name, ty.package, ty.name, q)?;
     node.create_publisher(&t, None)
-        .map_err(|e| err(format!("advertise {what}"), e))
+        .map_err(|e| err(Operation::Open, format!("advertise {what}"), e))
 }
 
 /// Create the topic and a subscription on it; `what` names it in errors.
@@ -246,7 +258,7 @@ pub(super) fn subscribe<M: 'static>(
 ) -> Result<Subscription<M>, TransportError> {
     let t = topic(node, name, ty.package, ty.name, q)?;
     node.create_subscription(&t, None)
-        .map_err(|e| err(format!("subscribe to {what}"), e))
+        .map_err(|e| err(Operation::Open, format!("subscribe to {what}"), e))
 }
 
 /// Output the loop hands to the I/O thread (through a preallocated
@@ -298,8 +310,10 @@ impl Ros2Node {
         let thread = std::thread::Builder::new()
             .name("ros2-io".into())
             .spawn(move || io::run(shared, tx))
-            .map_err(|e| err("start the I/O thread", e))?;
-        let (waker, ctx) = rx.recv().map_err(|e| err("start the I/O thread", e))??;
+            .map_err(|e| err(Operation::Open, "start the I/O thread", e))?;
+        let (waker, ctx) = rx
+            .recv()
+            .map_err(|e| err(Operation::Open, "start the I/O thread", e))??;
         let mut node = Self {
             commands,
             outputs,
@@ -317,10 +331,10 @@ impl Ros2Node {
             let t = std::thread::Builder::new()
                 .name("ros2-services".into())
                 .spawn(move || params::run(ctx, fqn, p, record, snapshot, stop, tx))
-                .map_err(|e| err("start the services thread", e))?;
+                .map_err(|e| err(Operation::Open, "start the services thread", e))?;
             node.services = Some(t);
             rx.recv()
-                .map_err(|e| err("start the services thread", e))??;
+                .map_err(|e| err(Operation::Open, "start the services thread", e))??;
         }
         Ok(node)
     }

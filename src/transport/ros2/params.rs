@@ -22,6 +22,7 @@ use crate::msgs::ros_interfaces::{
     ParameterEvent, ParameterValue, SetParametersAtomicallyResponse, SetParametersRequest,
     SetParametersResponse, SetParametersResult, TriggerRequest, TriggerResponse,
 };
+use crate::transport::Operation;
 use crate::transport::RecordQueue;
 use ros2_client::dds::rustdds::mio1::{Events, Interest, Poll, Token};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -252,11 +253,11 @@ fn setup(
     let qos = super::service::service_qos();
     let publisher = dp
         .create_publisher(&qos)
-        .map_err(|e| err("create the services' DDS publisher", e))?;
+        .map_err(|e| err(Operation::Open, "create the services' DDS publisher", e))?;
     let subscriber = dp
         .create_subscriber(&qos)
-        .map_err(|e| err("create the services' DDS subscriber", e))?;
-    let poll = Poll::new().map_err(|e| err("create a poll", e))?;
+        .map_err(|e| err(Operation::Open, "create the services' DDS subscriber", e))?;
+    let poll = Poll::new().map_err(|e| err(Operation::Open, "create a poll", e))?;
     let mut servers = Vec::new();
     for (k, (name, pkg, ty)) in SERVICES.iter().enumerate() {
         let mut s = DualServer::new(
@@ -269,7 +270,7 @@ fn setup(
         )?;
         poll.registry()
             .register(s.reader_mut(), Token(k), Interest::READABLE)
-            .map_err(|e| err(format!("register {name}"), e))?;
+            .map_err(|e| err(Operation::Open, format!("register {name}"), e))?;
         servers.push(s);
     }
     let snapshot = if snapshots {
@@ -283,7 +284,7 @@ fn setup(
         )?;
         poll.registry()
             .register(s.reader_mut(), Token(100), Interest::READABLE)
-            .map_err(|e| err("register ~/snapshot", e))?;
+            .map_err(|e| err(Operation::Open, "register ~/snapshot", e))?;
         Some(s)
     } else {
         None
@@ -307,10 +308,10 @@ fn setup(
             &events_qos,
             ros2_client::dds::rustdds::TopicKind::NoKey,
         )
-        .map_err(|e| err("create /parameter_events", e))?;
+        .map_err(|e| err(Operation::Open, "create /parameter_events", e))?;
     let events = publisher
         .create_datawriter_no_key_cdr::<ParameterEvent>(&topic, Some(events_qos))
-        .map_err(|e| err("advertise /parameter_events", e))?;
+        .map_err(|e| err(Operation::Open, "advertise /parameter_events", e))?;
     Ok(Entities {
         servers,
         snapshot,
@@ -414,7 +415,7 @@ pub fn record_applied(
     u: &ParameterUpdate,
     logged_ns: u64,
 ) -> Result<(), String> {
-    let cdr = crate::msgs::to_cdr(&event(node_fqn, u))?;
+    let cdr = crate::msgs::to_cdr(&event(node_fqn, u)).map_err(|e| e.to_string())?;
     queue
         .push(crate::link::RecordItem::ParameterEvent {
             cdr,

@@ -8,6 +8,7 @@ use crate::msgs::{
     self, Command, CommandKind, EstimateRecord, Float64, FrictionEstimate, LoopStatistics,
     StatisticsRecord, TwistStamped, FLOAT64, FRICTION_ESTIMATE, LOOP_STATISTICS, TWIST_STAMPED,
 };
+use crate::transport::Operation;
 use crate::transport::{JointEfforts, JointStateCommand, PeerPort, TransportError};
 use ros2_client::{Context, Node, Publisher, Subscription};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -113,19 +114,22 @@ impl Ros2Peer {
         let p = self
             .velocity_twist
             .as_ref()
-            .ok_or_else(|| err("publish a TwistStamped", "the node takes Float64 commands"))?;
+            .ok_or_else(|| TransportError::Send {
+                backend: NAME,
+                operation: "publish a TwistStamped".into(),
+                message: "the node takes Float64 commands".into(),
+            })?;
         p.publish(m.clone())
-            .map_err(|e| err("publish a TwistStamped", e))
+            .map_err(|e| err(Operation::Send, "publish a TwistStamped", e))
     }
 }
 
 /// What a one-contact peer says when asked for the joint topics.
 fn several_contacts() -> TransportError {
-    TransportError::backend(
-        NAME,
-        "use the joint topics",
-        "this peer was opened for one contact (a configuration with `contacts` opens them)",
-    )
+    TransportError::NotJoints {
+        backend: NAME,
+        operation: "use the joint topics",
+    }
 }
 
 impl PeerPort for Ros2Peer {
@@ -141,10 +145,11 @@ impl PeerPort for Ros2Peer {
         };
         // A joint velocity has no joint's name here: None.
         let Some(message) = CommandMessage::of(c, velocity, &self.frame_id, None) else {
-            return Err(err(
-                "send a joint velocity",
-                "send a JointState (send_joint_state) instead",
-            ));
+            return Err(TransportError::Send {
+                backend: NAME,
+                operation: "send a joint velocity".into(),
+                message: "send a JointState (send_joint_state) instead".into(),
+            });
         };
         let show = |e: &dyn std::fmt::Debug| format!("{e:?}");
         let r = match (c.kind, message, &self.velocity_f64, &self.velocity_twist) {
@@ -158,13 +163,13 @@ impl PeerPort for Ros2Peer {
             }
             _ => Err("no publisher for this command".into()),
         };
-        r.map_err(|e| err("publish a command", e))
+        r.map_err(|e| err(Operation::Send, "publish a command", e))
     }
 
     fn try_recv(&mut self) -> Result<Option<EstimateRecord>, TransportError> {
         match self.estimate.take() {
             Ok(m) => Ok(m.map(|(m, _)| EstimateRecord::from_wire(&m))),
-            Err(e) => Err(err("take an estimate", e)),
+            Err(e) => Err(err(Operation::Receive, "take an estimate", e)),
         }
     }
 
@@ -189,7 +194,7 @@ impl PeerPort for Ros2Peer {
     fn try_recv_statistics(&mut self) -> Result<Option<StatisticsRecord>, TransportError> {
         match self.statistics.take() {
             Ok(m) => Ok(m.map(|(m, _)| StatisticsRecord::from_wire(&m))),
-            Err(e) => Err(err("take loop statistics", e)),
+            Err(e) => Err(err(Operation::Receive, "take loop statistics", e)),
         }
     }
 

@@ -23,6 +23,7 @@
 
 use super::raw::{RawAdapter, RawCdr};
 use super::{err, TransportError};
+use crate::transport::Operation;
 use ros2_client::dds::rustdds::{
     self,
     bytes::Bytes,
@@ -200,7 +201,13 @@ impl DualServer {
                 &qos,
                 TopicKind::NoKey,
             )
-            .map_err(|e| err(format!("create the request topic of {service}"), e))?;
+            .map_err(|e| {
+                err(
+                    Operation::Open,
+                    format!("create the request topic of {service}"),
+                    e,
+                )
+            })?;
         let rr = participant
             .create_topic(
                 format!("rr/{base}Reply"),
@@ -208,13 +215,19 @@ impl DualServer {
                 &qos,
                 TopicKind::NoKey,
             )
-            .map_err(|e| err(format!("create the reply topic of {service}"), e))?;
+            .map_err(|e| {
+                err(
+                    Operation::Open,
+                    format!("create the reply topic of {service}"),
+                    e,
+                )
+            })?;
         let reader = subscriber
             .create_simple_datareader_no_key::<RawCdr, RawAdapter>(&rq, Some(qos.clone()))
-            .map_err(|e| err(format!("serve {service}"), e))?;
+            .map_err(|e| err(Operation::Open, format!("serve {service}"), e))?;
         let writer = publisher
             .create_datawriter_no_key::<RawPayload, RawPayloadAdapter>(&rr, Some(qos))
-            .map_err(|e| err(format!("reply on {service}"), e))?;
+            .map_err(|e| err(Operation::Open, format!("reply on {service}"), e))?;
         Ok(Self {
             name: service.to_string(),
             reader,
