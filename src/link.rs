@@ -38,8 +38,8 @@ pub struct LoopSettings {
     pub deceleration_m_s2: f64,
     /// The velocity and load commands accepted.
     pub limits: crate::config::InputLimits,
-    /// Steps between profile and statistics publications (0 = never).
-    pub profile_every_steps: u64,
+    /// Steps between film-profile and statistics publications (0 = never).
+    pub film_profile_every_steps: u64,
     /// Steps between LoopStatistics publications (0 = never).
     pub statistics_every_steps: u64,
     /// Lockstep: busy-wait this long for the next command before sleeping, ns.
@@ -83,7 +83,7 @@ impl LoopSettings {
             timeout_behaviour: c.node.timeout_behaviour,
             deceleration_m_s2: c.node.timeout_deceleration_m_s2,
             limits: crate::config::InputLimits::of(c),
-            profile_every_steps: every(c.node.profile_rate_hz),
+            film_profile_every_steps: every(c.node.profile_rate_hz),
             statistics_every_steps: every(c.node.statistics_rate_hz),
             lockstep_spin_ns: c.node.lockstep_spin_us.saturating_mul(1000),
             timer_spin_ns: c.node.timer_spin_us.saturating_mul(1000),
@@ -210,7 +210,7 @@ pub struct FilmProfileSlot {
 /// Contents of a [`FilmProfileSlot`].
 #[derive(Debug, Clone, Default)]
 pub struct FilmProfileData {
-    /// The step the profile belongs to, ns.
+    /// The step the film profile belongs to, ns.
     pub stamp_ns: u64,
     /// Cell width Δx, m.
     pub dx_m: f64,
@@ -221,7 +221,7 @@ pub struct FilmProfileData {
 }
 
 impl FilmProfileSlot {
-    /// An empty slot for profiles of `cells` cells (allocated here, once).
+    /// An empty slot for film profiles of `cells` cells (allocated here, once).
     pub fn new(cells: usize) -> Arc<Self> {
         Arc::new(Self {
             seq: AtomicU64::new(0),
@@ -246,7 +246,7 @@ impl FilmProfileSlot {
         }
     }
 
-    /// The profile, if newer than `seen` (updates `seen`).
+    /// The film profile, if newer than `seen` (updates `seen`).
     pub fn read_if_newer(&self, seen: &mut u64) -> Option<FilmProfileData> {
         let s = self.seq.load(Ordering::Acquire);
         if s == *seen {

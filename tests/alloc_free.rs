@@ -191,7 +191,7 @@ fn the_loop_allocates_nothing_while_a_transport_refuses_every_output_for_ten_min
     use friction_node::link::LiveStatus;
     use friction_node::msgs::{Command, CommandKind};
     use friction_node::node::Loop;
-    use friction_node::transport::memory::MemoryLink;
+    use friction_node::transport::memory::MemoryQueues;
     use friction_node::transport::PeerPort;
     use std::sync::atomic::AtomicBool;
     use std::sync::Arc;
@@ -202,7 +202,7 @@ fn the_loop_allocates_nothing_while_a_transport_refuses_every_output_for_ten_min
     cfg.node.profile_rate_hz = 0.0;
     // Nobody reads: the estimate queue is full after 16 steps, statistics
     // overwrite each other.
-    let link = MemoryLink::new(16);
+    let link = MemoryQueues::new(16);
     link.peer()
         .send(&Command {
             kind: CommandKind::Velocity,
@@ -287,13 +287,13 @@ fn a_parameter_change_is_applied_by_the_loop_between_two_steps_without_allocatin
     use friction_node::msgs::ros_interfaces::{parameter_type, ParameterValue};
     use friction_node::msgs::{Command, CommandKind};
     use friction_node::node::Loop;
-    use friction_node::transport::memory::MemoryLink;
+    use friction_node::transport::memory::MemoryQueues;
     use friction_node::transport::PeerPort;
     use std::sync::Arc;
     let mut cfg = Config::default();
     cfg.solver.cells = 32;
     cfg.node.step_mode = StepMode::Lockstep;
-    let link = MemoryLink::new(1000);
+    let link = MemoryQueues::new(1000);
     let mut peer = link.peer();
     let ch = Arc::new(ParameterChannel::default());
     let mut l = Loop::new(
@@ -353,7 +353,7 @@ fn a_loop_of_several_contacts_allocates_nothing_per_joint_state() {
     use friction_node::config::{Config, Origin};
     use friction_node::link::LiveStatus;
     use friction_node::node::Loop;
-    use friction_node::transport::memory::MemoryLink;
+    use friction_node::transport::memory::MemoryQueues;
     use friction_node::transport::{JointStateCommand, PeerPort};
     use std::sync::Arc;
     let cfg = Config::from_yaml(
@@ -373,7 +373,7 @@ fn a_loop_of_several_contacts_allocates_nothing_per_joint_state() {
     let joints = vec!["ja".to_string(), "jb".to_string(), "jc".to_string()];
     // Nobody reads: the output queues fill up, and a full queue is a
     // counted drop, never an allocation.
-    let link = MemoryLink::new(64).with_joints(&joints);
+    let link = MemoryQueues::new(64).with_joints(&joints);
     let mut peer = link.peer();
     let mut l = Loop::new(
         &cfg,

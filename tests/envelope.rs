@@ -8,7 +8,7 @@ use friction_node::config::{Config, Envelope, StepMode};
 use friction_node::link::LiveStatus;
 use friction_node::msgs::{estimate_constants as codes, Command, CommandKind};
 use friction_node::node::Loop;
-use friction_node::transport::memory::MemoryLink;
+use friction_node::transport::memory::MemoryQueues;
 use friction_node::transport::PeerPort;
 use std::process::Command as Process;
 use std::sync::atomic::AtomicBool;
@@ -123,7 +123,7 @@ fn the_node_rejects_every_case_as_a_command() {
         let mut cfg = config(&c);
         cfg.solver.cells = 32;
         cfg.node.step_mode = StepMode::Timer;
-        let link = MemoryLink::new(100);
+        let link = MemoryQueues::new(100);
         let mut peer = link.peer();
         let kind = match c.quantity.as_str() {
             "temperature" => CommandKind::Temperature,

@@ -248,7 +248,7 @@ fn joint_conformance(spec: BackendSpec, cfg: Config) {
 #[test]
 fn memory_transport_carries_several_contacts() {
     let cfg = config();
-    let link = transport::memory::MemoryLink::new(4096).with_joints(&joints(&cfg));
+    let link = transport::memory::MemoryQueues::new(4096).with_joints(&joints(&cfg));
     joint_conformance(BackendSpec::Memory(link), cfg);
 }
 

@@ -3,6 +3,11 @@
 //! its doc comment's file table, one row per file (`| \`name.rs\` | job |`),
 //! folder (`| \`name/\` | job |`) or module link (`| [\`name\`] | job |`), and the table lists nothing that is not
 //! there. A new file without its line in the parent's table fails here.
+//!
+//! What a module reads that is not Rust (a folder of `.msg` definitions, a
+//! data file beside the code) is part of the map too: every entry of a
+//! module's folder that is neither a `.rs` file nor a module folder has its
+//! row (`| \`legacy/\` | job |`, `| \`table.csv\` | job |`).
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
@@ -55,6 +60,36 @@ fn declared(text: &str, dir: &Path) -> BTreeSet<String> {
     out
 }
 
+/// The entries of `dir` that are neither Rust files nor module folders
+/// (folders without a `mod.rs`, files of other kinds), as a table row
+/// names them: `name/` for a folder, the file's name for a file.
+fn non_rust(dir: &Path) -> BTreeSet<String> {
+    let mut out = BTreeSet::new();
+    for e in std::fs::read_dir(dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display())) {
+        let p = e.unwrap().path();
+        let name = p.file_name().unwrap().to_str().unwrap().to_string();
+        if p.is_dir() {
+            if !p.join("mod.rs").is_file() {
+                out.insert(format!("{name}/"));
+            }
+        } else if p.extension().and_then(|x| x.to_str()) != Some("rs") {
+            out.insert(name);
+        }
+    }
+    out
+}
+
+/// The first cells of the doc comment's table rows that are code spans,
+/// as written (`` `x.rs` `` → `x.rs`, `` `x/` `` → `x/`).
+fn raw_rows(text: &str) -> BTreeSet<String> {
+    text.lines()
+        .filter_map(|line| line.trim_start().strip_prefix("//! | "))
+        .map(|row| row.split('|').next().unwrap_or("").trim())
+        .filter(|cell| cell.starts_with('`'))
+        .map(|cell| cell.trim_matches('`').to_string())
+        .collect()
+}
+
 /// The modules named in the doc comment's table rows, by the first cell:
 /// a file (`` `x.rs` ``), a folder (`` `x/` ``) or a link (``[`x`]``).
 fn listed(text: &str) -> BTreeSet<String> {
@@ -100,12 +135,23 @@ fn every_module_file_has_its_line_in_its_parents_file_table() {
             checked += 1;
             let rows = listed(&text);
             let rel = f.strip_prefix(root).unwrap().display().to_string();
+            let others = non_rust(dir);
+            let raw = raw_rows(&text);
+            for o in others.difference(&raw) {
+                problems.push(format!(
+                    "{rel}: `{o}` (not Rust, read beside the code) is missing from the file table"
+                ));
+            }
+            let other_modules: BTreeSet<String> = others
+                .iter()
+                .map(|o| o.trim_end_matches('/').to_string())
+                .collect();
             for c in children.difference(&rows) {
                 problems.push(format!("{rel}: `{c}` is missing from the file table"));
             }
             let this = f.file_stem().unwrap().to_str().unwrap().to_string();
             for c in rows.difference(&children) {
-                if *c != this {
+                if *c != this && !other_modules.contains(c) {
                     problems.push(format!(
                         "{rel}: the file table lists `{c}`, which is no module"
                     ));

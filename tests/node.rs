@@ -13,7 +13,7 @@ use friction_node::msgs::{
     estimate_constants as codes, Command, CommandKind, EstimateRecord, StatisticsRecord,
 };
 use friction_node::node::{Loop, RunSummary};
-use friction_node::transport::memory::{MemoryLink, MemoryNode};
+use friction_node::transport::memory::{MemoryNode, MemoryQueues};
 use friction_node::transport::{NodePort, PeerPort, PortCounters, TransportError};
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
@@ -89,7 +89,7 @@ fn run_sim(
     l.run(&AtomicBool::new(false), Some(Duration::from_millis(ms)))
 }
 
-fn sim(link: &MemoryLink, cfg: &Config, first_step: u64, ms: u64) -> (RunSummary, Arc<SimClock>) {
+fn sim(link: &MemoryQueues, cfg: &Config, first_step: u64, ms: u64) -> (RunSummary, Arc<SimClock>) {
     let clock = Arc::new(SimClock::starting_at(first_step * MS, WALL0));
     let s = run_sim(cfg, Box::new(link.node()), clock.clone(), first_step, ms);
     (s, clock)
@@ -98,7 +98,7 @@ fn sim(link: &MemoryLink, cfg: &Config, first_step: u64, ms: u64) -> (RunSummary
 #[test]
 fn timer_mode_takes_one_step_per_period_holds_the_command_and_flags_the_timeout() {
     let cfg = timer_config();
-    let link = MemoryLink::new(100_000);
+    let link = MemoryQueues::new(100_000);
     let mut peer = link.peer();
     peer.send(&velocity(0.4, 1)).unwrap();
     let (s, _) = sim(&link, &cfg, 0, 400);
@@ -134,7 +134,7 @@ fn timer_mode_takes_one_step_per_period_holds_the_command_and_flags_the_timeout(
 #[test]
 fn deadlines_stay_exactly_one_period_apart_across_step_2_pow_32_and_after_a_year() {
     for first in [(1u64 << 32) - 10, 365 * 86_400 * 1000] {
-        let link = MemoryLink::new(1000);
+        let link = MemoryQueues::new(1000);
         let mut peer = link.peer();
         peer.send(&velocity(0.1, 1)).unwrap();
         let (s, clock) = sim(&link, &timer_config(), first, 20);
@@ -154,7 +154,7 @@ fn deadlines_stay_exactly_one_period_apart_across_step_2_pow_32_and_after_a_year
 #[test]
 fn a_late_wake_up_is_caught_up_step_by_step_and_model_time_stays_wall_time() {
     let cfg = timer_config();
-    let link = MemoryLink::new(1000);
+    let link = MemoryQueues::new(1000);
     let mut peer = link.peer();
     let clock = Arc::new(SimClock::new(WALL0));
     let port = Scripted {
@@ -183,7 +183,7 @@ fn a_late_wake_up_is_caught_up_step_by_step_and_model_time_stays_wall_time() {
 #[test]
 fn a_stall_beyond_the_catch_up_bound_is_advanced_in_one_time_jump() {
     let cfg = timer_config(); // max_catch_up_s = 0.1
-    let link = MemoryLink::new(1000);
+    let link = MemoryQueues::new(1000);
     let mut peer = link.peer();
     let clock = Arc::new(SimClock::new(WALL0));
     let port = Scripted {
@@ -238,7 +238,7 @@ fn timer_spin_busy_waits_the_last_microseconds_of_each_period_and_changes_no_est
     let run = |spin_us: u64| {
         let mut cfg = timer_config();
         cfg.node.timer_spin_us = spin_us;
-        let link = MemoryLink::new(1000);
+        let link = MemoryQueues::new(1000);
         let mut peer = link.peer();
         peer.send(&velocity(0.3, 1)).unwrap();
         let clock = Arc::new(WaitLog {
@@ -284,7 +284,7 @@ fn timer_spin_busy_waits_the_last_microseconds_of_each_period_and_changes_no_est
 #[test]
 fn a_wall_clock_set_back_changes_no_deadline_and_stamps_stay_monotonic() {
     let cfg = timer_config();
-    let link = MemoryLink::new(1000);
+    let link = MemoryQueues::new(1000);
     let mut peer = link.peer();
     let clock = Arc::new(SimClock::new(WALL0));
     let port = Scripted {
@@ -312,7 +312,7 @@ fn timeout_ramp_brings_the_velocity_to_zero_at_the_configured_deceleration() {
     let mut cfg = timer_config();
     cfg.node.timeout_behaviour = TimeoutBehaviour::RampToZero;
     cfg.node.timeout_deceleration_m_s2 = 4.0;
-    let link = MemoryLink::new(100_000);
+    let link = MemoryQueues::new(100_000);
     let mut peer = link.peer();
     peer.send(&velocity(0.3, 1)).unwrap();
     sim(&link, &cfg, 0, 600);
@@ -333,7 +333,7 @@ fn timeout_ramp_brings_the_velocity_to_zero_at_the_configured_deceleration() {
 #[test]
 fn absurd_and_non_finite_commands_never_reach_the_solver_and_are_all_accounted_for() {
     let cfg = timer_config();
-    let link = MemoryLink::new(100_000);
+    let link = MemoryQueues::new(100_000);
     let mut peer = link.peer();
     let mut send = |kind, value| {
         peer.send(&Command {
@@ -379,7 +379,7 @@ fn a_rejection_is_reported_even_when_the_solver_also_hits_its_iteration_bound() 
     cfg.node.step_mode = StepMode::Lockstep;
     cfg.solver.max_iterations = 1;
     cfg.solver.tolerance = 1e-14;
-    let link = MemoryLink::new(1000);
+    let link = MemoryQueues::new(1000);
     let mut peer = link.peer();
     peer.send(&velocity(0.5, 10)).unwrap();
     peer.send(&velocity(f64::NAN, 20)).unwrap();
@@ -408,7 +408,7 @@ fn a_rejection_is_reported_even_when_the_solver_also_hits_its_iteration_bound() 
 fn an_output_nobody_reads_for_ten_simulated_minutes_is_counted_and_does_not_stop_the_loop() {
     let mut cfg = timer_config();
     cfg.solver.cells = 8;
-    let link = MemoryLink::new(16);
+    let link = MemoryQueues::new(16);
     let mut peer = link.peer();
     peer.send(&velocity(0.1, 1)).unwrap();
     let (s, _) = sim(&link, &cfg, 0, 600_000);

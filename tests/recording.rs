@@ -17,7 +17,7 @@ use friction_node::msgs::{Command, CommandKind};
 use friction_node::node::{Loop, RunSummary};
 use friction_node::record::{RecordPlan, Recorder, RecorderReport};
 use friction_node::replay::{self, ReplayOptions};
-use friction_node::transport::memory::MemoryLink;
+use friction_node::transport::memory::MemoryQueues;
 use friction_node::transport::PeerPort;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -55,7 +55,7 @@ fn record(
         clock.clone(),
     )
     .unwrap();
-    let link = MemoryLink::new(16);
+    let link = MemoryQueues::new(16);
     let mut peer = link.peer();
     peer.send(&Command {
         kind: CommandKind::Velocity,
@@ -329,7 +329,7 @@ fn a_run_whose_parameters_changed_midway_replays_bit_identically() {
         clock.clone(),
     )
     .unwrap();
-    let link = MemoryLink::new(16);
+    let link = MemoryQueues::new(16);
     let mut peer = link.peer();
     peer.send(&Command {
         kind: CommandKind::Velocity,
@@ -490,7 +490,7 @@ mod node_runs {
             Arc::new(SimClock::new(WALL0)),
         )
         .unwrap();
-        let link = MemoryLink::new(100_000);
+        let link = MemoryQueues::new(100_000);
         let mut peer = link.peer();
         let n = 200;
         for k in 1..=n {

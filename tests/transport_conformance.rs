@@ -331,7 +331,7 @@ fn flood(make_spec: impl Fn(&Config) -> BackendSpec, mut cfg: Config, n: u64) ->
 
 #[test]
 fn a_flood_through_the_memory_transport_is_accounted_for_exactly() {
-    let link = transport::memory::MemoryLink::new(100_000);
+    let link = transport::memory::MemoryQueues::new(100_000);
     let s = flood(
         |_| BackendSpec::Memory(link.clone()),
         lockstep_config(),
@@ -368,7 +368,7 @@ fn a_flood_through_ros2_is_accounted_for_exactly() {
 
 #[test]
 fn memory_transport_conforms() {
-    let link = transport::memory::MemoryLink::new(4096);
+    let link = transport::memory::MemoryQueues::new(4096);
     conformance(BackendSpec::Memory(link), lockstep_config());
 }
 

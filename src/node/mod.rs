@@ -32,7 +32,7 @@
 //! | `timer.rs` | timer mode: deadlines, catch-up, time jumps |
 //! | `lockstep.rs` | lockstep mode and [`Loop::feed`] (replay) |
 //! | `commands.rs` | command validation, timeouts, command status |
-//! | `publish.rs` | one step and what it publishes: estimates, profiles, statistics |
+//! | `publish.rs` | one step and what it publishes: estimates, film profiles, statistics |
 //! | `parameters.rs` | the loop's side of live parameters: changes applied between steps |
 //! | `runner.rs` | the `run` command around the loop |
 //! | `rt.rs` | real-time settings |
@@ -152,7 +152,7 @@ pub struct Loop {
     settings: LoopSettings,
     ports: Vec<Box<dyn NodePort>>,
     record: Option<Arc<ArrayQueue<RecordItem>>>,
-    profile: Option<Arc<FilmProfileSlot>>,
+    film_profile: Option<Arc<FilmProfileSlot>>,
     live: Arc<LiveStatus>,
     clock: Arc<dyn Clock>,
     stamps: WallStamps,
@@ -183,7 +183,7 @@ impl Loop {
         config: &Config,
         ports: Vec<Box<dyn NodePort>>,
         record: Option<Arc<ArrayQueue<RecordItem>>>,
-        profile: Option<Arc<FilmProfileSlot>>,
+        film_profile: Option<Arc<FilmProfileSlot>>,
         live: Arc<LiveStatus>,
     ) -> Result<Self, NodeError> {
         if ports.is_empty() {
@@ -229,7 +229,7 @@ impl Loop {
             by_joint: config.output_plan().by_joint(),
             ports,
             record,
-            profile,
+            film_profile,
             live,
             stamps: WallStamps::new(clock.as_ref()),
             clock,

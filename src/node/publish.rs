@@ -97,11 +97,11 @@ impl Loop {
     /// Profiles, statistics and live values after a step of every contact.
     fn after_step(&mut self, stamp_ns: u64, compute: u64, late_ns: u64) {
         let n = self.summary.steps;
-        if self.settings.profile_every_steps > 0
-            && n.is_multiple_of(self.settings.profile_every_steps)
+        if self.settings.film_profile_every_steps > 0
+            && n.is_multiple_of(self.settings.film_profile_every_steps)
         {
-            if let Some(slot) = self.profile.clone() {
-                // The first contact's film (the one-contact node's profile).
+            if let Some(slot) = self.film_profile.clone() {
+                // The first contact's film (the one-contact node's film profile).
                 self.contacts.with_solver(0, |solver| {
                     slot.try_write(|d| {
                         d.stamp_ns = stamp_ns;

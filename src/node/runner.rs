@@ -234,7 +234,7 @@ fn record_path(config: &Config, opts: &RunOptions) -> Option<PathBuf> {
 fn start_recorder(
     config: &Config,
     record_path: Option<PathBuf>,
-    profile: Option<Arc<FilmProfileSlot>>,
+    film_profile: Option<Arc<FilmProfileSlot>>,
     warnings: &mut Vec<String>,
 ) -> Result<Option<crate::record::Recorder>, RunError> {
     if record_path.is_none() && config.recording.snapshot_s == 0 {
@@ -253,7 +253,7 @@ fn start_recorder(
         plan,
         config,
         &crate::config::topics::TopicNames::from_config(config),
-        profile,
+        film_profile,
         Arc::new(crate::clock::SystemClock::new()),
     )?;
     if config.recording.snapshot_s > 0 {
@@ -289,7 +289,7 @@ fn open_ports(
             }
         });
         ports.push(s.open_node(transport::PortIo {
-            profile: io.profile.clone(),
+            film_profile: io.film_profile.clone(),
             record: io.record.clone(),
             snapshot: io.snapshot.clone(),
             parameters,
@@ -379,9 +379,13 @@ fn build_loop(
     live: Arc<LiveStatus>,
 ) -> Result<Loop, RunError> {
     let channel = Arc::new(crate::link::ParameterChannel::default());
-    let (queue, profile, sim_time) = (io.record.clone(), io.profile.clone(), io.sim_time.clone());
+    let (queue, film_profile, sim_time) = (
+        io.record.clone(),
+        io.film_profile.clone(),
+        io.sim_time.clone(),
+    );
     let (ports, served) = open_ports(config, specs, io, &channel)?;
-    let mut l = Loop::new(config, ports, queue, profile, live)?;
+    let mut l = Loop::new(config, ports, queue, film_profile, live)?;
     if served {
         l = l.with_parameters(channel);
     }
@@ -433,11 +437,16 @@ pub fn run_node(
         ..Default::default()
     };
     report.warnings.extend(spin_under_fifo(config));
-    let profile =
+    let film_profile =
         (config.node.profile_rate_hz > 0.0).then(|| FilmProfileSlot::new(config.solver.cells));
     let record_path = record_path(config, opts);
     #[cfg(feature = "mcap")]
-    let recorder = start_recorder(config, record_path, profile.clone(), &mut report.warnings)?;
+    let recorder = start_recorder(
+        config,
+        record_path,
+        film_profile.clone(),
+        &mut report.warnings,
+    )?;
     #[cfg(not(feature = "mcap"))]
     if record_path.is_some() || config.recording.snapshot_s > 0 {
         return Err(RunError::Option(
@@ -452,7 +461,7 @@ pub fn run_node(
     #[cfg(not(feature = "mcap"))]
     let (queue, snapshot) = (None, None);
     let io = transport::PortIo {
-        profile,
+        film_profile,
         record: queue,
         snapshot,
         parameters: None,

@@ -49,7 +49,7 @@ pub use estimate::{Diagnostics, Estimate, Regime, Status};
 pub use params::{Contact, Geometry, Lubricant, ModelParams, Pocket, Profile, Roughness};
 pub use settings::{CouetteFlux, Limiter, Method, ReferenceSettings, SolverSettings, TimeScheme};
 pub use solver::{FieldPoint, Isa, ModelMismatch, PreparedModel, Solver, StepBreakdown};
-pub use terms::boundary::BoundaryRate;
+pub use terms::boundary_film::BoundaryRate;
 pub use terms::drivetrain::Drivetrain;
 pub use terms::presliding::Presliding;
 pub use terms::soft_width::WidthLaw;

@@ -13,7 +13,7 @@
 //! | d | `Profile::*::depth` | profile depth (parabola rise, taper rise) | m |
 //! | μl, μg | `Lubricant::viscosity`, `gas_viscosity` | liquid / gas dynamic viscosity | Pa·s |
 //! | ρl, ρg | `Lubricant::density`, `gas_density` | liquid / gas density | kg/m³ |
-//! | p_amb | `Lubricant::ambient_pressure` | boundary pressure (absolute) | Pa |
+//! | p_amb | `Lubricant::ambient_pressure` | pressure at the domain's edges (absolute) | Pa |
 //! | p_s, p_v | `saturation_pressure`, `vapour_pressure` | EOS anchor pressures | Pa |
 //! | α_s, α_v | `vapour_fraction_*` | vapour fraction at p_s and p_v | – |
 //! | σ | `Roughness::sigma` | combined RMS roughness | m |
@@ -167,7 +167,7 @@ pub struct Contact {
     /// μ_bl, the boundary (asperity) friction coefficient.
     pub boundary_friction: f64,
     /// The boundary friction's dependence on speed (off by default).
-    pub boundary_rate: super::terms::boundary::BoundaryRate,
+    pub boundary_rate: super::terms::boundary_film::BoundaryRate,
     /// v_reg of the sign's tanh regularisation, m/s.
     pub sign_regularization: f64,
     /// Floor on h0; 0 disables it (the default: with GW it should not bind).
@@ -183,7 +183,7 @@ impl Default for Contact {
         Self {
             mass: 1.0,
             boundary_friction: 0.3,
-            boundary_rate: super::terms::boundary::BoundaryRate::default(),
+            boundary_rate: super::terms::boundary_film::BoundaryRate::default(),
             sign_regularization: 1e-4,
             min_film: 0.0,
             presliding: super::terms::presliding::Presliding::default(),

@@ -235,7 +235,7 @@ impl Encoder {
     }
 
     /// A film profile's entry.
-    pub fn profile(&self, p: FilmProfileData, log_ns: u64) -> Result<Entry, WriteError> {
+    pub fn film_profile(&self, p: FilmProfileData, log_ns: u64) -> Result<Entry, WriteError> {
         let stamp = p.stamp_ns;
         let m = msgs::FilmProfile {
             header: Header {

@@ -204,7 +204,7 @@ impl Recorder {
         plan: RecordPlan,
         config: &Config,
         names: &TopicNames,
-        profile: Option<Arc<FilmProfileSlot>>,
+        film_profile: Option<Arc<FilmProfileSlot>>,
         clock: Arc<dyn Clock>,
     ) -> Result<Self, RecorderError> {
         let now = clock.wall_ns();
@@ -250,7 +250,7 @@ impl Recorder {
         let (q, s, snap) = (queue.clone(), stop.clone(), snapshot.clone());
         let thread = std::thread::Builder::new()
             .name("mcap-recorder".into())
-            .spawn(move || w.run(q, s, snap, profile))
+            .spawn(move || w.run(q, s, snap, film_profile))
             .map_err(|cause| RecorderError::Create {
                 path: plan.path.clone().unwrap_or_default(),
                 cause,
@@ -431,7 +431,7 @@ impl Writer {
         queue: Arc<ArrayQueue<RecordItem>>,
         stop: Arc<AtomicBool>,
         snapshot: Arc<AtomicBool>,
-        profile: Option<Arc<FilmProfileSlot>>,
+        film_profile: Option<Arc<FilmProfileSlot>>,
     ) -> RecorderReport {
         let mut seen = 0u64;
         let mut last_flush = Instant::now();
@@ -442,13 +442,13 @@ impl Writer {
                 idle = false;
                 self.item(&item);
             }
-            if let Some(slot) = &profile {
+            if let Some(slot) = &film_profile {
                 if let Some(p) = slot.read_if_newer(&mut seen) {
                     // Logged at its step's stamp, like the step's estimate.
                     let at = p.stamp_ns;
-                    match self.encoder.profile(p, at) {
+                    match self.encoder.film_profile(p, at) {
                         Ok(e) => self.write(e),
-                        Err(m) => tracing::error!("recording: cannot encode a profile: {m}"),
+                        Err(m) => tracing::error!("recording: cannot encode a film profile: {m}"),
                     }
                 }
             }

@@ -8,7 +8,7 @@ use crate::link::LiveStatus;
 use crate::msgs::{CommandKind, EstimateRecord};
 use crate::node::Loop;
 use crate::physics::Estimate;
-use crate::transport::memory::{MemoryLink, MemoryPeer};
+use crate::transport::memory::{MemoryPeer, MemoryQueues};
 use crate::transport::PeerPort;
 use std::sync::Arc;
 
@@ -157,9 +157,9 @@ pub fn run(
     let joints = plan.joints();
     let several = plan.by_joint();
     let link = if several {
-        MemoryLink::new(16).with_joints(joints)
+        MemoryQueues::new(16).with_joints(joints)
     } else {
-        MemoryLink::new(16)
+        MemoryQueues::new(16)
     };
     let mut peer = link.peer();
     let mut l = Loop::new(

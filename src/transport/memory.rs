@@ -2,7 +2,7 @@
 //! process. The reference backend of the conformance suite, and the node's
 //! transport when it is embedded in another program.
 //!
-//! With several contacts ([`MemoryLink::with_joints`]) the peer's
+//! With several contacts ([`MemoryQueues::with_joints`]) the peer's
 //! JointStates are resolved by joint name into per-contact commands, and
 //! the node's outputs are per-contact estimates and joint efforts.
 
@@ -17,9 +17,11 @@ use crossbeam_queue::ArrayQueue;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-/// Both directions of an in-memory link (clone it to hand it to threads).
+/// The bounded queues of both directions between a node and its peers in
+/// one process (clone it to hand it to threads; not `crate::link`, which
+/// holds what the loop shares with every backend).
 #[derive(Clone)]
-pub struct MemoryLink {
+pub struct MemoryQueues {
     commands: Arc<ArrayQueue<Command>>,
     estimates: Arc<ArrayQueue<EstimateRecord>>,
     statistics: Arc<ArrayQueue<StatisticsRecord>>,
@@ -29,7 +31,7 @@ pub struct MemoryLink {
     efforts: Arc<ArrayQueue<JointEfforts>>,
 }
 
-impl MemoryLink {
+impl MemoryQueues {
     /// A link whose queues hold `capacity` items each.
     pub fn new(capacity: usize) -> Self {
         Self {
@@ -82,7 +84,7 @@ impl MemoryLink {
 
 /// The loop's side.
 pub struct MemoryNode {
-    link: MemoryLink,
+    link: MemoryQueues,
     record: RecordQueue,
     counters: SharedCounters,
     /// Stamps received commands for the recorder (default: the system's).
@@ -167,7 +169,7 @@ impl NodePort for MemoryNode {
 
 /// The peer's side.
 pub struct MemoryPeer {
-    link: MemoryLink,
+    link: MemoryQueues,
 }
 
 impl MemoryPeer {

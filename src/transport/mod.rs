@@ -217,8 +217,8 @@ pub type RecordQueue = Option<Arc<ArrayQueue<RecordItem>>>;
 #[derive(Clone, Default)]
 pub struct PortIo {
     /// The slot the loop writes film profiles into (backends that publish
-    /// profiles read it).
-    pub profile: Option<Arc<FilmProfileSlot>>,
+    /// film profiles read it).
+    pub film_profile: Option<Arc<FilmProfileSlot>>,
     /// The recorder's queue: the port puts every command it receives into
     /// it, as received.
     pub record: RecordQueue,
@@ -425,7 +425,7 @@ pub fn recv_timeout(
 #[derive(Clone)]
 pub enum BackendSpec {
     /// In-process queues (tests, replay).
-    Memory(memory::MemoryLink),
+    Memory(memory::MemoryQueues),
     #[cfg(feature = "iceoryx2")]
     /// iceoryx2 services.
     Iceoryx2(iceoryx::IceoryxSpec),

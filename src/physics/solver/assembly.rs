@@ -133,10 +133,10 @@ pub(super) fn balance_row(
 pub(super) fn face_pass(d: &Disc, p: &[f64], h0: f64, ctx: &Ctx, w: &mut Work) {
     let n = p.len();
     let inv_dx = 1.0 / d.grid.dx;
-    let boundary = CellProps {
-        rho: d.rho_b,
+    let edge = CellProps {
+        rho: d.rho_edge,
         drho: 0.0,
-        gr: d.gr_b,
+        gr: d.gr_edge,
         dgr: 0.0,
     };
     let fx = FluxCtx {
@@ -150,7 +150,7 @@ pub(super) fn face_pass(d: &Disc, p: &[f64], h0: f64, ctx: &Ctx, w: &mut Work) {
         h0 + gf[0],
         2.0 * inv_dx,
         d.p_amb,
-        &boundary,
+        &edge,
         p[0],
         &cells.props(0),
     );
@@ -160,7 +160,7 @@ pub(super) fn face_pass(d: &Disc, p: &[f64], h0: f64, ctx: &Ctx, w: &mut Work) {
         p[n - 1],
         &cells.props(n - 1),
         d.p_amb,
-        &boundary,
+        &edge,
     );
     w.faces.set(0, first);
     w.faces.set(n, last);

@@ -17,9 +17,9 @@
 //! Still a flux difference per cell, so mass is conserved exactly; every
 //! limiter is 0 when Δ− and Δ+ differ in sign, so the face density stays
 //! between its neighbours' (no new extrema where the film cavitates or
-//! reforms). Beyond the domain the boundary state (ρ at p_amb) stands in
-//! for the missing cell; a boundary face whose upwind side is the boundary
-//! keeps the boundary density (exact there).
+//! reforms). Beyond the domain the edge state (ρ at p_amb) stands in
+//! for the missing cell; an edge face whose upwind side is the domain's
+//! edge keeps the edge density (exact there).
 //!
 //! This pass adds ½(v/2)(h_f + σ φs) s to the first-order flux of
 //! `assembly.rs`, with its derivatives in the three cells' pressures
@@ -73,11 +73,11 @@ pub(crate) fn slope(limiter: Limiter, dm: f64, dp: f64) -> (f64, f64, f64) {
 pub(super) fn muscl_pass(d: &Disc, h0: f64, ctx: &Ctx, limiter: Limiter, w: &mut Work) {
     let n = d.grid.n;
     let forward = ctx.v >= 0.0;
-    // The face whose upwind side is the boundary keeps the boundary density.
+    // The face whose upwind side is the domain's edge keeps the edge density.
     w.faces.dqx[if forward { 0 } else { n }] = 0.0;
     // Faces whose three cells are all inside (v ≥ 0: face k reads cells
     // k − 2, k − 1, k; v < 0: k − 1, k, k + 1), then the two next to the
-    // boundaries, with the boundary state for the missing cell.
+    // edges, with the edge state for the missing cell.
     // One loop per limiter and direction, so that each vectorises.
     macro_rules! interior_for {
         ($l:expr) => {
@@ -113,7 +113,7 @@ fn one_face(d: &Disc, h0: f64, v: f64, limiter: Limiter, k: usize, w: &mut Work)
     let c = &w.cells;
     let rho = |i: isize| -> (f64, f64) {
         if i < 0 || i >= n as isize {
-            (d.rho_b, 0.0)
+            (d.rho_edge, 0.0)
         } else {
             (c.rho[i as usize], c.drho[i as usize])
         }

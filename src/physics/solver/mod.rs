@@ -24,7 +24,7 @@
 //! q_f = −φx h_f³/(12 d_f) · ½(ρ/μ|_L + ρ/μ|_R) · (p_R − p_L) + (v/2)(h_f + σ φs) ρ_up
 //! ```
 //!
-//! with `d_f = Δx` (interior) or `Δx/2` (boundary face, ghost at p_amb) and
+//! with `d_f = Δx` (interior) or `Δx/2` (edge face, ghost at p_amb) and
 //! `ρ_up` the density of the upwind cell. Only the density is upwinded: h is
 //! exact at the face, so in full film (ρ ≈ ρl) the scheme is second order and
 //! in cavitated zones it is monotone, but first order (`solver.flux:
@@ -105,9 +105,9 @@ pub(crate) struct Disc {
     pub flux: super::settings::CouetteFlux,
     pub sigma: f64,
     pub p_amb: f64,
-    /// ρ, ρ/μ at the boundary pressure.
-    pub rho_b: f64,
-    pub gr_b: f64,
+    /// ρ, ρ/μ at the domain's edges (ambient pressure).
+    pub rho_edge: f64,
+    pub gr_edge: f64,
     pub mass: f64,
     pub min_film: f64,
     /// The friction terms beside the film's shear, composed by
@@ -338,8 +338,8 @@ impl Solver {
             flux: settings.flux,
             sigma: model.roughness.sigma,
             p_amb,
-            rho_b: sb.rho,
-            gr_b: sb.rho / sb.mu,
+            rho_edge: sb.rho,
+            gr_edge: sb.rho / sb.mu,
             mass: model.contact.mass,
             min_film: model.contact.min_film,
             terms: crate::physics::terms::FrictionTerms::of(model),
@@ -526,8 +526,8 @@ impl Solver {
         }
         self.d.eos.mu_l = mu_l;
         let b = self.d.eos.eval(self.d.p_amb);
-        self.d.rho_b = b.rho;
-        self.d.gr_b = b.rho / b.mu;
+        self.d.rho_edge = b.rho;
+        self.d.gr_edge = b.rho / b.mu;
         true
     }
 

@@ -129,12 +129,12 @@ impl Solver {
                     None => (1.0, 0.0),
                 };
                 let (rl, gl) = if f == 0 {
-                    (d.rho_b, d.gr_b)
+                    (d.rho_edge, d.gr_edge)
                 } else {
                     (w.cells.rho[f - 1], w.cells.gr[f - 1])
                 };
                 let (rr, gr) = if f == n {
-                    (d.rho_b, d.gr_b)
+                    (d.rho_edge, d.gr_edge)
                 } else {
                     (w.cells.rho[f], w.cells.gr[f])
                 };

@@ -10,7 +10,7 @@
 //! | file | term |
 //! |---|---|
 //! | `mod.rs` | the catalogue, the sign functions, the composition |
-//! | `boundary.rs` | boundary friction μ_bl on the asperity load, the rigid contact's sign regularisation, and the boundary film's rise with the logarithm of speed (Eyring) |
+//! | `boundary_film.rs` | the boundary film: friction μ_bl on the asperity load, the rigid contact's sign regularisation, and the boundary film's rise with the logarithm of speed (Eyring) |
 //! | `presliding.rs` | the contact's elastic displacement before gross sliding (a bristle on the model's own level) |
 //! | `soft_width.rs` | a soft contact whose width follows the load |
 //! | `drivetrain.rs` | losses beside the contact (bearings, seals, gears, a motor) |
@@ -52,12 +52,12 @@
 //! and its tests. Validation, live-ness, the fit's bounds and the docs'
 //! table follow from `KEYS`.
 
-pub mod boundary;
+pub mod boundary_film;
 pub mod drivetrain;
 pub mod presliding;
 pub mod soft_width;
 
-use boundary::BoundaryRate;
+use boundary_film::BoundaryRate;
 use drivetrain::Drivetrain;
 use presliding::Presliding;
 use soft_width::WidthLaw;
@@ -139,7 +139,7 @@ pub struct TermKey {
 /// Every friction term's keys, term by term, in the composition's order.
 pub fn catalogue() -> impl Iterator<Item = &'static TermKey> {
     [
-        boundary::KEYS,
+        boundary_film::KEYS,
         presliding::KEYS,
         soft_width::KEYS,
         drivetrain::KEYS,

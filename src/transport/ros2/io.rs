@@ -1,5 +1,5 @@
 //! The ROS 2 node's I/O thread: commands in (raw samples, decoded here and
-//! recorded unchanged), estimates, profiles and statistics out.
+//! recorded unchanged), estimates, film profiles and statistics out.
 
 use super::raw::{RawAdapter, RawCdr};
 use super::{advertise, context, err, qos, ros_node, topic, Out, Ros2Spec};
@@ -30,7 +30,7 @@ pub(super) struct Shared {
     pub outputs: Arc<ArrayQueue<Out>>,
     pub stop: Arc<AtomicBool>,
     pub counters: Arc<SharedCounters>,
-    pub profile: Option<Arc<FilmProfileSlot>>,
+    pub film_profile: Option<Arc<FilmProfileSlot>>,
     pub record: RecordQueue,
     pub snapshot: Option<Arc<AtomicBool>>,
     /// `use_sim_time`: the clock `/clock` drives.
@@ -278,14 +278,14 @@ pub(super) fn run(
     let mut events = Events::with_capacity(16);
     let mut outgoing = Outgoing::new(&sh.spec);
     while !sh.stop.load(Ordering::Acquire) {
-        // Wake on commands, on outputs (the waker), or every 20 ms for profiles.
+        // Wake on commands, on outputs (the waker), or every 20 ms for film profiles.
         let _ = e.poll.poll(&mut events, Some(Duration::from_millis(20)));
         take_inputs(&sh, &mut e);
         while let Some(o) = sh.outputs.pop() {
             outgoing.publish(&e, o, &sh.counters);
         }
         outgoing.rosout(&e.out);
-        if let Some(slot) = &sh.profile {
+        if let Some(slot) = &sh.film_profile {
             outgoing.film_profile(&e.out, slot, &sh.counters);
         }
     }
@@ -327,7 +327,7 @@ struct Outgoing {
     logger: String,
     diagnostics: super::diagnostics::HealthReporter,
     last_diagnostics: Option<std::time::Instant>,
-    seen_profile: u64,
+    seen_film_profile: u64,
 }
 
 impl Outgoing {
@@ -339,7 +339,7 @@ impl Outgoing {
             fqn,
             diagnostics: Default::default(),
             last_diagnostics: None,
-            seen_profile: 0,
+            seen_film_profile: 0,
         }
     }
 
@@ -416,7 +416,7 @@ impl Outgoing {
         slot: &FilmProfileSlot,
         counters: &SharedCounters,
     ) {
-        if let Some(p) = slot.read_if_newer(&mut self.seen_profile) {
+        if let Some(p) = slot.read_if_newer(&mut self.seen_film_profile) {
             let m = FilmProfile {
                 header: Header {
                     stamp: Time::from_ns(p.stamp_ns),

@@ -302,7 +302,7 @@ impl Ros2Node {
             outputs: outputs.clone(),
             stop: stop.clone(),
             counters: counters.clone(),
-            profile: io.profile,
+            film_profile: io.film_profile,
             record: io.record.clone(),
             snapshot: io.snapshot.clone(),
             sim_time: io.sim_time.clone(),
