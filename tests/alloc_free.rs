@@ -373,7 +373,8 @@ fn a_loop_of_several_contacts_allocates_nothing_per_joint_state() {
     let joints = vec!["ja".to_string(), "jb".to_string(), "jc".to_string()];
     // Nobody reads: the output queues fill up, and a full queue is a
     // counted drop, never an allocation.
-    let link = MemoryQueues::new(64).with_joints(&joints);
+    let link =
+        MemoryQueues::new(64).for_plan(&friction_node::config::OutputPlan::Joints(joints.clone()));
     let mut peer = link.peer();
     let mut l = Loop::new(
         &cfg,

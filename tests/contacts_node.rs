@@ -83,7 +83,7 @@ fn run_timer(cfg: &Config, link: &MemoryQueues, ms: u64) -> RunSummary {
 fn a_joint_state_drives_each_contact_by_joint_name_at_gain_times_its_velocity_and_efforts_are_gain_times_friction(
 ) {
     let cfg = three();
-    let link = MemoryQueues::new(1000).with_joints(&joints(&cfg));
+    let link = MemoryQueues::new(1000).for_plan(&cfg.output_plan());
     let mut peer = link.peer();
     // Out of order, with a joint that is not this node's.
     let m = js(
@@ -133,7 +133,7 @@ fn a_joint_state_drives_each_contact_by_joint_name_at_gain_times_its_velocity_an
 #[test]
 fn a_joint_without_a_finite_velocity_is_rejected_alone_and_the_others_apply() {
     let cfg = three();
-    let link = MemoryQueues::new(1000).with_joints(&joints(&cfg));
+    let link = MemoryQueues::new(1000).for_plan(&cfg.output_plan());
     let mut peer = link.peer();
     // Two velocities for three names: j_wrist has none.
     peer.send_joint_state(&js(1, &["j_left", "j_right", "j_wrist"], &[0.4, 0.2]))
@@ -223,7 +223,7 @@ impl friction_node::transport::NodePort for LeftOnly {
 #[test]
 fn a_contact_left_out_of_the_joint_states_is_held_then_times_out_alone() {
     let cfg = three();
-    let link = MemoryQueues::new(100_000).with_joints(&joints(&cfg));
+    let link = MemoryQueues::new(100_000).for_plan(&cfg.output_plan());
     let mut peer = link.peer();
     peer.send_joint_state(&js(1, &["j_left", "j_right", "j_wrist"], &[0.4, 0.2, 0.1]))
         .unwrap();
@@ -326,7 +326,7 @@ fn worker_threads_change_no_result() {
 fn a_lockstep_joint_state_with_an_old_stamp_takes_no_step() {
     let mut cfg = three();
     cfg.node.step_mode = friction_node::config::StepMode::Lockstep;
-    let link = MemoryQueues::new(1000).with_joints(&joints(&cfg));
+    let link = MemoryQueues::new(1000).for_plan(&cfg.output_plan());
     let mut peer = link.peer();
     let mut l = new_loop(&cfg, &link);
     let all = ["j_left", "j_right", "j_wrist"];
@@ -387,7 +387,7 @@ fn lockstep_with_change(
     let mut cfg = cfg.clone();
     cfg.node.step_mode = friction_node::config::StepMode::Lockstep;
     let names = joints(&cfg);
-    let link = MemoryQueues::new(100_000).with_joints(&names);
+    let link = MemoryQueues::new(100_000).for_plan(&cfg.output_plan());
     let mut peer = link.peer();
     let mut l = new_loop(&cfg, &link);
     let mut per: Vec<Vec<EstimateRecord>> = vec![Vec::new(); names.len()];
@@ -520,7 +520,7 @@ fn a_configuration_with_one_listed_contact_publishes_its_joint_effort_as_several
         &[],
     )
     .unwrap();
-    let link = MemoryQueues::new(1000).with_joints(&joints(&cfg));
+    let link = MemoryQueues::new(1000).for_plan(&cfg.output_plan());
     let mut peer = link.peer();
     peer.send_joint_state(&js(1, &["elbow"], &[2.0])).unwrap();
     let s = run_timer(&cfg, &link, 5);

@@ -248,7 +248,7 @@ fn joint_conformance(spec: BackendSpec, cfg: Config) {
 #[test]
 fn memory_transport_carries_several_contacts() {
     let cfg = config();
-    let link = transport::memory::MemoryQueues::new(4096).with_joints(&joints(&cfg));
+    let link = transport::memory::MemoryQueues::new(4096).for_plan(&cfg.output_plan());
     joint_conformance(BackendSpec::Memory(link), cfg);
 }
 
@@ -256,7 +256,7 @@ fn memory_transport_carries_several_contacts() {
 #[test]
 fn iceoryx2_transport_carries_several_contacts() {
     let cfg = config();
-    let spec = transport::iceoryx::IceoryxSpec::from(&cfg.iceoryx2).with_joints(joints(&cfg));
+    let spec = transport::iceoryx::IceoryxSpec::from(&cfg.iceoryx2).for_plan(cfg.output_plan());
     joint_conformance(BackendSpec::Iceoryx2(spec), cfg);
 }
 

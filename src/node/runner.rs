@@ -123,10 +123,7 @@ pub fn backend_specs(
         #[cfg(feature = "iceoryx2")]
         {
             let spec = transport::iceoryx::IceoryxSpec::from(&config.iceoryx2);
-            let plan = config.output_plan();
-            out.push(BackendSpec::Iceoryx2(
-                spec.with_joints(plan.joints().to_vec()),
-            ));
+            out.push(BackendSpec::Iceoryx2(spec.for_plan(config.output_plan())));
         }
         #[cfg(not(feature = "iceoryx2"))]
         return Err(TransportError::NotBuiltIn("iceoryx2"));

@@ -156,11 +156,7 @@ pub fn run(
     let plan = cfg.output_plan();
     let joints = plan.joints();
     let several = plan.by_joint();
-    let link = if several {
-        MemoryQueues::new(16).with_joints(joints)
-    } else {
-        MemoryQueues::new(16)
-    };
+    let link = MemoryQueues::new(16).for_plan(&plan);
     let mut peer = link.peer();
     let mut l = Loop::new(
         &cfg,

@@ -2,7 +2,7 @@
 //! process. The reference backend of the conformance suite, and the node's
 //! transport when it is embedded in another program.
 //!
-//! With several contacts ([`MemoryQueues::with_joints`]) the peer's
+//! With several contacts ([`MemoryQueues::for_plan`]) the peer's
 //! JointStates are resolved by joint name into per-contact commands, and
 //! the node's outputs are per-contact estimates and joint efforts.
 
@@ -11,6 +11,7 @@ use super::{
     PortCounters, RecordQueue, SharedCounters, TransportError,
 };
 use crate::clock::system_wall_ns;
+use crate::config::OutputPlan;
 use crate::link::RecordItem;
 use crate::msgs::{Command, EstimateRecord, StatisticsRecord};
 use crossbeam_queue::ArrayQueue;
@@ -25,8 +26,8 @@ pub struct MemoryQueues {
     commands: Arc<ArrayQueue<Command>>,
     estimates: Arc<ArrayQueue<EstimateRecord>>,
     statistics: Arc<ArrayQueue<StatisticsRecord>>,
-    /// Several contacts: the configured joints (empty: one contact).
-    joints: Arc<[String]>,
+    /// One contact, or joints (their configured order).
+    plan: OutputPlan,
     contact_estimates: Arc<ArrayQueue<(usize, EstimateRecord)>>,
     efforts: Arc<ArrayQueue<JointEfforts>>,
 }
@@ -38,17 +39,20 @@ impl MemoryQueues {
             commands: Arc::new(ArrayQueue::new(capacity)),
             estimates: Arc::new(ArrayQueue::new(capacity)),
             statistics: Arc::new(ArrayQueue::new(capacity.min(64))),
-            joints: Arc::from(Vec::new()),
+            plan: OutputPlan::OneContact,
             contact_estimates: Arc::new(ArrayQueue::new(1)),
             efforts: Arc::new(ArrayQueue::new(1)),
         }
     }
 
-    /// A link for several contacts with these joints (configured order):
-    /// per-contact estimates (`capacity` each contact) and efforts.
-    pub fn with_joints(mut self, joints: &[String]) -> Self {
+    /// The queues of `plan`: for joints, per-contact estimates (`capacity`
+    /// each contact) and efforts; for one contact, unchanged.
+    pub fn for_plan(mut self, plan: &OutputPlan) -> Self {
+        let OutputPlan::Joints(joints) = plan else {
+            return self;
+        };
         let capacity = self.estimates.capacity();
-        self.joints = Arc::from(joints.to_vec());
+        self.plan = plan.clone();
         self.contact_estimates = Arc::new(ArrayQueue::new(
             capacity.saturating_mul(joints.len().max(1)),
         ));
@@ -126,7 +130,7 @@ impl NodePort for MemoryNode {
 
     fn publish_estimate(&mut self, contact: usize, e: &EstimateRecord) -> bool {
         // A full queue is a drop, which the loop counts.
-        if self.link.joints.is_empty() {
+        if !self.link.plan.by_joint() {
             self.link.estimates.push(*e).is_ok()
         } else {
             self.link.contact_estimates.push((contact, *e)).is_ok()
@@ -176,7 +180,7 @@ impl MemoryPeer {
     /// Ok when the link was opened for joints (a configuration with
     /// `contacts`), else the error of `operation`.
     fn joints(&self, operation: &'static str) -> Result<(), TransportError> {
-        if self.link.joints.is_empty() {
+        if !self.link.plan.by_joint() {
             return Err(TransportError::NotJoints {
                 backend: "memory",
                 operation,
@@ -214,7 +218,7 @@ impl PeerPort for MemoryPeer {
         let mut full = false;
         let names = js.name.iter().map(String::as_str);
         joint_commands(
-            &self.link.joints,
+            self.link.plan.joints(),
             js.stamp_ns,
             names,
             &js.velocity,

@@ -48,7 +48,7 @@ impl JointNode {
         let ef = service::<EffortsPayload>(n, &spec.efforts, OUTPUT_BUFFER)?;
         let ce = service::<ContactEstimatePayload>(n, &spec.contact_estimate, OUTPUT_BUFFER)?;
         Ok(Self {
-            joints: spec.joints.clone(),
+            joints: spec.plan.joints().to_vec(),
             joint_state: js
                 .subscriber_builder()
                 .buffer_size(JOINT_BUFFER)

@@ -29,6 +29,7 @@ mod peer;
 
 use super::TransportError;
 use crate::config::Iceoryx2Config;
+use crate::config::OutputPlan;
 use crate::transport::Operation;
 use iceoryx2::identifiers::UniquePublisherId;
 use iceoryx2::prelude::*;
@@ -53,9 +54,9 @@ pub struct IceoryxSpec {
     pub statistics: String,
     /// The event service that wakes the node on a command.
     pub event: String,
-    /// Several contacts: the configured joints (empty: one contact) and
-    /// the joint services.
-    pub joints: Vec<String>,
+    /// One contact, or joints (their configured order) on the joint
+    /// services.
+    pub plan: OutputPlan,
     /// Several contacts: the joint-velocity service.
     pub joint_state: String,
     /// Several contacts: the efforts service.
@@ -65,9 +66,9 @@ pub struct IceoryxSpec {
 }
 
 impl IceoryxSpec {
-    /// The spec of a node serving several contacts with these joints.
-    pub fn with_joints(mut self, joints: Vec<String>) -> Self {
-        self.joints = joints;
+    /// The spec of a node following `plan`.
+    pub fn for_plan(mut self, plan: OutputPlan) -> Self {
+        self.plan = plan;
         self
     }
 }
@@ -81,7 +82,7 @@ impl From<&Iceoryx2Config> for IceoryxSpec {
             estimate: c.friction_service.clone(),
             statistics: c.loop_statistics_service.clone(),
             event: c.cmd_event_service.clone(),
-            joints: Vec::new(),
+            plan: OutputPlan::OneContact,
             joint_state: c.joint_state_service.clone(),
             efforts: c.efforts_service.clone(),
             contact_estimate: c.contact_friction_service.clone(),

@@ -76,7 +76,7 @@ impl IceoryxNode {
                 .map_err(|e| err(Operation::Open, "create the command event listener", e))?,
             velocity_sequences: Sequences::new(),
             load_sequences: Sequences::new(),
-            joints: if spec.joints.is_empty() {
+            joints: if !spec.plan.by_joint() {
                 None
             } else {
                 Some(JointNode::open(&n, spec)?)

@@ -68,7 +68,7 @@ impl IceoryxPeer {
                 .notifier_builder()
                 .create()
                 .map_err(|e| err(Operation::Open, "create the command notifier", e))?,
-            joints: if spec.joints.is_empty() {
+            joints: if !spec.plan.by_joint() {
                 None
             } else {
                 Some(JointPeer::open(&n, spec)?)

@@ -166,7 +166,7 @@ fn setup(spec: &Ros2Spec, snapshots: bool, sim_time: bool) -> Result<Entities, T
             super::subscribe(n, "/clock", &msgs::ros_interfaces::CLOCK, &q, "/clock")
         })
         .transpose()?;
-    let mut joints = (!spec.joints.is_empty())
+    let mut joints = (spec.plan.by_joint())
         .then(|| super::joints::JointTopics::open(n, spec, &cq, &eq))
         .transpose()?;
     let poll = Poll::new().map_err(|e| err(Operation::Open, "create a poll", e))?;

@@ -54,7 +54,7 @@ impl JointTopics {
             )?);
         }
         Ok(Self {
-            joints: spec.joints.clone(),
+            joints: spec.plan.joints().to_vec(),
             commands: subscribe(
                 n,
                 &spec.topics.joint_commands,

@@ -44,6 +44,7 @@ pub use peer::Ros2Peer;
 
 use super::{NodePort, PortCounters, PortIo, SharedCounters, TransportError};
 use crate::config::topics::TopicNames;
+use crate::config::OutputPlan;
 use crate::config::{self, CommandType, Config, DiscoveryRange, QosConfig, Reliability};
 use crate::msgs::{Command, EstimateRecord, MsgType, StatisticsRecord};
 use crate::transport::Operation;
@@ -93,8 +94,8 @@ pub struct Ros2Spec {
     pub frame_id: String,
     /// Capacity of each output queue.
     pub queue_capacity: usize,
-    /// Several contacts: the configured joints (empty: one contact).
-    pub joints: Vec<String>,
+    /// One contact, or joints (their configured order).
+    pub plan: OutputPlan,
 }
 
 /// The domain id: the config's, else `ROS_DOMAIN_ID`, else 0.
@@ -154,7 +155,7 @@ impl Ros2Spec {
             estimate_qos: r.qos.estimates.clone(),
             frame_id: cfg.node.frame_id.clone(),
             queue_capacity: cfg.node.queue_capacity,
-            joints: cfg.output_plan().joints().to_vec(),
+            plan: cfg.output_plan(),
         })
     }
 }
@@ -322,7 +323,7 @@ impl Ros2Node {
             counters,
             thread: Some(thread),
             services: None,
-            several: !spec.joints.is_empty(),
+            several: spec.plan.by_joint(),
         };
         if let Some(p) = io.parameters {
             let (tx, rx) = std::sync::mpsc::channel();

@@ -87,7 +87,7 @@ impl Ros2Peer {
             &eq,
             "the statistics",
         )?;
-        let joints = if spec.joints.is_empty() {
+        let joints = if !spec.plan.by_joint() {
             None
         } else {
             Some(super::joints::JointPeer::open(n, spec, &cq, &eq)?)
