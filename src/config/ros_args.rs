@@ -101,6 +101,23 @@ fn rule<'a>(flag: &str, s: &'a str) -> Result<(Option<&'a str>, &'a str, &'a str
     Ok((node, from, to))
 }
 
+/// The level of `--log-level LEVEL` or `--log-level LOGGER:=LEVEL`,
+/// lower case.
+fn log_level(flag: &str, v: &str) -> Result<String, ConfigError> {
+    let level = v.rsplit_once(":=").map_or(v, |(_, l)| l);
+    let l = level.to_ascii_lowercase();
+    if !matches!(
+        l.as_str(),
+        "debug" | "info" | "warn" | "warning" | "error" | "fatal" | "unset"
+    ) {
+        return Err(err(
+            &format!("{flag} {v}"),
+            "the level is one of debug, info, warn, error, fatal",
+        ));
+    }
+    Ok(l)
+}
+
 impl RosArgs {
     /// Parse the tokens of the `--ros-args` sections; `node_name` is the
     /// name a node-prefixed rule must carry to apply (it is resolved from
@@ -118,38 +135,7 @@ impl RosArgs {
             match flag {
                 "-r" | "--remap" => {
                     let v = value(i, flag)?;
-                    let (node, from, to) = rule(flag, v)?;
-                    let me = a.node_name.as_deref().unwrap_or(default_node_name);
-                    if node.is_none_or(|n| n == me) {
-                        match from {
-                            "__node" | "__name" => {
-                                super::check_node_name(to)
-                                    .map_err(|m| err(&format!("{flag} {v}"), m))?;
-                                a.node_name = Some(to.to_string());
-                            }
-                            "__ns" => {
-                                super::check_namespace(to)
-                                    .map_err(|m| err(&format!("{flag} {v}"), m))?;
-                                a.namespace = Some(to.to_string());
-                            }
-                            f if f.starts_with("__") => {
-                                return Err(err(
-                                    &format!("{flag} {v}"),
-                                    format!(
-                                        "`{f}` is not a remapping this node knows (__node, __ns)"
-                                    ),
-                                ));
-                            }
-                            _ => {
-                                for (what, name) in [("from", from), ("to", to)] {
-                                    super::check_topic(name).map_err(|m| {
-                                        err(&format!("{flag} {v}"), format!("{what}: {m}"))
-                                    })?;
-                                }
-                                a.remaps.push((from.to_string(), to.to_string()));
-                            }
-                        }
-                    }
+                    a.remap(flag, v, default_node_name)?;
                     i += 2;
                 }
                 "-p" | "--param" => {
@@ -166,20 +152,7 @@ impl RosArgs {
                     i += 2;
                 }
                 "--log-level" => {
-                    let v = value(i, flag)?;
-                    // `--log-level LEVEL` or `--log-level LOGGER:=LEVEL`.
-                    let level = v.rsplit_once(":=").map_or(v.as_str(), |(_, l)| l);
-                    let l = level.to_ascii_lowercase();
-                    if !matches!(
-                        l.as_str(),
-                        "debug" | "info" | "warn" | "warning" | "error" | "fatal" | "unset"
-                    ) {
-                        return Err(err(
-                            &format!("{flag} {v}"),
-                            "the level is one of debug, info, warn, error, fatal",
-                        ));
-                    }
-                    a.log_level = Some(l);
+                    a.log_level = Some(log_level(flag, value(i, flag)?)?);
                     i += 2;
                 }
                 "--enable-rosout-logs" => {
@@ -214,6 +187,40 @@ impl RosArgs {
             }
         }
         Ok(a)
+    }
+
+    /// Apply one `-r FROM:=TO` rule (when it is for this node): a node
+    /// name, a namespace or a topic remapping.
+    fn remap(&mut self, flag: &str, v: &str, default_node_name: &str) -> Result<(), ConfigError> {
+        let (node, from, to) = rule(flag, v)?;
+        let me = self.node_name.as_deref().unwrap_or(default_node_name);
+        if node.is_some_and(|n| n != me) {
+            return Ok(());
+        }
+        let here = || format!("{flag} {v}");
+        match from {
+            "__node" | "__name" => {
+                super::check_node_name(to).map_err(|m| err(&here(), m))?;
+                self.node_name = Some(to.to_string());
+            }
+            "__ns" => {
+                super::check_namespace(to).map_err(|m| err(&here(), m))?;
+                self.namespace = Some(to.to_string());
+            }
+            f if f.starts_with("__") => {
+                return Err(err(
+                    &here(),
+                    format!("`{f}` is not a remapping this node knows (__node, __ns)"),
+                ));
+            }
+            _ => {
+                for (what, name) in [("from", from), ("to", to)] {
+                    super::check_topic(name).map_err(|m| err(&here(), format!("{what}: {m}")))?;
+                }
+                self.remaps.push((from.to_string(), to.to_string()));
+            }
+        }
+        Ok(())
     }
 
     /// The fully qualified node name these arguments give, falling back to

@@ -31,7 +31,7 @@
 //! | β | steepness of the EOS transition (`eos.rs`) | 1/Pa |
 
 use super::newton::MAX_SUBSTEPS;
-use super::{Ctx, H0Mode, Isa, Solver};
+use super::{Ctx, H0Mode, Isa, Outcome, Solver};
 use crate::physics::eos::MixtureEos;
 use crate::physics::estimate::{Diagnostics, Estimate, Regime, Status};
 use crate::physics::params::{MAX_ABS_VELOCITY, MAX_LOAD, MAX_VARIABLE_STEP_S};
@@ -214,10 +214,39 @@ impl Solver {
         };
         self.w.p_backup.copy_from_slice(&self.p);
         let h_backup = self.h0;
-        // Warm start: pressure and h0 extrapolated in time, quadratically
-        // once three levels exist (error O(Δt³): within the tolerance for
-        // smooth motion, so such steps take one Newton iteration), with a
-        // liquid cell kept out of the vapour ([`PredictionGuard`]).
+        self.predict(gap);
+        let predicted = self.p_hist >= 1 && self.hist_len >= 2;
+        self.held_h0 = predicted.then_some(h_backup);
+        let out = match self.settings.method {
+            Method::Newton => self.solve(&ctx),
+            Method::Reference => self.reference_solve(&ctx),
+        };
+        let (out, substeps) = self.recover(&ctx, out, h_backup);
+        let (out, floor) = self.hold_floor(&ctx, out);
+        if out.status == Status::NonFinite {
+            self.p.copy_from_slice(&self.w.p_backup);
+            self.h0 = h_backup;
+        }
+        std::mem::swap(&mut self.p_old2, &mut self.p_old);
+        std::mem::swap(&mut self.p_old, &mut self.w.p_backup);
+        self.p_hist = (self.p_hist + 1).min(2);
+        // Level n−2 now becomes n−3 for the next step.
+        self.h0_n3 = self.hist[1].h0;
+        self.velocity = v;
+        self.last_load = Some(load);
+        let mut e = self.finish(&ctx, out, true);
+        e.diagnostics.film_floor_active = floor;
+        e.diagnostics.substeps = substeps as u32;
+        self.last = Some(e);
+        e
+    }
+
+    /// Warm start: pressure and h0 extrapolated in time, quadratically
+    /// once three levels exist (error O(Δt³): within the tolerance for
+    /// smooth motion, so such steps take one Newton iteration), with a
+    /// liquid cell kept out of the vapour ([`PredictionGuard`]).
+    #[inline(always)]
+    fn predict(&mut self, gap: H0Mode) {
         let quadratic = self.p_hist == 2 && self.hist_len >= 2;
         let guard = self.d.guard;
         if quadratic {
@@ -245,63 +274,55 @@ impl Solver {
                 }
             }
         }
-        let predicted = self.p_hist >= 1 && self.hist_len >= 2;
-        self.held_h0 = predicted.then_some(h_backup);
-        let mut out = match self.settings.method {
-            Method::Newton => self.solve(&ctx),
-            Method::Reference => self.reference_solve(&ctx),
+    }
+
+    /// Fallbacks for the rare hard step (a fast vapour-pocket collapse):
+    /// Newton from the last state instead of the extrapolated one, then
+    /// the step split into backward-Euler sub-steps. The outcome and the
+    /// number of sub-steps (0: none).
+    #[inline(always)]
+    fn recover(&mut self, ctx: &Ctx, out: Outcome, h_backup: f64) -> (Outcome, usize) {
+        if out.status == Status::Converged || self.settings.method != Method::Newton {
+            return (out, 0);
+        }
+        let spent = out.iterations;
+        self.p.copy_from_slice(&self.w.p_backup);
+        self.h0 = match ctx.gap {
+            H0Mode::Prescribed(h) => h,
+            H0Mode::Balance => h_backup,
         };
-        let mut substeps = 0;
-        if out.status != Status::Converged && self.settings.method == Method::Newton {
-            // Fallbacks for the rare hard step (a fast vapour-pocket collapse):
-            // Newton from the last state instead of the extrapolated one, then
-            // the step split into backward-Euler sub-steps.
+        let mut out = self.solve(ctx);
+        out.iterations += spent;
+        let (mut m, mut substeps) = (2, 0);
+        while out.status != Status::Converged && m <= MAX_SUBSTEPS {
             let spent = out.iterations;
-            self.p.copy_from_slice(&self.w.p_backup);
-            self.h0 = match gap {
-                H0Mode::Prescribed(h) => h,
-                H0Mode::Balance => h_backup,
-            };
-            out = self.solve(&ctx);
+            out = self.solve_substepped(ctx, m, h_backup);
             out.iterations += spent;
-            let mut m = 2;
-            while out.status != Status::Converged && m <= MAX_SUBSTEPS {
-                let spent = out.iterations;
-                out = self.solve_substepped(&ctx, m, h_backup);
-                out.iterations += spent;
-                substeps = m;
-                m *= 2;
-            }
+            substeps = m;
+            m *= 2;
         }
-        let mut floor = false;
-        if out.status != Status::NonFinite && gap == H0Mode::Balance && self.h0 < self.d.min_film {
-            // The floor binds: hold h0 there and give up the load balance.
-            floor = true;
-            let inner = out.iterations;
-            let c2 = Ctx {
-                gap: H0Mode::Prescribed(self.d.min_film),
-                ..ctx
-            };
-            self.h0 = self.d.min_film;
-            out = self.solve(&c2);
-            out.iterations += inner;
+        (out, substeps)
+    }
+
+    /// When the film would fall below its floor, hold h0 there and give up
+    /// the load balance. The outcome and whether the floor binds.
+    #[inline(always)]
+    fn hold_floor(&mut self, ctx: &Ctx, out: Outcome) -> (Outcome, bool) {
+        let binds = out.status != Status::NonFinite
+            && ctx.gap == H0Mode::Balance
+            && self.h0 < self.d.min_film;
+        if !binds {
+            return (out, false);
         }
-        if out.status == Status::NonFinite {
-            self.p.copy_from_slice(&self.w.p_backup);
-            self.h0 = h_backup;
-        }
-        std::mem::swap(&mut self.p_old2, &mut self.p_old);
-        std::mem::swap(&mut self.p_old, &mut self.w.p_backup);
-        self.p_hist = (self.p_hist + 1).min(2);
-        // Level n−2 now becomes n−3 for the next step.
-        self.h0_n3 = self.hist[1].h0;
-        self.velocity = v;
-        self.last_load = Some(load);
-        let mut e = self.finish(&ctx, out, true);
-        e.diagnostics.film_floor_active = floor;
-        e.diagnostics.substeps = substeps as u32;
-        self.last = Some(e);
-        e
+        let inner = out.iterations;
+        let c2 = Ctx {
+            gap: H0Mode::Prescribed(self.d.min_film),
+            ..*ctx
+        };
+        self.h0 = self.d.min_film;
+        let mut out = self.solve(&c2);
+        out.iterations += inner;
+        (out, true)
     }
 }
 
