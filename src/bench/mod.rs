@@ -75,10 +75,19 @@ pub struct BenchOptions<'a> {
     pub progress: &'a dyn Fn(&str),
 }
 
+/// The bench's velocity, m/s: a 1 Hz sine of amplitude 1 m/s.
+fn velocity(t: f64) -> f64 {
+    (2.0 * std::f64::consts::PI * t).sin()
+}
+
+/// Elapsed time since `start`, ns.
+fn elapsed_ns(start: Instant) -> u64 {
+    u64::try_from(start.elapsed().as_nanos()).unwrap_or(u64::MAX)
+}
+
 /// Time the paper's reciprocating case on every grid of `opts`.
 pub fn run(config: &Config, opts: &BenchOptions<'_>) -> Result<Vec<BenchCase>, SimulationError> {
     let load = config.contact.load_n;
-    let velocity = |t: f64| (2.0 * std::f64::consts::PI * t).sin();
     let mut out = Vec::new();
     for &cells in &opts.cells {
         let mut cfg = config.clone();
@@ -93,80 +102,29 @@ pub fn run(config: &Config, opts: &BenchOptions<'_>) -> Result<Vec<BenchCase>, S
             s.step(velocity(k as f64 * st.dt), load);
         }
         let steps = opts.cycles * per_cycle;
-        let sample_every = (steps / opts.reference_steps.max(1)).max(1);
-        let mut times = Vec::with_capacity(steps);
-        let (mut it_sum, mut it_max) = (0u64, 0u32);
-        let mut allocs = 0u64;
-        let mut samples = Vec::new();
         (opts.progress)(&format!("N = {cells}: {steps} timed Newton steps"));
-        for j in 0..steps {
-            let k = per_cycle + 1 + j;
-            let t = k as f64 * st.dt;
-            if j % sample_every == sample_every / 2 && samples.len() < opts.reference_steps {
-                samples.push((s.clone(), velocity(t)));
-            }
-            let a0 = opts.allocation_counter.map(|c| c());
-            let start = Instant::now();
-            let e = s.step(velocity(t), load);
-            times.push(start.elapsed().as_nanos() as u64);
-            if let (Some(c), Some(a0)) = (opts.allocation_counter, a0) {
-                allocs += c() - a0;
-            }
-            it_sum += e.diagnostics.iterations as u64;
-            it_max = it_max.max(e.diagnostics.iterations);
-        }
+        let timed = timed_steps(&mut s, load, per_cycle, steps, opts);
         let isa = s.isa();
         let baseline = (isa != Isa::Baseline).then(|| {
             (opts.progress)(&format!(
                 "N = {cells}: the same steps, baseline instruction set"
             ));
-            let mut b = Solver::new(&cfg.model(), &st).expect("validated above");
-            b.set_isa(Isa::Baseline);
-            b.initialize_steady(0.0, load);
-            let mut times = Vec::with_capacity(steps);
-            for k in 1..=per_cycle + steps {
-                let start = Instant::now();
-                b.step(velocity(k as f64 * st.dt), load);
-                if k > per_cycle {
-                    times.push(start.elapsed().as_nanos() as u64);
-                }
-            }
-            Timing::from_ns(&times)
+            baseline_steps(&cfg, load, per_cycle, steps)
         });
-        // Side by side from identical states at equal tolerance.
-        let tol = cfg.solver.reference.motion_tolerance;
-        let (mut tn, mut tr, mut picard) = (Vec::new(), Vec::new(), 0u64);
-        for (i, (state, v)) in samples.iter().enumerate() {
-            (opts.progress)(&format!(
-                "N = {cells}: reference step {}/{}",
-                i + 1,
-                samples.len()
-            ));
-            let mut a = state.clone();
-            a.set_method(Method::Newton, tol);
-            let start = Instant::now();
-            a.step(*v, load);
-            tn.push(start.elapsed().as_nanos() as u64);
-            let mut b = state.clone();
-            b.set_method(Method::Reference, tol);
-            let start = Instant::now();
-            let e = b.step(*v, load);
-            tr.push(start.elapsed().as_nanos() as u64);
-            picard += e.diagnostics.inner_iterations as u64;
-        }
+        let side = side_by_side(&cfg, load, &timed.samples, opts);
         out.push(BenchCase {
             cells,
             steps,
-            newton: Timing::from_ns(&times),
-            newton_mean_iterations: it_sum as f64 / steps as f64,
-            newton_max_iterations: it_max,
-            newton_equal_tol: Timing::from_ns(&tn),
-            reference: Timing::from_ns(&tr),
-            reference_samples: tr.len(),
-            reference_mean_picard: picard as f64 / tr.len().max(1) as f64,
+            newton: Timing::from_ns(&timed.times),
+            newton_mean_iterations: timed.iterations_sum as f64 / steps as f64,
+            newton_max_iterations: timed.iterations_max,
+            newton_equal_tol: Timing::from_ns(&side.newton),
+            reference: Timing::from_ns(&side.reference),
+            reference_samples: side.reference.len(),
+            reference_mean_picard: side.picard as f64 / side.reference.len().max(1) as f64,
             allocations_per_step: opts
                 .allocation_counter
-                .map(|_| allocs as f64 / steps as f64),
+                .map(|_| timed.allocations as f64 / steps as f64),
             isa,
             baseline,
             breakdown: opts.breakdown.then(|| {
@@ -176,6 +134,116 @@ pub fn run(config: &Config, opts: &BenchOptions<'_>) -> Result<Vec<BenchCase>, S
         });
     }
     Ok(out)
+}
+
+/// The timed Newton steps of one grid.
+struct TimedSteps {
+    /// Each step's time, ns.
+    times: Vec<u64>,
+    iterations_sum: u64,
+    iterations_max: u32,
+    /// Allocations over every step (0 without a counter).
+    allocations: u64,
+    /// States (with the velocity of their next step) for the side-by-side
+    /// comparison with the reference solver.
+    samples: Vec<(Solver, f64)>,
+}
+
+/// `steps` timed steps of `s` after `per_cycle` warm-up steps, sampling
+/// states for the reference comparison evenly.
+fn timed_steps(
+    s: &mut Solver,
+    load: f64,
+    per_cycle: usize,
+    steps: usize,
+    opts: &BenchOptions<'_>,
+) -> TimedSteps {
+    let dt = s.settings().dt;
+    let sample_every = (steps / opts.reference_steps.max(1)).max(1);
+    let mut r = TimedSteps {
+        times: Vec::with_capacity(steps),
+        iterations_sum: 0,
+        iterations_max: 0,
+        allocations: 0,
+        samples: Vec::new(),
+    };
+    for j in 0..steps {
+        let t = (per_cycle + 1 + j) as f64 * dt;
+        if j % sample_every == sample_every / 2 && r.samples.len() < opts.reference_steps {
+            r.samples.push((s.clone(), velocity(t)));
+        }
+        let a0 = opts.allocation_counter.map(|c| c());
+        let start = Instant::now();
+        let e = s.step(velocity(t), load);
+        r.times.push(elapsed_ns(start));
+        if let (Some(c), Some(a0)) = (opts.allocation_counter, a0) {
+            r.allocations += c() - a0;
+        }
+        r.iterations_sum += u64::from(e.diagnostics.iterations);
+        r.iterations_max = r.iterations_max.max(e.diagnostics.iterations);
+    }
+    r
+}
+
+/// The same steps on the baseline instruction set.
+fn baseline_steps(cfg: &Config, load: f64, per_cycle: usize, steps: usize) -> Timing {
+    let st = cfg.solver_settings();
+    let mut b = Solver::new(&cfg.model(), &st).expect("validated by the caller");
+    b.set_isa(Isa::Baseline);
+    b.initialize_steady(0.0, load);
+    let mut times = Vec::with_capacity(steps);
+    for k in 1..=per_cycle + steps {
+        let start = Instant::now();
+        b.step(velocity(k as f64 * st.dt), load);
+        if k > per_cycle {
+            times.push(elapsed_ns(start));
+        }
+    }
+    Timing::from_ns(&times)
+}
+
+/// Newton and the reference solver side by side.
+struct SideBySide {
+    newton: Vec<u64>,
+    reference: Vec<u64>,
+    /// Picard iterations of the reference steps.
+    picard: u64,
+}
+
+/// Newton and the reference solver from identical states at equal
+/// tolerance.
+fn side_by_side(
+    cfg: &Config,
+    load: f64,
+    samples: &[(Solver, f64)],
+    opts: &BenchOptions<'_>,
+) -> SideBySide {
+    let tol = cfg.solver.reference.motion_tolerance;
+    let mut r = SideBySide {
+        newton: Vec::new(),
+        reference: Vec::new(),
+        picard: 0,
+    };
+    for (i, (state, v)) in samples.iter().enumerate() {
+        (opts.progress)(&format!(
+            "N = {}: reference step {}/{}",
+            cfg.solver.cells,
+            i + 1,
+            samples.len()
+        ));
+        let mut a = state.clone();
+        a.set_method(Method::Newton, tol);
+        let start = Instant::now();
+        a.step(*v, load);
+        r.newton.push(elapsed_ns(start));
+        let mut b = state.clone();
+        b.set_method(Method::Reference, tol);
+        let start = Instant::now();
+        let e = b.step(*v, load);
+        r.reference.push(elapsed_ns(start));
+        r.picard += u64::from(e.diagnostics.inner_iterations);
+    }
+    r
 }
 
 /// States every 25 steps of a cycle after a warm-up cycle, each part timed

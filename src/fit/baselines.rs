@@ -187,87 +187,36 @@ impl Baseline {
         let samples = Samples::of(series);
         let fit = starts(kind, load_form, &samples, v);
         let fc0 = mean_abs_n.clamp(1e-3 * f, f);
-        let generic = |name: &str| -> f64 {
-            match name {
-                "fs" => (1.5 * fc0).min(f),
-                _ => fc0,
-            }
-        };
-        let mut params = Vec::new();
-        let mut next = 0;
-        let mut take = |default: f64| -> f64 {
-            let x = fit
-                .as_ref()
-                .and_then(|x| x.get(next).copied())
-                .unwrap_or(default);
-            next += 1;
-            x
-        };
-        // A start outside the default bounds widens them: a bound never
-        // excludes the least-squares answer.
-        let push = |params: &mut Vec<FittedParameter>, name: &str, start: f64, lo: f64, hi: f64| {
-            let (lo, hi) = (
-                if start < lo {
-                    start - (lo - start).abs().max(lo.abs())
-                } else {
-                    lo
-                },
-                if start > hi { 2.0 * start } else { hi },
-            );
-            params.push(FittedParameter::new(name, start.clamp(lo, hi), lo, hi));
-        };
         let top = 4.0 * f;
-        let mu_hi = top / load_min;
-        let level =
-            |params: &mut Vec<FittedParameter>, name: &str, take: &mut dyn FnMut(f64) -> f64| {
-                let start = generic(name);
-                let suffix = &name[1..];
-                match load_form {
-                    LoadForm::Linear => {
-                        let a = take(0.0);
-                        push(params, &format!("{name}0_n"), a, -top, top);
-                        let m = take(0.5 * start / load_min);
-                        push(params, &format!("mu_{suffix}"), m.max(0.0), 0.0, mu_hi);
-                    }
-                    LoadForm::Proportional => {
-                        let m = take(start / load_min);
-                        push(params, &format!("mu_{suffix}"), m.max(0.0), 0.0, mu_hi);
-                    }
-                    LoadForm::Constant => {
-                        let c = take(start);
-                        push(params, &format!("{name}_n"), c.max(0.0), 0.0, top);
-                    }
-                }
-            };
-        level(&mut params, "fc", &mut take);
+        let mut p = ParamList {
+            fit,
+            next: 0,
+            params: Vec::new(),
+        };
+        let level = Level {
+            form: load_form,
+            top,
+            mu_hi: top / load_min,
+            load_min,
+        };
+        level.push(&mut p, "fc", fc0);
         if kind != BaselineKind::CoulombViscous {
-            level(&mut params, "fs", &mut take);
-            let vs = take(0.01 * v);
-            push(&mut params, "vs_m_s", vs, 1e-4 * v, 10.0 * v);
+            level.push(&mut p, "fs", (1.5 * fc0).min(f));
+            let vs = p.take(0.01 * v);
+            p.push("vs_m_s", vs, 1e-4 * v, 10.0 * v);
         }
-        let b = take(0.0);
-        push(&mut params, "b_n_s_m", b.max(0.0), 0.0, 10.0 * f / v);
+        let b = p.take(0.0);
+        p.push("b_n_s_m", b.max(0.0), 0.0, 10.0 * f / v);
         if kind == BaselineKind::LuGre {
             let stiffness = super::reversals::stiffness(series)
                 .stiffness_n_m
                 .unwrap_or(1e3 * f / v);
-            push(
-                &mut params,
-                "sigma0_n_m",
-                stiffness,
-                stiffness * 1e-4,
-                stiffness * 1e4,
-            );
+            p.push("sigma0_n_m", stiffness, stiffness * 1e-4, stiffness * 1e4);
             // Damping from a small share of critical-like damping; a start
             // inside its range (0 is its bound).
-            push(
-                &mut params,
-                "sigma1_n_s_m",
-                0.01 * f / v,
-                0.0,
-                100.0 * f / v,
-            );
+            p.push("sigma1_n_s_m", 0.01 * f / v, 0.0, 100.0 * f / v);
         }
+        let params = p.params;
         Self {
             kind,
             load_form,
@@ -477,6 +426,74 @@ impl Model for Baseline {
             out.push(l.sigma0 * z + l.sigma1 * zdot + l.b * v);
         }
         Ok(out)
+    }
+}
+
+/// The parameters of a baseline as they are built: each takes its start
+/// from the least-squares fit (in order) when there is one.
+struct ParamList {
+    fit: Option<Vec<f64>>,
+    next: usize,
+    params: Vec<FittedParameter>,
+}
+
+impl ParamList {
+    /// The next least-squares value, else `default`.
+    fn take(&mut self, default: f64) -> f64 {
+        let x = self
+            .fit
+            .as_ref()
+            .and_then(|x| x.get(self.next).copied())
+            .unwrap_or(default);
+        self.next += 1;
+        x
+    }
+
+    /// A parameter in [lo, hi]; a start outside the default bounds widens
+    /// them: a bound never excludes the least-squares answer.
+    fn push(&mut self, name: &str, start: f64, lo: f64, hi: f64) {
+        let lo = if start < lo {
+            start - (lo - start).abs().max(lo.abs())
+        } else {
+            lo
+        };
+        let hi = if start > hi { 2.0 * start } else { hi };
+        self.params
+            .push(FittedParameter::new(name, start.clamp(lo, hi), lo, hi));
+    }
+}
+
+/// How a friction level (Coulomb, static) depends on the load.
+struct Level {
+    form: LoadForm,
+    /// The largest level, N.
+    top: f64,
+    /// The largest coefficient.
+    mu_hi: f64,
+    /// The data's smallest load, N.
+    load_min: f64,
+}
+
+impl Level {
+    /// Level `name` (`fc`, `fs`) with `start` (N) when the fit has none.
+    fn push(&self, p: &mut ParamList, name: &str, start: f64) {
+        let suffix = &name[1..];
+        match self.form {
+            LoadForm::Linear => {
+                let a = p.take(0.0);
+                p.push(&format!("{name}0_n"), a, -self.top, self.top);
+                let m = p.take(0.5 * start / self.load_min);
+                p.push(&format!("mu_{suffix}"), m.max(0.0), 0.0, self.mu_hi);
+            }
+            LoadForm::Proportional => {
+                let m = p.take(start / self.load_min);
+                p.push(&format!("mu_{suffix}"), m.max(0.0), 0.0, self.mu_hi);
+            }
+            LoadForm::Constant => {
+                let c = p.take(start);
+                p.push(&format!("{name}_n"), c.max(0.0), 0.0, self.top);
+            }
+        }
     }
 }
 
