@@ -289,53 +289,13 @@ pub fn one_cycle(
         .iter()
         .map(|s| (s.inertia_force / s.load).abs())
         .fold(0.0, f64::max);
-    // Zero crossings between samples j and j+1, cyclically (the motion is
-    // periodic, so a crossing can fall between the cycle's last and first
-    // samples).
-    let crossings: Vec<usize> = (0..n)
-        .filter(|&j| {
-            let (a, b) = (cyc[j].velocity, cyc[(j + 1) % n].velocity);
-            (a > 0.0 && b <= 0.0) || (a < 0.0 && b >= 0.0)
-        })
-        .collect();
-    let extrapolate = |s1: &LoopSample, s2: &LoopSample| -> Option<f64> {
-        let dv = s2.velocity - s1.velocity;
-        if dv == 0.0 {
-            return None;
-        }
-        // The boundary rate's part is exactly 0 at v = 0 and steep near it
-        // (asinh): only the smooth remainder is extrapolated.
-        let (c1, c2) = (s1.cof - s1.boundary_rate_cof, s2.cof - s2.boundary_rate_cof);
-        Some(c2 + (c2 - c1) * (0.0 - s2.velocity) / dv)
-    };
-    let mut acc = Vec::new();
-    let mut dec = Vec::new();
-    let at = |k: usize| &cyc[k % n];
-    for &j in &crossings {
-        if let Some(c) = extrapolate(at(j + n - 1), at(j)) {
-            dec.push(c);
-        }
-        if let Some(c) = extrapolate(at(j + 2), at(j + 1)) {
-            acc.push(c);
-        }
-    }
+    let crossings = zero_crossings(cyc);
+    let (acc, dec) = cof_at_reversals(cyc, &crossings);
     let avg = |v: &[f64]| (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64);
     // Loop areas per half-cycle lobe.
     let friction_loop_area = lobe_areas(cyc, &crossings, |s| s.friction);
     let cof_loop_area = lobe_areas(cyc, &crossings, |s| s.cof);
-    // Accelerating (|v| rising) versus decelerating branch.
-    let (mut ca, mut cd, mut ha, mut hd) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    for j in 1..n - 1 {
-        let rising = cyc[j + 1].velocity.abs() > cyc[j - 1].velocity.abs();
-        let falling = cyc[j + 1].velocity.abs() < cyc[j - 1].velocity.abs();
-        if rising {
-            ca.push(cyc[j].cof);
-            ha.push(cyc[j].h0);
-        } else if falling {
-            cd.push(cyc[j].cof);
-            hd.push(cyc[j].h0);
-        }
-    }
+    let branches = Branches::of(cyc);
     let gap = |a: &[f64], b: &[f64]| match (avg(a), avg(b)) {
         (Some(x), Some(y)) => Some(x - y),
         _ => None,
@@ -357,10 +317,81 @@ pub fn one_cycle(
         h0_max,
         mean_asperity_share: mean(&|s| s.asperity_share),
         mean_fluid_share: mean(&|s| s.hydrodynamic_force / s.load),
-        branch_cof_gap: gap(&ca, &cd),
-        branch_h0_gap: gap(&ha, &hd),
+        branch_cof_gap: gap(&branches.cof_accelerating, &branches.cof_decelerating),
+        branch_h0_gap: gap(&branches.h0_accelerating, &branches.h0_decelerating),
         inertia_share,
         inertia_share_smooth,
+    }
+}
+
+/// Zero crossings of the velocity between samples j and j+1, cyclically
+/// (the motion is periodic, so a crossing can fall between the cycle's
+/// last and first samples).
+fn zero_crossings(cyc: &[LoopSample]) -> Vec<usize> {
+    let n = cyc.len();
+    (0..n)
+        .filter(|&j| {
+            let (a, b) = (cyc[j].velocity, cyc[(j + 1) % n].velocity);
+            (a > 0.0 && b <= 0.0) || (a < 0.0 && b >= 0.0)
+        })
+        .collect()
+}
+
+/// The COF extrapolated to v = 0 at every crossing: from the two samples
+/// after it (accelerating) and the two before it (decelerating).
+fn cof_at_reversals(cyc: &[LoopSample], crossings: &[usize]) -> (Vec<f64>, Vec<f64>) {
+    let n = cyc.len();
+    let extrapolate = |s1: &LoopSample, s2: &LoopSample| -> Option<f64> {
+        let dv = s2.velocity - s1.velocity;
+        if dv == 0.0 {
+            return None;
+        }
+        // The boundary rate's part is exactly 0 at v = 0 and steep near it
+        // (asinh): only the smooth remainder is extrapolated.
+        let (c1, c2) = (s1.cof - s1.boundary_rate_cof, s2.cof - s2.boundary_rate_cof);
+        Some(c2 + (c2 - c1) * (0.0 - s2.velocity) / dv)
+    };
+    let (mut acc, mut dec) = (Vec::new(), Vec::new());
+    let at = |k: usize| &cyc[k % n];
+    for &j in crossings {
+        if let Some(c) = extrapolate(at(j + n - 1), at(j)) {
+            dec.push(c);
+        }
+        if let Some(c) = extrapolate(at(j + 2), at(j + 1)) {
+            acc.push(c);
+        }
+    }
+    (acc, dec)
+}
+
+/// The samples of the accelerating (|v| rising) and the decelerating
+/// branch.
+struct Branches {
+    cof_accelerating: Vec<f64>,
+    cof_decelerating: Vec<f64>,
+    h0_accelerating: Vec<f64>,
+    h0_decelerating: Vec<f64>,
+}
+
+impl Branches {
+    fn of(cyc: &[LoopSample]) -> Self {
+        let mut b = Branches {
+            cof_accelerating: Vec::new(),
+            cof_decelerating: Vec::new(),
+            h0_accelerating: Vec::new(),
+            h0_decelerating: Vec::new(),
+        };
+        for j in 1..cyc.len().saturating_sub(1) {
+            let (before, after) = (cyc[j - 1].velocity.abs(), cyc[j + 1].velocity.abs());
+            if after > before {
+                b.cof_accelerating.push(cyc[j].cof);
+                b.h0_accelerating.push(cyc[j].h0);
+            } else if after < before {
+                b.cof_decelerating.push(cyc[j].cof);
+                b.h0_decelerating.push(cyc[j].h0);
+            }
+        }
+        b
     }
 }
 

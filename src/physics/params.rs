@@ -227,97 +227,122 @@ impl ModelParams {
     /// Mathematical invariants the solver relies on. Physical plausibility
     /// ranges are checked by the configuration layer.
     pub fn check(&self) -> Result<(), SetupError> {
-        let g = &self.geometry;
-        positive("geometry.length", g.length)?;
-        positive("geometry.width", g.width)?;
-        match g.profile {
-            Profile::Parabolic { depth } | Profile::Linear { depth } => {
-                non_negative("geometry.profile.depth", depth)?
-            }
-            Profile::Flat => {}
-        }
-        for pk in &g.pockets {
-            non_negative("geometry.pocket.start", pk.start)?;
-            positive("geometry.pocket.width", pk.width)?;
-            non_negative("geometry.pocket.depth", pk.depth)?;
-            if pk.start + pk.width > g.length * (1.0 + 1e-12) {
-                return Err(SetupError::invalid(
-                    "geometry.pocket.end",
-                    pk.start + pk.width,
-                    "pocket must end inside the slider (start + width <= length)",
-                ));
-            }
-        }
-        let l = &self.lubricant;
-        positive("lubricant.viscosity", l.viscosity)?;
-        positive("lubricant.density", l.density)?;
-        positive("lubricant.gas_viscosity", l.gas_viscosity)?;
-        positive("lubricant.gas_density", l.gas_density)?;
-        positive("lubricant.ambient_pressure", l.ambient_pressure)?;
-        positive("lubricant.saturation_pressure", l.saturation_pressure)?;
-        non_negative("lubricant.vapour_pressure", l.vapour_pressure)?;
-        if l.vapour_pressure >= l.saturation_pressure {
-            return Err(SetupError::invalid(
-                "lubricant.vapour_pressure",
-                l.vapour_pressure,
-                "must be below the saturation pressure",
-            ));
-        }
-        let (a_s, a_v) = (l.vapour_fraction_saturation, l.vapour_fraction_vapour);
-        if !(a_s > 0.0 && a_s < 1.0) {
-            return Err(SetupError::invalid(
-                "lubricant.vapour_fraction_saturation",
-                a_s,
-                "must lie in (0, 1)",
-            ));
-        }
-        if !(a_v > a_s && a_v < 1.0) {
-            return Err(SetupError::invalid(
-                "lubricant.vapour_fraction_vapour",
-                a_v,
-                "must lie in (vapour_fraction_saturation, 1)",
-            ));
-        }
-        let r = &self.roughness;
-        positive("roughness.sigma", r.sigma)?;
-        non_negative("roughness.asperity_density", r.asperity_density)?;
-        positive("roughness.asperity_radius", r.asperity_radius)?;
-        positive("roughness.effective_modulus", r.effective_modulus)?;
-        if r.flow_factors {
-            super::flow_factors::FlowFactors::new(r.lay_gamma, r.sigma)?;
-        }
-        let c = &self.contact;
-        non_negative("contact.mass", c.mass)?;
-        non_negative("contact.boundary_friction", c.boundary_friction)?;
-        non_negative(
-            "contact.boundary_rate.sensitivity",
-            c.boundary_rate.sensitivity,
-        )?;
-        positive(
-            "contact.boundary_rate.activation_speed",
-            c.boundary_rate.activation_speed,
-        )?;
-        positive("contact.sign_regularization", c.sign_regularization)?;
-        non_negative("contact.min_film", c.min_film)?;
-        non_negative("contact.presliding.stiffness", c.presliding.stiffness)?;
-        non_negative("contact.presliding.damping", c.presliding.damping)?;
-        non_negative("contact.width_law.exponent", c.width_law.exponent)?;
-        positive(
-            "contact.width_law.reference_load",
-            c.width_law.reference_load,
-        )?;
-        let d = &self.drivetrain;
-        non_negative("drivetrain.coulomb", d.coulomb)?;
-        non_negative("drivetrain.viscous", d.viscous)?;
-        non_negative("drivetrain.load_coefficient", d.load_coefficient)?;
-        non_negative("drivetrain.quadratic", d.quadratic)?;
-        if !d.coulomb_asymmetry.is_finite() {
-            return Err(SetupError::invalid(
-                "drivetrain.coulomb_asymmetry",
-                d.coulomb_asymmetry,
-                "must be finite",
-            ));
-        }
+        check_geometry(&self.geometry)?;
+        check_lubricant(&self.lubricant)?;
+        check_roughness(&self.roughness)?;
+        check_contact(&self.contact)?;
+        check_drivetrain(&self.drivetrain)?;
         Ok(())
     }
+}
+
+/// The slider's dimensions, profile and pockets.
+fn check_geometry(g: &Geometry) -> Result<(), SetupError> {
+    positive("geometry.length", g.length)?;
+    positive("geometry.width", g.width)?;
+    match g.profile {
+        Profile::Parabolic { depth } | Profile::Linear { depth } => {
+            non_negative("geometry.profile.depth", depth)?
+        }
+        Profile::Flat => {}
+    }
+    for pk in &g.pockets {
+        non_negative("geometry.pocket.start", pk.start)?;
+        positive("geometry.pocket.width", pk.width)?;
+        non_negative("geometry.pocket.depth", pk.depth)?;
+        if pk.start + pk.width > g.length * (1.0 + 1e-12) {
+            return Err(SetupError::invalid(
+                "geometry.pocket.end",
+                pk.start + pk.width,
+                "pocket must end inside the slider (start + width <= length)",
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The lubricant's properties and its cavitation model.
+fn check_lubricant(l: &Lubricant) -> Result<(), SetupError> {
+    positive("lubricant.viscosity", l.viscosity)?;
+    positive("lubricant.density", l.density)?;
+    positive("lubricant.gas_viscosity", l.gas_viscosity)?;
+    positive("lubricant.gas_density", l.gas_density)?;
+    positive("lubricant.ambient_pressure", l.ambient_pressure)?;
+    positive("lubricant.saturation_pressure", l.saturation_pressure)?;
+    non_negative("lubricant.vapour_pressure", l.vapour_pressure)?;
+    if l.vapour_pressure >= l.saturation_pressure {
+        return Err(SetupError::invalid(
+            "lubricant.vapour_pressure",
+            l.vapour_pressure,
+            "must be below the saturation pressure",
+        ));
+    }
+    let (a_s, a_v) = (l.vapour_fraction_saturation, l.vapour_fraction_vapour);
+    if !(a_s > 0.0 && a_s < 1.0) {
+        return Err(SetupError::invalid(
+            "lubricant.vapour_fraction_saturation",
+            a_s,
+            "must lie in (0, 1)",
+        ));
+    }
+    if !(a_v > a_s && a_v < 1.0) {
+        return Err(SetupError::invalid(
+            "lubricant.vapour_fraction_vapour",
+            a_v,
+            "must lie in (vapour_fraction_saturation, 1)",
+        ));
+    }
+    Ok(())
+}
+
+/// The asperities.
+fn check_roughness(r: &Roughness) -> Result<(), SetupError> {
+    positive("roughness.sigma", r.sigma)?;
+    non_negative("roughness.asperity_density", r.asperity_density)?;
+    positive("roughness.asperity_radius", r.asperity_radius)?;
+    positive("roughness.effective_modulus", r.effective_modulus)?;
+    if r.flow_factors {
+        super::flow_factors::FlowFactors::new(r.lay_gamma, r.sigma)?;
+    }
+    Ok(())
+}
+
+/// The contact's mass, film floor and friction terms.
+fn check_contact(c: &Contact) -> Result<(), SetupError> {
+    non_negative("contact.mass", c.mass)?;
+    non_negative("contact.boundary_friction", c.boundary_friction)?;
+    non_negative(
+        "contact.boundary_rate.sensitivity",
+        c.boundary_rate.sensitivity,
+    )?;
+    positive(
+        "contact.boundary_rate.activation_speed",
+        c.boundary_rate.activation_speed,
+    )?;
+    positive("contact.sign_regularization", c.sign_regularization)?;
+    non_negative("contact.min_film", c.min_film)?;
+    non_negative("contact.presliding.stiffness", c.presliding.stiffness)?;
+    non_negative("contact.presliding.damping", c.presliding.damping)?;
+    non_negative("contact.width_law.exponent", c.width_law.exponent)?;
+    positive(
+        "contact.width_law.reference_load",
+        c.width_law.reference_load,
+    )?;
+    Ok(())
+}
+
+/// The drivetrain's terms.
+fn check_drivetrain(d: &super::terms::drivetrain::Drivetrain) -> Result<(), SetupError> {
+    non_negative("drivetrain.coulomb", d.coulomb)?;
+    non_negative("drivetrain.viscous", d.viscous)?;
+    non_negative("drivetrain.load_coefficient", d.load_coefficient)?;
+    non_negative("drivetrain.quadratic", d.quadratic)?;
+    if !d.coulomb_asymmetry.is_finite() {
+        return Err(SetupError::invalid(
+            "drivetrain.coulomb_asymmetry",
+            d.coulomb_asymmetry,
+            "must be finite",
+        ));
+    }
+    Ok(())
 }
