@@ -14,6 +14,16 @@ pub fn claim2(r: &Results) -> Claim {
     let Some(s) = r.get(&StudyKind::AmplitudeFrequency) else {
         return c;
     };
+    c.checks.extend(area_checks(s));
+    let (checks, observation) = branch_checks(s);
+    c.checks.extend(checks);
+    c.observations.push(observation);
+    c
+}
+
+/// Claim 2's loop areas: growing with amplitude, more so at higher
+/// frequency, and with frequency at large amplitude.
+fn area_checks(s: &StudyResult) -> [Check; 3] {
     let area = |v1: &str, f: &str| metric(s, &format!("v1-{v1}_f-{f}"), |m| m.cof_loop_area);
     let mut amp_ok = true;
     let mut ev = Vec::new();
@@ -24,22 +34,6 @@ pub fn claim2(r: &Results) -> Claim {
         growth.push(a[2] - a[0]);
         ev.push(format!("f {f} Hz: {}", sci(&a)));
     }
-    c.checks.push(check(
-        "area_grows_with_amplitude",
-        amp_ok,
-        format!(
-            "COF loop area (m/s) for V1 = 0.1, 0.5, 1 m/s: {}",
-            ev.join("; ")
-        ),
-    ));
-    c.checks.push(check(
-        "growth_larger_at_higher_frequency",
-        increasing(&growth),
-        format!(
-            "area(V1 = 1) − area(V1 = 0.1) at f = 0.25, 1, 4 Hz: {}",
-            sci(&growth)
-        ),
-    ));
     let mut freq_ev = Vec::new();
     let mut freq_ok = true;
     for v1 in ["0.1", "0.5", "1"] {
@@ -49,14 +43,37 @@ pub fn claim2(r: &Results) -> Claim {
         }
         freq_ev.push(format!("V1 {v1}: {}", sci(&a)));
     }
-    c.checks.push(check(
-        "area_grows_with_frequency_at_large_amplitude",
-        freq_ok,
-        format!(
-            "COF loop area at f = 0.25, 1, 4 Hz (V1 ≥ 0.5 checked): {}",
-            freq_ev.join("; ")
+    [
+        check(
+            "area_grows_with_amplitude",
+            amp_ok,
+            format!(
+                "COF loop area (m/s) for V1 = 0.1, 0.5, 1 m/s: {}",
+                ev.join("; ")
+            ),
         ),
-    ));
+        check(
+            "growth_larger_at_higher_frequency",
+            increasing(&growth),
+            format!(
+                "area(V1 = 1) − area(V1 = 0.1) at f = 0.25, 1, 4 Hz: {}",
+                sci(&growth)
+            ),
+        ),
+        check(
+            "area_grows_with_frequency_at_large_amplitude",
+            freq_ok,
+            format!(
+                "COF loop area at f = 0.25, 1, 4 Hz (V1 ≥ 0.5 checked): {}",
+                freq_ev.join("; ")
+            ),
+        ),
+    ]
+}
+
+/// Claim 2's branches against the steady curve and each other, and the
+/// mean offsets as an observation.
+fn branch_checks(s: &StudyResult) -> ([Check; 5], String) {
     let mut counts = [0usize; 5];
     let mut n = 0;
     let mut rows = Vec::new();
@@ -80,37 +97,26 @@ pub fn claim2(r: &Results) -> Claim {
             ));
         }
     }
-    let all = |k: usize| n > 0 && counts[k] == n;
-    c.checks.push(check(
-        "accelerating_branch_above_decelerating",
-        all(4),
-        format!("{}/{n} cases", counts[4]),
-    ));
-    c.checks.push(check(
-        "accelerating_branch_above_steady",
-        all(0),
-        format!("{}/{n} cases", counts[0]),
-    ));
-    c.checks.push(check(
-        "decelerating_branch_below_steady",
-        all(1),
-        format!("{}/{n} cases", counts[1]),
-    ));
-    c.checks.push(check(
-        "film_thinner_than_steady_when_accelerating",
-        all(2),
-        format!("{}/{n} cases", counts[2]),
-    ));
-    c.checks.push(check(
-        "film_thicker_than_steady_when_decelerating",
-        all(3),
-        format!("{}/{n} cases", counts[3]),
-    ));
-    c.observations.push(format!(
-        "Mean offsets from the steady curve at the same velocity: {}",
-        rows.join("; ")
-    ));
-    c
+    let all = |name: &str, k: usize| {
+        check(
+            name,
+            n > 0 && counts[k] == n,
+            format!("{}/{n} cases", counts[k]),
+        )
+    };
+    (
+        [
+            all("accelerating_branch_above_decelerating", 4),
+            all("accelerating_branch_above_steady", 0),
+            all("decelerating_branch_below_steady", 1),
+            all("film_thinner_than_steady_when_accelerating", 2),
+            all("film_thicker_than_steady_when_decelerating", 3),
+        ],
+        format!(
+            "Mean offsets from the steady curve at the same velocity: {}",
+            rows.join("; ")
+        ),
+    )
 }
 
 /// Claim 3: COF at zero velocity.
