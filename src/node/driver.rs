@@ -4,7 +4,7 @@
 
 use crate::config::StepMode;
 use crate::msgs::{Command, CommandKind};
-use crate::transport::{self, BackendSpec};
+use crate::transport::{self, BackendSpec, PeerPort};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -130,7 +130,10 @@ pub fn drive(
         joints,
     } = plan;
     let mut report = DemoReport::default();
-    let mut peer = match spec.open_peer() {
+    let opened = spec
+        .open_peer()
+        .and_then(|mut p| transport::wait_matched(p.as_mut(), Duration::from_secs(20)).map(|()| p));
+    let mut peer = match opened {
         Ok(p) => p,
         Err(e) => {
             let _ = ready.send(Err(e.to_string()));
@@ -138,11 +141,6 @@ pub fn drive(
             return report;
         }
     };
-    if let Err(e) = transport::wait_matched(peer.as_mut(), Duration::from_secs(20)) {
-        let _ = ready.send(Err(e.to_string()));
-        report.error = Some(e.to_string());
-        return report;
-    }
     let _ = ready.send(Ok(()));
     let mut velocity = motion.start();
     let steps = (seconds / dt).round() as u64;
@@ -166,47 +164,61 @@ pub fn drive(
             value: velocity.at(t, dt),
             stamp_ns: t0 + (t * 1e9) as u64,
         };
-        if !joints.is_empty() {
-            let js = transport::JointStateCommand {
+        let sent = if joints.is_empty() {
+            peer.send(&c)
+        } else {
+            peer.send_joint_state(&transport::JointStateCommand {
                 stamp_ns: c.stamp_ns,
                 name: joints.clone(),
                 velocity: vec![c.value; joints.len()],
-            };
-            if let Err(e) = peer.send_joint_state(&js) {
-                report.error.get_or_insert(e.to_string());
-                continue;
-            }
-            report.commands_sent += 1;
-            if mode == StepMode::Lockstep && efforts_timeout(peer.as_mut(), Duration::from_secs(2))
-            {
-                report.estimates_received += 1;
-            }
-            while let Ok(Some(_)) = peer.try_recv_efforts() {
-                report.estimates_received += 1;
-            }
-            continue;
-        }
-        if let Err(e) = peer.send(&c) {
+            })
+        };
+        if let Err(e) = sent {
             report.error.get_or_insert(e.to_string());
             continue;
         }
         report.commands_sent += 1;
-        if mode == StepMode::Lockstep {
-            if let Ok(Some(_)) = transport::recv_timeout(peer.as_mut(), Duration::from_secs(2)) {
-                report.estimates_received += 1;
-            }
-        }
-        while let Ok(Some(_)) = peer.try_recv() {
+        if mode == StepMode::Lockstep && answered(peer.as_mut(), !joints.is_empty()) {
             report.estimates_received += 1;
         }
+        report.estimates_received += drain(peer.as_mut(), !joints.is_empty());
     }
-    // Estimates still in flight.
+    // Answers still in flight.
     let until = Instant::now() + Duration::from_millis(300);
     while Instant::now() < until {
-        match peer.try_recv() {
-            Ok(Some(_)) => report.estimates_received += 1,
-            _ => std::thread::sleep(Duration::from_millis(5)),
+        match drain(peer.as_mut(), !joints.is_empty()) {
+            0 => std::thread::sleep(Duration::from_millis(5)),
+            n => report.estimates_received += n,
         }
     }
     report
+}
+
+/// Whether the answer to one command (an estimate; joint efforts with
+/// joints) arrives within 2 s.
+fn answered(peer: &mut dyn PeerPort, joints: bool) -> bool {
+    if joints {
+        efforts_timeout(peer, Duration::from_secs(2))
+    } else {
+        matches!(
+            transport::recv_timeout(peer, Duration::from_secs(2)),
+            Ok(Some(_))
+        )
+    }
+}
+
+/// Take every answer waiting (estimates; joint efforts with joints): how
+/// many.
+fn drain(peer: &mut dyn PeerPort, joints: bool) -> u64 {
+    let mut n = 0;
+    if joints {
+        while let Ok(Some(_)) = peer.try_recv_efforts() {
+            n += 1;
+        }
+    } else {
+        while let Ok(Some(_)) = peer.try_recv() {
+            n += 1;
+        }
+    }
+    n
 }
