@@ -384,45 +384,54 @@ impl std::fmt::Display for SimulateReport {
                         ""
                     }
                 )?;
-                writeln!(
-                    f,
-                    "  friction loop area   {:.4} N·m/s",
-                    m.friction_loop_area
-                )?;
-                writeln!(f, "  COF loop area        {:.5} m/s", m.cof_loop_area)?;
-                writeln!(
-                    f,
-                    "  peak COF             {:.4} at v = {:+.3} m/s",
-                    m.peak_cof, m.peak_cof_velocity
-                )?;
-                writeln!(f, "  mean COF             {:.4}", m.mean_cof)?;
-                if let (Some(a), Some(d)) = (m.cof_v0_accelerating, m.cof_v0_decelerating) {
-                    writeln!(
-                        f,
-                        "  COF at v = 0         accelerating {a:.4}, decelerating {d:.4}"
-                    )?;
-                }
-                writeln!(
-                    f,
-                    "  h0 range             {:.3} … {:.3} µm",
-                    m.h0_min * 1e6,
-                    m.h0_max * 1e6
-                )?;
-                writeln!(
-                    f,
-                    "  asperity load share  {:.1} % (mean)",
-                    100.0 * m.mean_asperity_share
-                )?;
-                writeln!(
-                    f,
-                    "  inertia share M      {:.2e} % (raw max), {:.2e} % (smooth)",
-                    100.0 * m.inertia_share,
-                    100.0 * m.inertia_share_smooth
-                )?;
+                write_cycle(f, m)?;
             }
             (Some(p), None) => writeln!(f, "no complete cycle of {p} s in the run")?,
             _ => {}
         }
         Ok(())
     }
+}
+
+/// The metrics of one cycle, one line each.
+fn write_cycle(
+    f: &mut std::fmt::Formatter<'_>,
+    m: &crate::analysis::LoopMetrics,
+) -> std::fmt::Result {
+    writeln!(
+        f,
+        "  friction loop area   {:.4} N·m/s",
+        m.friction_loop_area
+    )?;
+    writeln!(f, "  COF loop area        {:.5} m/s", m.cof_loop_area)?;
+    writeln!(
+        f,
+        "  peak COF             {:.4} at v = {:+.3} m/s",
+        m.peak_cof, m.peak_cof_velocity
+    )?;
+    writeln!(f, "  mean COF             {:.4}", m.mean_cof)?;
+    if let (Some(a), Some(d)) = (m.cof_v0_accelerating, m.cof_v0_decelerating) {
+        writeln!(
+            f,
+            "  COF at v = 0         accelerating {a:.4}, decelerating {d:.4}"
+        )?;
+    }
+    writeln!(
+        f,
+        "  h0 range             {:.3} … {:.3} µm",
+        m.h0_min * 1e6,
+        m.h0_max * 1e6
+    )?;
+    writeln!(
+        f,
+        "  asperity load share  {:.1} % (mean)",
+        100.0 * m.mean_asperity_share
+    )?;
+    writeln!(
+        f,
+        "  inertia share M      {:.2e} % (raw max), {:.2e} % (smooth)",
+        100.0 * m.inertia_share,
+        100.0 * m.inertia_share_smooth
+    )?;
+    Ok(())
 }

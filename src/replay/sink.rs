@@ -200,6 +200,76 @@ const BATCH: usize = 1024;
 /// The writer thread hands its sink back with the first write error.
 type SinkOutcome = (Box<dyn Sink>, Result<(), ReplayError>);
 
+impl CsvSink {
+    /// The CSV file at `path` with its header (a contact column with
+    /// joints).
+    fn create(path: &Path, p: &PreparedReplay) -> Result<Self, ReplayError> {
+        let mut file = crate::output::AtomicFile::create(path)?;
+        let contacts: Vec<String> = if p.config.output_plan().by_joint() {
+            p.config.contacts.0.iter().map(|c| c.name.clone()).collect()
+        } else {
+            Vec::new()
+        };
+        file.line(format_args!(
+            "{},stamp_ns,command_status{}",
+            crate::offline::SIMULATE_COLUMNS,
+            if contacts.is_empty() { "" } else { ",contact" }
+        ))?;
+        Ok(CsvSink {
+            file,
+            t0: None,
+            contacts,
+        })
+    }
+}
+
+impl McapSink {
+    /// The MCAP recording of the replay of `source`, written to a temporary
+    /// sibling of `path` (a device such as /dev/null is written in place,
+    /// never renamed over).
+    fn create(path: &Path, p: &PreparedReplay, source: &Path) -> Result<Self, ReplayError> {
+        let tmp = (!crate::output::is_special(path)).then(|| tmp_sibling(path));
+        let target = tmp.clone().unwrap_or_else(|| path.to_path_buf());
+        let mut extra = BTreeMap::new();
+        extra.insert("replay_of".to_string(), source.display().to_string());
+        extra.insert("replay_input".to_string(), input_label(&p.mode));
+        let names = crate::config::topics::TopicNames::from_config(&p.config);
+        let w = crate::record::BagWriter::create(
+            &target,
+            &p.config,
+            &names,
+            extra,
+            crate::clock::system_wall_ns(),
+        )
+        .map_err(|e| {
+            if let Some(t) = &tmp {
+                let _ = std::fs::remove_file(t);
+                crate::output::forget_temporary(t);
+            }
+            OutputError::other(path, e.to_string())
+        })?;
+        Ok(McapSink {
+            w: Some(w),
+            path: path.to_path_buf(),
+            tmp,
+            commands: p.commands.clone(),
+            next: 0,
+        })
+    }
+}
+
+/// What the replay's model was driven by, for the recording's metadata.
+fn input_label(mode: &InputMode) -> String {
+    match mode {
+        InputMode::Topics { velocity, .. } => format!("topic {velocity}"),
+        InputMode::RecordedEstimates { topic } => format!("recorded estimates {topic}"),
+        InputMode::RecordedContacts { topics } => {
+            format!("recorded estimates of {} contacts", topics.len())
+        }
+        InputMode::JointStates { topic, .. } => format!("joint states {topic}"),
+    }
+}
+
 impl OutputStream {
     /// Create the temporary output next to `path` and start the writer.
     pub fn start(
@@ -210,66 +280,8 @@ impl OutputStream {
     ) -> Result<Self, ReplayError> {
         let out_err = |message: String| OutputError::other(path, message);
         let sink: Box<dyn Sink> = match format {
-            OutputFormat::Csv => {
-                let mut file = crate::output::AtomicFile::create(path)?;
-                let contacts: Vec<String> = if p.config.output_plan().by_joint() {
-                    p.config.contacts.0.iter().map(|c| c.name.clone()).collect()
-                } else {
-                    Vec::new()
-                };
-                file.line(format_args!(
-                    "{},stamp_ns,command_status{}",
-                    crate::offline::SIMULATE_COLUMNS,
-                    if contacts.is_empty() { "" } else { ",contact" }
-                ))?;
-                Box::new(CsvSink {
-                    file,
-                    t0: None,
-                    contacts,
-                })
-            }
-            OutputFormat::Mcap => {
-                // A device (e.g. /dev/null) is written in place, never renamed over.
-                let tmp = (!crate::output::is_special(path)).then(|| tmp_sibling(path));
-                let target = tmp.clone().unwrap_or_else(|| path.to_path_buf());
-                let mut extra = BTreeMap::new();
-                extra.insert("replay_of".to_string(), source.display().to_string());
-                extra.insert(
-                    "replay_input".to_string(),
-                    match &p.mode {
-                        InputMode::Topics { velocity, .. } => format!("topic {velocity}"),
-                        InputMode::RecordedEstimates { topic } => {
-                            format!("recorded estimates {topic}")
-                        }
-                        InputMode::RecordedContacts { topics } => {
-                            format!("recorded estimates of {} contacts", topics.len())
-                        }
-                        InputMode::JointStates { topic, .. } => format!("joint states {topic}"),
-                    },
-                );
-                let names = crate::config::topics::TopicNames::from_config(&p.config);
-                let w = crate::record::BagWriter::create(
-                    &target,
-                    &p.config,
-                    &names,
-                    extra,
-                    crate::clock::system_wall_ns(),
-                )
-                .map_err(|e| {
-                    if let Some(t) = &tmp {
-                        let _ = std::fs::remove_file(t);
-                        crate::output::forget_temporary(t);
-                    }
-                    out_err(e.to_string())
-                })?;
-                Box::new(McapSink {
-                    w: Some(w),
-                    path: path.to_path_buf(),
-                    tmp,
-                    commands: p.commands.clone(),
-                    next: 0,
-                })
-            }
+            OutputFormat::Csv => Box::new(CsvSink::create(path, p)?),
+            OutputFormat::Mcap => Box::new(McapSink::create(path, p, source)?),
         };
         let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<Step>>(8);
         let thread = std::thread::Builder::new()
