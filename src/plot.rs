@@ -138,6 +138,21 @@ fn bounds(panel: &Panel, log_x: bool, log_y: bool) -> ((f64, f64), (f64, f64)) {
     (pad(x0, x1, log_x), pad(y0, y1, log_y))
 }
 
+/// A line's points that its axes can show (finite; positive on a log
+/// axis), decimated to [`MAX_POINTS`].
+fn plottable(l: &Line, ax: &Axes<'_>) -> Vec<(f64, f64)> {
+    decimate(
+        l.points
+            .iter()
+            .copied()
+            .filter(|&(x, y)| {
+                x.is_finite() && y.is_finite() && (!ax.log_x || x > 0.0) && (!ax.log_y || y > 0.0)
+            })
+            .collect(),
+        MAX_POINTS,
+    )
+}
+
 fn draw_panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, plotters::coord::Shift>,
     p: &Panel,
@@ -168,19 +183,7 @@ where
                 .map_err(|e| e.to_string())?;
             let mut labelled = false;
             for l in &p.lines {
-                let pts: Vec<(f64, f64)> = decimate(
-                    l.points
-                        .iter()
-                        .copied()
-                        .filter(|&(x, y)| {
-                            x.is_finite()
-                                && y.is_finite()
-                                && (!ax.log_x || x > 0.0)
-                                && (!ax.log_y || y > 0.0)
-                        })
-                        .collect(),
-                    MAX_POINTS,
-                );
+                let pts = plottable(l, ax);
                 let style = ShapeStyle::from(&l.color).stroke_width(if l.dashed { 1 } else { 2 });
                 let s = if l.dashed {
                     chart

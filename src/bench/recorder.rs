@@ -27,6 +27,65 @@ pub struct RecorderBench {
     pub steps: u64,
 }
 
+/// Queue `item`, waiting for room: full rate, never lossy (the recorder is
+/// waited for, not time).
+fn push(q: &crossbeam_queue::ArrayQueue<RecordItem>, item: RecordItem) {
+    let mut item = item;
+    while let Err(back) = q.push(item) {
+        item = back;
+        std::thread::yield_now();
+    }
+}
+
+/// One simulated step of the recording bench.
+struct Step {
+    /// Its number, from 1.
+    k: u64,
+    stamp_ns: u64,
+    /// Whether loop statistics are due.
+    statistics: bool,
+}
+
+impl Step {
+    /// What the loop would hand the recorder at this step: the command,
+    /// the estimate and, when due, the statistics.
+    fn items(&self, config: &Config) -> impl Iterator<Item = RecordItem> {
+        let (k, t) = (self.k, self.stamp_ns);
+        let v = (2.0 * std::f64::consts::PI * k as f64 * config.solver.dt_s).sin();
+        let command = RecordItem::Command {
+            command: Command {
+                kind: CommandKind::Velocity,
+                value: v,
+                stamp_ns: t,
+            },
+            received_ns: t,
+        };
+        let estimate = RecordItem::Estimate {
+            record: EstimateRecord {
+                stamp_ns: t,
+                velocity_m_s: v,
+                load_n: config.contact.load_n,
+                friction_force_n: 3000.0 * v,
+                cof: 0.1 + 0.01 * v,
+                h0_m: 1e-5,
+                iterations: 1,
+                ..Default::default()
+            },
+            logged_ns: t,
+            contact: 0,
+        };
+        let statistics = self.statistics.then_some(RecordItem::Statistics {
+            record: StatisticsRecord {
+                stamp_ns: t,
+                steps: k,
+                ..Default::default()
+            },
+            logged_ns: t,
+        });
+        [command, estimate].into_iter().chain(statistics)
+    }
+}
+
 /// Feed `hours` of simulated recording into `dir` (a split directory).
 pub fn run(
     config: &Config,
@@ -51,53 +110,19 @@ pub fn run(
     let stats_every = (1.0 / config.node.statistics_rate_hz / config.solver.dt_s).round() as u64;
     let started = std::time::Instant::now();
     let mut rss_by_hour = Vec::new();
-    let push = |item: RecordItem| {
-        let mut item = item;
-        // Full rate, never lossy: wait for the recorder, not for time.
-        while let Err(back) = q.push(item) {
-            item = back;
-            std::thread::yield_now();
-        }
-    };
     let wall0 = 1_763_900_000_000_000_000u64;
     let mut k = 0u64;
     for h in 0..hours {
         for _ in 0..per_hour {
             k += 1;
-            let t = wall0 + k * dt_ns;
             clock.advance(dt_ns);
-            let v = (2.0 * std::f64::consts::PI * k as f64 * config.solver.dt_s).sin();
-            push(RecordItem::Command {
-                command: Command {
-                    kind: CommandKind::Velocity,
-                    value: v,
-                    stamp_ns: t,
-                },
-                received_ns: t,
-            });
-            push(RecordItem::Estimate {
-                record: EstimateRecord {
-                    stamp_ns: t,
-                    velocity_m_s: v,
-                    load_n: config.contact.load_n,
-                    friction_force_n: 3000.0 * v,
-                    cof: 0.1 + 0.01 * v,
-                    h0_m: 1e-5,
-                    iterations: 1,
-                    ..Default::default()
-                },
-                logged_ns: t,
-                contact: 0,
-            });
-            if stats_every > 0 && k.is_multiple_of(stats_every) {
-                push(RecordItem::Statistics {
-                    record: StatisticsRecord {
-                        stamp_ns: t,
-                        steps: k,
-                        ..Default::default()
-                    },
-                    logged_ns: t,
-                });
+            let step = Step {
+                k,
+                stamp_ns: wall0 + k * dt_ns,
+                statistics: stats_every > 0 && k.is_multiple_of(stats_every),
+            };
+            for item in step.items(config) {
+                push(&q, item);
             }
         }
         // Let the recorder catch up before sampling.

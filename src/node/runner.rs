@@ -420,6 +420,58 @@ fn announce_start(config: &Config, transports: &[String]) {
     );
 }
 
+/// The threads beside the loop: the demo driver and the status line.
+struct Helpers {
+    driver: Option<std::thread::JoinHandle<DemoReport>>,
+    driver_stop: Arc<AtomicBool>,
+    status: Option<std::thread::JoinHandle<()>>,
+    status_stop: Arc<AtomicBool>,
+}
+
+impl Helpers {
+    /// Start what `opts` asks for (the demo drives `spec`).
+    fn start(
+        config: &Config,
+        opts: &RunOptions,
+        spec: &BackendSpec,
+        live: &Arc<LiveStatus>,
+        warnings: &mut Vec<String>,
+    ) -> Result<Self, RunError> {
+        let driver_stop = Arc::new(AtomicBool::new(false));
+        let driver = match opts.demo_s {
+            Some(seconds) => Some(start_demo(
+                config,
+                opts,
+                seconds,
+                spec.clone(),
+                driver_stop.clone(),
+                warnings,
+            )?),
+            None => None,
+        };
+        let status_stop = Arc::new(AtomicBool::new(false));
+        let status = opts
+            .status_line
+            .then(|| status_thread(live.clone(), status_stop.clone(), config.solver.dt_s));
+        Ok(Self {
+            driver,
+            driver_stop,
+            status,
+            status_stop,
+        })
+    }
+
+    /// Stop both and wait for them: the demo's report, if it ran.
+    fn stop(self) -> Option<DemoReport> {
+        self.driver_stop.store(true, Ordering::Relaxed);
+        self.status_stop.store(true, Ordering::Relaxed);
+        if let Some(s) = self.status {
+            let _ = s.join();
+        }
+        self.driver.and_then(|d| d.join().ok())
+    }
+}
+
 /// Run the node until `stop`, the duration or the demo ends.
 pub fn run_node(
     config: &Config,
@@ -470,36 +522,14 @@ pub fn run_node(
     if let Some(r) = &recorder {
         l = l.with_recorder(r.counters());
     }
-    let driver_stop = Arc::new(AtomicBool::new(false));
-    let driver = match opts.demo_s {
-        Some(seconds) => Some(start_demo(
-            config,
-            opts,
-            seconds,
-            specs[0].clone(),
-            driver_stop.clone(),
-            &mut report.warnings,
-        )?),
-        None => None,
-    };
+    let helpers = Helpers::start(config, opts, &specs[0], &live, &mut report.warnings)?;
     apply_realtime(config, &mut report);
-    let status_stop = Arc::new(AtomicBool::new(false));
-    let status = opts
-        .status_line
-        .then(|| status_thread(live.clone(), status_stop.clone(), config.solver.dt_s));
     let duration = opts.demo_s.or(opts.duration_s).map(Duration::from_secs_f64);
     announce_start(config, &report.transports);
     report.summary = l.run(&stop, duration);
     report.interrupted = stop.load(Ordering::Relaxed);
-    driver_stop.store(true, Ordering::Relaxed);
-    status_stop.store(true, Ordering::Relaxed);
-    if let Some(s) = status {
-        let _ = s.join();
-    }
+    report.demo = helpers.stop();
     drop(l);
-    if let Some(d) = driver {
-        report.demo = d.join().ok();
-    }
     #[cfg(feature = "mcap")]
     if let Some(r) = recorder {
         finish_recording(r, &mut report);
