@@ -181,6 +181,47 @@ pub fn service_qos() -> QosPolicies {
         .build()
 }
 
+/// A request in Cyclone DDS's layout: the client's GUID has its upper half
+/// from the writer and its lower half from the header (as rmw_cyclonedds
+/// splits it), the sequence number the header's last 8 bytes in the
+/// message's byte order; the header is echoed little-endian (the reply's
+/// encoding).
+fn cyclone_request<T>(
+    body: T,
+    header: [u8; 16],
+    big: bool,
+    writer_guid: GUID,
+    sender: [u8; 12],
+) -> Request<T> {
+    let mut g = writer_guid.to_bytes();
+    g[8..16].copy_from_slice(&header[..8]);
+    let word = |b: &[u8]| {
+        let a = [b[0], b[1], b[2], b[3]];
+        if big {
+            u32::from_be_bytes(a)
+        } else {
+            u32::from_le_bytes(a)
+        }
+    };
+    let (high, low) = (word(&header[8..12]), word(&header[12..16]));
+    let seq = SequenceNumber::from_high_low(high as i32, low);
+    let mut echoed = header;
+    if big {
+        echoed[8..12].copy_from_slice(&high.to_le_bytes());
+        echoed[12..16].copy_from_slice(&low.to_le_bytes());
+    }
+    Request {
+        layout: Layout::Cyclone,
+        body,
+        identity: SampleIdentity {
+            writer_guid: GUID::from_bytes(g),
+            sequence_number: seq,
+        },
+        header: echoed,
+        sender,
+    }
+}
+
 impl DualServer {
     /// Serve `service` (fully qualified, e.g. `/friction_node/list_parameters`)
     /// of type `package/srv/Type`.
@@ -283,42 +324,8 @@ impl DualServer {
                     });
                 }
                 Classified::Cyclone { header, body } => {
-                    // The client's GUID: upper half from the writer, lower
-                    // half from the header (as rmw_cyclonedds splits it).
-                    let mut g = writer_guid.to_bytes();
-                    g[8..16].copy_from_slice(&header[..8]);
                     let big = cdr.get(1) == Some(&0);
-                    let word = |b: &[u8]| {
-                        let a = [b[0], b[1], b[2], b[3]];
-                        if big {
-                            u32::from_be_bytes(a)
-                        } else {
-                            u32::from_le_bytes(a)
-                        }
-                    };
-                    let seq = SequenceNumber::from_high_low(
-                        word(&header[8..12]) as i32,
-                        word(&header[12..16]),
-                    );
-                    let header = if big {
-                        // Echo in the reply's (little-endian) encoding.
-                        let mut h = header;
-                        h[8..12].copy_from_slice(&(word(&header[8..12])).to_le_bytes());
-                        h[12..16].copy_from_slice(&(word(&header[12..16])).to_le_bytes());
-                        h
-                    } else {
-                        header
-                    };
-                    return Some(Request {
-                        layout: Layout::Cyclone,
-                        body,
-                        identity: SampleIdentity {
-                            writer_guid: GUID::from_bytes(g),
-                            sequence_number: seq,
-                        },
-                        header,
-                        sender,
-                    });
+                    return Some(cyclone_request(body, header, big, writer_guid, sender));
                 }
                 Classified::Undecodable => {
                     self.undecodable += 1;
