@@ -366,6 +366,24 @@ pub fn held_out_scale(o: &FitOutcome) -> f64 {
     (ss / n.max(1) as f64).sqrt()
 }
 
+/// The optimiser's options for classic model `kind`.
+fn baseline_options(req: &FitRequest, kind: BaselineKind) -> Options {
+    let mut opts = req.options(kind.label());
+    // A classic model costs microseconds per evaluation: give it ten times
+    // the budget, so that a non-converged baseline is never the budget's
+    // fault.
+    opts.max_evaluations = req.max_evaluations.saturating_mul(10);
+    // The secant update saves simulations; a classic model costs
+    // microseconds, so it keeps the exact Jacobian (whose path the classic
+    // models' optima were checked on against SciPy).
+    opts.jacobian = super::local_run::JacobianRule::Differences;
+    // For the same reason every later run walks to its end: the valley test
+    // saves simulations at the risk of missing a better optimum, a risk the
+    // baselines need not take.
+    opts.later_runs = super::local_run::LaterRuns::Full;
+    opts
+}
+
 /// Fit the classic models with the same optimiser; load-only map
 /// coefficients stay at their starts (the load-linear levels absorb them).
 /// Returns the outcomes and a note for each model skipped.
@@ -411,19 +429,7 @@ pub fn fit_baselines(
             p.mean_abs_n,
             &series,
         );
-        // A classic model costs microseconds per evaluation: give it ten
-        // times the budget, so that a non-converged baseline is never the
-        // budget's fault.
-        let mut opts = req.options(kind.label());
-        opts.max_evaluations = req.max_evaluations.saturating_mul(10);
-        // The secant update saves simulations; a classic model costs
-        // microseconds, so it keeps the exact Jacobian (whose path the
-        // classic models' optima were checked on against SciPy).
-        opts.jacobian = super::local_run::JacobianRule::Differences;
-        // For the same reason every later run walks to its end: the valley
-        // test saves simulations at the risk of missing a better optimum,
-        // a risk the baselines need not take.
-        opts.later_runs = super::local_run::LaterRuns::Full;
+        let mut opts = baseline_options(req, kind);
         // Each model contains the one before it: it also starts from that
         // one's optimum, so it never ends worse than the simpler model; and
         // from generic starts that ignore the data (mean level, static

@@ -46,59 +46,52 @@ impl TopicTable {
         };
         let cq = offered_qos_yaml(&config.ros.qos.commands);
         let eq = offered_qos_yaml(&config.ros.qos.estimates);
+        let pq = offered_qos_yaml(&crate::config::QosConfig {
+            reliability: Reliability::Reliable,
+            depth: 1000,
+            durability: crate::config::Durability::Volatile,
+        });
+        let row = |id, name: &String, ty, qos: &String| (id, name.clone(), ty, qos.clone());
+        let n = names;
         let mut table = Self {
             topics: vec![
-                (
-                    TopicId::Velocity,
-                    names.cmd_velocity.clone(),
-                    velocity_type,
-                    cq.clone(),
-                ),
-                (
-                    TopicId::Load,
-                    names.normal_load.clone(),
-                    &msgs::FLOAT64,
-                    cq.clone(),
-                ),
-                (
+                row(TopicId::Velocity, &n.cmd_velocity, velocity_type, &cq),
+                row(TopicId::Load, &n.normal_load, &msgs::FLOAT64, &cq),
+                row(
                     TopicId::Friction,
-                    names.friction.clone(),
+                    &n.friction,
                     &msgs::FRICTION_ESTIMATE,
-                    eq.clone(),
+                    &eq,
                 ),
-                (
+                row(
                     TopicId::FrictionForce,
-                    names.friction_force.clone(),
+                    &n.friction_force,
                     &msgs::FLOAT64,
-                    eq.clone(),
+                    &eq,
                 ),
-                (
+                row(
                     TopicId::FilmProfile,
-                    names.film_profile.clone(),
+                    &n.film_profile,
                     &msgs::FILM_PROFILE,
-                    eq.clone(),
+                    &eq,
                 ),
-                (
+                row(
                     TopicId::Statistics,
-                    names.loop_statistics.clone(),
+                    &n.loop_statistics,
                     &msgs::LOOP_STATISTICS,
-                    eq,
+                    &eq,
                 ),
-                (
+                row(
                     TopicId::Temperature,
-                    names.temperature.clone(),
+                    &n.temperature,
                     &msgs::TEMPERATURE,
-                    cq,
+                    &cq,
                 ),
-                (
+                row(
                     TopicId::ParameterEvents,
-                    names.parameter_events.clone(),
+                    &n.parameter_events,
                     &msgs::ros_interfaces::PARAMETER_EVENT,
-                    offered_qos_yaml(&crate::config::QosConfig {
-                        reliability: Reliability::Reliable,
-                        depth: 1000,
-                        durability: crate::config::Durability::Volatile,
-                    }),
+                    &pq,
                 ),
             ],
         };
