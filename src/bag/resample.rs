@@ -44,6 +44,49 @@ pub fn resample(
     resample_held(velocity, &mut [(CommandKind::Load, load)], hold)
 }
 
+/// The gaps longer than the timeout between velocity samples.
+fn silences_of(velocity: &[(u64, f64)], timeout_ns: u64) -> impl Iterator<Item = Silence> + '_ {
+    velocity
+        .windows(2)
+        .filter(move |w| w[1].0 - w[0].0 > timeout_ns)
+        .map(|w| Silence {
+            from_ns: w[0].0,
+            length_s: (w[1].0 - w[0].0) as f64 / 1e9,
+        })
+}
+
+/// The velocity at step time `t` from sample `(ta, va)` at or before it
+/// and the next sample: interpolated between samples no further apart than
+/// the timeout, held within the timeout, else as `hold.behaviour` says
+/// (`applied`: the previous step's velocity, for ramp-to-zero).
+fn velocity_at(
+    t: u64,
+    (ta, va): (u64, f64),
+    next: Option<&(u64, f64)>,
+    timeout_ns: u64,
+    applied: f64,
+    hold: &Hold,
+) -> f64 {
+    match next {
+        _ if ta == t => va,
+        Some(&(tb, vb)) if tb - ta <= timeout_ns => {
+            va + (vb - va) * ((t - ta) as f64 / (tb - ta) as f64)
+        }
+        _ if t - ta <= timeout_ns => va,
+        _ => match hold.behaviour {
+            TimeoutBehaviour::Hold => va,
+            TimeoutBehaviour::RampToZero => {
+                let dv = hold.deceleration_m_s2 * hold.dt_s;
+                if applied.abs() <= dv {
+                    0.0
+                } else {
+                    applied - dv * applied.signum()
+                }
+            }
+        },
+    }
+}
+
 /// [`resample`] with any number of held set points (load, temperature):
 /// each is sent when its value changes, before the velocity of its step.
 pub fn resample_held(
@@ -65,14 +108,7 @@ pub fn resample_held(
         return (commands, silences);
     };
     let timeout_ns = (hold.timeout_s * 1e9) as u64;
-    for w in velocity.windows(2) {
-        if w[1].0 - w[0].0 > timeout_ns {
-            silences.push(Silence {
-                from_ns: w[0].0,
-                length_s: (w[1].0 - w[0].0) as f64 / 1e9,
-            });
-        }
-    }
+    silences.extend(silences_of(velocity, timeout_ns));
     let dt_ns = hold.dt_s * 1e9;
     let steps = ((t_last - t_first) as f64 / dt_ns).floor() as u64;
     commands.reserve(steps as usize + 1);
@@ -86,25 +122,14 @@ pub fn resample_held(
         while j + 1 < velocity.len() && velocity[j + 1].0 <= t {
             j += 1;
         }
-        let (ta, va) = velocity[j];
-        let v = match velocity.get(j + 1) {
-            _ if ta == t => va,
-            Some(&(tb, vb)) if tb - ta <= timeout_ns => {
-                va + (vb - va) * ((t - ta) as f64 / (tb - ta) as f64)
-            }
-            _ if t - ta <= timeout_ns => va,
-            _ => match hold.behaviour {
-                TimeoutBehaviour::Hold => va,
-                TimeoutBehaviour::RampToZero => {
-                    let dv = hold.deceleration_m_s2 * hold.dt_s;
-                    if applied.abs() <= dv {
-                        0.0
-                    } else {
-                        applied - dv * applied.signum()
-                    }
-                }
-            },
-        };
+        let v = velocity_at(
+            t,
+            velocity[j],
+            velocity.get(j + 1),
+            timeout_ns,
+            applied,
+            hold,
+        );
         applied = v;
         for (k, (kind, samples)) in held.iter().enumerate() {
             let l = &mut next[k];
