@@ -90,9 +90,11 @@ use super::gw::{Greenwood, SummedContact};
 use super::params::ModelParams;
 use super::scheme::StepCoefficients;
 use super::settings::{Method, SolverSettings};
+use super::terms::FrictionTerms;
 use newton::CONTRACTION_MAX;
 
-/// Immutable discretisation data.
+/// The film's model discretised on its grid, immutable between model swaps
+/// (the friction terms, which act after the film, are [`Solver`]'s `terms`).
 #[derive(Debug, Clone)]
 pub(crate) struct Disc {
     pub grid: Grid,
@@ -110,9 +112,6 @@ pub(crate) struct Disc {
     pub gr_edge: f64,
     pub mass: f64,
     pub min_film: f64,
-    /// The friction terms beside the film's shear, composed by
-    /// [`crate::physics::terms`].
-    pub terms: crate::physics::terms::FrictionTerms,
     pub guard: step::PredictionGuard,
 }
 
@@ -239,6 +238,10 @@ pub struct FieldPoint {
 #[derive(Debug, Clone)]
 pub struct Solver {
     pub(crate) d: Disc,
+    /// The friction terms beside the film's shear, composed by
+    /// [`crate::physics::terms`] after the film is solved (they do not act
+    /// on the film; the soft width's scale is applied to its forces).
+    pub(crate) terms: FrictionTerms,
     /// The geometry the grid was built from (a swapped model must match it).
     geometry: super::params::Geometry,
     pub(crate) settings: SolverSettings,
@@ -293,6 +296,7 @@ pub struct Solver {
 #[derive(Debug, Clone)]
 pub struct PreparedModel {
     d: Disc,
+    terms: FrictionTerms,
     cells: usize,
     geometry: super::params::Geometry,
 }
@@ -342,7 +346,6 @@ impl Solver {
             gr_edge: sb.rho / sb.mu,
             mass: model.contact.mass,
             min_film: model.contact.min_film,
-            terms: crate::physics::terms::FrictionTerms::of(model),
             guard: step::PredictionGuard::new(&eos, model.lubricant.saturation_pressure),
         })
     }
@@ -354,6 +357,7 @@ impl Solver {
     ) -> Result<PreparedModel, SetupError> {
         Ok(PreparedModel {
             d: Self::disc(model, settings)?,
+            terms: FrictionTerms::of(model),
             cells: settings.cells,
             geometry: model.geometry.clone(),
         })
@@ -371,14 +375,14 @@ impl Solver {
         if !self.fits(m) {
             return Err(ModelMismatch);
         }
-        let was_rigid = !self.d.terms.presliding.is_on();
+        let was_rigid = !self.terms.presliding.is_on();
         std::mem::swap(&mut self.d, &mut m.d);
-        if was_rigid && self.d.terms.presliding.is_on() {
+        std::mem::swap(&mut self.terms, &mut m.terms);
+        if was_rigid && self.terms.presliding.is_on() {
             // Compliance switched on: as if it had always been, the
             // displacement of the last state's level.
             self.bristle = self.last.map_or(0.0, |e| {
-                self.d
-                    .terms
+                self.terms
                     .presliding
                     .steady_displacement(e.contact_friction_force)
             });
@@ -395,6 +399,7 @@ impl Solver {
         let p_amb = d.p_amb;
         let mut s = Self {
             d,
+            terms: FrictionTerms::of(model),
             geometry: model.geometry.clone(),
             settings: *settings,
             p: vec![p_amb; n],
@@ -500,7 +505,7 @@ impl Solver {
     /// The load per reference width of a solve at `load` (N), after
     /// setting the width scale the solve's forces are reported with.
     pub(crate) fn per_reference_width(&mut self, load: f64) -> f64 {
-        self.width_scale = self.d.terms.width_law.scale(load);
+        self.width_scale = self.terms.width_law.scale(load);
         load / self.width_scale
     }
 

@@ -152,8 +152,7 @@ impl Solver {
             (_, None) => BristleMove::Steady,
             _ => BristleMove::Hold,
         };
-        self.d
-            .terms
+        self.terms
             .friction((ctx.v, load), forces, &mut self.bristle, how)
     }
 
@@ -216,7 +215,7 @@ impl Solver {
         let load = w * ctx.load;
         let (contact_friction, friction) = self.friction(ctx, load, (f_visc, f_asp), advance);
         let d = &self.d;
-        let (cof, boundary_rate_cof) = d.terms.cof(v, f_visc, f_asp, contact_friction, load);
+        let (cof, boundary_rate_cof) = self.terms.cof(v, f_visc, f_asp, contact_friction, load);
         let share = f_asp / load;
         let load_residual = match ctx.gap {
             H0Mode::Balance => load_res,
