@@ -18,7 +18,6 @@
 
 mod cli;
 
-use clap::Parser;
 use std::cell::Cell;
 
 /// Counts heap allocations (per thread) so that `bench` can report
@@ -81,7 +80,7 @@ fn main() {
         }
     };
     cli::logging::init(ros.as_ref());
-    let cli = match cli::args::Cli::try_parse_from(std::iter::once(argv[0].clone()).chain(rest)) {
+    let cli = match cli::args::parse(std::iter::once(argv[0].clone()).chain(rest)) {
         Ok(c) => c,
         Err(e) => match e.kind() {
             clap::error::ErrorKind::DisplayHelp

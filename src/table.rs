@@ -98,6 +98,31 @@ impl Table {
         }
     }
 
+    /// The rows where `keep` holds, in order (`keep` has one entry per row).
+    pub fn select_rows(&self, keep: &[bool]) -> Self {
+        let pick = |c: &Vec<f64>| -> Vec<f64> {
+            c.iter()
+                .zip(keep)
+                .filter(|(_, k)| **k)
+                .map(|(v, _)| *v)
+                .collect()
+        };
+        Self {
+            source: self.source.clone(),
+            names: self.names.clone(),
+            columns: self.columns.iter().map(pick).collect(),
+            text: self.text.clone(),
+            lines: self
+                .lines
+                .iter()
+                .zip(keep)
+                .filter(|(_, k)| **k)
+                .map(|(l, _)| *l)
+                .collect(),
+            has_header: self.has_header,
+        }
+    }
+
     /// A numeric column by name (None: no such column, or it holds text).
     pub fn column(&self, name: &str) -> Option<&[f64]> {
         self.index(name)

@@ -245,3 +245,222 @@ fn a_bound_that_excludes_the_value_the_chosen_scale_rests_on_is_an_error_naming_
     );
     assert!(!d.join("x.yaml").exists());
 }
+
+/// A joint's record through a 20 mm lever, written with the joint's
+/// column names (`velocity_rad_s`, `torque_nm`): `seconds` of a 0.5 Hz
+/// sine of `amplitude_rad_s`.
+fn joint_record(d: &Path, amplitude_rad_s: f64, seconds: f64) -> std::path::PathBuf {
+    let c = d.join("contact.csv");
+    let (code, _, err) = run(&[
+        "simulate",
+        "--velocity",
+        &format!("sine:0,{},0.5", 0.02 * amplitude_rad_s),
+        "--duration",
+        &seconds.to_string(),
+        "--set",
+        "solver.cells=32",
+        "--out",
+        c.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let mut text = String::from("t_s,velocity_rad_s,torque_nm\n");
+    for (t, v, f) in simulated(&c).into_iter().step_by(10) {
+        text += &format!("{t},{},{}\n", v / 0.02, f * 0.02);
+    }
+    let joint = d.join("joint.csv");
+    std::fs::write(&joint, text).unwrap();
+    joint
+}
+
+#[test]
+fn a_rotary_report_speaks_in_the_joints_units_and_names_its_lever() {
+    let d = dir("units");
+    // The joint's own column names, read without --velocity / --friction.
+    let joint = joint_record(&d, 0.5, 4.0);
+    let report = d.join("report");
+    let (code, stdout, err) = run(&[
+        "fit",
+        joint.to_str().unwrap(),
+        "--rotary",
+        "--set",
+        "solver.cells=32",
+        "--fit",
+        "contact.boundary_friction,drivetrain.coulomb_n",
+        "--starts",
+        "1",
+        "--global-points",
+        "0",
+        "--max-evaluations",
+        "30",
+        "--baselines",
+        "--out",
+        d.join("f.yaml").to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    assert!(code == 0 || code == 4, "{err}");
+    let summary = std::fs::read_to_string(report.join("summary.md")).unwrap();
+    // The joint: lever arm and load in the summary, not only on stderr.
+    assert!(
+        summary.contains("## The joint") && summary.contains("lever arm r = "),
+        "{summary}"
+    );
+    // Residual by direction in rad/s and N·m; nothing in mm/s or N.
+    assert!(
+        summary.contains("mean speed (rad/s) | measured mean (N·m)"),
+        "{summary}"
+    );
+    assert!(
+        !summary.contains("(mm/s)") && !summary.contains("(N) |"),
+        "{summary}"
+    );
+    // Our drivetrain Coulomb level as it acts on the joint; the classic
+    // models' levels named in N·m.
+    assert!(
+        summary.contains("`drivetrain.coulomb_n`") && summary.contains(" N·m |"),
+        "{summary}"
+    );
+    assert!(stdout.contains("N·m on the joint"), "{stdout}");
+    assert!(
+        stdout.contains("fc_n_m=") && stdout.contains("b_n_m_s_rad=") && !stdout.contains("fc_n="),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("held-out / friction scale: the held-out RMS divided by"),
+        "{stdout}"
+    );
+}
+
+#[test]
+fn a_fast_joint_is_asked_whether_its_velocity_is_in_degrees_per_second() {
+    let d = dir("deg-s");
+    // 0.5 rad/s written as deg/s: 28.6 "rad/s".
+    let joint = joint_record(&d, 0.5f64.to_degrees(), 2.0);
+    let (code, _, err) = run(&[
+        "fit",
+        joint.to_str().unwrap(),
+        "--rotary",
+        "--set",
+        "solver.cells=32",
+        "--fit",
+        "contact.boundary_friction",
+        "--starts",
+        "1",
+        "--global-points",
+        "0",
+        "--max-evaluations",
+        "10",
+        "--out",
+        d.join("f.yaml").to_str().unwrap(),
+    ]);
+    assert!(code == 0 || code == 4, "{err}");
+    assert!(
+        err.contains("warning: --rotary: the top speed is") && err.contains("deg/s"),
+        "{err}"
+    );
+}
+
+#[test]
+fn under_auto_a_bound_on_a_candidate_key_is_accepted_and_a_term_without_a_reversal_says_so() {
+    let d = dir("auto-bounds");
+    // One speed, no reversal: pre-sliding is no candidate, for that reason.
+    let c = d.join("c.csv");
+    let (code, _, err) = run(&[
+        "simulate",
+        "--velocity",
+        "const:0.05",
+        "--duration",
+        "1",
+        "--set",
+        "solver.cells=32",
+        "--out",
+        c.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let fit = |extra: &[&str]| {
+        let mut args = vec![
+            "fit",
+            c.to_str().unwrap(),
+            "--set",
+            "solver.cells=32",
+            "--fit",
+            "auto",
+            "--max-evaluations",
+            "20",
+            "--out",
+        ];
+        let out = d.join("f.yaml");
+        args.push(out.to_str().unwrap());
+        args.extend_from_slice(extra);
+        run(&args)
+    };
+    let (code, stdout, err) = fit(&[
+        "--bounds",
+        "contact.boundary_friction=0.1:0.5",
+        "--bounds",
+        "contact.presliding_stiffness_n_m=1e5:1e9",
+        "--start",
+        "drivetrain.viscous_n_s_m=10",
+        "--bounds",
+        "drivetrain.viscous_n_s_m=0:1000",
+    ]);
+    assert!(code == 0 || code == 4, "{err}");
+    assert!(
+        stdout.contains("pre-sliding: the data hold no velocity reversal"),
+        "{stdout}"
+    );
+    // The base key's bound is used.
+    let row = stdout
+        .lines()
+        .find(|l| l.starts_with("| `contact.boundary_friction`"))
+        .unwrap();
+    assert!(row.contains("[1.0000e-1, 5.0000e-1]"), "{row}");
+    // A key auto never fits is still refused, naming what it may choose.
+    let (code, _, err) = fit(&["--bounds", "roughness.sigma_m=1e-6:1e-5"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("roughness.sigma_m") && err.contains("--fit auto may choose"),
+        "{err}"
+    );
+}
+
+#[cfg(feature = "mcap")]
+#[test]
+fn one_joint_state_topic_gives_both_the_velocity_and_the_effort_of_a_bag() {
+    let root = env!("CARGO_MANIFEST_DIR");
+    for bag in ["bags/rosbags_mcap", "bags/rosbags_sqlite3"] {
+        let d = dir(&format!("one-topic-{}", bag.replace('/', "-")));
+        let fit = |friction_topic: &str| {
+            let (code, stdout, err) = run(&[
+                "fit",
+                &format!("{root}/{bag}"),
+                "--velocity-topic",
+                "/joint_states",
+                "--friction-topic",
+                friction_topic,
+                "--joint",
+                "slider",
+                "--set",
+                "solver.cells=32",
+                "--fit",
+                "contact.boundary_friction",
+                "--starts",
+                "1",
+                "--global-points",
+                "0",
+                "--max-evaluations",
+                "10",
+                "--out",
+                d.join("f.yaml").to_str().unwrap(),
+            ]);
+            assert!(code == 0 || code == 4, "{bag} {friction_topic}: {err}");
+            stdout
+                .lines()
+                .find(|l| l.starts_with("| `contact.boundary_friction`"))
+                .unwrap()
+                .to_string()
+        };
+        // The JointState's effort is the same friction as the Float64 topic.
+        assert_eq!(fit("/joint_states"), fit("/slider/friction"), "{bag}");
+    }
+}

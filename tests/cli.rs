@@ -414,3 +414,180 @@ fn an_accuracy_reference_no_finer_than_the_tested_setting_is_refused() {
     assert!(!ok);
     assert!(err.contains("--reference-dt 0.002"), "{err}");
 }
+
+#[test]
+fn run_check_on_a_joint_configuration_lists_the_joint_topics_with_their_remaps() {
+    let config = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/launch-config/gantry-8-contacts.yaml"
+    );
+    let (ok, stdout, stderr) = run(&[
+        "run",
+        "--check",
+        "--config",
+        config,
+        "--ros-args",
+        "-r",
+        "~/joint_commands:=/robot/joint_cmds",
+    ]);
+    assert!(ok, "{stderr}");
+    for line in [
+        "  joint_commands: /robot/joint_cmds",
+        "  joint_efforts: /friction_node/joint_efforts",
+        "  joint_friction: /friction_node/joint_friction",
+        "  contacts/shoulder/friction: /friction_node/contacts/shoulder/friction",
+        "  contacts/wrist_roll/friction: /friction_node/contacts/wrist_roll/friction",
+    ] {
+        assert!(stdout.lines().any(|l| l == line), "`{line}` in {stdout}");
+    }
+    // One contact: no joint topics.
+    let (ok, stdout, stderr) = run(&["run", "--check"]);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("  cmd_velocity: /friction_node/cmd_velocity"));
+    assert!(!stdout.contains("joint_commands"), "{stdout}");
+}
+
+#[cfg(feature = "mcap")]
+#[test]
+fn a_recording_named_neither_mcap_nor_a_split_directory_is_refused_and_overwrites_nothing() {
+    let d = dir("record-name");
+    let csv = d.join("sim.csv");
+    std::fs::write(&csv, "t_s,velocity_m_s\n0,1\n").unwrap();
+    for name in [csv.clone(), d.join("out.txt")] {
+        let (ok, _, stderr) = run(&[
+            "run",
+            "--duration",
+            "0.2",
+            "--quiet",
+            "--record",
+            name.to_str().unwrap(),
+        ]);
+        assert!(!ok, "{stderr}");
+        assert!(
+            stderr.contains(name.to_str().unwrap()) && stderr.contains(".mcap"),
+            "{stderr}"
+        );
+        assert!(!stderr.contains("loop running"), "{stderr}");
+    }
+    assert_eq!(
+        std::fs::read_to_string(&csv).unwrap(),
+        "t_s,velocity_m_s\n0,1\n"
+    );
+    assert!(!d.join("out.txt").exists());
+}
+
+#[test]
+fn a_negative_number_gets_the_options_range_message_not_an_unknown_argument() {
+    for (args, option) in [
+        (vec!["bench-accuracy", "--grids", "-64"], "--grids"),
+        (
+            vec![
+                "fit",
+                "x.csv",
+                "--fit",
+                "auto",
+                "--holdout",
+                "-0.5",
+                "--out",
+                "o.yaml",
+            ],
+            "--holdout",
+        ),
+        (
+            vec![
+                "fit", "x.csv", "--fit", "auto", "--smooth", "-1", "--out", "o.yaml",
+            ],
+            "--smooth",
+        ),
+        (vec!["bench-cases", "--count", "-3"], "--count"),
+        (vec!["bench-latency", "--samples", "-5"], "--samples"),
+        (
+            vec!["bench-accuracy", "--reference-dt", "-1"],
+            "--reference-dt",
+        ),
+    ] {
+        let (code, _, stderr) = common::cli::run(&args);
+        assert_eq!(code, 2, "{args:?}: {stderr}");
+        let value = args[args.iter().position(|a| *a == option).unwrap() + 1];
+        assert!(
+            stderr.contains(&format!("invalid value '{value}' for '{option}")),
+            "{args:?}: {stderr}"
+        );
+        assert!(!stderr.contains("unexpected argument"), "{stderr}");
+    }
+}
+
+/// A steady curve `stribeck` wrote into `d`.
+fn steady_curve(d: &std::path::Path) -> std::path::PathBuf {
+    let curve = d.join("curve.csv");
+    let (ok, _, stderr) = run(&[
+        "stribeck",
+        "--v-min",
+        "0.01",
+        "--v-max",
+        "1",
+        "--points",
+        "8",
+        "--set",
+        "solver.cells=32",
+        "--out",
+        curve.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    curve
+}
+
+#[test]
+fn a_validation_file_without_the_named_columns_is_named_in_the_error() {
+    let d = dir("validate-columns");
+    let curve = steady_curve(&d);
+    let other = d.join("other_columns.csv");
+    std::fs::write(&other, "speed,torque\n0.1,2\n0.2,3\n").unwrap();
+    let (code, _, stderr) = common::cli::run(&[
+        "fit",
+        curve.to_str().unwrap(),
+        "--validate",
+        other.to_str().unwrap(),
+        "--fit",
+        "contact.boundary_friction",
+        "--out",
+        d.join("f.yaml").to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("other_columns.csv"), "{stderr}");
+}
+
+#[test]
+fn expressions_call_functions_by_their_usual_names_and_an_unknown_one_lists_them() {
+    let d = dir("functions");
+    let curve = steady_curve(&d);
+    let fit = |friction: &str| {
+        common::cli::run(&[
+            "fit",
+            curve.to_str().unwrap(),
+            "--friction",
+            friction,
+            "--set",
+            "solver.cells=32",
+            "--fit",
+            "contact.boundary_friction",
+            "--starts",
+            "1",
+            "--global-points",
+            "0",
+            "--out",
+            d.join("f.yaml").to_str().unwrap(),
+        ])
+    };
+    // sqrt(x²) = |x|, cos(0) = 1, abs and tanh: the friction itself.
+    let (code, stdout, stderr) =
+        fit("sqrt(friction_n * friction_n) * cos(0) * abs(tanh(velocity_m_s * 1e9))");
+    assert!(code == 0 || code == 4, "{stderr}");
+    assert!(stdout.contains("training RMS"), "{stdout}");
+    let (code, _, stderr) = fit("sine(friction_n)");
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains("`sine(…)`") && stderr.contains("sin, cos, tan"),
+        "{stderr}"
+    );
+}

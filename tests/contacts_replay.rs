@@ -77,6 +77,36 @@ fn recording(d: &Path) -> PathBuf {
     bag
 }
 
+/// A joint's replay row holds the joint's velocity and effort beside the
+/// contact's: ω = v / gain, τ = gain · F (the wrist's gain is 0.03).
+fn assert_the_joint_columns_are_the_contacts_through_their_gains(
+    rows: &[Vec<&str>],
+    col: &dyn Fn(&str) -> usize,
+) {
+    let num = |r: &Vec<&str>, c: &str| -> f64 { r[col(c)].parse().unwrap() };
+    let mut moving = 0;
+    for r in rows {
+        let (joint, gain) = match r[col("contact")] {
+            "left" => ("x_left", 1.0),
+            "right" => ("x_right", 1.0),
+            _ => ("wrist", 0.03),
+        };
+        assert_eq!(r[col("joint")], joint);
+        approx::assert_relative_eq!(
+            num(r, "joint_velocity"),
+            num(r, "velocity_m_s") / gain,
+            max_relative = 1e-12
+        );
+        approx::assert_relative_eq!(
+            num(r, "joint_effort"),
+            gain * num(r, "friction_n"),
+            max_relative = 1e-12
+        );
+        moving += usize::from(num(r, "joint_effort") != 0.0);
+    }
+    assert!(moving > rows.len() / 2);
+}
+
 #[test]
 fn a_recording_of_three_contacts_replays_bit_identical_for_each_contact() {
     let d = fresh_dir("contacts-replay", "identical");
@@ -111,20 +141,19 @@ fn a_recording_of_three_contacts_replays_bit_identical_for_each_contact() {
             "{out}"
         );
     }
-    // Every contact's rows, named in the last column.
+    // Every contact's rows, named in the contact column.
     let text = std::fs::read_to_string(&csv).unwrap();
     let mut lines = text.lines();
-    assert!(lines.next().unwrap().ends_with(",contact"));
-    let rows: Vec<&str> = lines.collect();
-    let per = |n: &str| {
-        rows.iter()
-            .filter(|r| r.ends_with(&format!(",{n}")))
-            .count()
-    };
+    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert!(head.ends_with(&["contact", "joint", "joint_velocity", "joint_effort"]));
+    let col = |n: &str| head.iter().position(|h| *h == n).unwrap();
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    let per = |n: &str| rows.iter().filter(|r| r[col("contact")] == n).count();
     assert!(per("left") > 500);
     assert_eq!(per("left"), per("right"));
     assert_eq!(per("left"), per("wrist"));
     assert_eq!(rows.len(), 3 * per("left"));
+    assert_the_joint_columns_are_the_contacts_through_their_gains(&rows, &col);
     // Replayed to MCAP, and that replayed again: still identical.
     let again = d.join("replay.mcap");
     ok(&node(
@@ -256,15 +285,25 @@ fn a_joint_state_bag_drives_every_configured_joint_each_as_its_one_joint_replay(
     // and resampling included); the yaw joint has as many of its own.
     let two = std::fs::read_to_string(&two).unwrap();
     let one = std::fs::read_to_string(&one).unwrap();
+    // A row of several contacts: the one-contact columns, then contact,
+    // joint, joint velocity and joint effort.
+    fn split(l: &str) -> (&str, &str) {
+        let mut back = l.rsplitn(5, ',');
+        let _effort_velocity_joint = (back.next(), back.next(), back.next());
+        let contact = back.next().unwrap();
+        (back.next().unwrap(), contact)
+    }
     let slide: Vec<&str> = two
         .lines()
         .skip(1)
-        .filter_map(|l| l.strip_suffix(",slide"))
+        .map(split)
+        .filter(|(_, c)| *c == "slide")
+        .map(|(row, _)| row)
         .collect();
     let single: Vec<&str> = one.lines().skip(1).collect();
     assert!(single.len() > 1900);
     assert_eq!(slide, single);
-    let yaw = two.lines().filter(|l| l.ends_with(",yaw")).count();
+    let yaw = two.lines().skip(1).filter(|l| split(l).1 == "yaw").count();
     assert_eq!(yaw, single.len());
     // A configured joint the bag does not have is named.
     std::fs::write(

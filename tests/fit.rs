@@ -2,7 +2,7 @@
 //! were made with (ours, with drivetrain terms, and the classic models
 //! their own), its standard errors cover the truth, the global phase is
 //! reproducible; steady curves and mapped inputs (the O-ring seal's real
-//! data, read from ../shared/data) fit too; bad input gets a clear message.
+//! data, `data/oring-seal/`) fit too; bad input gets a clear message.
 
 mod common;
 use common::cli::run;
@@ -39,6 +39,7 @@ fn data(csv: &str) -> Data {
     let table = Table::parse(csv, Path::new("synthetic.csv"), Delimiter::Auto, None, 0).unwrap();
     Data {
         train: vec![Source::new(table, &Mapping::default()).unwrap()],
+        held_out: vec![],
         validate: vec![],
         holdout: Default::default(),
         units: Default::default(),
@@ -609,12 +610,11 @@ fn a_steady_stribeck_curve_recovers_roughness_and_boundary_friction_and_viscosit
 
 /// The real-data benchmark, shortened (one local run, a small budget):
 /// the O-ring seal calibrated at 1 and 3 bar through mapped inputs predicts
-/// 5 and 7 bar, and the four models are in one table. The data stay in
-/// ../shared/data, beside the clone (present in CI; not copied into the
-/// repository).
+/// 5 and 7 bar, and the four models are in one table (the data:
+/// `data/oring-seal/`, CC0).
 #[test]
 fn the_oring_seal_is_calibrated_at_1_and_3_bar_through_mapped_inputs_and_predicts_5_and_7() {
-    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/oring-seal");
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/oring-seal");
     let f = |p: u32| {
         data.join(format!("O-ring257_{p}bar.csv"))
             .display()

@@ -82,6 +82,27 @@ fn sigint_and_sigterm_stop_simulate_and_remove_its_temporary_file() {
     }
 }
 
+#[cfg(feature = "iceoryx2")]
+#[test]
+fn sigint_and_sigterm_end_the_node_with_their_exit_codes_after_its_summary() {
+    // One after the other: the two runs use the same iceoryx2 services.
+    for (signal, code) in [(libc::SIGINT, 130), (libc::SIGTERM, 143)] {
+        let (rc, err) = interrupt(
+            &[
+                "run",
+                "--transport",
+                "iceoryx2",
+                "--duration",
+                "600",
+                "--quiet",
+            ],
+            "loop running",
+            signal,
+        );
+        assert_eq!(rc, Some(code), "{err}");
+    }
+}
+
 #[test]
 fn sigint_stops_a_study_before_anything_is_written() {
     let d = fresh_dir("interrupt", "study");
@@ -271,4 +292,53 @@ fn an_interrupted_term_selection_writes_nothing_and_exits_130() {
     assert_eq!(rc, Some(130), "{err}");
     assert!(!report.exists(), "the report folder it made is gone");
     assert_eq!(files(&d), vec![data], "only the data is there");
+}
+
+#[test]
+fn a_stop_during_the_classic_models_keeps_the_fitted_file_and_says_so() {
+    let d = fresh_dir("interrupt", "baselines");
+    let data = d.join("data.csv");
+    // A long record: the classic models take seconds on it.
+    let sim = bin()
+        .args([
+            "simulate",
+            "--velocity",
+            "sine:0,0.5,1",
+            "--duration",
+            "200",
+        ])
+        .args(["--set", "solver.cells=8", "--out"])
+        .arg(&data)
+        .output()
+        .unwrap();
+    assert!(sim.status.success());
+    let out = d.join("fitted.yaml");
+    let (rc, err) = interrupt(
+        &[
+            "fit",
+            data.to_str().unwrap(),
+            "--fit",
+            "contact.boundary_friction",
+            "--starts",
+            "1",
+            "--global-points",
+            "0",
+            "--max-evaluations",
+            "10",
+            "--baselines",
+            "--out",
+            out.to_str().unwrap(),
+            "--set",
+            "solver.cells=8",
+        ],
+        "fit: wrote",
+        libc::SIGINT,
+    );
+    assert_eq!(rc, Some(130), "{err}");
+    assert!(
+        err.contains(&format!("fit: wrote {} (complete)", out.display())),
+        "{err}"
+    );
+    let kept = std::fs::read_to_string(&out).unwrap();
+    assert!(kept.contains("contact:"), "a whole parameter file: {kept}");
 }

@@ -705,8 +705,10 @@ mod node_runs {
         unsafe { libc::kill(child.id() as i32, libc::SIGTERM) };
         let out = child.wait_with_output().unwrap();
         let stdout = String::from_utf8_lossy(&out.stdout);
-        assert!(
-            out.status.success(),
+        // Finalised, and the exit code says SIGTERM ended it (128 + 15).
+        assert_eq!(
+            out.status.code(),
+            Some(143),
             "{stdout}\n{}",
             String::from_utf8_lossy(&out.stderr)
         );

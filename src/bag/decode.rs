@@ -314,22 +314,32 @@ pub fn read_topics(
             }
         };
         let view = m.view();
-        if let Some(k) = decoders.iter().position(|d| d.topic() == view.topic) {
-            match decoders[k].sample(&view) {
+        // Every decoder of the message's topic gets it: one topic may carry
+        // two of the inputs (a JointState's velocity and its effort).
+        let mut failed = None;
+        for (k, d) in decoders.iter_mut().enumerate() {
+            if d.topic() != view.topic {
+                continue;
+            }
+            match d.sample(&view) {
                 Ok(s) => out.samples[k].push(s),
                 Err(e @ (BagError::JointRequired { .. } | BagError::JointMissing { .. })) => {
                     return Err(e)
                 }
                 Err(e) => {
-                    out.damage = Some(super::Damage {
-                        after_messages: read,
-                        last_log_time_ns: last_log,
-                        file: bag.path().to_path_buf(),
-                        error: e.to_string(),
-                    });
+                    failed = Some(e);
                     break;
                 }
             }
+        }
+        if let Some(e) = failed {
+            out.damage = Some(super::Damage {
+                after_messages: read,
+                last_log_time_ns: last_log,
+                file: bag.path().to_path_buf(),
+                error: e.to_string(),
+            });
+            break;
         }
         read += 1;
         last_log = Some(view.log_time);

@@ -83,6 +83,7 @@ fn source(o: &FitBenchOptions<'_>, name: &str, csv: &str) -> Result<Source, FitB
 fn data(train: Source, validate: Vec<Source>) -> Data {
     Data {
         train: vec![train],
+        held_out: vec![],
         validate,
         holdout: Default::default(),
         map_names: vec![],

@@ -542,6 +542,36 @@ pub enum StudyName {
     All,
 }
 
+/// The command line as clap parses it: the derived command with every
+/// option that takes a value accepting a negative number as that value
+/// (`--holdout -0.5` reaches the option's range check and gets its message,
+/// instead of clap's "unexpected argument '-0'").
+pub fn command() -> clap::Command {
+    use clap::CommandFactory;
+    fn negatives(c: clap::Command) -> clap::Command {
+        c.mut_args(|a| {
+            if a.get_action().takes_values() && !a.is_positional() {
+                a.allow_negative_numbers(true)
+            } else {
+                a
+            }
+        })
+        .mut_subcommands(negatives)
+    }
+    negatives(Cli::command())
+}
+
+/// Parse `argv` (the program name first) with [`command`].
+pub fn parse<I, T>(argv: I) -> Result<Cli, clap::Error>
+where
+    I: IntoIterator<Item = T>,
+    T: Into<std::ffi::OsString> + Clone,
+{
+    use clap::FromArgMatches;
+    let matches = command().try_get_matches_from(argv)?;
+    Cli::from_arg_matches(&matches)
+}
+
 /// A clap error as one line that names the argument and what is allowed
 /// (clap's own rendering ends with a bare "For more information" line).
 pub fn one_line_error(e: &clap::Error) -> String {

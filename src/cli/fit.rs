@@ -338,6 +338,8 @@ pub fn run(config: &Config, args: &FitArgs) -> Result<()> {
     } = fit_ours(&p, &req).context("the fitted configuration")?;
     let yaml = report::fitted_yaml(&fitted_config, &ours, &p.names, &map);
     friction_node::output::write_file(&args.out, yaml.as_bytes())?;
+    // Said at once: a stop during the classic models keeps this file.
+    eprintln!("fit: wrote {} (complete)", args.out.display());
     println!("{}", report::summary(&ours, &selection_md));
     let mut extra = selection_md.clone();
     let mut classic = Vec::new();
@@ -358,7 +360,6 @@ pub fn run(config: &Config, args: &FitArgs) -> Result<()> {
     if let Some(d) = report_dir {
         d.keep();
     }
-    eprintln!("fit: wrote {}", args.out.display());
     if !ours.converged {
         eprintln!(
             "fit: NOT converged ({}); {} holds the best point found",

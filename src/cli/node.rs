@@ -50,17 +50,7 @@ pub fn check(config: &Config, transport: Option<TransportArg>) {
     println!("transport: {}", transport.trim_end());
     let t = TopicNames::from_config(config);
     println!("topics:");
-    for (what, name) in [
-        ("cmd_velocity", &t.cmd_velocity),
-        ("normal_load", &t.normal_load),
-        ("temperature", &t.temperature),
-        ("friction", &t.friction),
-        ("friction_force", &t.friction_force),
-        ("film_profile", &t.film_profile),
-        ("loop_statistics", &t.loop_statistics),
-        ("snapshot", &t.snapshot),
-        ("parameter_events", &t.parameter_events),
-    ] {
+    for (what, name) in t.opened(config) {
         println!("  {what}: {name}");
     }
     let defaults: std::collections::HashMap<String, serde_norway::Value> =
@@ -234,6 +224,11 @@ fn summary(config: &Config, r: &RunReport) {
     }
     if r.recording.as_ref().is_some_and(|rec| rec.error.is_some()) {
         std::process::exit(1);
+    }
+    // Stopped by SIGINT/SIGTERM: everything is finalised; the exit code
+    // says how it ended (130, 143), as for every other command.
+    if let Some(sig) = r.signal {
+        std::process::exit(128 + sig);
     }
 }
 

@@ -208,7 +208,7 @@ fn write_studies(out: &Path, results: &claims::Results) -> Result<Vec<String>> {
     Ok(failed)
 }
 
-/// The paper's claims (MODEL.md §8) the studies evaluate: `claims.md` and a
+/// The paper's claims (docs/model.md §9) the studies evaluate: `claims.md` and a
 /// line each.
 fn write_claims(
     out: &Path,
@@ -228,7 +228,10 @@ fn write_claims(
         &path,
         report::claims_markdown(&evaluated, failed).as_bytes(),
     )?;
-    println!("\nclaims (MODEL.md §8), details in {}:", path.display());
+    println!(
+        "\nclaims (docs/model.md §9), details in {}:",
+        path.display()
+    );
     for c in &evaluated {
         if c.verdict() != claims::Verdict::NotEvaluated {
             let passed = c.checks.iter().filter(|k| k.pass).count();

@@ -101,6 +101,36 @@ impl TopicNames {
             },
         }
     }
+
+    /// Every topic the node opens, as (what, resolved name), in the order
+    /// `run --check` prints them: the one contact's topics (opened in every
+    /// plan), and with joints also the joint commands, the efforts and one
+    /// estimate topic per contact (`contacts/NAME/friction`).
+    pub fn opened(&self, cfg: &Config) -> Vec<(String, &str)> {
+        let mut out: Vec<(String, &str)> = [
+            ("cmd_velocity", &self.cmd_velocity),
+            ("normal_load", &self.normal_load),
+            ("temperature", &self.temperature),
+            ("friction", &self.friction),
+            ("friction_force", &self.friction_force),
+            ("film_profile", &self.film_profile),
+            ("loop_statistics", &self.loop_statistics),
+            ("snapshot", &self.snapshot),
+            ("parameter_events", &self.parameter_events),
+        ]
+        .into_iter()
+        .map(|(what, name)| (what.to_string(), name.as_str()))
+        .collect();
+        if cfg.output_plan().by_joint() {
+            out.push(("joint_commands".into(), &self.joint_commands));
+            out.push(("joint_efforts".into(), &self.joint_efforts));
+            out.push(("joint_friction".into(), &self.joint_friction));
+            for (c, name) in cfg.contacts.0.iter().zip(&self.contact_friction) {
+                out.push((format!("contacts/{}/friction", c.name), name));
+            }
+        }
+        out
+    }
 }
 
 #[cfg(test)]

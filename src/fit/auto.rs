@@ -38,7 +38,7 @@
 use super::driver::fit;
 use super::options::Options;
 use super::params::ParamSpec;
-use super::problem::{Data, HoldOut};
+use super::problem::Data;
 use super::request::{FitRequest, Prepared};
 use super::FitError;
 use rayon::prelude::*;
@@ -155,6 +155,20 @@ pub const NOT_CANDIDATES: &[(&str, &str)] = &[
 /// The key always fitted.
 pub const BASE_KEY: &str = "contact.boundary_friction";
 
+/// Whether the selection may fit configuration key `key` (the base key,
+/// or a key of a candidate): a bound or start on it is accepted under
+/// `--fit auto`, and used if its term is chosen.
+pub fn may_choose(key: &str) -> bool {
+    key == BASE_KEY || CANDIDATES.iter().any(|c| c.keys.contains(&key))
+}
+
+/// Every key the selection may fit, the base key first.
+pub fn choosable_keys() -> Vec<&'static str> {
+    std::iter::once(BASE_KEY)
+        .chain(CANDIDATES.iter().flat_map(|c| c.keys.iter().copied()))
+        .collect()
+}
+
 /// Whether `--fit` asks for the selection; the names besides `auto`.
 pub fn split(keys: &[String]) -> (bool, Vec<String>) {
     let auto = keys.iter().any(|k| k.trim() == AUTO);
@@ -194,21 +208,16 @@ pub struct Selection {
     pub wall_s: f64,
 }
 
-/// The training data alone (the --validate data are not even predicted).
+/// The training data alone (neither the held-out parts nor the
+/// --validate data are even predicted).
 fn training_data(p: &Prepared) -> Data {
-    Data {
-        train: p.data.train.clone(),
-        validate: Vec::new(),
-        holdout: HoldOut::None,
-        map_names: p.data.map_names.clone(),
-        map_values: p.data.map_values.clone(),
-        units: p.data.units,
-    }
+    p.data.training_only()
 }
 
 /// The specs of a set: the set's keys, then the given names' specs (a
-/// given spec replaces a key's default one).
-fn set_specs(given: &[ParamSpec], keys: &[&str]) -> Vec<ParamSpec> {
+/// given spec replaces a key's default one; a spec given only in case its
+/// term is chosen, [`ParamSpec::if_chosen`], is used only then).
+pub fn set_specs(given: &[ParamSpec], keys: &[&str]) -> Vec<ParamSpec> {
     let mut specs: Vec<ParamSpec> = keys
         .iter()
         .map(|k| ParamSpec {
@@ -218,8 +227,11 @@ fn set_specs(given: &[ParamSpec], keys: &[&str]) -> Vec<ParamSpec> {
         .collect();
     for g in given {
         if let Some(s) = specs.iter_mut().find(|s| s.name == g.name) {
-            *s = g.clone();
-        } else {
+            *s = ParamSpec {
+                if_chosen: false,
+                ..g.clone()
+            };
+        } else if !g.if_chosen {
             specs.push(g.clone());
         }
     }
@@ -305,23 +317,33 @@ fn paired(a: &[f64], b: &[f64]) -> (f64, f64) {
 /// no given name already fits.
 fn candidates_here(p: &Prepared, given: &[ParamSpec]) -> (Vec<&'static Candidate>, Vec<String>) {
     let mut excluded: Vec<String> = Vec::new();
-    let candidates = CANDIDATES
-        .iter()
-        .filter(|c| !c.needs_varying_load || p.loads_vary)
-        .filter(|c| !c.keys.iter().any(|k| given.iter().any(|g| g.name == *k)))
-        .filter(|c| {
-            let keys: Vec<&str> = std::iter::once(BASE_KEY)
-                .chain(c.keys.iter().copied())
-                .collect();
-            match super::request::model_for(p, &set_specs(given, &keys), &[]) {
-                Ok(_) => true,
-                Err(e) => {
-                    excluded.push(format!("{}: {e}", c.name));
-                    false
-                }
-            }
-        })
-        .collect();
+    let mut candidates = Vec::new();
+    let no_reversal = p.scale.reversal_stiffness_n_m.is_none();
+    for c in CANDIDATES {
+        if c.needs_varying_load && !p.loads_vary {
+            continue;
+        }
+        // A name given to --fit already fits it (a bound or start given in
+        // case it is chosen does not).
+        let fitted = |k: &&str| given.iter().any(|g| g.name == *k && !g.if_chosen);
+        if c.keys.iter().any(fitted) {
+            continue;
+        }
+        if no_reversal && c.keys.iter().any(|k| k.contains("presliding_")) {
+            excluded.push(format!(
+                "{}: the data hold no velocity reversal, and pre-sliding shows only through one",
+                c.name
+            ));
+            continue;
+        }
+        let keys: Vec<&str> = std::iter::once(BASE_KEY)
+            .chain(c.keys.iter().copied())
+            .collect();
+        match super::request::model_for(p, &set_specs(given, &keys), &[]) {
+            Ok(_) => candidates.push(c),
+            Err(e) => excluded.push(format!("{}: {e}", c.name)),
+        }
+    }
     (candidates, excluded)
 }
 
@@ -390,7 +412,12 @@ pub fn select(
     let keys = set_keys(&current.terms)
         .into_iter()
         .map(String::from)
-        .chain(given.iter().map(|g| g.name.clone()))
+        .chain(
+            given
+                .iter()
+                .filter(|g| !g.if_chosen)
+                .map(|g| g.name.clone()),
+        )
         .fold(Vec::<String>::new(), |mut v, k| {
             if !v.contains(&k) {
                 v.push(k);

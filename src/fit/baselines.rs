@@ -71,19 +71,47 @@ pub enum LoadForm {
 }
 
 impl LoadForm {
-    /// The form a fit should give the classic models: linear when the
-    /// training data span loads; proportional when they hold one load but
-    /// the model must predict at others (validation data at another load);
-    /// constant otherwise.
-    pub fn for_data(training_loads_vary: bool, predicts_other_loads: bool) -> Self {
+    /// The form a fit gives the classic models, decided by the training
+    /// data alone (never by the data held out): linear when the training
+    /// loads vary; proportional when they hold one load that the data give
+    /// (a load column or topic: at that load it fits exactly as a constant
+    /// level, and it is the one form that carries to another load);
+    /// constant when the data give no load at all.
+    pub fn for_data(training_loads_vary: bool, training_has_load: bool) -> Self {
         if training_loads_vary {
             LoadForm::Linear
-        } else if predicts_other_loads {
+        } else if training_has_load {
             LoadForm::Proportional
         } else {
             LoadForm::Constant
         }
     }
+}
+
+/// A classic model's parameter name in the data's units: the names carry
+/// a linear axis's units (`fc_n`, `b_n_s_m`, `vs_m_s`, `sigma0_n_m`); on a
+/// rotary joint's data the same parameters are in N·m, rad/s and per rad
+/// (`fc_n_m`, `b_n_m_s_rad`, `vs_rad_s`, `sigma0_n_m_rad`).
+pub fn parameter_name(name: &str, units: super::Units) -> String {
+    if units == super::Units::Linear {
+        return name.to_string();
+    }
+    for (linear, rotary) in [
+        ("_n_s_m", "_n_m_s_rad"),
+        ("sigma0_n_m", "sigma0_n_m_rad"),
+        ("_m_s", "_rad_s"),
+        ("_n", "_n_m"),
+    ] {
+        if let Some(stem) = name.strip_suffix(linear) {
+            let stem = if linear.starts_with('_') {
+                stem.to_string()
+            } else {
+                String::new()
+            };
+            return format!("{stem}{rotary}");
+        }
+    }
+    name.to_string()
 }
 
 /// A classic model with its fitted parameters.
@@ -501,6 +529,36 @@ impl Level {
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
+
+    #[test]
+    fn a_classic_model_on_a_joint_names_its_parameters_in_the_joint_units() {
+        use crate::fit::Units::{Linear, Rotary};
+        let names = [
+            "fc_n",
+            "fc0_n",
+            "mu_c",
+            "vs_m_s",
+            "b_n_s_m",
+            "sigma0_n_m",
+            "sigma1_n_s_m",
+        ];
+        let rotary: Vec<String> = names.iter().map(|n| parameter_name(n, Rotary)).collect();
+        assert_eq!(
+            rotary,
+            [
+                "fc_n_m",
+                "fc0_n_m",
+                "mu_c",
+                "vs_rad_s",
+                "b_n_m_s_rad",
+                "sigma0_n_m_rad",
+                "sigma1_n_m_s_rad"
+            ]
+        );
+        for n in names {
+            assert_eq!(parameter_name(n, Linear), n);
+        }
+    }
 
     fn scale() -> DataScale {
         DataScale {

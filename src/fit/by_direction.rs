@@ -22,12 +22,16 @@
 //! friction.
 
 use super::driver::FitOutcome;
-use super::problem::SeriesFit;
+use super::problem::{Role, SeriesFit};
 use std::fmt::Write as _;
 
 /// Samples slower than this fraction of their source's top speed count as
 /// passing through reversal, not as sliding.
 pub const SLIDING_FRACTION: f64 = 0.1;
+
+/// The fewest samples sliding in each direction for a level and an offset
+/// error: fewer say "too few samples" (a mean of one sample is noise).
+pub const MIN_DIRECTION_SAMPLES: usize = 10;
 
 /// Sums over the samples of one group, for means and an RMS.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -95,34 +99,50 @@ pub struct SourceResidual {
 }
 
 impl SourceResidual {
+    /// Whether both directions hold [`MIN_DIRECTION_SAMPLES`] or more.
+    pub fn enough_samples(&self) -> bool {
+        self.forward.samples >= MIN_DIRECTION_SAMPLES
+            && self.backward.samples >= MIN_DIRECTION_SAMPLES
+    }
+
     /// e_level = (b₊ − b₋)/2, N: > 0 when the model's friction is too large
-    /// in magnitude (None without samples in both directions).
+    /// in magnitude (None without [`MIN_DIRECTION_SAMPLES`] in each
+    /// direction).
     pub fn level_error_n(&self) -> Option<f64> {
-        Some((self.forward.bias_n()? - self.backward.bias_n()?) / 2.0)
+        self.enough_samples()
+            .then(|| Some((self.forward.bias_n()? - self.backward.bias_n()?) / 2.0))?
     }
 
     /// e_offset = (b₊ + b₋)/2, N: the shift common to both directions.
     pub fn offset_error_n(&self) -> Option<f64> {
-        Some((self.forward.bias_n()? + self.backward.bias_n()?) / 2.0)
+        self.enough_samples()
+            .then(|| Some((self.forward.bias_n()? + self.backward.bias_n()?) / 2.0))?
     }
 }
 
-/// The role of sample `k` of a source: `fit`, `held_out` (training data
-/// not fitted) or `validate`.
-pub fn sample_role(training: bool, fitted: bool) -> &'static str {
-    match (training, fitted) {
-        (true, true) => "fit",
-        (true, false) => "held_out",
-        _ => "validate",
+/// The role of a sample of a source of `role`: `fit`, `held_out` (the
+/// held-out part of a training file, or a training sample left out of the
+/// cost) or `validate`.
+pub fn sample_role(role: Role, fitted: bool) -> &'static str {
+    match (role, fitted) {
+        (Role::Train, false) => Role::HeldOut.name(),
+        (r, _) => r.name(),
     }
 }
 
-/// Every source's residual by direction, training sources first (split
-/// into fitted and held-out samples when both occur), then `--validate`
-/// sources.
-pub fn source_residuals(train: &[SeriesFit], validate: &[SeriesFit]) -> Vec<SourceResidual> {
+/// Every source's residual by direction: training sources first, then
+/// the held-out parts, then `--validate` sources.
+pub fn source_residuals(
+    train: &[SeriesFit],
+    held_out: &[SeriesFit],
+    validate: &[SeriesFit],
+) -> Vec<SourceResidual> {
     let mut out = Vec::new();
-    for (fits, training) in [(train, true), (validate, false)] {
+    for (fits, training) in [
+        (train, Role::Train),
+        (held_out, Role::HeldOut),
+        (validate, Role::Validate),
+    ] {
         for sf in fits {
             let s = &sf.series;
             let top = s.velocity.iter().fold(0.0f64, |m, v| m.max(v.abs()));
@@ -179,12 +199,18 @@ fn short(source: &str) -> &str {
     source.rsplit(['/', '\\']).next().unwrap_or(source)
 }
 
-/// One model's residual by source and direction (markdown).
+/// One model's residual by source and direction (markdown), in the
+/// data's units (a joint's rad/s and N·m with `--rotary`).
 pub fn direction_table(o: &FitOutcome) -> String {
-    let mut s = String::from(
-        "| source | role | motion | samples | mean speed (mm/s) | measured mean (N) | model mean (N) | bias (N) | RMS (N) |\n|---|---|---|---|---|---|---|---|---|\n",
+    let f = o.units.force();
+    let (speed_unit, speed_scale, digits) = match o.units {
+        super::Units::Linear => ("mm/s", 1e3, 2),
+        super::Units::Rotary => ("rad/s", 1.0, 4),
+    };
+    let mut s = format!(
+        "| source | role | motion | samples | mean speed ({speed_unit}) | measured mean ({f}) | model mean ({f}) | bias ({f}) | RMS ({f}) |\n|---|---|---|---|---|---|---|---|---|\n",
     );
-    for r in source_residuals(&o.train, &o.validate) {
+    for r in source_residuals(&o.train, &o.held_out, &o.validate) {
         for (motion, g) in [
             ("forward", &r.forward),
             ("backward", &r.backward),
@@ -199,7 +225,7 @@ pub fn direction_table(o: &FitOutcome) -> String {
                 short(&r.source),
                 r.role,
                 g.samples,
-                cell(g.mean_speed_m_s(), 1e3, 2),
+                cell(g.mean_speed_m_s(), speed_scale, digits),
                 force_cell(g.measured_mean_n()),
                 force_cell(g.predicted_mean_n()),
                 force_cell(g.bias_n()),
@@ -225,12 +251,13 @@ pub fn models_direction_table(models: &[&FitOutcome]) -> String {
     }
     let rows: Vec<Vec<SourceResidual>> = models
         .iter()
-        .map(|o| source_residuals(&o.train, &o.validate))
+        .map(|o| source_residuals(&o.train, &o.held_out, &o.validate))
         .collect();
     let held_out = rows[0].iter().any(|r| r.role != "fit");
-    let mut s = String::from("| source | role | measured +/− (N)¹ |");
+    let f = models[0].units.force();
+    let mut s = format!("| source | role | measured +/− ({f})¹ |");
     for o in models {
-        let _ = write!(s, " {}: level / offset error (N) |", o.label);
+        let _ = write!(s, " {}: level / offset error ({f}) |", o.label);
     }
     s.push_str("\n|---|---|---|");
     s.push_str(&"---|".repeat(models.len()));
@@ -248,16 +275,26 @@ pub fn models_direction_table(models: &[&FitOutcome]) -> String {
             force_cell(r.backward.measured_mean_n())
         );
         for m in &rows {
-            let (level, offset) = m
-                .get(i)
-                .map_or((None, None), |x| (x.level_error_n(), x.offset_error_n()));
-            let _ = write!(s, " {} / {} |", force_cell(level), force_cell(offset));
+            match m.get(i) {
+                Some(x) if !x.enough_samples() => {
+                    let _ = write!(
+                        s,
+                        " too few samples (n₊ = {}, n₋ = {}) |",
+                        x.forward.samples, x.backward.samples
+                    );
+                }
+                x => {
+                    let (level, offset) =
+                        x.map_or((None, None), |x| (x.level_error_n(), x.offset_error_n()));
+                    let _ = write!(s, " {} / {} |", force_cell(level), force_cell(offset));
+                }
+            }
         }
         s.push('\n');
     }
     let _ = writeln!(
         s,
-        "\nWhile sliding (faster than {:.0} % of the source's top speed): level error (b₊ − b₋)/2 > 0 where the \
+        "\nWhile sliding (faster than {:.0} % of the source's top speed; at least {MIN_DIRECTION_SAMPLES} samples each way): level error (b₊ − b₋)/2 > 0 where the \
          model's friction is too large in magnitude; offset error (b₊ + b₋)/2, the same shift in both \
          directions (an offset, an effective area, a level that differs by direction), which no friction \
          level carries. b = mean(model − measured), each model against the data through its own input maps; \
@@ -305,7 +342,7 @@ mod tests {
 
     #[test]
     fn a_force_that_does_not_change_sign_is_an_offset_error_not_a_level_error() {
-        let r = source_residuals(&[source(0.0, 0.8)], &[]);
+        let r = source_residuals(&[source(0.0, 0.8)], &[], &[]);
         assert_eq!(r.len(), 1);
         assert_relative_eq!(r[0].offset_error_n().unwrap(), -0.8, epsilon = 1e-12);
         assert_relative_eq!(r[0].level_error_n().unwrap(), 0.0, epsilon = 1e-12);
@@ -313,7 +350,7 @@ mod tests {
 
     #[test]
     fn a_friction_level_too_large_is_a_level_error_not_an_offset_error() {
-        let r = source_residuals(&[source(0.1, 0.0)], &[]);
+        let r = source_residuals(&[source(0.1, 0.0)], &[], &[]);
         let level = r[0].level_error_n().unwrap();
         // 10 % of 5 N, a little less where tanh has not saturated.
         assert!(level > 0.45 && level <= 0.5, "level error {level}");
@@ -321,12 +358,35 @@ mod tests {
     }
 
     #[test]
-    fn slow_samples_count_as_reversal_and_roles_split_sources() {
-        let mut a = source(0.0, 0.0);
-        for k in 200..400 {
-            a.series.fit[k] = false;
+    fn a_direction_with_too_few_samples_gives_no_level_or_offset_error() {
+        let mut one_back = source(0.0, 0.8);
+        // Every backward sample but one becomes a reversal sample.
+        let mut kept = false;
+        for v in one_back.series.velocity.iter_mut() {
+            if *v < -0.001 {
+                if kept {
+                    *v = 0.0;
+                }
+                kept = true;
+            }
         }
-        let r = source_residuals(&[a], &[source(0.0, 0.0)]);
+        let r = source_residuals(&[one_back.clone()], &[], &[]);
+        assert_eq!(r[0].backward.samples, 1);
+        assert!(!r[0].enough_samples());
+        assert_eq!(r[0].level_error_n(), None);
+        assert_eq!(r[0].offset_error_n(), None);
+        let o = crate::fit::driver::tests_outcome(vec![one_back]);
+        let table = models_direction_table(&[&o]);
+        assert!(table.contains("too few samples (n₊ = "), "{table}");
+    }
+
+    #[test]
+    fn slow_samples_count_as_reversal_and_roles_split_sources() {
+        let r = source_residuals(
+            &[source(0.0, 0.0)],
+            &[source(0.0, 0.0)],
+            &[source(0.0, 0.0)],
+        );
         let roles: Vec<&str> = r.iter().map(|x| x.role).collect();
         assert_eq!(roles, ["fit", "held_out", "validate"]);
         // |sin| < 0.1 on about 6.4 % of a period.

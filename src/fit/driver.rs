@@ -6,7 +6,7 @@
 use super::local_run::LocalRun;
 use super::options::Options;
 use super::params::FittedParameter;
-use super::problem::{Data, Model, Problem, SeriesFit};
+use super::problem::{Data, Model, Problem, Role, SeriesFit};
 use std::sync::atomic::Ordering;
 use std::time::Instant;
 
@@ -32,19 +32,21 @@ pub struct FitOutcome {
     pub block_mse: Option<Vec<f64>>,
     /// The training sources with the prediction.
     pub train: Vec<SeriesFit>,
+    /// The held-out parts of the training files with the prediction.
+    pub held_out: Vec<SeriesFit>,
     /// The validation sources with the prediction.
     pub validate: Vec<SeriesFit>,
     /// RMS and max |residual| on the fitted samples, N.
     pub train_rms: f64,
     /// Max |residual| on the fitted samples, N.
     pub train_max: f64,
-    /// RMS on held-out samples of the training sources, N.
+    /// RMS on the held-out parts of the training files, N.
     pub holdout_rms: Option<f64>,
     /// RMS on the validation sources, N.
     pub validate_rms: Option<f64>,
     /// Why the fitted model gives no prediction on the validation sources
-    /// (e.g. LuGre's g(v) ≤ 0 beyond the training velocities): an outcome
-    /// to report, not an error.
+    /// or the held-out parts (e.g. LuGre's g(v) ≤ 0 beyond the training
+    /// velocities): an outcome to report, not an error.
     pub validate_failure: Option<String>,
     /// Model evaluations (simulations of a source).
     pub simulations: usize,
@@ -52,6 +54,10 @@ pub struct FitOutcome {
     pub simulation_mean_s: f64,
     /// Wall time of the whole fit, s.
     pub wall_s: f64,
+    /// Our model on a rotary joint's data: the lever arm and load it runs
+    /// through (None: linear data, or a classic model, which is fitted in
+    /// the joint's own units).
+    pub joint: Option<super::rotary::Lever>,
 }
 
 impl FitOutcome {
@@ -103,13 +109,19 @@ pub fn fit(
             })
             .collect()
     };
-    let train = collect(problem.predict_sources(&best.x, true))?;
-    let (validate, validate_failure) = match collect(problem.predict_sources(&best.x, false)) {
-        Ok(v) => (v, None),
-        Err(e) => (Vec::new(), Some(e.to_string())),
+    let train = collect(problem.predict_sources(&best.x, Role::Train))?;
+    let mut validate_failure = None;
+    let mut not_fitted = |role: Role| match collect(problem.predict_sources(&best.x, role)) {
+        Ok(v) => v,
+        Err(e) => {
+            validate_failure.get_or_insert(e.to_string());
+            Vec::new()
+        }
     };
+    let held_out = not_fitted(Role::HeldOut);
+    let validate = not_fitted(Role::Validate);
     let (train_rms, train_max) = pooled(&train, |f, i| f.series.fit[i]).unwrap_or((f64::NAN, 0.0));
-    let holdout_rms = pooled(&train, |f, i| !f.series.fit[i]).map(|p| p.0);
+    let holdout_rms = pooled(&held_out, |_, _| true).map(|p| p.0);
     let validate_rms = pooled(&validate, |_, _| true).map(|p| p.0);
     let simulations = problem.simulations.load(Ordering::Relaxed);
     let ns = problem.simulation_ns.load(Ordering::Relaxed);
@@ -123,6 +135,7 @@ pub fn fit(
         statistics,
         block_mse,
         train,
+        held_out,
         validate,
         train_rms,
         train_max,
@@ -132,5 +145,33 @@ pub fn fit(
         simulations,
         simulation_mean_s: ns as f64 / 1e9 / simulations.max(1) as f64,
         wall_s: wall.elapsed().as_secs_f64(),
+        joint: None,
     })
+}
+
+/// An outcome of `train` alone (for tests of what reads outcomes).
+#[cfg(test)]
+pub(crate) fn tests_outcome(train: Vec<SeriesFit>) -> FitOutcome {
+    FitOutcome {
+        label: "model".into(),
+        units: super::Units::Linear,
+        params: Vec::new(),
+        best: Vec::new(),
+        optima: Vec::new(),
+        converged: true,
+        statistics: Default::default(),
+        block_mse: None,
+        train,
+        held_out: Vec::new(),
+        validate: Vec::new(),
+        train_rms: 0.0,
+        train_max: 0.0,
+        holdout_rms: None,
+        validate_rms: None,
+        validate_failure: None,
+        simulations: 0,
+        simulation_mean_s: 0.0,
+        wall_s: 0.0,
+        joint: None,
+    }
 }

@@ -152,12 +152,18 @@ pub(super) fn compile(
         }
         t = format!("{}{}{}", &t[..i], id, &rest[j + 1..]);
     }
+    let t = crate::expression::with_functions(&t);
     let node =
         build_operator_tree::<DefaultNumericTypes>(&t).map_err(|e| FitError::Expression {
             what: what.into(),
             text: text.into(),
             message: e.to_string(),
         })?;
+    crate::expression::check_functions(&node).map_err(|message| FitError::Expression {
+        what: what.into(),
+        text: text.into(),
+        message,
+    })?;
     for id in node.iter_variable_identifiers() {
         if table.index(id).is_some() && table.column(id).is_none() {
             return Err(FitError::Expression {
@@ -174,7 +180,8 @@ pub(super) fn compile(
                 what: what.into(),
                 text: text.into(),
                 message: format!(
-                    "`{id}` is neither a column ({}) nor a map coefficient (--map NAME=VALUE)",
+                    "`{id}` is neither a column of {} ({}) nor a map coefficient (--map NAME=VALUE)",
+                    table.source.display(),
                     table.names.join(", ")
                 ),
             });

@@ -23,6 +23,10 @@ pub struct ParamSpec {
     /// `--start NAME=VALUE` (default: the configuration's value, or the
     /// map coefficient's `--map` value).
     pub start: Option<f64>,
+    /// Under `--fit auto`: a bound or start for a key that the selection
+    /// may choose, not named in `--fit`. It is used if its term is chosen,
+    /// and fits nothing by itself.
+    pub if_chosen: bool,
 }
 
 /// One fitted parameter.

@@ -57,7 +57,16 @@ fn auto_specs(params: &[ParamSpec]) -> (bool, Vec<ParamSpec>, Vec<ParamSpec>) {
         .filter(|s| s.name != super::auto::AUTO)
         .cloned()
         .collect();
-    let mut specs = given.clone();
+    // A bound or start given in case its term is chosen fits nothing yet
+    // (the base key's applies at once: it is always fitted).
+    let mut specs: Vec<ParamSpec> = given
+        .iter()
+        .filter(|s| !s.if_chosen || s.name == super::auto::BASE_KEY)
+        .map(|s| ParamSpec {
+            if_chosen: false,
+            ..s.clone()
+        })
+        .collect();
     if auto && !specs.iter().any(|s| s.name == super::auto::BASE_KEY) {
         specs.insert(
             0,
@@ -110,8 +119,9 @@ pub struct Prepared {
     pub mean_abs_n: f64,
     /// Whether the training loads differ by more than 1 %.
     pub loads_vary: bool,
-    /// The validation data hold loads outside the training data's range.
-    pub other_loads: bool,
+    /// Whether the training data give the load (a load column or topic),
+    /// rather than the configuration's `contact.load_n`.
+    pub load_given: bool,
     /// The training files, as given.
     pub names: Vec<String>,
     /// What was read from each bag (topics used, warnings).
@@ -194,6 +204,46 @@ fn load_range(sources: &[Source], map: &[f64], load_n: f64) -> Result<(f64, f64)
     Ok((lo, hi))
 }
 
+/// The column names a joint's table may use for the velocity and the
+/// friction when `--velocity` / `--friction` keep their defaults.
+const ROTARY_VELOCITY_COLUMNS: &[&str] = &["velocity_rad_s"];
+/// See [`ROTARY_VELOCITY_COLUMNS`].
+const ROTARY_FRICTION_COLUMNS: &[&str] =
+    &["friction_nm", "friction_n_m", "torque_nm", "torque_n_m"];
+
+/// `--rotary` with the default column names: a table without
+/// `velocity_m_s` / `friction_n` but with a joint's names (`velocity_rad_s`,
+/// `friction_nm`, `torque_nm`, …) is read through those.
+fn rotary_columns(mapping: &super::Mapping, table: &super::Table) -> super::Mapping {
+    let defaults = super::Mapping::default();
+    let pick = |given: &str, default: &str, joint: &[&str]| -> String {
+        if given != default || table.column(given).is_some() {
+            return given.to_string();
+        }
+        joint
+            .iter()
+            .find(|c| table.column(c).is_some())
+            .map_or(given.to_string(), |c| c.to_string())
+    };
+    super::Mapping {
+        velocity: pick(
+            &mapping.velocity,
+            &defaults.velocity,
+            ROTARY_VELOCITY_COLUMNS,
+        ),
+        friction: pick(
+            &mapping.friction,
+            &defaults.friction,
+            ROTARY_FRICTION_COLUMNS,
+        ),
+        ..mapping.clone()
+    }
+}
+
+/// A joint turning faster than this, rad/s, is unusual enough to ask
+/// whether its velocity is in deg/s.
+const FAST_JOINT_RAD_S: f64 = 20.0;
+
 /// Read the data and set up the parameters (everything checked before any
 /// simulation).
 pub fn prepare(config: &Config, req: &FitRequest) -> Result<Prepared, FitError> {
@@ -202,9 +252,14 @@ pub fn prepare(config: &Config, req: &FitRequest) -> Result<Prepared, FitError> 
     let mut source = |p: &PathBuf| -> Result<Source, FitError> {
         let (table, note) = req.table(p)?;
         notes.extend(note);
-        Source::new(table, &req.mapping)
+        let mapping = if req.rotary {
+            rotary_columns(&req.mapping, &table)
+        } else {
+            req.mapping.clone()
+        };
+        Source::new(table, &mapping)
     };
-    let train = req
+    let given = req
         .data
         .iter()
         .map(&mut source)
@@ -214,18 +269,28 @@ pub fn prepare(config: &Config, req: &FitRequest) -> Result<Prepared, FitError> 
         .iter()
         .map(&mut source)
         .collect::<Result<Vec<_>, _>>()?;
+    // --holdout cuts each training file in two here, before anything reads
+    // it: from now on every choice sees the training part alone.
+    let (train, held_out) = if req.holdout > 0.0 {
+        let parts = given
+            .iter()
+            .map(|s| s.split_held_out(req.holdout, &req.mapping))
+            .collect::<Result<Vec<_>, _>>()?;
+        parts.into_iter().unzip()
+    } else {
+        (given, Vec::new())
+    };
     let mapping = &req.mapping;
     let map_names: Vec<String> = mapping.coefficients.iter().map(|c| c.0.clone()).collect();
     let map_values: Vec<f64> = mapping.coefficients.iter().map(|c| c.1).collect();
     let load_n = config.contact.load_n;
     let (scale, mean_abs_n, loads_vary) = data_scale(&train, &map_values, load_n)?;
-    let other_loads = if validate.is_empty() {
-        false
-    } else {
-        let (tl, th) = load_range(&train, &map_values, load_n)?;
-        let (vl, vh) = load_range(&validate, &map_values, load_n)?;
-        vl < 0.99 * tl || vh > 1.01 * th
-    };
+    let load_given = train
+        .iter()
+        .map(|s| s.series(&map_values).map(|se| se.load.is_some()))
+        .collect::<Result<Vec<_>, _>>()?
+        .into_iter()
+        .any(|g| g);
     let (auto, given, specs) = auto_specs(&req.params);
     let (key_specs, map_fit) = split_specs(&specs, &map_names, &map_values)?;
     if scale.reversal_stiffness_n_m.is_none() {
@@ -235,6 +300,13 @@ pub fn prepare(config: &Config, req: &FitRequest) -> Result<Prepared, FitError> 
                 s.name
             ));
         }
+    }
+    if req.rotary && scale.velocity_m_s > FAST_JOINT_RAD_S {
+        notes.push(format!(
+            "warning: --rotary: the top speed is {} rad/s ({} deg/s); a robot joint rarely turns faster than {FAST_JOINT_RAD_S} rad/s. If the velocity is in deg/s, convert it: --velocity 'NAME * 3.14159265 / 180' (a motor shaft's speed in rad/s is fine as it is)",
+            crate::text::Num(scale.velocity_m_s),
+            crate::text::Num(scale.velocity_m_s.to_degrees().round())
+        ));
     }
     let (model_config, lever, model_scale) = model_setup(
         config,
@@ -257,12 +329,9 @@ pub fn prepare(config: &Config, req: &FitRequest) -> Result<Prepared, FitError> 
         names: req.data.iter().map(|p| p.display().to_string()).collect(),
         data: Data {
             train,
+            held_out,
             validate,
-            holdout: if req.holdout > 0.0 {
-                super::problem::HoldOut::Fraction(req.holdout)
-            } else {
-                super::problem::HoldOut::None
-            },
+            holdout: super::problem::HoldOut::None,
             map_names,
             map_values,
             units: if req.rotary {
@@ -276,7 +345,7 @@ pub fn prepare(config: &Config, req: &FitRequest) -> Result<Prepared, FitError> 
         scale,
         mean_abs_n,
         loads_vary,
-        other_loads,
+        load_given,
         notes,
     })
 }
@@ -290,20 +359,8 @@ pub fn select_terms(
 ) -> Result<super::auto::Selection, FitError> {
     let given = p.given.clone();
     let s = super::auto::select(p, req, &given, say)?;
-    let specs: Vec<ParamSpec> = s
-        .keys
-        .iter()
-        .map(|k| {
-            given
-                .iter()
-                .find(|g| g.name == *k)
-                .cloned()
-                .unwrap_or(ParamSpec {
-                    name: k.clone(),
-                    ..Default::default()
-                })
-        })
-        .collect();
+    let keys: Vec<&str> = s.keys.iter().map(String::as_str).collect();
+    let specs = super::auto::set_specs(&given, &keys);
     let (model, map_fit) = model_for(p, &specs, &[])?;
     p.model = model;
     p.map_fit = map_fit;

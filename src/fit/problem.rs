@@ -23,14 +23,24 @@ pub trait Model: Sync {
     fn predict(&self, x: &[f64], series: &Series) -> Result<Vec<f64>, String>;
 }
 
-/// The data of a fit: training sources (a part may be held out) and
-/// validation sources, with the input maps' coefficients.
+/// The data of a fit: training sources, the parts of the given training
+/// files held out of them (`--holdout`), and validation sources
+/// (`--validate`), with the input maps' coefficients.
+///
+/// The held-out parts are sources of their own, cut from the files before
+/// anything else reads them: every choice a fit makes (the scale, the
+/// terms, the starts, the bounds) sees `train` only, so nothing held out
+/// can reach one. They are predicted after the fit, as validation files
+/// are (from their own first sample).
 pub struct Data {
     /// Training sources.
     pub train: Vec<Source>,
+    /// The held-out parts of the training files (not fitted).
+    pub held_out: Vec<Source>,
     /// Validation sources (not fitted).
     pub validate: Vec<Source>,
-    /// What of each training source is held out.
+    /// Which samples of each training source are left out of the cost (a
+    /// block of cross-validation; [`HoldOut::None`] in a plain fit).
     pub holdout: HoldOut,
     /// Map coefficient names and their values (fixed or starts).
     pub map_names: Vec<String>,
@@ -40,16 +50,60 @@ pub struct Data {
     pub units: super::Units,
 }
 
-/// What of each training source is held out of the fit (scored, not
-/// fitted).
+/// The role of a source in a fit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Role {
+    /// Fitted.
+    Train,
+    /// A held-out part of a training file (`--holdout`).
+    HeldOut,
+    /// A `--validate` file.
+    Validate,
+}
+
+impl Role {
+    /// Its name in `fit.csv` and the tables.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Train => "fit",
+            Self::HeldOut => "held_out",
+            Self::Validate => "validate",
+        }
+    }
+}
+
+impl Data {
+    /// The sources of `role`.
+    pub fn sources(&self, role: Role) -> &[Source] {
+        match role {
+            Role::Train => &self.train,
+            Role::HeldOut => &self.held_out,
+            Role::Validate => &self.validate,
+        }
+    }
+
+    /// The same data without what is not fitted: the training sources
+    /// alone (what the term selection sees).
+    pub fn training_only(&self) -> Self {
+        Self {
+            train: self.train.clone(),
+            held_out: Vec::new(),
+            validate: Vec::new(),
+            holdout: HoldOut::None,
+            map_names: self.map_names.clone(),
+            map_values: self.map_values.clone(),
+            units: self.units,
+        }
+    }
+}
+
+/// Which samples of each training source are left out of the cost
+/// (scored, not fitted): a fold of cross-validation.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum HoldOut {
     /// Nothing.
     #[default]
     None,
-    /// The last fraction of a time series, or every k-th point of a steady
-    /// curve (see [`Series::hold_out`]).
-    Fraction(f64),
     /// Block `index` of `count` contiguous blocks of a time series (of a
     /// steady curve: the points whose index is `index` modulo `count`):
     /// a fold of blocked cross-validation.
@@ -66,7 +120,6 @@ impl HoldOut {
     pub fn apply(self, s: &mut Series) {
         match self {
             Self::None => {}
-            Self::Fraction(f) => s.hold_out(f),
             Self::Block { index, count } => {
                 let n = s.len();
                 let steady = s.steady;
@@ -110,17 +163,17 @@ impl SeriesFit {
 /// A residual of a failed prediction, times the data's friction scale.
 const PENALTY: f64 = 1e3;
 
-/// Series computed for one set of map coefficients: (training?, the
+/// Series computed for one set of map coefficients: (role, the
 /// coefficients' bits, one series or error per source).
-type SeriesEntry = (bool, Vec<u64>, Arc<Vec<Result<Series, String>>>);
+type SeriesEntry = (Role, Vec<u64>, Arc<Vec<Result<Series, String>>>);
 
 /// Map-coefficient values whose series are kept.
 const RECENT_SERIES: usize = 8;
 
-/// A prediction kept for reuse: (training?, source index, the model
+/// A prediction kept for reuse: (role, source index, the model
 /// parameters' bits, the fingerprint of the series' inputs, the
 /// prediction).
-type PredictionEntry = (bool, usize, Vec<u64>, u64, Arc<Vec<f64>>);
+type PredictionEntry = (Role, usize, Vec<u64>, u64, Arc<Vec<f64>>);
 
 /// Predictions kept: enough for one Jacobian's columns and its base point.
 fn predictions_kept(params: usize, sources: usize) -> usize {
@@ -156,9 +209,9 @@ pub struct Problem<'a> {
     pub params: Vec<FittedParameter>,
     fitted_samples: usize,
     friction_scale: f64,
-    /// The series of every training and validation source when no map
-    /// coefficient is fitted (they do not change).
-    fixed: Option<(Vec<Series>, Vec<Series>)>,
+    /// The series of every source (training, held out, validation) when
+    /// no map coefficient is fitted (they do not change).
+    fixed: Option<[Vec<Series>; 3]>,
     /// The series of the last few map-coefficient values (training or
     /// validation): a Jacobian column that moves only a model parameter
     /// reuses them instead of evaluating the column expressions again.
@@ -218,10 +271,11 @@ impl<'a> Problem<'a> {
                     })
                     .collect::<Result<Vec<_>, super::FitError>>()
             };
-            Some((
+            Some([
                 all(&data.train, data.holdout)?,
+                all(&data.held_out, HoldOut::None)?,
                 all(&data.validate, HoldOut::None)?,
-            ))
+            ])
         } else {
             None
         };
@@ -255,18 +309,18 @@ impl<'a> Problem<'a> {
         m
     }
 
-    /// The model on the training (or validation) sources, in parallel,
-    /// with the held-out part marked on training sources.
-    pub fn predict_sources(&self, x: &[f64], train: bool) -> Vec<Result<SeriesFit, String>> {
+    /// The model on the sources of `role`, in parallel (training sources
+    /// with the samples left out of the cost marked).
+    pub fn predict_sources(&self, x: &[f64], role: Role) -> Vec<Result<SeriesFit, String>> {
         let n = self.model.parameters().len();
-        let (sources, holdout) = if train {
-            (&self.data.train, self.data.holdout)
-        } else {
-            (&self.data.validate, HoldOut::None)
+        let sources = self.data.sources(role);
+        let holdout = match role {
+            Role::Train => self.data.holdout,
+            Role::HeldOut | Role::Validate => HoldOut::None,
         };
         let map = self.map_values(x);
         let computed = if self.fixed.is_none() {
-            Some(self.series_for(&map, train, sources, holdout))
+            Some(self.series_for(&map, role, sources, holdout))
         } else {
             None
         };
@@ -274,11 +328,11 @@ impl<'a> Problem<'a> {
             .into_par_iter()
             .map(|i| {
                 let series = match (&self.fixed, &computed) {
-                    (Some((t, v)), _) => (if train { t } else { v })[i].clone(),
+                    (Some(fixed), _) => fixed[role as usize][i].clone(),
                     (None, Some(c)) => c[i].clone()?,
                     (None, None) => unreachable!("computed when not fixed"),
                 };
-                let predicted = self.predict_one(&x[..n], train, i, &series)?;
+                let predicted = self.predict_one(&x[..n], role, i, &series)?;
                 Ok(SeriesFit { series, predicted })
             })
             .collect()
@@ -290,7 +344,7 @@ impl<'a> Problem<'a> {
     fn predict_one(
         &self,
         x: &[f64],
-        train: bool,
+        role: Role,
         source: usize,
         series: &Series,
     ) -> Result<Vec<f64>, String> {
@@ -301,7 +355,7 @@ impl<'a> Problem<'a> {
         if keep {
             if let Some(e) = lock()
                 .iter()
-                .find(|e| e.0 == train && e.1 == source && e.2 == bits && e.3 == print)
+                .find(|e| e.0 == role && e.1 == source && e.2 == bits && e.3 == print)
             {
                 return Ok(e.4.as_ref().clone());
             }
@@ -320,7 +374,7 @@ impl<'a> Problem<'a> {
             if kept.len() >= most {
                 kept.remove(0);
             }
-            kept.push((train, source, bits, print, Arc::new(predicted.clone())));
+            kept.push((role, source, bits, print, Arc::new(predicted.clone())));
         }
         Ok(predicted)
     }
@@ -330,13 +384,13 @@ impl<'a> Problem<'a> {
     fn series_for(
         &self,
         map: &[f64],
-        train: bool,
+        role: Role,
         sources: &[Source],
         holdout: HoldOut,
     ) -> Arc<Vec<Result<Series, String>>> {
         let key: Vec<u64> = map.iter().map(|v| v.to_bits()).collect();
         let lock = || self.recent.lock().unwrap_or_else(|p| p.into_inner());
-        if let Some((_, _, s)) = lock().iter().find(|(t, k, _)| *t == train && *k == key) {
+        if let Some((_, _, s)) = lock().iter().find(|(r, k, _)| *r == role && *k == key) {
             return s.clone();
         }
         let computed: Arc<Vec<Result<Series, String>>> = Arc::new(
@@ -353,14 +407,14 @@ impl<'a> Problem<'a> {
         if recent.len() >= RECENT_SERIES {
             recent.remove(0);
         }
-        recent.push((train, key, computed.clone()));
+        recent.push((role, key, computed.clone()));
         computed
     }
 
     /// Residuals on the fitted samples; a failed prediction gives large
     /// residuals (a step there is rejected).
     pub fn residuals(&self, x: &[f64]) -> Vec<f64> {
-        let fits = self.predict_sources(x, true);
+        let fits = self.predict_sources(x, Role::Train);
         let penalty = vec![PENALTY * self.friction_scale; self.fitted_samples];
         let mut r = Vec::with_capacity(self.fitted_samples);
         for f in fits {
@@ -464,6 +518,7 @@ mod tests {
         };
         Data {
             train: vec![Source::new(table, &mapping).unwrap()],
+            held_out: vec![],
             validate: vec![],
             holdout: HoldOut::None,
             map_names: coefficients.iter().map(|c| c.0.clone()).collect(),

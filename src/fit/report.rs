@@ -4,7 +4,7 @@
 //! directory; the fitted parameter file.
 
 use super::driver::FitOutcome;
-use super::problem::SeriesFit;
+use super::problem::{Role, SeriesFit};
 use super::stats::CORRELATION_FLAG;
 use crate::config::Config;
 use crate::output::{AtomicFile, OutputError};
@@ -20,15 +20,30 @@ fn g(v: f64) -> String {
     }
 }
 
-/// Parameters: value, SE, 95 % interval, bounds, flags.
+/// A parameter's value as it acts on a rotary joint (our model behind a
+/// lever arm), e.g. `2.1e-4 N·m`; empty for a property of the contact
+/// itself or without a joint.
+fn on_joint(o: &FitOutcome, name: &str, value: f64) -> String {
+    o.joint
+        .as_ref()
+        .and_then(|j| super::rotary::joint_equivalent(name, value, j.lever_m))
+        .map_or(String::new(), |(v, unit)| format!("{} {unit}", sig(v)))
+}
+
+/// Parameters: value, SE, 95 % interval, bounds, flags (and, on a rotary
+/// joint, each value as it acts on the joint).
 pub fn parameter_table(o: &FitOutcome) -> String {
-    let mut s = String::from(
-        "| parameter | value | std. error | 95 % interval | bounds | flag |\n|---|---|---|---|---|---|\n",
-    );
+    let joint = o.joint.is_some();
+    let mut s = String::from("| parameter | value | std. error | 95 % interval | bounds | flag |");
+    if joint {
+        s.push_str(" on the joint |");
+    }
+    s.push_str("\n|---|---|---|---|---|---|");
+    s.push_str(if joint { "---|\n" } else { "\n" });
     for (j, p) in o.params.iter().enumerate() {
         let st = &o.statistics;
         let flag = parameter_flag(st.at_bound[j], o.best[j], st.standard_error[j]);
-        let _ = writeln!(
+        let _ = write!(
             s,
             "| `{}` | {} | {} | [{}, {}] | [{}, {}]{} | {flag} |",
             p.name,
@@ -40,8 +55,25 @@ pub fn parameter_table(o: &FitOutcome) -> String {
             g(p.hi),
             if p.log { " log" } else { "" },
         );
+        if joint {
+            let _ = write!(s, " {} |", on_joint(o, &p.name, o.best[j]));
+        }
+        s.push('\n');
     }
     s
+}
+
+/// The joint a rotary fit ran through: lever arm, load and how they were
+/// found (empty for linear data).
+pub fn joint_lines(o: &FitOutcome) -> String {
+    o.joint.as_ref().map_or(String::new(), |j| {
+        format!(
+            "\n## The joint\n\nThe data are a rotary joint's (rad/s, N·m). The model's contact slides at r ω and puts r F on the joint: lever arm r = {} m (the fitted file's `gain`), contact load F_N = {} N; {}. Every table below is in the joint's units; the parameter table also gives each term as it acts on the joint.\n",
+            sig(j.lever_m),
+            sig(j.load_n),
+            j.how
+        )
+    })
 }
 
 /// What a parameter's row warns of: at a bound; not identifiable (no
@@ -91,8 +123,12 @@ pub fn correlation_table(o: &FitOutcome) -> String {
 
 /// The distinct optima, best first.
 pub fn optima_table(o: &FitOutcome) -> String {
+    let u = match o.units {
+        super::Units::Linear => "N²".to_string(),
+        super::Units::Rotary => format!("({})²", o.units.force()),
+    };
     let mut s = format!(
-        "| # | cost ½Σr² (N²) | {} | outcome |\n|---|---|{}---|\n",
+        "| # | cost ½Σr² ({u}) | {} | outcome |\n|---|---|{}---|\n",
         o.params
             .iter()
             .map(|p| format!("`{}`", p.name))
@@ -125,7 +161,7 @@ pub fn residual_lines(o: &FitOutcome) -> String {
     if let Some(h) = o.holdout_rms {
         let _ = writeln!(
             s,
-            "held-out RMS {} {u} (held-out part of the training data)",
+            "held-out RMS {} {u} (the held-out parts of the training files: --holdout)",
             sig(h)
         );
     }
@@ -150,8 +186,9 @@ pub fn residual_lines(o: &FitOutcome) -> String {
 pub struct ModelRow {
     /// The model's name.
     pub label: String,
-    /// Its fitted parameters.
-    pub parameters: Vec<(String, f64)>,
+    /// Its fitted parameters: name, value, and the value as it acts on a
+    /// rotary joint when it differs (else empty).
+    pub parameters: Vec<(String, f64, String)>,
     /// The data's units.
     pub units: super::Units,
     /// RMS residual on the training samples, N.
@@ -173,11 +210,21 @@ impl From<&FitOutcome> for ModelRow {
         Self {
             label: o.label.clone(),
             units: o.units,
+            // Ours on a joint: a term's contact value with what it is on
+            // the joint; a classic model: its names in the data's units.
             parameters: o
                 .params
                 .iter()
                 .zip(&o.best)
-                .map(|(p, v)| (p.name.clone(), *v))
+                .map(|(p, v)| {
+                    let joint = on_joint(o, &p.name, *v);
+                    let name = if o.joint.is_some() {
+                        p.name.clone()
+                    } else {
+                        super::baselines::parameter_name(&p.name, o.units)
+                    };
+                    (name, *v, joint)
+                })
                 .collect(),
             train_rms: o.train_rms,
             held_out_rms: o.held_out_rms(),
@@ -203,7 +250,13 @@ pub fn models_table(rows: &[ModelRow], scale_n: f64) -> String {
         let params: Vec<String> = r
             .parameters
             .iter()
-            .map(|(n, v)| format!("{n}={}", Num(round4(*v))))
+            .map(|(n, v, joint)| {
+                if joint.is_empty() {
+                    format!("{n}={}", Num(round4(*v)))
+                } else {
+                    format!("{n}={} ({joint} on the joint)", Num(round4(*v)))
+                }
+            })
             .collect();
         let _ = writeln!(
             s,
@@ -214,7 +267,12 @@ pub fn models_table(rows: &[ModelRow], scale_n: f64) -> String {
             if r.converged {
                 "converged".to_string()
             } else {
-                format!("NOT converged: {}", r.termination.replace('|', "/"))
+                format!(
+                    "NOT converged: {}",
+                    r.termination
+                        .trim_start_matches("not converged: ")
+                        .replace('|', "/")
+                )
             },
             sig(r.train_rms),
             match (&r.held_out_rms, &r.held_out_failure) {
@@ -226,6 +284,11 @@ pub fn models_table(rows: &[ModelRow], scale_n: f64) -> String {
                 .map_or("–".into(), |h| format!("{:.1} %", 100.0 * h / scale_n)),
         );
     }
+    let _ = writeln!(
+        s,
+        "\nheld-out / friction scale: the held-out RMS divided by the RMS of the measured friction on the held-out samples ({} {u}), the same for every model.",
+        sig(scale_n)
+    );
     s
 }
 
@@ -313,22 +376,22 @@ pub fn fitted_yaml(
 }
 
 /// `fit.csv`: every sample of every source with the prediction.
-fn write_samples(
-    path: &Path,
-    units: super::Units,
-    train: &[SeriesFit],
-    validate: &[SeriesFit],
-) -> Result<PathBuf, OutputError> {
+fn write_samples(path: &Path, o: &FitOutcome) -> Result<PathBuf, OutputError> {
+    let units = o.units;
     let mut f = AtomicFile::create(path)?;
     let (v, n) = (units.speed_column(), units.force_column());
     f.line(format_args!(
         "source,role,t_s,velocity_{v},load_n,measured_{n},predicted_{n},residual_{n}"
     ))?;
-    for (fits, train) in [(train, true), (validate, false)] {
+    for (fits, role) in [
+        (&o.train, Role::Train),
+        (&o.held_out, Role::HeldOut),
+        (&o.validate, Role::Validate),
+    ] {
         for sf in fits {
             let s = &sf.series;
             for k in 0..s.len() {
-                let role = super::by_direction::sample_role(train, s.fit[k]);
+                let role = super::by_direction::sample_role(role, s.fit[k]);
                 f.line(format_args!(
                     "{},{role},{},{},{},{},{},{}",
                     s.name.replace(',', ";"),
@@ -350,10 +413,11 @@ fn write_samples(
 /// The whole markdown summary of one fit.
 pub fn summary(o: &FitOutcome, extra: &str) -> String {
     format!(
-        "# Fit of {}: {}\n\n{}\n## Parameters\n\n{}\n## Correlations\n\n{}\n## Distinct optima (best first)\n\n{}\n## Residual by direction of motion\n\n{}\n{}",
+        "# Fit of {}: {}\n\n{}{}\n## Parameters\n\n{}\n## Correlations\n\n{}\n## Distinct optima (best first)\n\n{}\n## Residual by direction of motion\n\n{}\n{}",
         o.label,
         if o.converged { "converged" } else { "NOT converged (best point found)" },
         residual_lines(o),
+        joint_lines(o),
         parameter_table(o),
         correlation_table(o),
         optima_table(o),
@@ -366,7 +430,7 @@ pub fn summary(o: &FitOutcome, extra: &str) -> String {
 pub fn write_report(dir: &Path, o: &FitOutcome, extra: &str) -> Result<Vec<PathBuf>, OutputError> {
     let files = vec![
         crate::output::write_file(&dir.join("summary.md"), summary(o, extra).as_bytes())?,
-        write_samples(&dir.join("fit.csv"), o.units, &o.train, &o.validate)?,
+        write_samples(&dir.join("fit.csv"), o)?,
     ];
     #[cfg(feature = "plots")]
     let files = [files, plots::write(dir, o)?].concat();
@@ -485,12 +549,18 @@ mod plots {
         dir: &Path,
         models: &[&FitOutcome],
     ) -> Result<Vec<PathBuf>, OutputError> {
-        let held_out = !models[0].validate.is_empty();
-        let sources = if held_out {
-            &models[0].validate
-        } else {
-            &models[0].train
-        };
+        // The data not fitted: --validate files, else the held-out parts,
+        // else (nothing held out) the training data.
+        fn pick(o: &FitOutcome) -> (&[SeriesFit], &'static str) {
+            if !o.validate.is_empty() {
+                (&o.validate, "validation")
+            } else if !o.held_out.is_empty() {
+                (&o.held_out, "held out")
+            } else {
+                (&o.train, "training")
+            }
+        }
+        let (sources, role) = pick(models[0]);
         let panels: Vec<Panel> = (0..sources.len())
             .map(|j| {
                 let name = Path::new(&sources[j].series.name)
@@ -499,16 +569,14 @@ mod plots {
                         s.to_string_lossy().into_owned()
                     });
                 Panel {
-                    title: format!(
-                        "{name} ({})",
-                        if held_out { "held out" } else { "training" }
-                    ),
+                    title: format!("{name} ({role})"),
                     lines: models
                         .iter()
                         .enumerate()
                         .filter_map(|(m, o)| {
-                            let fits = if held_out { &o.validate } else { &o.train };
-                            fits.get(j)
+                            pick(o)
+                                .0
+                                .get(j)
                                 .map(|f| line(&o.label, m, binned_residual(f, 40), m > 0))
                         })
                         .collect(),
@@ -556,27 +624,20 @@ mod plots {
                 legend_everywhere: true,
             }
         }
-        let mut all = panels(&o.train, "training", |f, k| f.series.t[k], false);
-        all.extend(panels(
-            &o.validate,
-            "validation",
-            |f, k| f.series.t[k],
-            false,
-        ));
-        let mut vel = panels(&o.train, "training", |f, k| f.series.velocity[k], false);
-        vel.extend(panels(
-            &o.validate,
-            "validation",
-            |f, k| f.series.velocity[k],
-            false,
-        ));
-        let mut res = panels(&o.train, "training", |f, k| f.series.t[k], true);
-        res.extend(panels(
-            &o.validate,
-            "validation",
-            |f, k| f.series.t[k],
-            true,
-        ));
+        let roles = [
+            (&o.train, "training"),
+            (&o.held_out, "held out"),
+            (&o.validate, "validation"),
+        ];
+        let every = |x: &dyn Fn(&SeriesFit, usize) -> f64, resid: bool| -> Vec<Panel> {
+            roles
+                .iter()
+                .flat_map(|(fits, role)| panels(fits, role, x, resid))
+                .collect()
+        };
+        let all = every(&|f, k| f.series.t[k], false);
+        let vel = every(&|f, k| f.series.velocity[k], false);
+        let res = every(&|f, k| f.series.t[k], true);
         let steady = o.train.iter().all(|f| f.series.steady);
         let tx = if steady { "point" } else { "time (s)" };
         Ok(vec![

@@ -245,8 +245,50 @@ pub fn is_bag(p: &Path) -> bool {
     p.is_dir() || matches!(p.extension().and_then(|e| e.to_str()), Some("mcap" | "db3"))
 }
 
+/// The spec a bound or start of `name` applies to: a fitted parameter's,
+/// or under `--fit auto` one of a key the selection may choose (made on
+/// first use, marked [`ParamSpec::if_chosen`]).
+fn spec_for<'a>(
+    specs: &'a mut Vec<ParamSpec>,
+    name: &str,
+    flag: &str,
+) -> Result<&'a mut ParamSpec, FitError> {
+    if let Some(i) = specs.iter().position(|s| s.name == name) {
+        return Ok(&mut specs[i]);
+    }
+    let auto = specs.iter().any(|s| s.name == super::auto::AUTO);
+    if auto && super::auto::may_choose(name) {
+        specs.push(ParamSpec {
+            name: name.to_string(),
+            if_chosen: true,
+            ..Default::default()
+        });
+        return Ok(specs.last_mut().expect("just pushed"));
+    }
+    let message = if auto {
+        format!(
+            "`{name}` is neither in --fit nor a key --fit auto may choose ({})",
+            super::auto::choosable_keys().join(", ")
+        )
+    } else {
+        format!("`{name}` is not in --fit")
+    };
+    Err(if flag == "--bounds" {
+        FitError::Bounds {
+            key: name.to_string(),
+            message,
+        }
+    } else {
+        FitError::Data {
+            what: format!("{flag} {name}"),
+            message,
+        }
+    })
+}
+
 /// Fitted parameters from names, `(name, lo, hi)` bounds and `(name,
-/// start)` starts; every bound and start must name a fitted parameter.
+/// start)` starts; every bound and start must name a fitted parameter or,
+/// under `--fit auto`, a key the selection may choose (used if chosen).
 pub fn param_specs(
     keys: &[String],
     bounds: &[(String, f64, f64)],
@@ -273,21 +315,10 @@ pub fn param_specs(
         });
     }
     for (n, lo, hi) in bounds {
-        let Some(s) = specs.iter_mut().find(|s| s.name == *n) else {
-            return Err(FitError::Bounds {
-                key: n.clone(),
-                message: format!("`{n}` is not in --fit"),
-            });
-        };
-        s.bounds = Some((*lo, *hi));
+        spec_for(&mut specs, n, "--bounds")?.bounds = Some((*lo, *hi));
     }
     for (n, v) in starts {
-        let Some(s) = specs.iter_mut().find(|s| s.name == *n) else {
-            return Err(FitError::Data {
-                what: format!("--start {n}"),
-                message: format!("`{n}` is not in --fit"),
-            });
-        };
+        let s = spec_for(&mut specs, n, "--start")?;
         if !v.is_finite() {
             return Err(FitError::Data {
                 what: format!("--start {n}"),
@@ -320,6 +351,8 @@ pub fn fit_ours(p: &Prepared, req: &FitRequest) -> Result<OursFitted, FitError> 
         p.map_fit.clone(),
         &req.options("friction-node"),
     )?;
+    let mut outcome = outcome;
+    outcome.joint = p.lever.clone();
     let n_model = p.model.parameters_len();
     let mut config = p.model.config(&outcome.best[..n_model])?;
     if let Some(l) = &p.lever {
@@ -343,26 +376,17 @@ pub fn fit_ours(p: &Prepared, req: &FitRequest) -> Result<OursFitted, FitError> 
 }
 
 /// RMS of the measured friction on held-out samples (validation data, else
-/// the held-out part), N: the scale of the held-out error.
+/// the held-out parts), N: the scale of the held-out error.
 pub fn held_out_scale(o: &FitOutcome) -> f64 {
-    let (mut ss, mut n) = (0.0, 0usize);
-    let mut add = |f: f64| {
-        ss += f * f;
-        n += 1;
-    };
-    if o.validate.is_empty() {
-        for sf in &o.train {
-            for k in 0..sf.series.len() {
-                if !sf.series.fit[k] {
-                    add(sf.series.friction[k]);
-                }
-            }
-        }
+    let fits = if o.validate.is_empty() {
+        &o.held_out
     } else {
-        for sf in &o.validate {
-            sf.series.friction.iter().for_each(|f| add(*f));
-        }
-    }
+        &o.validate
+    };
+    let (ss, n) = fits
+        .iter()
+        .flat_map(|sf| sf.series.friction.iter())
+        .fold((0.0, 0usize), |(ss, n), f| (ss + f * f, n + 1));
     (ss / n.max(1) as f64).sqrt()
 }
 
@@ -424,7 +448,7 @@ pub fn fit_baselines(
         }
         let model = Baseline::from_data(
             kind,
-            LoadForm::for_data(p.loads_vary, p.other_loads),
+            LoadForm::for_data(p.loads_vary, p.load_given),
             &p.scale,
             p.mean_abs_n,
             &series,
@@ -440,7 +464,7 @@ pub fn fit_baselines(
         }
         let generic = Baseline::from_data(
             kind,
-            LoadForm::for_data(p.loads_vary, p.other_loads),
+            LoadForm::for_data(p.loads_vary, p.load_given),
             &p.scale,
             p.mean_abs_n,
             &[],

@@ -266,10 +266,52 @@ pub fn on_joint(config: Config, joint: &str, lever_m: f64) -> Config {
     }
 }
 
+/// A fitted contact key's value as it acts on the joint behind lever arm
+/// `lever_m` (v = r ω, τ = r F): a force times r (N·m), a stiffness or a
+/// damping times r² (per rad), a quadratic loss times r³, a speed divided
+/// by r (rad/s). None for a property of the contact itself (a friction
+/// coefficient, the viscosity, the roughness, a load), which reads the
+/// same on the joint.
+pub fn joint_equivalent(key: &str, value: f64, lever_m: f64) -> Option<(f64, &'static str)> {
+    let r = lever_m;
+    Some(match key {
+        "drivetrain.coulomb_n" | "drivetrain.coulomb_asymmetry_n" => (value * r, "N·m"),
+        "drivetrain.viscous_n_s_m" => (value * r * r, "N·m·s/rad"),
+        "drivetrain.quadratic_n_s2_m2" => (value * r * r * r, "N·m·s²/rad²"),
+        "contact.presliding_stiffness_n_m" => (value * r * r, "N·m/rad"),
+        "contact.presliding_damping_n_s_m" => (value * r * r, "N·m·s/rad"),
+        "contact.boundary_activation_speed_m_s" | "contact.sign_regularization_m_s" => {
+            (value / r, "rad/s")
+        }
+        _ => return None,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
+
+    #[test]
+    fn every_friction_term_key_with_a_force_or_a_speed_has_its_joint_equivalent() {
+        for k in crate::physics::terms::catalogue() {
+            let dimensional = k.unit.contains('N') || k.unit.contains("m/s");
+            // A load is the contact's normal load, not a force on the joint.
+            let load = k.key.ends_with("_load_n");
+            assert_eq!(
+                joint_equivalent(k.key, 1.0, 0.1).is_some(),
+                dimensional && !load,
+                "{} ({})",
+                k.key,
+                k.unit
+            );
+        }
+        let (v, unit) = joint_equivalent("contact.presliding_stiffness_n_m", 2e6, 0.01).unwrap();
+        assert_relative_eq!(v, 200.0, max_relative = 1e-12);
+        assert_eq!(unit, "N·m/rad");
+        let (v, _) = joint_equivalent("contact.boundary_activation_speed_m_s", 1e-3, 0.01).unwrap();
+        assert_relative_eq!(v, 0.1, max_relative = 1e-12);
+    }
 
     #[test]
     fn the_chosen_lever_puts_the_top_speed_at_the_transition_and_the_level_on_the_boundary_friction(

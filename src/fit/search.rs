@@ -248,6 +248,7 @@ mod tests {
         let table = Table::parse(&text, Path::new("d.csv"), Delimiter::Auto, None, 0).unwrap();
         let data = Data {
             train: vec![Source::new(table, &Mapping::default()).unwrap()],
+            held_out: vec![],
             validate: vec![],
             holdout: HoldOut::None,
             map_names: vec![],

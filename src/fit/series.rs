@@ -85,25 +85,21 @@ impl Series {
     pub fn load_at(&self, k: usize, default: f64) -> f64 {
         self.load.as_ref().map_or(default, |l| l[k])
     }
+}
 
-    /// Hold out the last `fraction` of a time series, or every k-th point of
-    /// a steady curve (interleaved, so both ends stay in the fit).
-    pub fn hold_out(&mut self, fraction: f64) {
-        if fraction <= 0.0 {
-            return;
-        }
-        let n = self.len();
-        if self.steady {
-            let every = (1.0 / fraction).round().max(2.0) as usize;
-            for (k, f) in self.fit.iter_mut().enumerate() {
-                *f = k % every != every / 2;
-            }
-        } else {
-            let cut = ((1.0 - fraction) * n as f64).round() as usize;
-            for (k, f) in self.fit.iter_mut().enumerate() {
-                *f = k < cut;
-            }
-        }
+/// The rows `--holdout FRACTION` holds out of a table of `rows` rows: the
+/// last fraction of a time series, or every k-th point of a steady curve
+/// (k = round(1/fraction), interleaved so both ends stay in the fit).
+pub fn held_out_rows(rows: usize, steady: bool, fraction: f64) -> Vec<bool> {
+    if fraction <= 0.0 {
+        return vec![false; rows];
+    }
+    if steady {
+        let every = (1.0 / fraction).round().max(2.0) as usize;
+        (0..rows).map(|k| k % every == every / 2).collect()
+    } else {
+        let cut = ((1.0 - fraction) * rows as f64).round() as usize;
+        (0..rows).map(|k| k >= cut).collect()
     }
 }
 
@@ -293,6 +289,31 @@ impl Source {
     /// The source's name (its file).
     pub fn name(&self) -> &str {
         &self.name
+    }
+
+    /// `--holdout FRACTION`: the table cut in two before anything reads it,
+    /// the training rows and the held-out rows ([`held_out_rows`]), each a
+    /// source of its own with `mapping` (a `ddt()` is taken within each
+    /// part). The held-out part is named `NAME (held out)`.
+    pub fn split_held_out(
+        &self,
+        fraction: f64,
+        mapping: &Mapping,
+    ) -> Result<(Source, Source), FitError> {
+        let held = held_out_rows(self.table.rows(), self.steady, fraction);
+        let part = |keep_held: bool, label: &str| -> Result<Source, FitError> {
+            let keep: Vec<bool> = held.iter().map(|h| *h == keep_held).collect();
+            let table = self.table.select_rows(&keep);
+            let mut s = Source::new(table, mapping).map_err(|e| FitError::Data {
+                what: format!("{} ({label}, --holdout {fraction})", self.name),
+                message: e.to_string(),
+            })?;
+            if keep_held {
+                s.name = format!("{} (held out)", self.name);
+            }
+            Ok(s)
+        };
+        Ok((part(false, "training part")?, part(true, "held-out part")?))
     }
 
     /// The columns its expressions read.

@@ -20,7 +20,7 @@ use rayon::prelude::*;
 pub const CORRELATION_FLAG: f64 = 0.95;
 
 /// Statistics of a fit at its best point.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct Statistics {
     /// Standard error of each parameter (its own unit).
     pub standard_error: Vec<f64>,

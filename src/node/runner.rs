@@ -8,7 +8,7 @@ use crate::link::FilmProfileSlot;
 use crate::link::LiveStatus;
 use crate::transport::{self, BackendSpec, NodePort, TransportError};
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
 
@@ -71,8 +71,11 @@ pub struct RunReport {
     pub rss_bytes: Option<u64>,
     /// Peak resident memory, bytes.
     pub peak_rss_bytes: Option<u64>,
-    /// Whether a signal ended the run.
+    /// Whether a signal (or the stop flag) ended the run.
     pub interrupted: bool,
+    /// The signal that ended it (SIGINT 2, SIGTERM 15): the command exits
+    /// with 128 + its number once the recording is finalised.
+    pub signal: Option<i32>,
 }
 
 /// How the recording went.
@@ -528,6 +531,11 @@ pub fn run_node(
     announce_start(config, &report.transports);
     report.summary = l.run(&stop, duration);
     report.interrupted = stop.load(Ordering::Relaxed);
+    report.signal = match last_signal().load(Ordering::Relaxed) {
+        0 => None,
+        n => i32::try_from(n).ok(),
+    }
+    .filter(|_| report.interrupted);
     report.demo = helpers.stop();
     drop(l);
     #[cfg(feature = "mcap")]
@@ -539,11 +547,25 @@ pub fn run_node(
     Ok(report)
 }
 
-/// Install SIGINT/SIGTERM handlers that set the returned flag.
+/// The number of the last SIGINT/SIGTERM the handlers of
+/// [`stop_on_signals`] saw (0: none).
+fn last_signal() -> &'static Arc<AtomicUsize> {
+    static LAST: std::sync::OnceLock<Arc<AtomicUsize>> = std::sync::OnceLock::new();
+    LAST.get_or_init(|| Arc::new(AtomicUsize::new(0)))
+}
+
+/// Install SIGINT/SIGTERM handlers that set the returned flag (and note
+/// which signal it was, for [`RunReport::signal`]).
 pub fn stop_on_signals() -> Arc<AtomicBool> {
     let stop = Arc::new(AtomicBool::new(false));
     for sig in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
-        if let Err(e) = signal_hook::flag::register(sig, stop.clone()) {
+        // The signal's number first: the loop ends on the flag.
+        let which = signal_hook::flag::register_usize(
+            sig,
+            last_signal().clone(),
+            usize::try_from(sig).unwrap_or(0),
+        );
+        if let Err(e) = which.and_then(|_| signal_hook::flag::register(sig, stop.clone())) {
             tracing::warn!("cannot handle signal {sig}: {e}");
         }
     }

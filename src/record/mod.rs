@@ -83,6 +83,24 @@ pub enum RecorderError {
         /// What is wrong with it.
         message: String,
     },
+    /// A recording's name that is neither an `.mcap` file nor a split
+    /// recording's directory: nothing is written (an existing file of that
+    /// name, a CSV say, is never overwritten with MCAP bytes).
+    #[error("recording {}: a recording is an .mcap file (or, with recording.split.*, a directory of split files); name it NAME.mcap", path.display())]
+    Name {
+        /// The name given.
+        path: PathBuf,
+    },
+}
+
+/// Whether `path` can hold one recording file: a name ending in `.mcap`
+/// (any case), or a device such as `/dev/null`.
+pub fn is_recording_name(path: &Path) -> bool {
+    crate::output::is_special(path)
+        || path
+            .extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| e.eq_ignore_ascii_case("mcap"))
 }
 
 /// A write into a recording failed (the recording stops; what is on disk
@@ -208,6 +226,11 @@ impl Recorder {
         clock: Arc<dyn Clock>,
     ) -> Result<Self, RecorderError> {
         let now = clock.wall_ns();
+        if let Some(p) = &plan.path {
+            if !config.recording.splits() && !is_recording_name(p) {
+                return Err(RecorderError::Name { path: p.clone() });
+            }
+        }
         let out = match &plan.path {
             None => Output::None,
             Some(p) if config.recording.splits() => {

@@ -26,8 +26,11 @@ fn map_samples(
         message,
     };
     crate::expression::check_size(expr).map_err(err)?;
-    let node = evalexpr::build_operator_tree::<DefaultNumericTypes>(expr)
-        .map_err(|e| err(e.to_string()))?;
+    let node = evalexpr::build_operator_tree::<DefaultNumericTypes>(
+        &crate::expression::with_functions(expr),
+    )
+    .map_err(|e| err(e.to_string()))?;
+    crate::expression::check_functions(&node).map_err(err)?;
     if let Some(id) = node.iter_variable_identifiers().find(|id| *id != "x") {
         return Err(err(format!(
             "`{id}` is unknown: the expression reads the topic's value as `x`"

@@ -32,8 +32,57 @@ pub fn gap_list(gaps: &[Silence], t0_ns: u64) -> String {
     s.join(", ")
 }
 
-/// Cycles of a replay: segments between upward crossings of the mean
-/// velocity (with 10 % hysteresis), and their loop metrics.
+/// Hysteresis of the cycle detection, as a fraction of the velocity's
+/// half-range: a swing must reach this far past the mean on both sides to
+/// count as a cycle, so chatter about a reversal (noise, a controller's
+/// limit cycle at standstill) is not one.
+pub const CYCLE_HYSTERESIS: f64 = 0.25;
+
+/// Where the cycles of `velocity` start: at its last upward crossing of
+/// the mean before it rises [`CYCLE_HYSTERESIS`] of its half-range above
+/// the mean, having been as far below it since the last start (a Schmitt
+/// trigger placed on the mean crossing); and at a last upward crossing the
+/// record ends after.
+pub fn cycle_starts(velocity: &[f64]) -> Vec<usize> {
+    let n = velocity.len();
+    if n < 2 {
+        return Vec::new();
+    }
+    let (lo, hi) = velocity
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(*v), b.max(*v))
+        });
+    let mean = velocity.iter().sum::<f64>() / n as f64;
+    let band = CYCLE_HYSTERESIS * 0.5 * (hi - lo);
+    if band.is_nan() || band <= 0.0 {
+        return Vec::new();
+    }
+    let mut starts = Vec::new();
+    let (mut armed, mut last_up) = (velocity[0] < mean - band, None);
+    for k in 1..n {
+        let (a, b) = (velocity[k - 1], velocity[k]);
+        if armed && a < mean && b >= mean {
+            last_up = Some(k);
+        }
+        if armed && b >= mean + band {
+            starts.push(last_up.unwrap_or(k));
+            armed = false;
+        } else if b < mean - band {
+            armed = true;
+            last_up = None;
+        }
+    }
+    // A record that ends just after its last upward crossing (a whole
+    // number of periods) closes its last cycle there.
+    if let (true, Some(k)) = (armed, last_up) {
+        starts.push(k);
+    }
+    starts
+}
+
+/// Cycles of a replay: segments between the starts [`cycle_starts`]
+/// finds, and their loop metrics.
 pub fn cycles(r: &ReplayResult, mass: f64) -> Vec<crate::analysis::LoopMetrics> {
     use crate::analysis::{metrics::one_cycle, LoopSample};
     let e = &r.estimates;
@@ -49,27 +98,8 @@ pub fn cycles(r: &ReplayResult, mass: f64) -> Vec<crate::analysis::LoopMetrics> 
             s
         })
         .collect();
-    let (lo, hi) = samples
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), s| {
-            (a.min(s.velocity), b.max(s.velocity))
-        });
-    let mean = samples.iter().map(|s| s.velocity).sum::<f64>() / samples.len() as f64;
-    let band = 0.1 * 0.5 * (hi - lo);
-    if band <= 0.0 {
-        return Vec::new();
-    }
-    let mut crossings = Vec::new();
-    let mut below = samples[0].velocity < mean;
-    for (k, s) in samples.iter().enumerate() {
-        if below && s.velocity >= mean {
-            crossings.push(k);
-            below = false;
-        } else if s.velocity < mean - band {
-            below = true;
-        }
-    }
-    crossings
+    let velocity: Vec<f64> = samples.iter().map(|s| s.velocity).collect();
+    cycle_starts(&velocity)
         .windows(2)
         .enumerate()
         .filter(|(_, w)| w[1] - w[0] >= 8)
@@ -419,5 +449,36 @@ mod plots {
             time_series(dir, e)?,
             regime_share(dir, e)?,
         ])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn chatter_at_reversals_is_not_counted_as_cycles() {
+        // 5 cycles of a 1 Hz motion at 1 kHz, with a 25 Hz chatter of 20 %
+        // of the amplitude while the motion passes through zero.
+        let v: Vec<f64> = (0..5000)
+            .map(|k| {
+                let t = k as f64 * 1e-3;
+                let s = (2.0 * std::f64::consts::PI * t).sin();
+                let chatter = if s.abs() < 0.2 {
+                    0.2 * (2.0 * std::f64::consts::PI * 25.0 * t).sin()
+                } else {
+                    0.0
+                };
+                s + chatter
+            })
+            .collect();
+        let starts = cycle_starts(&v);
+        // Starts at t = 1, 2, 3, 4 s (the first, at t = 0, is not armed;
+        // the record ends just before t = 5 s, below the mean).
+        assert_eq!(starts.len(), 4, "{starts:?}");
+        for (i, k) in starts.iter().enumerate() {
+            let t = *k as f64 * 1e-3;
+            assert!((t - (i + 1) as f64).abs() < 0.02, "start {i} at {t} s");
+        }
     }
 }

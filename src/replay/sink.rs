@@ -52,9 +52,9 @@ trait Sink: Send {
 struct CsvSink {
     file: crate::output::AtomicFile,
     t0: Option<u64>,
-    /// Several contacts: their names, for the last column (empty: one contact,
-    /// no such column).
-    contacts: Vec<String>,
+    /// Driven by joints: each contact's name, joint and gain, for the last
+    /// columns (empty: one contact, no such columns).
+    contacts: Vec<(String, String, f64)>,
 }
 
 impl Sink for CsvSink {
@@ -68,8 +68,14 @@ impl Sink for CsvSink {
                 msgs::status_name(rec.status),
                 rec.temperature_c,
             );
+            // A joint's row also holds the joint's velocity and effort, in
+            // the joint's units: ω = v / gain, τ = gain · F.
             let contact = match self.contacts.get(usize::from(*k)) {
-                Some(name) => format!(",{name}"),
+                Some((name, joint, gain)) => format!(
+                    ",{name},{joint},{},{}",
+                    crate::text::Num(e.velocity / gain),
+                    crate::text::Num(gain * e.friction_force)
+                ),
                 None => String::new(),
             };
             self.file.line(format_args!(
@@ -197,23 +203,37 @@ pub struct OutputStream {
 
 const BATCH: usize = 1024;
 
+/// The last columns of a replay driven by joints: the contact, its joint,
+/// and the joint's velocity (v / gain) and effort (gain · friction), in the
+/// joint's units (rad/s and N·m for a revolute joint, as `fit --rotary`
+/// writes it; m/s and N for a prismatic one).
+pub const JOINT_COLUMNS: &str = ",contact,joint,joint_velocity,joint_effort";
+
 /// The writer thread hands its sink back with the first write error.
 type SinkOutcome = (Box<dyn Sink>, Result<(), ReplayError>);
 
 impl CsvSink {
-    /// The CSV file at `path` with its header (a contact column with
-    /// joints).
+    /// The CSV file at `path` with its header (driven by joints: the
+    /// contact, its joint, and the joint's velocity and effort).
     fn create(path: &Path, p: &PreparedReplay) -> Result<Self, ReplayError> {
         let mut file = crate::output::AtomicFile::create(path)?;
-        let contacts: Vec<String> = if p.config.output_plan().by_joint() {
-            p.config.contacts.0.iter().map(|c| c.name.clone()).collect()
+        let contacts: Vec<(String, String, f64)> = if p.config.output_plan().by_joint() {
+            p.config
+                .resolved_contacts()
+                .into_iter()
+                .map(|c| (c.name, c.joint, c.gain))
+                .collect()
         } else {
             Vec::new()
         };
         file.line(format_args!(
             "{},stamp_ns,command_status{}",
             crate::offline::SIMULATE_COLUMNS,
-            if contacts.is_empty() { "" } else { ",contact" }
+            if contacts.is_empty() {
+                ""
+            } else {
+                JOINT_COLUMNS
+            }
         ))?;
         Ok(CsvSink {
             file,

@@ -43,6 +43,7 @@ fn outcome_dict<'py>(py: Python<'py>, o: &FitOutcome) -> PyResult<Bound<'py, PyD
         Ok(out)
     };
     d.set_item("series", series(&o.train)?)?;
+    d.set_item("held_out_series", series(&o.held_out)?)?;
     d.set_item("validate_series", series(&o.validate)?)?;
     d.set_item("train_rms_n", o.train_rms)?;
     d.set_item("train_max_n", o.train_max)?;
