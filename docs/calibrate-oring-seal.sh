@@ -3,7 +3,7 @@
 # 3 bar, predict 5 and 7 bar, and compare with the classic models fitted on
 # the same data with the same optimiser.
 #
-# Data: ../shared/data/oring-seal (CC0; its README gives the columns and the
+# Data: data/oring-seal (CC0; its README gives the columns and the
 # provenance). Whitespace-separated, no header, 100 Hz:
 #   t_ms laser_v p_raw_v f_raw_v x_mm p_bar force_n
 #
@@ -27,7 +27,7 @@
 # report with plots (summary.md, fit.csv, SVGs per model).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-DATA=${ORING_DATA:-../shared/data/oring-seal}
+DATA=${ORING_DATA:-data/oring-seal}
 OUT=${1:-out/oring-seal}
 rm -rf "$OUT"
 mkdir -p "$OUT"

@@ -10,9 +10,9 @@
 //! `SPIN_US=N` in the environment busy-waits the last N µs before each
 //! deadline, as the node's `node.timer_spin_us` does (≥ 1000: never sleep).
 //! Every
-//! contact follows v = sin 2π(t + i/8) m/s under its own load. Run
-//! `../shared/tools/timer-baseline SECONDS` in the same minute to read the
-//! misses.
+//! contact follows v = sin 2π(t + i/8) m/s under its own load. Run the
+//! empty 1 kHz loop, `cargo run --release --example timer_baseline --
+//! SECONDS`, in the same minute to read the misses.
 
 use friction_node::clock::{Clock, SystemClock};
 use friction_node::config::{Config, Origin, RealtimeConfig};

@@ -1,5 +1,5 @@
 //! Method of manufactured solutions for the transient Reynolds equation with
-//! the mixture equation of state (MODEL.md §9).
+//! the mixture equation of state (docs/model.md §10).
 //!
 //! A pressure p(x,t), gap h0(t) and velocity v(t) are chosen; the residual of
 //! ∂t(ρh) + ∂x q = S is added as a mass source, and the discrete solution is

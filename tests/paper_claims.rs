@@ -1,7 +1,7 @@
-//! The paper's claims (MODEL.md §8, 1–9) on settings fast enough for CI:
+//! The paper's claims (docs/model.md §9, 1–9) on settings fast enough for CI:
 //! N = 64 cells (the paper: 256), 1 ms steps, 3 cycles per case, the last
 //! analysed. At N = 64, 128 and 256 the verdicts are the same (see
-//! docs/paper-reproduction.md). Each test asserts the checks MODEL.md says an
+//! docs/paper-reproduction.md). Each test asserts the checks docs/model.md says an
 //! implementation reproduces, the numbers behind them, and the differences it
 //! predicts.
 
@@ -106,7 +106,7 @@ fn claim2_loops_grow_with_amplitude_and_frequency_and_acceleration_lies_above_de
         area(s, "v1-1_f-4"),
     );
     assert!(a4 > 2.0 * a1 && a1 > 2.0 * a025, "{a025} {a1} {a4}");
-    // MODEL.md: at V1 = 0.1 m/s the area need not grow from 1 to 4 Hz (it shrinks here).
+    // docs/model.md: at V1 = 0.1 m/s the area need not grow from 1 to 4 Hz (it shrinks here).
     assert!(area(s, "v1-0.1_f-4") < area(s, "v1-0.1_f-1"));
     // The decelerating branch and film sit on the steady side except at small
     // amplitude or high frequency, where the whole loop stays above it.
@@ -131,7 +131,7 @@ fn claim3_cof_at_zero_velocity_stays_near_boundary_friction_and_falls_with_frequ
             m.cof_v0_accelerating.unwrap(),
             m.cof_v0_decelerating.unwrap(),
         ] {
-            // Non-zero, and never more than 1 % above μ_bl (MODEL.md: the
+            // Non-zero, and never more than 1 % above μ_bl (docs/model.md: the
             // negative gauge pressure of the vapour pocket allows ~1 %).
             assert!(v > 0.5 * MU_BL && v < 1.01 * MU_BL, "{}: {v}", r.case.id);
         }
@@ -151,7 +151,7 @@ fn claim4_mean_friction_rises_and_loops_shrink_with_load() {
 fn claim5_mean_friction_falls_with_viscosity() {
     let c = claims::claim5(&results(&[StudyKind::Viscosity]));
     assert_eq!(c.verdict(), Verdict::Reproduced, "{c:#?}");
-    // MODEL.md: loops grow with frequency at every viscosity (the paper says
+    // docs/model.md: loops grow with frequency at every viscosity (the paper says
     // they shrink at high viscosity).
     let s = study(StudyKind::Viscosity);
     for mu in ["0.056", "0.103", "0.143"] {
@@ -176,7 +176,7 @@ fn claim6_inertia_is_negligible_and_proportional_to_mass_and_its_smooth_part_to_
             "smooth_part_scales_with_frequency_squared",
         ],
     );
-    // MODEL.md: the raw maximum sits on the collapse spike and does not scale as f².
+    // docs/model.md: the raw maximum sits on the collapse spike and does not scale as f².
     assert!(!passes(&c, "raw_maximum_scales_with_frequency_squared"));
     let s = study(StudyKind::Inertia);
     let m = s.metrics("m-1_f-1").unwrap();
@@ -198,7 +198,7 @@ fn claim7_unidirectional_loops_are_centred_on_the_steady_curve_and_largest_in_mi
 fn claim8_roughness_raises_cof_shrinks_loops_and_moves_the_load_to_the_asperities() {
     let c = claims::claim8(&results(&[StudyKind::Roughness]));
     assert_eq!(c.verdict(), Verdict::Reproduced, "{c:#?}");
-    // MODEL.md: at V0 = 0.25 m/s the fluid does not carry 75 % at σ = 2.5 µm.
+    // docs/model.md: at V0 = 0.25 m/s the fluid does not carry 75 % at σ = 2.5 µm.
     let s = study(StudyKind::Roughness);
     let m = s.metrics("v0-0.25_sigma-2.5_f-1").unwrap();
     assert!(m.mean_fluid_share < 0.75, "{}", m.mean_fluid_share);

@@ -1,4 +1,4 @@
-//! Cross-checks between solvers and the inertia claims of MODEL.md §8.
+//! Cross-checks between solvers and the inertia claims of docs/model.md §9.
 
 use approx::assert_relative_eq;
 use friction_node::analysis::{cycle_metrics, LoopSample};
@@ -95,7 +95,7 @@ fn inertia_share_is_proportional_to_mass() {
 #[test]
 fn smooth_inertia_share_scales_with_frequency_squared() {
     // The smooth part (6 harmonics of h0 over the cycle) scales as f²; the raw
-    // maximum sits on the vapour-pocket collapse spike and does not (MODEL.md §8).
+    // maximum sits on the vapour-pocket collapse spike and does not (docs/model.md §9).
     let f = [0.5, 1.0, 2.0];
     let m: Vec<(f64, f64)> = f.iter().map(|&f| reciprocating(1.0, f, 64, 3)).collect();
     let slope = |a: f64, b: f64, fa: f64, fb: f64| (b / a).ln() / (fb / fa).ln();

@@ -1,5 +1,5 @@
 //! Verification of the physics core against closed-form solutions
-//! (MODEL.md §9). Each test is named as the claim it checks.
+//! (docs/model.md §10). Each test is named as the claim it checks.
 //!
 //! Where a closed form assumes an incompressible liquid, the vapour fraction
 //! at the saturation pressure is set to 1e-9 (the default 0.01 puts 1 %
@@ -176,7 +176,7 @@ fn steady_load_balance_closes_to_the_external_load() {
 
 #[test]
 fn cold_steady_start_at_high_speed_converges_by_continuation() {
-    // MODEL.md §7: plain Newton from p_amb and the GW gap stalls at v ≳ 4 m/s.
+    // docs/model.md §7: plain Newton from p_amb and the GW gap stalls at v ≳ 4 m/s.
     for v in [4.5, -5.0] {
         let mut s = Solver::new(&ModelParams::default(), &settings(256)).unwrap();
         let e = s.steady(v, 20_762.0);
@@ -358,7 +358,7 @@ fn a_failed_full_step_is_retried_from_the_last_state_and_then_sub_stepped() {
 /// The accuracy guide's claim (`bench-accuracy`) for `solver.flux: upwind`:
 /// on the paper's reciprocating case the friction loop area converges at
 /// first order in the grid (cavitation makes the upwind scheme first order,
-/// MODEL.md), so halving Δx halves its error, while the mean COF is already
+/// docs/model.md), so halving Δx halves its error, while the mean COF is already
 /// within 0.5 % at N = 32.
 #[test]
 fn the_loop_area_converges_at_first_order_in_the_grid_with_the_upwind_flux() {

@@ -19,7 +19,7 @@ from scipy.optimize import least_squares
 import friction_node as fn
 
 REPO = Path(__file__).resolve().parents[2]
-SEAL = REPO.parent / "shared" / "data" / "oring-seal"
+SEAL = REPO / "data" / "oring-seal"
 
 
 def _levels(form, names, x, load):

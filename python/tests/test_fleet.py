@@ -1,6 +1,7 @@
 """Fleet replay and calibration on a two-worker local Dask cluster."""
 
 import os
+import shutil
 import subprocess
 import sys
 
@@ -61,11 +62,19 @@ def test_a_glob_that_matches_nothing_is_an_error_naming_it(tmp_path):
 
 
 def test_a_glob_keeps_rosbag2_directories_as_one_bag_each(repo, tmp_path):
-    # The shipped bags: two MCAP files and a rosbag2 directory of MCAP files.
-    got = fleet.expand(str(repo / "bags" / "**" / "*.mcap"))
+    # The shipped fixture bags, copied by name (whatever else lies in bags/,
+    # a demo recording say, is not the test's): two MCAP files, a rosbag2
+    # directory of MCAP files and one of SQLite files.
+    shipped = tmp_path / "shipped"
+    shipped.mkdir()
+    for name in ("foreign_joint_states.mcap", "node_lockstep.mcap"):
+        shutil.copy(repo / "bags" / name, shipped / name)
+    for name in ("rosbags_mcap", "rosbags_sqlite3"):
+        shutil.copytree(repo / "bags" / name, shipped / name)
+    got = fleet.expand(str(shipped / "**" / "*.mcap"))
     assert got == sorted(
-        [str(repo / "bags" / "foreign_joint_states.mcap"), str(repo / "bags" / "node_lockstep.mcap"),
-         str(repo / "bags" / "rosbags_mcap")]
+        [str(shipped / "foreign_joint_states.mcap"), str(shipped / "node_lockstep.mcap"),
+         str(shipped / "rosbags_mcap")]
     )
     # A tree holding only split recordings: each directory once, however
     # many files it holds; a directory without metadata.yaml is no bag.

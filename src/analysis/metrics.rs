@@ -1,4 +1,4 @@
-//! Hysteresis-loop metrics per motion cycle (MODEL.md §8).
+//! Hysteresis-loop metrics per motion cycle (docs/model.md §9).
 //!
 //! | metric | definition | unit |
 //! |---|---|---|

@@ -2,7 +2,7 @@
 //!
 //! | file | job |
 //! |---|---|
-//! | `metrics.rs` | hysteresis-loop metrics per motion cycle (MODEL.md §8) |
+//! | `metrics.rs` | hysteresis-loop metrics per motion cycle (docs/model.md §9) |
 
 pub mod metrics;
 

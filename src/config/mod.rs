@@ -9,7 +9,7 @@
 //! ```
 //!
 //! Every key carries its SI unit in its name. Every default equals the
-//! paper's Tables A2–A4 and `MODEL.md` (they are taken from the physics
+//! paper's Tables A2–A4 and `docs/model.md` (they are taken from the physics
 //! core's `Default` impls, so there is one source of truth).
 //! `launch-config/default.yaml` documents every key; it is embedded in the
 //! binary and used when no `--config` is given.

@@ -63,7 +63,7 @@ pub enum ProfileKind {
 }
 
 /// The paper's load for the reciprocating studies (Table A4 says 5 kN, the
-/// figures use the text's 20 762 N; MODEL.md §8 decides for the text).
+/// figures use the text's 20 762 N; docs/model.md §9 decides for the text).
 pub const DEFAULT_LOAD_N: f64 = 20_762.0;
 
 impl Default for ContactConfig {

@@ -1,4 +1,4 @@
-//! Homogeneous-mixture cavitation equation of state (MODEL.md §3).
+//! Homogeneous-mixture cavitation equation of state (docs/model.md §3).
 //!
 //! ```text
 //! α(p) = ½ [1 − tanh(β (p − p0))]

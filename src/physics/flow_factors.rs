@@ -1,4 +1,4 @@
-//! Patir–Cheng average-flow factors (MODEL.md §2, paper Table A1).
+//! Patir–Cheng average-flow factors (docs/model.md §2, paper Table A1).
 //!
 //! ```text
 //! pressure:  φx = 1 − C e^(−r H)   (γ ≤ 1)      φx = 1 + C H^(−r)   (γ > 1)

@@ -1,4 +1,4 @@
-//! Finite-volume grid and the film-thickness shape (MODEL.md §1).
+//! Finite-volume grid and the film-thickness shape (docs/model.md §1).
 //!
 //! ```text
 //! h(x,t) = h0(t) + hg(x) + ht(x)

@@ -1,4 +1,4 @@
-//! Greenwood–Williamson asperity contact (MODEL.md §4).
+//! Greenwood–Williamson asperity contact (docs/model.md §4).
 //!
 //! ```text
 //! F_n(Λ) = ∫_Λ^∞ (s − Λ)^n φ(s) ds ,   φ(s) = e^(−s²/2) / √(2π)

@@ -1,5 +1,5 @@
 //! The physics core: the transient mixed-lubrication model of Driesen et al.
-//! 2023 as specified in `MODEL.md`, advanced in fixed steps.
+//! 2023 as specified in `docs/model.md`, advanced in fixed steps.
 //!
 //! This module has no middleware, file, clock or logging dependency; it builds
 //! and tests with `--no-default-features`. Everything is SI (m, s, N, Pa,

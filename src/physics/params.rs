@@ -2,7 +2,7 @@
 //! numerical settings are in [`super::settings`].
 //!
 //! All quantities are SI. Defaults are the paper's Tables A2–A4 with the
-//! decisions of `MODEL.md` (parabolic slider of depth 25.4 µm, text loads,
+//! decisions of `docs/model.md` (parabolic slider of depth 25.4 µm, text loads,
 //! BDF2). The configuration layer (`crate::config`) maps its unit-suffixed
 //! keys onto these structs and takes its defaults from here.
 //!
@@ -90,7 +90,7 @@ impl Default for Geometry {
     }
 }
 
-/// Lubricant and its cavitation equation of state (MODEL.md §3).
+/// Lubricant and its cavitation equation of state (docs/model.md §3).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Lubricant {
     /// μl, liquid viscosity, Pa·s.

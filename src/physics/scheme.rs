@@ -1,4 +1,4 @@
-//! Three-level θ time discretisation (MODEL.md §6, Zienkiewicz).
+//! Three-level θ time discretisation (docs/model.md §6, Zienkiewicz).
 //!
 //! ```text
 //! u'  ≈ [ (θ1+½) uⁿ − 2θ1 uⁿ⁻¹ + (θ1−½) uⁿ⁻² ] / Δt

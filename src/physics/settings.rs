@@ -1,7 +1,7 @@
 //! Numerical settings of the solver (in-memory core types): the method,
 //! the time scheme, the grid, tolerances, the Couette flux and its
 //! limiter, and the reference (Picard) solver's relaxation. The physical
-//! parameters are in [`super::params`]. Defaults follow `MODEL.md` (coupled
+//! parameters are in [`super::params`]. Defaults follow `docs/model.md` (coupled
 //! Newton, BDF2).
 
 use super::error::SetupError;
@@ -10,14 +10,14 @@ use super::params::positive;
 /// Which algorithm advances the model.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Method {
-    /// Coupled Newton on (p, h0) with a bordered tridiagonal solve (MODEL.md §7).
+    /// Coupled Newton on (p, h0) with a bordered tridiagonal solve (docs/model.md §7).
     #[default]
     Newton,
     /// The paper's Algorithm 1: under-relaxed Picard inside a secant loop on h0.
     Reference,
 }
 
-/// Time discretisation: the three-level θ family (MODEL.md §6).
+/// Time discretisation: the three-level θ family (docs/model.md §6).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum TimeScheme {
     /// (θ1, θ2) = (1, 1).

@@ -1,4 +1,4 @@
-//! The cases of each study: MODEL.md §8's table, one function per study.
+//! The cases of each study: docs/model.md §9's table, one function per study.
 
 use super::{fmt_g, steady_key, with, Case, Motion, StudyKind, StudyOptions, FREQUENCIES};
 use crate::config::Config;

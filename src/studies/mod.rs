@@ -1,4 +1,4 @@
-//! The paper's parametric studies (MODEL.md §8) as data and computation.
+//! The paper's parametric studies (docs/model.md §9) as data and computation.
 //!
 //! A study is a list of [`Case`]s (a resolved configuration and a sinusoidal
 //! motion v = V0 + V1 sin 2πft) plus the steady Stribeck curves that are
@@ -7,17 +7,17 @@
 //! on the results. The computation does no I/O; [`report`] writes the CSVs,
 //! plots and the claims page for the `study` command.
 //!
-//! Where MODEL.md's study table is silent this module decides, and says so:
+//! Where docs/model.md's study table is silent this module decides, and says so:
 //! the load, viscosity and inertia studies use V1 = 1 m/s (Table A4 lists
 //! 0.25 and 1); the unidirectional study runs at 5 762 N (Table A3 says 5 kN,
 //! the text gives no load) with V0 extended to 1, 2, 3 m/s so that the loops
-//! reach full film; the roughness study runs at V0 = 1 m/s (where MODEL.md
+//! reach full film; the roughness study runs at V0 = 1 m/s (where docs/model.md
 //! says the σ = 2.5 µm fluid-share claim holds) and also at V0 = 0.25 m/s;
 //! the Hersey study is two groups of four loops with equal μ·V1/F.
 //!
 //! | file | job |
 //! |---|---|
-//! | `cases.rs` | the cases of each study (MODEL.md §8), one function per study |
+//! | `cases.rs` | the cases of each study (docs/model.md §9), one function per study |
 //! | `run.rs` | steady curves, one case's transient run and its analysed cycle |
 //! | `report.rs` | per-case CSVs, steady curves, figures and the claims' report |
 //! | `claims/` | the paper's claims 1–9 evaluated on the results |
@@ -30,7 +30,7 @@ use crate::analysis::{cycle_metrics, LoopMetrics, LoopSample};
 use crate::config::Config;
 use crate::physics::{Estimate, Solver, Status};
 
-/// The studies of MODEL.md §8.
+/// The studies of docs/model.md §9.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum StudyKind {
     /// Steady Stribeck curves (Fig. 4).

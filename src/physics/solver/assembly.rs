@@ -1,4 +1,4 @@
-//! Residual and Jacobian of one Newton iterate (MODEL.md §2–§5, finite volumes).
+//! Residual and Jacobian of one Newton iterate (docs/model.md §2–§5, finite volumes).
 //!
 //! Three passes over the cells: mixture properties of each cell (in
 //! `cell_pass.rs`), the mass flux through each face with its derivatives,

@@ -1,6 +1,6 @@
 //! Pass 1 of the assembly: the mixture properties of every cell at the
 //! current iterate (density, ρ/μ, viscosity and their derivatives in p),
-//! from the mixture EOS (`crate::physics::eos`, MODEL.md §2).
+//! from the mixture EOS (`crate::physics::eos`, docs/model.md §2).
 
 use super::work::{CellColumns, Work};
 use super::Disc;

@@ -1,5 +1,5 @@
 //! The second-order (MUSCL) Couette flux: the face density is the upwind
-//! cell's plus half its limited slope (MODEL.md §4 upwinds the density; this
+//! cell's plus half its limited slope (docs/model.md §2 upwinds the density; this
 //! is the `solver.flux: muscl_…` option: `muscl_minmod`, `muscl_van_leer`, `muscl_van_albada`).
 //!
 //! | symbol | meaning | unit |

@@ -1,6 +1,6 @@
 //! The coupled solver: transient Reynolds + mixture EOS + GW + load balance.
 //!
-//! ## Equations (MODEL.md §2, §5)
+//! ## Equations (docs/model.md §2, §5)
 //!
 //! ```text
 //! ∂x( φx ρ h³/(12 μ) ∂x p ) = (v/2) ∂x(ρ h) + (v/2) σ ∂x(ρ φs) + ∂t(ρ h)

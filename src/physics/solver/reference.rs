@@ -1,4 +1,4 @@
-//! The paper's reference algorithm (Algorithm 1, MODEL.md §7).
+//! The paper's reference algorithm (Algorithm 1, docs/model.md §7).
 //!
 //! For each step, an under-relaxed secant iteration on h0 drives the load
 //! residual `ΔF = Σ w_k (F_hyd + F_asp − F_ext)^(n−k) − m h0''` to zero. For

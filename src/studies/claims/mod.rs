@@ -1,7 +1,7 @@
-//! The paper's claims (MODEL.md §8, 1–9), evaluated on study results.
+//! The paper's claims (docs/model.md §9, 1–9), evaluated on study results.
 //!
 //! Each claim is a list of named checks with the numbers behind them; the
-//! verdict is computed from the checks, never set by hand. Where MODEL.md
+//! verdict is computed from the checks, never set by hand. Where docs/model.md
 //! expects our model to differ from the paper, the paper's statement is still
 //! a check (and is allowed to fail); the difference is explained in
 //! `docs/paper-reproduction.md`.
@@ -51,10 +51,10 @@ impl Verdict {
     }
 }
 
-/// A claim of MODEL.md §8 with its checks.
+/// A claim of docs/model.md §9 with its checks.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Claim {
-    /// The claim's number in MODEL.md §8.
+    /// The claim's number in docs/model.md §9.
     pub number: u8,
     /// The claim.
     pub statement: &'static str,
