@@ -10,11 +10,11 @@ use common::cli::run;
 use friction_node::config::Config;
 use friction_node::fit::driver::{fit, FitOutcome};
 use friction_node::fit::options::Options;
-use friction_node::fit::params::DataScale;
 use friction_node::fit::problem::Model;
 use friction_node::fit::synthetic::{
     gaussian, model_friction, noisy_csv, two_amplitudes_two_loads,
 };
+use friction_node::fit::unknowns::DataScale;
 use friction_node::fit::{
     Baseline, BaselineKind, Data, Delimiter, LoadForm, Mapping, ParamSpec, PhysicsModel, Source,
     Table,
@@ -729,7 +729,7 @@ fn the_oring_seal_is_calibrated_at_1_and_3_bar_through_mapped_inputs_and_predict
 
 #[test]
 fn secant_jacobians_reach_the_optimum_of_finite_differences_with_fewer_simulations() {
-    use friction_node::fit::local_run::JacobianRule;
+    use friction_node::fit::options::JacobianRule;
     let mut truth = coarse();
     truth.roughness.sigma_m = 3.5e-6;
     truth.contact.boundary_friction = 0.22;

@@ -162,3 +162,78 @@ fn every_module_file_has_its_line_in_its_parents_file_table() {
     assert!(checked >= 20, "only {checked} parent modules found");
     assert!(problems.is_empty(), "{}", problems.join("\n"));
 }
+
+/// The files of `fit/` named by `super::NAME` / `crate::fit::NAME` in
+/// `text` (its code before its test module, comments dropped), including
+/// those of grouped imports (`use super::{a::X, b};`).
+fn sibling_uses(text: &str, siblings: &BTreeSet<String>) -> BTreeSet<String> {
+    let code = text.split("#[cfg(test)]\nmod tests").next().unwrap_or(text);
+    let code: String = code
+        .lines()
+        .map(|l| l.split("//").next().unwrap_or(""))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let mut out = BTreeSet::new();
+    let mut add = |name: &str| {
+        let name = name.trim_matches(|c: char| !c.is_alphanumeric() && c != '_');
+        if siblings.contains(name) {
+            out.insert(name.to_string());
+        }
+    };
+    for prefix in ["super::", "crate::fit::"] {
+        for (at, _) in code.match_indices(prefix) {
+            let rest = &code[at + prefix.len()..];
+            if let Some(group) = rest.strip_prefix('{') {
+                for item in group[..group.find('}').unwrap_or(0)].split(',') {
+                    add(item.trim().split("::").next().unwrap_or(""));
+                }
+            } else {
+                let name: String = rest
+                    .chars()
+                    .take_while(|c| c.is_alphanumeric() || *c == '_')
+                    .collect();
+                // A sibling module only if a path goes on from it.
+                if rest[name.len()..].starts_with("::") {
+                    add(&name);
+                }
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn the_calibration_reads_top_down_every_file_using_only_files_below_it() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/fit");
+    let map = std::fs::read_to_string(dir.join("mod.rs")).unwrap();
+    // The file table's order is the reading order.
+    let order: Vec<String> = map
+        .lines()
+        .filter_map(|l| l.strip_prefix("//! | `"))
+        .filter_map(|l| l.split('`').next())
+        .filter_map(|f| f.strip_suffix(".rs"))
+        .map(str::to_string)
+        .collect();
+    let siblings: BTreeSet<String> = order.iter().cloned().collect();
+    assert!(order.len() > 20, "{order:?}");
+    assert_eq!(order[0], "request", "the flow comes first");
+    // Shared by every file: the errors and the units.
+    let everywhere = ["error", "units"];
+    let mut edges = 0;
+    let mut up = Vec::new();
+    for (i, f) in order.iter().enumerate() {
+        let text = std::fs::read_to_string(dir.join(format!("{f}.rs"))).unwrap();
+        for used in sibling_uses(&text, &siblings) {
+            if used == *f || everywhere.contains(&used.as_str()) {
+                continue;
+            }
+            edges += 1;
+            let j = order.iter().position(|o| *o == used).unwrap();
+            if j < i {
+                up.push(format!("{f}.rs uses {used}.rs, above it"));
+            }
+        }
+    }
+    assert!(edges > 40, "{edges} uses found: the scan reads nothing");
+    assert!(up.is_empty(), "{}", up.join("\n"));
+}

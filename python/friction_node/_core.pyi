@@ -106,4 +106,5 @@ def fit(
     out: Optional[str] = None,
     report_dir: Optional[str] = None,
     progress: bool = False,
+    rotary: bool = False,
 ) -> Dict[str, Any]: ...

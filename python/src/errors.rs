@@ -43,6 +43,7 @@ pub fn fit(e: FitError) -> PyErr {
         FitError::Io { ref cause, .. } => io(cause, e.to_string()),
         FitError::Bag(b) => bag(b),
         FitError::Config(c) => config(c),
+        FitError::Output(_) => PyOSError::new_err(e.to_string()),
         other => PyValueError::new_err(keywords(&other.to_string())),
     }
 }
@@ -109,10 +110,6 @@ pub fn keywords(message: &str) -> String {
 
 pub fn value(message: impl Into<String>) -> PyErr {
     PyValueError::new_err(message.into())
-}
-
-pub fn os(message: impl Into<String>) -> PyErr {
-    PyOSError::new_err(message.into())
 }
 
 #[cfg(test)]

@@ -12,8 +12,8 @@
 use crate::config::Config;
 use crate::fit::driver::{fit, FitOutcome};
 use crate::fit::options::Options;
+use crate::fit::prepare::data_scale;
 use crate::fit::report::{models_table, ModelRow};
-use crate::fit::request::data_scale;
 use crate::fit::synthetic::{
     model_friction, motion, noisy_csv, two_amplitudes_two_loads, Sample, Segment,
 };
@@ -210,7 +210,7 @@ fn recovery(base: &Config, o: &FitBenchOptions<'_>) -> Result<String, FitBenchEr
 /// `base` with `keys` set to `values` (numeric keys of the configuration).
 fn with(base: &Config, keys: &[&str], values: &[f64]) -> Config {
     let names: Vec<String> = keys.iter().map(|k| k.to_string()).collect();
-    crate::fit::params::ConfigKeys::new(base)
+    crate::fit::unknowns::ConfigKeys::new(base)
         .with(&names, values)
         .expect("the benchmark's truth is a valid configuration")
 }

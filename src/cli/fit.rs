@@ -1,14 +1,12 @@
 //! `fit`: calibrate configuration keys (and input-map coefficients) to
 //! recorded friction; optionally fit the classic models on the same data.
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use friction_node::config::Config;
-use friction_node::fit::local_run::{JacobianRule, LaterRuns};
-use friction_node::fit::report;
-use friction_node::fit::request::{
-    fit_baselines, fit_ours, param_specs, prepare, select_terms, FitRequest, OursFitted,
-    TopicChoice,
-};
+use friction_node::fit::inputs::{DataRequest, TopicChoice};
+use friction_node::fit::options::{JacobianRule, LaterRuns};
+use friction_node::fit::options::{LabelledProgress, SearchSettings};
+use friction_node::fit::request::{param_specs, FitOutputs, FitRequest};
 use friction_node::fit::{Delimiter, Mapping, ParamSpec};
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -264,102 +262,60 @@ impl FitArgs {
             DelimiterArg::Whitespace => Delimiter::Whitespace,
         };
         Ok(FitRequest {
-            data: self.data.clone(),
-            validate: self.validate.clone(),
-            params: self.specs()?,
-            mapping: self.mapping()?,
-            holdout: self.holdout,
-            columns: self.columns.clone(),
-            skip: self.skip,
-            delimiter,
-            topics: TopicChoice {
-                velocity: self.velocity_topic.clone(),
-                friction: self.friction_topic.clone(),
-                joint: self.joint.clone(),
-                load: self.load_topic.clone(),
-                temperature: self.temperature_topic.clone(),
+            data: DataRequest {
+                files: self.data.clone(),
+                validate: self.validate.clone(),
+                holdout: self.holdout,
+                mapping: self.mapping()?,
+                columns: self.columns.clone(),
+                skip: self.skip,
+                delimiter,
+                topics: TopicChoice {
+                    velocity: self.velocity_topic.clone(),
+                    friction: self.friction_topic.clone(),
+                    joint: self.joint.clone(),
+                    load: self.load_topic.clone(),
+                    temperature: self.temperature_topic.clone(),
+                },
+                rotary: self.rotary,
             },
-            starts: self.starts,
-            global_points: self.global_points,
-            seed: self.seed,
-            max_evaluations: self.max_evaluations,
-            jacobian: self.jacobian,
-            later_runs: self.later_runs,
+            params: self.specs()?,
+            search: SearchSettings {
+                starts: self.starts,
+                global_points: self.global_points,
+                seed: self.seed,
+                max_evaluations: self.max_evaluations,
+                jacobian: self.jacobian,
+                later_runs: self.later_runs,
+            },
             baselines: self.baselines,
-            rotary: self.rotary,
-            progress: Some(Arc::new(|label: &str, l: &str| {
-                eprintln!("fit [{label}]: {l}")
-            })),
-            stop: friction_node::interrupt::Stop::process().clone(),
         })
     }
 }
 
-/// Run `fit`; exits with status 4 (after writing) when the fit did not
-/// converge.
+/// Run `fit` (the library's one flow); prints the summary, and exits with
+/// status 4 (after writing) when the fit did not converge.
 pub fn run(config: &Config, args: &FitArgs) -> Result<()> {
     let req = args.request()?;
-    let mut p = prepare(config, &req)?;
-    for n in &p.notes {
-        eprintln!("fit: {n}");
-    }
-    // Outputs are checked before any computation.
-    let out_probe = friction_node::output::AtomicFile::create(&args.out)?;
-    drop(out_probe);
-    // A report folder made here is removed again if the fit fails or is
-    // stopped before anything is written into it.
-    let report_dir = args
-        .report
-        .as_deref()
-        .map(friction_node::output::prepare_output_dir)
-        .transpose()?;
-    let selection = if p.auto {
-        let say = |l: &str| eprintln!("fit: {l}");
-        Some(select_terms(&mut p, &req, &say)?)
-    } else {
-        None
+    let outputs = FitOutputs {
+        fitted: Some(args.out.clone()),
+        report: args.report.clone(),
     };
-    let selection_md = selection.as_ref().map_or(String::new(), |s| {
-        friction_node::fit::auto::report(s, p.data.units)
-    });
-    let n_model = p.model.parameters_len();
-    eprintln!(
-        "fit: {} parameter(s) on {} file(s) ({} validation), {} local run(s), {} global points",
-        n_model + p.map_fit.len(),
-        p.data.train.len(),
-        p.data.validate.len(),
-        args.starts,
-        args.global_points
-    );
-    let OursFitted {
-        outcome: ours,
-        config: fitted_config,
-        map,
-    } = fit_ours(&p, &req).context("the fitted configuration")?;
-    let yaml = report::fitted_yaml(&fitted_config, &ours, &p.names, &map);
-    friction_node::output::write_file(&args.out, yaml.as_bytes())?;
-    // Said at once: a stop during the classic models keeps this file.
-    eprintln!("fit: wrote {} (complete)", args.out.display());
-    println!("{}", report::summary(&ours, &selection_md));
-    let mut extra = selection_md.clone();
-    let mut classic = Vec::new();
-    if args.baselines {
-        let (baselines, skipped) = fit_baselines(&p, &req)?;
-        for s in skipped {
-            eprintln!("fit: {s}");
+    let progress: LabelledProgress = Arc::new(|label: &str, l: &str| {
+        if label == "fit" {
+            eprintln!("fit: {l}");
+        } else {
+            eprintln!("fit [{label}]: {l}");
         }
-        let models = report::models_section(&ours, &baselines);
-        println!("{models}");
-        extra.push_str(&models);
-        classic = baselines;
-    }
-    if let Some(r) = &args.report {
-        let files = report::write_models_report(r, &ours, &classic, &extra)?;
-        eprintln!("fit: report in {} ({} files)", r.display(), files.len());
-    }
-    if let Some(d) = report_dir {
-        d.keep();
-    }
+    });
+    let c = req.run(
+        config,
+        &outputs,
+        Some(&progress),
+        friction_node::interrupt::Stop::process(),
+    )?;
+    println!("{}", c.summary_md());
+    let ours = &c.ours.outcome;
     if !ours.converged {
         eprintln!(
             "fit: NOT converged ({}); {} holds the best point found",

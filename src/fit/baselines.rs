@@ -24,9 +24,9 @@
 //! at its end (ż = v − a z is linear in z), so it is stable for any σ₀;
 //! it starts in its steady state. On a steady curve LuGre is Stribeck.
 
-use super::params::{DataScale, FittedParameter};
 use super::problem::Model;
 use super::series::Series;
+use super::unknowns::{DataScale, FittedParameter};
 use crate::physics::sgn;
 use nalgebra::{DMatrix, DVector};
 
@@ -418,7 +418,7 @@ impl Model for Baseline {
         &self.params
     }
 
-    fn predict(&self, x: &[f64], s: &Series) -> Result<Vec<f64>, String> {
+    fn predict(&self, x: &[f64], s: &Series) -> Result<Vec<f64>, super::PredictError> {
         let n = s.len();
         let load = |k: usize| s.load_at(k, 1.0);
         if self.kind != BaselineKind::LuGre || s.steady {
@@ -438,7 +438,10 @@ impl Model for Baseline {
             let v = s.velocity[k];
             let gv = g(&l, v);
             if gv <= 0.0 {
-                return Err(format!("g(v) = {gv} N ≤ 0 at sample {}", k + 1));
+                return Err(super::PredictError::Domain(format!(
+                    "g(v) = {gv} N ≤ 0 at sample {}",
+                    k + 1
+                )));
             }
             let a = l.sigma0 * v.abs() / gv;
             let dt = if k == 0 { 0.0 } else { s.t[k] - s.t[k - 1] };

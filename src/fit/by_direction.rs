@@ -187,7 +187,7 @@ pub fn source_residuals(
 
 /// A force in significant digits (any scale: N, N·m, mN).
 fn force_cell(v: Option<f64>) -> String {
-    v.map_or("–".into(), super::report::sig)
+    v.map_or("–".into(), |x| crate::text::Num::sig(x, 5).to_string())
 }
 
 fn cell(v: Option<f64>, scale: f64, digits: usize) -> String {

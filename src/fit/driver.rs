@@ -5,8 +5,8 @@
 
 use super::local_run::LocalRun;
 use super::options::Options;
-use super::params::FittedParameter;
 use super::problem::{Data, Model, Problem, Role, SeriesFit};
+use super::unknowns::FittedParameter;
 use std::sync::atomic::Ordering;
 use std::time::Instant;
 
@@ -90,7 +90,7 @@ pub fn fit(
     let wall = Instant::now();
     let mut problem = Problem::new(model, data, map_fit)?;
     problem.stop = options.stop.clone();
-    let optima = super::search::search(&problem, options);
+    let optima = super::multistart::search(&problem, options);
     options.stop.check()?;
     let best = optima[0].clone();
     let (r0, jac) = super::stats::jacobian(&problem, &best.x);
@@ -99,7 +99,7 @@ pub fn fit(
         let blocks = problem.residual_blocks(options.cv_blocks);
         super::stats::block_cv(&r0, &jac, &blocks, options.cv_blocks)
     });
-    let collect = |v: Vec<Result<SeriesFit, String>>| -> Result<Vec<SeriesFit>, super::FitError> {
+    let collect = |v: Vec<Result<SeriesFit, super::PredictError>>| -> Result<Vec<SeriesFit>, super::FitError> {
         v.into_iter()
             .map(|r| {
                 r.map_err(|message| super::FitError::Data {

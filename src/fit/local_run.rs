@@ -36,6 +36,7 @@
 //! `--later-runs full` walks every run to its end. The first run (no
 //! earlier optimum) is the same either way.
 
+use super::options::{JacobianRule, LaterRuns};
 use super::problem::Problem;
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt, TerminationReason};
 use nalgebra::{storage::Owned, DMatrix, DVector, Dyn};
@@ -87,34 +88,6 @@ pub struct Found {
     pub curvature: DMatrix<f64>,
 }
 
-/// How a local run gets its Jacobian.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum JacobianRule {
-    /// Forward differences at every iteration.
-    Differences,
-    /// Broyden's secant update between differences, polished on
-    /// differences at the end.
-    #[default]
-    Secant,
-}
-
-impl JacobianRule {
-    /// The rules by name (the command line's values).
-    pub const NAMES: [(&'static str, JacobianRule); 2] = [
-        ("secant", JacobianRule::Secant),
-        ("differences", JacobianRule::Differences),
-    ];
-
-    /// The rule named `s`.
-    pub fn parse(s: &str) -> Result<Self, String> {
-        Self::NAMES
-            .iter()
-            .find(|(n, _)| *n == s)
-            .map(|(_, r)| *r)
-            .ok_or_else(|| format!("`{s}` is not a Jacobian rule: secant or differences"))
-    }
-}
-
 /// The secant model is kept while the accepted step's actual reduction
 /// of the cost is at least this fraction of the reduction it predicted.
 const SECANT_TRUST: f64 = 0.25;
@@ -134,33 +107,6 @@ pub const VALLEY_POINTS: usize = 4;
 /// A run asks the valley test again once its cost has fallen by this
 /// factor since the last time.
 const VALLEY_RETEST: f64 = 10.0;
-
-/// How the runs after the first end.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum LaterRuns {
-    /// Each stops when a straight line from its point falls all the way
-    /// to an earlier optimum (the valley test), or inside that optimum's
-    /// confidence region.
-    #[default]
-    Valley,
-    /// Each stops only inside an earlier optimum's confidence region.
-    Full,
-}
-
-impl LaterRuns {
-    /// The rules by name (the command line's values).
-    pub const NAMES: [(&'static str, LaterRuns); 2] =
-        [("valley", LaterRuns::Valley), ("full", LaterRuns::Full)];
-
-    /// The rule named `s`.
-    pub fn parse(s: &str) -> Result<Self, String> {
-        Self::NAMES
-            .iter()
-            .find(|(n, _)| *n == s)
-            .map(|(_, r)| *r)
-            .ok_or_else(|| format!("`{s}` is not a rule for later runs: valley or full"))
-    }
-}
 
 /// How a run came to an earlier optimum.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

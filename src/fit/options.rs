@@ -4,6 +4,10 @@
 /// Where progress lines go.
 pub type Progress = Box<dyn Fn(&str) + Sync>;
 
+/// Progress lines with the label of what they are about (the model being
+/// fitted, or `fit` for the calibration's own steps).
+pub type LabelledProgress = std::sync::Arc<dyn Fn(&str, &str) + Send + Sync>;
+
 /// How a fit searches.
 pub struct Options {
     /// Local (LM) runs: the start and the best distinct points of the
@@ -25,9 +29,9 @@ pub struct Options {
     /// points: e.g. a nested model's optimum.
     pub extra_starts: Vec<Vec<f64>>,
     /// How the local runs get their Jacobians.
-    pub jacobian: super::local_run::JacobianRule,
+    pub jacobian: JacobianRule,
     /// How the runs after the first end (the valley test or not).
-    pub later_runs: super::local_run::LaterRuns,
+    pub later_runs: LaterRuns,
     /// Convergence: relative change of the cost, and of the step.
     pub ftol: f64,
     /// See `ftol`.
@@ -62,5 +66,146 @@ impl Options {
         if let Some(p) = &self.progress {
             p(line);
         }
+    }
+}
+
+/// How a calibration searches, as its user asked (the command line's and
+/// Python's settings); each model's fit gets its [`Options`] from these.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SearchSettings {
+    /// Local runs: the start and the best distinct global points.
+    pub starts: usize,
+    /// Points of the global phase (0: none).
+    pub global_points: usize,
+    /// Seed of the global phase.
+    pub seed: u64,
+    /// Residual evaluations per local run.
+    pub max_evaluations: usize,
+    /// How the local runs get their Jacobians.
+    pub jacobian: JacobianRule,
+    /// How the runs after the first end.
+    pub later_runs: LaterRuns,
+}
+
+impl Default for SearchSettings {
+    /// The command line's defaults.
+    fn default() -> Self {
+        Self {
+            starts: 3,
+            global_points: 16,
+            seed: 1,
+            max_evaluations: 200,
+            jacobian: Default::default(),
+            later_runs: Default::default(),
+        }
+    }
+}
+
+impl SearchSettings {
+    /// The ranges the command line enforces.
+    pub fn check(&self) -> Result<(), super::FitError> {
+        use super::error::range_error;
+        if !(1..=100).contains(&self.starts) {
+            return Err(range_error(
+                "--starts",
+                self.starts.to_string(),
+                "in [1, 100]",
+            ));
+        }
+        if self.global_points > 10_000 {
+            return Err(range_error(
+                "--global-points",
+                self.global_points.to_string(),
+                "in [0, 10000]",
+            ));
+        }
+        if !(10..=100_000).contains(&self.max_evaluations) {
+            return Err(range_error(
+                "--max-evaluations",
+                self.max_evaluations.to_string(),
+                "in [10, 100000]",
+            ));
+        }
+        Ok(())
+    }
+
+    /// The options of one model's fit, its progress lines labelled `label`.
+    pub fn options(
+        &self,
+        label: &str,
+        progress: Option<&LabelledProgress>,
+        stop: &crate::interrupt::Stop,
+    ) -> Options {
+        let progress: Option<Progress> = progress.cloned().map(|p| {
+            let label = label.to_string();
+            Box::new(move |l: &str| p(&label, l)) as Progress
+        });
+        Options {
+            starts: self.starts,
+            global_points: self.global_points,
+            seed: self.seed,
+            max_evaluations: self.max_evaluations,
+            progress,
+            stop: stop.clone(),
+            extra_starts: Vec::new(),
+            jacobian: self.jacobian,
+            later_runs: self.later_runs,
+            ..Default::default()
+        }
+    }
+}
+
+/// How a local run gets its Jacobian.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum JacobianRule {
+    /// Forward differences at every iteration.
+    Differences,
+    /// Broyden's secant update between differences, polished on
+    /// differences at the end.
+    #[default]
+    Secant,
+}
+
+impl JacobianRule {
+    /// The rules by name (the command line's values).
+    pub const NAMES: [(&'static str, JacobianRule); 2] = [
+        ("secant", JacobianRule::Secant),
+        ("differences", JacobianRule::Differences),
+    ];
+
+    /// The rule named `s`.
+    pub fn parse(s: &str) -> Result<Self, String> {
+        Self::NAMES
+            .iter()
+            .find(|(n, _)| *n == s)
+            .map(|(_, r)| *r)
+            .ok_or_else(|| format!("`{s}` is not a Jacobian rule: secant or differences"))
+    }
+}
+
+/// How the runs after the first end.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum LaterRuns {
+    /// Each stops when a straight line from its point falls all the way
+    /// to an earlier optimum (the valley test), or inside that optimum's
+    /// confidence region.
+    #[default]
+    Valley,
+    /// Each stops only inside an earlier optimum's confidence region.
+    Full,
+}
+
+impl LaterRuns {
+    /// The rules by name (the command line's values).
+    pub const NAMES: [(&'static str, LaterRuns); 2] =
+        [("valley", LaterRuns::Valley), ("full", LaterRuns::Full)];
+
+    /// The rule named `s`.
+    pub fn parse(s: &str) -> Result<Self, String> {
+        Self::NAMES
+            .iter()
+            .find(|(n, _)| *n == s)
+            .map(|(_, r)| *r)
+            .ok_or_else(|| format!("`{s}` is not a rule for later runs: valley or full"))
     }
 }

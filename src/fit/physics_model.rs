@@ -15,10 +15,10 @@
 //! - A steady curve is solved point by point with the steady solver, each
 //!   point warm-started from the previous one.
 
-use super::params::{ConfigKeys, DataScale, FittedParameter, ParamSpec};
 use super::problem::Model;
 use super::series::Series;
-use super::FitError;
+use super::unknowns::{ConfigKeys, DataScale, FittedParameter, ParamSpec};
+use super::{FitError, PredictError};
 use crate::config::{Config, ViscosityLaw};
 use crate::physics::{Solver, Status, ViscosityModel};
 
@@ -90,8 +90,10 @@ impl Model for PhysicsModel {
         &self.params
     }
 
-    fn predict(&self, x: &[f64], series: &Series) -> Result<Vec<f64>, String> {
-        let config = self.config(x).map_err(|e| e.to_string())?;
+    fn predict(&self, x: &[f64], series: &Series) -> Result<Vec<f64>, PredictError> {
+        let config = self
+            .config(x)
+            .map_err(|e| PredictError::Parameters(e.to_string()))?;
         let run = |s: &Series| {
             if s.steady {
                 steady(&config, s)
@@ -141,8 +143,9 @@ fn follows_temperature(config: &Config, s: &Series) -> bool {
 
 /// The liquid viscosity at `t_c` °C by the configuration's law, or why
 /// these parameters give none there (the rule of every entry point).
-fn viscosity(law: &ViscosityLaw, t_c: f64) -> Result<f64, String> {
-    law.viscosity_at(t_c).map_err(|e| e.to_string())
+fn viscosity(law: &ViscosityLaw, t_c: f64) -> Result<f64, PredictError> {
+    law.viscosity_at(t_c)
+        .map_err(|e| PredictError::Viscosity(e.to_string()))
 }
 
 /// Where a simulated series starts (see the module documentation).
@@ -194,10 +197,11 @@ impl Start {
     }
 }
 
-fn transient(config: &Config, s: &Series) -> Result<Vec<f64>, String> {
+fn transient(config: &Config, s: &Series) -> Result<Vec<f64>, PredictError> {
     let settings = config.solver_settings();
     let dt = settings.dt;
-    let mut solver = Solver::new(&config.model(), &settings).map_err(|e| e.to_string())?;
+    let mut solver =
+        Solver::new(&config.model(), &settings).map_err(|e| PredictError::Solver(e.to_string()))?;
     let n = s.len();
     let start = Start::of(s);
     let t0 = start.t;
@@ -236,11 +240,11 @@ fn transient(config: &Config, s: &Series) -> Result<Vec<f64>, String> {
         if !e.friction_force.is_finite()
             || !matches!(e.status, Status::Converged | Status::MaxIterations)
         {
-            return Err(format!(
-                "the step at t = {t:.4} s ended {} ({} iterations)",
-                e.status.as_str(),
-                e.diagnostics.iterations
-            ));
+            return Err(PredictError::Step {
+                t_s: t,
+                status: e.status.as_str(),
+                iterations: e.diagnostics.iterations,
+            });
         }
         stuck = if e.status == Status::MaxIterations {
             stuck + 1
@@ -248,9 +252,10 @@ fn transient(config: &Config, s: &Series) -> Result<Vec<f64>, String> {
             0
         };
         if stuck >= STUCK_STEPS {
-            return Err(format!(
-                "{STUCK_STEPS} steps in a row up to t = {t:.4} s hit the iteration bound: these parameters cannot follow the inputs (e.g. a load the contact cannot carry)"
-            ));
+            return Err(PredictError::Stuck {
+                steps: STUCK_STEPS,
+                t_s: t,
+            });
         }
         while k < n && s.t[k] <= t + 1e-12 * dt {
             let w = ((s.t[k] - t_prev) / (t - t_prev)).clamp(0.0, 1.0);
@@ -265,9 +270,9 @@ fn transient(config: &Config, s: &Series) -> Result<Vec<f64>, String> {
     Ok(out)
 }
 
-fn steady(config: &Config, s: &Series) -> Result<Vec<f64>, String> {
-    let mut solver =
-        Solver::new(&config.model(), &config.solver_settings()).map_err(|e| e.to_string())?;
+fn steady(config: &Config, s: &Series) -> Result<Vec<f64>, PredictError> {
+    let mut solver = Solver::new(&config.model(), &config.solver_settings())
+        .map_err(|e| PredictError::Solver(e.to_string()))?;
     let follows = follows_temperature(config, s);
     let law = ViscosityLaw::of(config);
     (0..s.len())
@@ -280,11 +285,10 @@ fn steady(config: &Config, s: &Series) -> Result<Vec<f64>, String> {
             if e.status.is_converged() && e.friction_force.is_finite() {
                 Ok(e.friction_force)
             } else {
-                Err(format!(
-                    "the steady state at v = {} m/s did not converge ({})",
-                    s.velocity[k],
-                    e.status.as_str()
-                ))
+                Err(PredictError::Steady {
+                    velocity_m_s: s.velocity[k],
+                    status: e.status.as_str(),
+                })
             }
         })
         .collect()

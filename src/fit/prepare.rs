@@ -1,11 +1,12 @@
-//! Data → our model: read the sources, the data's scales, the fitted
-//! keys and map coefficients (`--fit auto`'s base set, a rotary joint's
-//! lever), everything checked before any simulation; and `--fit auto`'s
-//! choice of keys applied to it. The request itself is `request.rs`.
+//! Data → our model: read the sources (the held-out part cut off first),
+//! the data's scales, the fitted keys and map coefficients, a rotary
+//! joint's lever, everything checked before any simulation. What it makes
+//! is [`Prepared`] (`prepared.rs`).
 
-use super::params::{map_parameter, DataScale};
-use super::request::FitRequest;
-use super::{Data, FitError, FittedParameter, ParamSpec, PhysicsModel, Source};
+use super::inputs::DataRequest;
+use super::prepared::{split_specs, Prepared};
+use super::unknowns::DataScale;
+use super::{Data, FitError, ParamSpec, PhysicsModel, Source};
 use crate::config::Config;
 use std::path::PathBuf;
 
@@ -47,38 +48,6 @@ pub fn data_scale(
     Ok((scale, sum_abs / n.max(1) as f64, lmax > 1.01 * lmin))
 }
 
-/// `--fit` as `auto`, the names given besides it, and the specs our model
-/// starts with (with `auto`: the base key first; the selection chooses the
-/// rest).
-fn auto_specs(params: &[ParamSpec]) -> (bool, Vec<ParamSpec>, Vec<ParamSpec>) {
-    let auto = params.iter().any(|s| s.name == super::auto::AUTO);
-    let given: Vec<ParamSpec> = params
-        .iter()
-        .filter(|s| s.name != super::auto::AUTO)
-        .cloned()
-        .collect();
-    // A bound or start given in case its term is chosen fits nothing yet
-    // (the base key's applies at once: it is always fitted).
-    let mut specs: Vec<ParamSpec> = given
-        .iter()
-        .filter(|s| !s.if_chosen || s.name == super::auto::BASE_KEY)
-        .map(|s| ParamSpec {
-            if_chosen: false,
-            ..s.clone()
-        })
-        .collect();
-    if auto && !specs.iter().any(|s| s.name == super::auto::BASE_KEY) {
-        specs.insert(
-            0,
-            ParamSpec {
-                name: super::auto::BASE_KEY.into(),
-                ..Default::default()
-            },
-        );
-    }
-    (auto, given, specs)
-}
-
 /// The configuration our model runs on, a rotary joint's lever, and the
 /// data's scales as the model sees them (through the lever).
 fn model_setup(
@@ -103,92 +72,6 @@ fn model_setup(
     let load_min = load_range(train, map_values, c.contact.load_n)?.0;
     let contact_scale = scale.through_lever(l.lever_m, load_min);
     Ok((c, Some(l), contact_scale))
-}
-
-/// Data, the physics model's parameters and the fitted map coefficients.
-pub struct Prepared {
-    /// The sources.
-    pub data: Data,
-    /// Our model with its fitted keys.
-    pub model: PhysicsModel,
-    /// Fitted map coefficients (index, bounds).
-    pub map_fit: Vec<(usize, FittedParameter)>,
-    /// The data's velocity and friction scales (for the baselines' starts and bounds).
-    pub scale: DataScale,
-    /// Mean |friction| of the training data, N.
-    pub mean_abs_n: f64,
-    /// Whether the training loads differ by more than 1 %.
-    pub loads_vary: bool,
-    /// Whether the training data give the load (a load column or topic),
-    /// rather than the configuration's `contact.load_n`.
-    pub load_given: bool,
-    /// The training files, as given.
-    pub names: Vec<String>,
-    /// What was read from each bag (topics used, warnings).
-    pub notes: Vec<String>,
-    /// A rotary joint's lever arm and load (`--rotary`).
-    pub lever: Option<super::rotary::Lever>,
-    /// The joint's name in the fitted file (`--joint`, else `joint`).
-    pub joint: String,
-    /// The configuration our model runs on (a rotary joint's contact with
-    /// its chosen load).
-    pub model_config: Config,
-    /// The data's scales as our model sees them (through the lever).
-    pub model_scale: DataScale,
-    /// The names given to `--fit` (besides `auto`).
-    pub given: Vec<ParamSpec>,
-    /// `--fit auto`: the data choose the terms.
-    pub auto: bool,
-}
-
-/// Fitted map coefficients: index into the data's maps and bounds.
-pub type MapFit = Vec<(usize, FittedParameter)>;
-
-/// Split specs into configuration keys and map coefficients (with their
-/// bounds resolved).
-fn split_specs(
-    specs: &[ParamSpec],
-    map_names: &[String],
-    map_values: &[f64],
-) -> Result<(Vec<ParamSpec>, MapFit), FitError> {
-    let mut key_specs = Vec::new();
-    let mut map_fit = Vec::new();
-    for s in specs {
-        if s.name.contains('.') {
-            key_specs.push(s.clone());
-        } else if let Some(i) = map_names.iter().position(|n| *n == s.name) {
-            map_fit.push((i, map_parameter(s, map_values[i])?));
-        } else {
-            return Err(FitError::Key {
-                key: s.name.clone(),
-                message:
-                    "neither a configuration key (dotted, e.g. roughness.sigma_m) nor a --map coefficient"
-                        .into(),
-            });
-        }
-    }
-    Ok((key_specs, map_fit))
-}
-
-/// Our model for `specs` on `p`'s data (a rotary joint's lever included)
-/// and its fitted map coefficients, every parameter started at its value
-/// in `warm` when it has one (the bounds stay those of `specs`).
-pub fn model_for(
-    p: &Prepared,
-    specs: &[ParamSpec],
-    warm: &[(String, f64)],
-) -> Result<(PhysicsModel, MapFit), FitError> {
-    let (key_specs, mut map_fit) = split_specs(specs, &p.data.map_names, &p.data.map_values)?;
-    let lever_m = p.lever.as_ref().map_or(1.0, |l| l.lever_m);
-    let mut model =
-        PhysicsModel::new(&p.model_config, &key_specs, &p.model_scale)?.with_lever(lever_m);
-    model.warm(warm);
-    for (_, q) in &mut map_fit {
-        if let Some((_, v)) = warm.iter().find(|(n, _)| *n == q.name) {
-            q.warm(*v);
-        }
-    }
-    Ok((model, map_fit))
 }
 
 fn load_range(sources: &[Source], map: &[f64], load_n: f64) -> Result<(f64, f64), FitError> {
@@ -246,7 +129,11 @@ const FAST_JOINT_RAD_S: f64 = 20.0;
 
 /// Read the data and set up the parameters (everything checked before any
 /// simulation).
-pub fn prepare(config: &Config, req: &FitRequest) -> Result<Prepared, FitError> {
+pub fn prepare(
+    config: &Config,
+    req: &DataRequest,
+    params: &[ParamSpec],
+) -> Result<Prepared, FitError> {
     req.check()?;
     let mut notes = Vec::new();
     let mut source = |p: &PathBuf| -> Result<Source, FitError> {
@@ -260,7 +147,7 @@ pub fn prepare(config: &Config, req: &FitRequest) -> Result<Prepared, FitError> 
         Source::new(table, &mapping)
     };
     let given = req
-        .data
+        .files
         .iter()
         .map(&mut source)
         .collect::<Result<Vec<_>, _>>()?;
@@ -291,8 +178,7 @@ pub fn prepare(config: &Config, req: &FitRequest) -> Result<Prepared, FitError> 
         .collect::<Result<Vec<_>, _>>()?
         .into_iter()
         .any(|g| g);
-    let (auto, given, specs) = auto_specs(&req.params);
-    let (key_specs, map_fit) = split_specs(&specs, &map_names, &map_values)?;
+    let (key_specs, map_fit) = split_specs(params, &map_names, &map_values)?;
     if scale.reversal_stiffness_n_m.is_none() {
         for s in key_specs.iter().filter(|s| s.name.contains("presliding_")) {
             notes.push(format!(
@@ -322,11 +208,9 @@ pub fn prepare(config: &Config, req: &FitRequest) -> Result<Prepared, FitError> 
     Ok(Prepared {
         model_config,
         model_scale,
-        given,
-        auto,
         lever,
         joint: req.topics.joint.clone().unwrap_or_else(|| "joint".into()),
-        names: req.data.iter().map(|p| p.display().to_string()).collect(),
+        names: req.files.iter().map(|p| p.display().to_string()).collect(),
         data: Data {
             train,
             held_out,
@@ -334,11 +218,7 @@ pub fn prepare(config: &Config, req: &FitRequest) -> Result<Prepared, FitError> 
             holdout: super::problem::HoldOut::None,
             map_names,
             map_values,
-            units: if req.rotary {
-                super::Units::Rotary
-            } else {
-                super::Units::Linear
-            },
+            units: req.units(),
         },
         model,
         map_fit,
@@ -348,21 +228,4 @@ pub fn prepare(config: &Config, req: &FitRequest) -> Result<Prepared, FitError> 
         load_given,
         notes,
     })
-}
-
-/// `--fit auto`: choose the terms (see `auto.rs`) and set `p`'s model to
-/// the chosen keys; `say` receives a line per set tried.
-pub fn select_terms(
-    p: &mut Prepared,
-    req: &FitRequest,
-    say: &(dyn Fn(&str) + Sync),
-) -> Result<super::auto::Selection, FitError> {
-    let given = p.given.clone();
-    let s = super::auto::select(p, req, &given, say)?;
-    let keys: Vec<&str> = s.keys.iter().map(String::as_str).collect();
-    let specs = super::auto::set_specs(&given, &keys);
-    let (model, map_fit) = model_for(p, &specs, &[])?;
-    p.model = model;
-    p.map_fit = map_fit;
-    Ok(s)
 }

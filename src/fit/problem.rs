@@ -2,8 +2,9 @@
 //! coefficients), the residuals on the samples used for the fit and the
 //! predictions per source. How it is solved is `driver.rs`.
 
-use super::params::FittedParameter;
 use super::series::{Series, Source};
+use super::unknowns::FittedParameter;
+use super::PredictError;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
@@ -20,7 +21,7 @@ pub trait Model: Sync {
     /// series' inputs (time, velocity, load, temperature, steady), not the
     /// measured friction or which samples are fitted: a prediction is
     /// reused when only those change (a map coefficient of the friction).
-    fn predict(&self, x: &[f64], series: &Series) -> Result<Vec<f64>, String>;
+    fn predict(&self, x: &[f64], series: &Series) -> Result<Vec<f64>, PredictError>;
 }
 
 /// The data of a fit: training sources, the parts of the given training
@@ -165,7 +166,7 @@ const PENALTY: f64 = 1e3;
 
 /// Series computed for one set of map coefficients: (role, the
 /// coefficients' bits, one series or error per source).
-type SeriesEntry = (Role, Vec<u64>, Arc<Vec<Result<Series, String>>>);
+type SeriesEntry = (Role, Vec<u64>, Arc<Vec<Result<Series, PredictError>>>);
 
 /// Map-coefficient values whose series are kept.
 const RECENT_SERIES: usize = 8;
@@ -311,7 +312,7 @@ impl<'a> Problem<'a> {
 
     /// The model on the sources of `role`, in parallel (training sources
     /// with the samples left out of the cost marked).
-    pub fn predict_sources(&self, x: &[f64], role: Role) -> Vec<Result<SeriesFit, String>> {
+    pub fn predict_sources(&self, x: &[f64], role: Role) -> Vec<Result<SeriesFit, PredictError>> {
         let n = self.model.parameters().len();
         let sources = self.data.sources(role);
         let holdout = match role {
@@ -347,7 +348,7 @@ impl<'a> Problem<'a> {
         role: Role,
         source: usize,
         series: &Series,
-    ) -> Result<Vec<f64>, String> {
+    ) -> Result<Vec<f64>, PredictError> {
         let bits: Vec<u64> = x.iter().map(|v| v.to_bits()).collect();
         let lock = || self.predictions.lock().unwrap_or_else(|p| p.into_inner());
         let keep = self.fixed.is_none();
@@ -387,17 +388,19 @@ impl<'a> Problem<'a> {
         role: Role,
         sources: &[Source],
         holdout: HoldOut,
-    ) -> Arc<Vec<Result<Series, String>>> {
+    ) -> Arc<Vec<Result<Series, PredictError>>> {
         let key: Vec<u64> = map.iter().map(|v| v.to_bits()).collect();
         let lock = || self.recent.lock().unwrap_or_else(|p| p.into_inner());
         if let Some((_, _, s)) = lock().iter().find(|(r, k, _)| *r == role && *k == key) {
             return s.clone();
         }
-        let computed: Arc<Vec<Result<Series, String>>> = Arc::new(
+        let computed: Arc<Vec<Result<Series, PredictError>>> = Arc::new(
             sources
                 .par_iter()
                 .map(|s| {
-                    let mut se = s.series(map).map_err(|e| e.to_string())?;
+                    let mut se = s
+                        .series(map)
+                        .map_err(|e| PredictError::Inputs(e.to_string()))?;
                     holdout.apply(&mut se);
                     Ok(se)
                 })
@@ -499,7 +502,7 @@ mod tests {
         fn parameters(&self) -> &[FittedParameter] {
             &self.0
         }
-        fn predict(&self, x: &[f64], s: &Series) -> Result<Vec<f64>, String> {
+        fn predict(&self, x: &[f64], s: &Series) -> Result<Vec<f64>, PredictError> {
             Ok(s.velocity.iter().map(|v| x[0] * v).collect())
         }
     }

@@ -12,14 +12,6 @@ use crate::text::Num;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-fn g(v: f64) -> String {
-    if v.is_finite() {
-        format!("{v:.4e}")
-    } else {
-        format!("{v}")
-    }
-}
-
 /// A parameter's value as it acts on a rotary joint (our model behind a
 /// lever arm), e.g. `2.1e-4 N·m`; empty for a property of the contact
 /// itself or without a joint.
@@ -27,7 +19,9 @@ fn on_joint(o: &FitOutcome, name: &str, value: f64) -> String {
     o.joint
         .as_ref()
         .and_then(|j| super::rotary::joint_equivalent(name, value, j.lever_m))
-        .map_or(String::new(), |(v, unit)| format!("{} {unit}", sig(v)))
+        .map_or(String::new(), |(v, unit)| {
+            format!("{} {unit}", Num::sig(v, 5))
+        })
 }
 
 /// Parameters: value, SE, 95 % interval, bounds, flags (and, on a rotary
@@ -47,12 +41,12 @@ pub fn parameter_table(o: &FitOutcome) -> String {
             s,
             "| `{}` | {} | {} | [{}, {}] | [{}, {}]{} | {flag} |",
             p.name,
-            g(o.best[j]),
-            g(st.standard_error[j]),
-            g(st.interval95[j].0),
-            g(st.interval95[j].1),
-            g(p.lo),
-            g(p.hi),
+            Num(o.best[j]).sci(4),
+            Num(st.standard_error[j]).sci(4),
+            Num(st.interval95[j].0).sci(4),
+            Num(st.interval95[j].1).sci(4),
+            Num(p.lo).sci(4),
+            Num(p.hi).sci(4),
             if p.log { " log" } else { "" },
         );
         if joint {
@@ -69,8 +63,8 @@ pub fn joint_lines(o: &FitOutcome) -> String {
     o.joint.as_ref().map_or(String::new(), |j| {
         format!(
             "\n## The joint\n\nThe data are a rotary joint's (rad/s, N·m). The model's contact slides at r ω and puts r F on the joint: lever arm r = {} m (the fitted file's `gain`), contact load F_N = {} N; {}. Every table below is in the joint's units; the parameter table also gives each term as it acts on the joint.\n",
-            sig(j.lever_m),
-            sig(j.load_n),
+            Num::sig(j.lever_m, 5),
+            Num::sig(j.load_n, 5),
             j.how
         )
     })
@@ -141,8 +135,11 @@ pub fn optima_table(o: &FitOutcome) -> String {
             s,
             "| {} | {} | {} | {} |",
             k + 1,
-            g(r.cost),
-            r.x.iter().map(|v| g(*v)).collect::<Vec<_>>().join(" | "),
+            Num(r.cost).sci(4),
+            r.x.iter()
+                .map(|v| Num(*v).sci(4))
+                .collect::<Vec<_>>()
+                .join(" | "),
             r.termination
         );
     }
@@ -154,19 +151,19 @@ pub fn residual_lines(o: &FitOutcome) -> String {
     let u = o.units.force();
     let mut s = format!(
         "training RMS {} {u}, max |residual| {} {u} (σ = {} {u})\n",
-        sig(o.train_rms),
-        sig(o.train_max),
-        sig(o.statistics.sigma)
+        Num::sig(o.train_rms, 5),
+        Num::sig(o.train_max, 5),
+        Num::sig(o.statistics.sigma, 5)
     );
     if let Some(h) = o.holdout_rms {
         let _ = writeln!(
             s,
             "held-out RMS {} {u} (the held-out parts of the training files: --holdout)",
-            sig(h)
+            Num::sig(h, 5)
         );
     }
     if let Some(v) = o.validate_rms {
-        let _ = writeln!(s, "validation RMS {} {u} (--validate data)", sig(v));
+        let _ = writeln!(s, "validation RMS {} {u} (--validate data)", Num::sig(v, 5));
     }
     if let Some(why) = &o.validate_failure {
         let _ = writeln!(s, "no prediction on the --validate data: {why}");
@@ -252,9 +249,9 @@ pub fn models_table(rows: &[ModelRow], scale_n: f64) -> String {
             .iter()
             .map(|(n, v, joint)| {
                 if joint.is_empty() {
-                    format!("{n}={}", Num(round4(*v)))
+                    format!("{n}={}", Num::sig(*v, 4))
                 } else {
-                    format!("{n}={} ({joint} on the joint)", Num(round4(*v)))
+                    format!("{n}={} ({joint} on the joint)", Num::sig(*v, 4))
                 }
             })
             .collect();
@@ -274,9 +271,9 @@ pub fn models_table(rows: &[ModelRow], scale_n: f64) -> String {
                         .replace('|', "/")
                 )
             },
-            sig(r.train_rms),
+            Num::sig(r.train_rms, 5),
             match (&r.held_out_rms, &r.held_out_failure) {
-                (Some(h), _) => sig(*h),
+                (Some(h), _) => Num::sig(*h, 5).to_string(),
                 (None, Some(why)) => format!("none: {}", why.replace('|', "/")),
                 (None, None) => "–".into(),
             },
@@ -287,16 +284,31 @@ pub fn models_table(rows: &[ModelRow], scale_n: f64) -> String {
     let _ = writeln!(
         s,
         "\nheld-out / friction scale: the held-out RMS divided by the RMS of the measured friction on the held-out samples ({} {u}), the same for every model.",
-        sig(scale_n)
+        Num::sig(scale_n, 5)
     );
     s
+}
+
+/// RMS of the measured friction on held-out samples (validation data, else
+/// the held-out parts), N: the scale of the held-out error.
+pub fn held_out_scale(o: &FitOutcome) -> f64 {
+    let fits = if o.validate.is_empty() {
+        &o.held_out
+    } else {
+        &o.validate
+    };
+    let (ss, n) = fits
+        .iter()
+        .flat_map(|sf| sf.series.friction.iter())
+        .fold((0.0, 0usize), |(ss, n), f| (ss + f * f, n + 1));
+    (ss / n.max(1) as f64).sqrt()
 }
 
 /// The models table of ours and the classic models fitted beside it.
 pub fn models_table_of(ours: &FitOutcome, classic: &[FitOutcome]) -> String {
     let mut rows = vec![ModelRow::from(ours)];
     rows.extend(classic.iter().map(ModelRow::from));
-    models_table(&rows, super::request::held_out_scale(ours))
+    models_table(&rows, held_out_scale(ours))
 }
 
 /// The comparison section of a fit with classic models (markdown): the
@@ -308,27 +320,6 @@ pub fn models_section(ours: &FitOutcome, classic: &[FitOutcome]) -> String {
         models_table_of(ours, classic),
         super::by_direction::models_direction_table(&all)
     )
-}
-
-/// Five significant digits, as text: a joint's friction in N·m or a lead
-/// screw's in N keeps its digits whatever its scale (0.00071234, not 0.0007).
-pub fn sig(v: f64) -> String {
-    if v == 0.0 || !v.is_finite() {
-        return format!("{v}");
-    }
-    let e = v.abs().log10().floor() as i32 - 4;
-    let m = 10f64.powi(-e);
-    Num((v * m).round() / m).to_string()
-}
-
-/// Four significant digits.
-fn round4(v: f64) -> f64 {
-    if v == 0.0 || !v.is_finite() {
-        return v;
-    }
-    let e = v.abs().log10().floor() as i32 - 3;
-    let m = 10f64.powi(-e);
-    (v * m).round() / m
 }
 
 /// The fitted parameter file: the complete configuration, a header naming
@@ -348,10 +339,10 @@ pub fn fitted_yaml(
         } else {
             "NOT CONVERGED: the best point found"
         },
-        sig(o.train_rms),
+        Num::sig(o.train_rms, 5),
         o.held_out_rms().map_or(String::new(), |h| format!(
             ", held-out RMS {} {}",
-            sig(h),
+            Num::sig(h, 5),
             o.units.force()
         )),
         u = o.units.force(),
@@ -362,7 +353,7 @@ pub fn fitted_yaml(
             "# {} = {} ± {}",
             p.name,
             Num(o.best[j]),
-            g(o.statistics.standard_error[j])
+            Num(o.statistics.standard_error[j]).sci(4)
         );
     }
     if !map.is_empty() {
@@ -696,16 +687,5 @@ mod tests {
         );
         assert_eq!(parameter_flag(true, 0.3, 1.0), "at a bound");
         assert_eq!(parameter_flag(false, 0.0, 0.0), "");
-    }
-
-    #[test]
-    fn small_errors_keep_their_significant_digits() {
-        // A joint's friction in N·m (before: "0.0007", "0.0000").
-        assert_eq!(sig(0.000_712_345), "7.1235e-4");
-        assert_eq!(sig(0.002_198_765), "0.0021988");
-        assert_eq!(sig(1.002_345_6), "1.0023");
-        assert_eq!(sig(7_290.123), "7290.1");
-        assert_eq!(sig(0.0), "0");
-        assert_eq!(sig(f64::NAN), "NaN");
     }
 }

@@ -32,8 +32,8 @@
 //! | v_t | transition speed: half the load on the film | m/s |
 //! | μ_bl | boundary friction (`contact.boundary_friction`) | – |
 
-use super::params::ParamSpec;
 use super::series::Source;
+use super::unknowns::ParamSpec;
 use super::FitError;
 use crate::config::Config;
 use crate::physics::Solver;

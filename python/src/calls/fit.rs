@@ -3,16 +3,16 @@
 
 use crate::errors;
 use crate::model::load_config;
+use friction_node::fit::compare::OursFitted;
+use friction_node::fit::inputs::{DataRequest, TopicChoice};
+use friction_node::fit::options::{LabelledProgress, SearchSettings};
 use friction_node::fit::report;
-use friction_node::fit::request::{
-    fit_baselines, fit_ours, param_specs, prepare, select_terms, FitRequest, LabelledProgress,
-    OursFitted, Prepared, TopicChoice,
-};
+use friction_node::fit::request::{param_specs, FitOutputs, FitRequest};
 use friction_node::fit::{Delimiter, FitOutcome, Mapping};
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 
 fn outcome_dict<'py>(py: Python<'py>, o: &FitOutcome) -> PyResult<Bound<'py, PyDict>> {
@@ -147,60 +147,61 @@ pub fn fit<'py>(
         )));
     }
     let req = FitRequest {
-        data,
-        validate,
+        data: DataRequest {
+            files: data,
+            validate,
+            holdout,
+            mapping: Mapping {
+                time,
+                velocity,
+                friction,
+                load,
+                temperature,
+                smooth_s: smooth,
+                coefficients: map,
+            },
+            columns,
+            skip,
+            delimiter,
+            topics: TopicChoice {
+                velocity: velocity_topic,
+                friction: friction_topic,
+                joint,
+                load: load_topic,
+                temperature: temperature_topic,
+            },
+            rotary,
+        },
         params: param_specs(&keys, &bounds, &starts_at).map_err(errors::fit)?,
-        mapping: Mapping {
-            time,
-            velocity,
-            friction,
-            load,
-            temperature,
-            smooth_s: smooth,
-            coefficients: map,
+        search: SearchSettings {
+            starts,
+            global_points,
+            seed,
+            max_evaluations,
+            ..Default::default()
         },
-        holdout,
-        columns,
-        skip,
-        delimiter,
-        topics: TopicChoice {
-            velocity: velocity_topic,
-            friction: friction_topic,
-            joint,
-            load: load_topic,
-            temperature: temperature_topic,
-        },
-        starts,
-        global_points,
-        seed,
-        max_evaluations,
         baselines,
-        rotary,
-        jacobian: Default::default(),
-        later_runs: Default::default(),
-        progress: progress.then(|| {
-            Arc::new(|label: &str, l: &str| eprintln!("fit [{label}]: {l}")) as LabelledProgress
-        }),
-        stop: friction_node::interrupt::Stop::new(),
     };
-    let (p, ours, classic, skipped) = calibrate(py, &config, &req, &out, &report_dir)?;
-    let yaml = report::fitted_yaml(&ours.config, &ours.outcome, &p.names, &ours.map);
-    let d = fit_dict(py, &ours, baselines.then_some(&classic[..]), &yaml)?;
-    let mut notes = p.notes.clone();
-    notes.extend(skipped);
+    let progress = progress.then(|| {
+        Arc::new(|label: &str, l: &str| eprintln!("fit [{label}]: {l}")) as LabelledProgress
+    });
+    let outputs = FitOutputs {
+        fitted: out,
+        report: report_dir,
+    };
+    // The command line's flow: the same steps, files and report sections.
+    let c = crate::interrupts::interruptible(py, |stop| {
+        req.run(&config, &outputs, progress.as_ref(), stop)
+    })?
+    .map_err(errors::fit)?;
+    let d = fit_dict(py, &c.ours, baselines.then_some(&c.classic[..]), &c.yaml)?;
+    let mut notes = c.prepared.notes.clone();
+    notes.extend(c.skipped.iter().cloned());
+    if let Some(s) = &c.selection {
+        notes.push(friction_node::fit::select::report(s, c.prepared.data.units));
+    }
     d.set_item("notes", notes)?;
-    if let Some(o) = &out {
-        friction_node::output::write_file(o, yaml.as_bytes())
-            .map_err(|e| errors::os(e.to_string()))?;
-    }
-    if let Some(r) = &report_dir {
-        let extra = if baselines {
-            report::models_section(&ours.outcome, &classic)
-        } else {
-            String::new()
-        };
-        write_fit_report(r, &ours.outcome, &classic, &extra)?;
-    }
+    d.set_item("summary_md", c.summary_md())?;
     Ok(d)
 }
 
@@ -218,59 +219,6 @@ fn delimiter_named(name: &str) -> PyResult<Delimiter> {
             )))
         }
     })
-}
-
-/// What a calibration fitted: the prepared problem, ours, the classic
-/// models (with `req.baselines`) and the notes on those skipped. Outputs
-/// are checked before any computation; Ctrl-C stops the fit.
-fn calibrate(
-    py: Python<'_>,
-    config: &friction_node::config::Config,
-    req: &FitRequest,
-    out: &Option<PathBuf>,
-    report_dir: &Option<PathBuf>,
-) -> PyResult<(Prepared, OursFitted, Vec<FitOutcome>, Vec<String>)> {
-    crate::interrupts::interruptible(py, |stop| -> PyResult<_> {
-        let req = FitRequest {
-            stop: stop.clone(),
-            ..req.clone()
-        };
-        let mut p = prepare(config, &req).map_err(errors::fit)?;
-        if let Some(o) = out {
-            drop(
-                friction_node::output::AtomicFile::create(o)
-                    .map_err(|e| errors::os(e.to_string()))?,
-            );
-        }
-        // A report folder made here is removed again if the fit fails or
-        // is stopped (the report itself is written by the caller).
-        let dir = report_dir
-            .as_deref()
-            .map(friction_node::output::prepare_output_dir)
-            .transpose()
-            .map_err(|e| errors::os(e.to_string()))?;
-        if p.auto {
-            let progress = req.progress.clone();
-            let say = move |l: &str| {
-                if let Some(f) = &progress {
-                    f("auto", l)
-                }
-            };
-            let s = select_terms(&mut p, &req, &say).map_err(errors::fit)?;
-            p.notes
-                .push(friction_node::fit::auto::report(&s, p.data.units));
-        }
-        let ours = fit_ours(&p, &req).map_err(errors::fit)?;
-        let (classic, skipped) = if req.baselines {
-            fit_baselines(&p, &req).map_err(errors::fit)?
-        } else {
-            (Vec::new(), Vec::new())
-        };
-        if let Some(d) = dir {
-            d.keep();
-        }
-        Ok((p, ours, classic, skipped))
-    })?
 }
 
 /// The result dict of a fit: ours at the top level, every model in
@@ -303,14 +251,4 @@ fn fit_dict<'py>(
     d.set_item("map", ours.map.clone())?;
     d.set_item("fitted_yaml", yaml)?;
     Ok(d)
-}
-
-fn write_fit_report(
-    r: &Path,
-    ours: &FitOutcome,
-    classic: &[FitOutcome],
-    extra: &str,
-) -> PyResult<()> {
-    report::write_models_report(r, ours, classic, extra).map_err(|e| errors::os(e.to_string()))?;
-    Ok(())
 }

@@ -37,9 +37,10 @@
 
 use super::driver::fit;
 use super::options::Options;
-use super::params::ParamSpec;
+use super::options::SearchSettings;
+use super::prepared::{model_for, Prepared};
 use super::problem::Data;
-use super::request::{FitRequest, Prepared};
+use super::unknowns::ParamSpec;
 use super::FitError;
 use rayon::prelude::*;
 use std::fmt::Write as _;
@@ -257,19 +258,20 @@ type Optimum = Vec<(String, f64)>;
 fn try_set(
     p: &Prepared,
     data: &Data,
-    req: &FitRequest,
+    search: &SearchSettings,
+    stop: &crate::interrupt::Stop,
     given: &[ParamSpec],
     terms: &[&'static str],
     warm: &Optimum,
 ) -> Result<(Tried, Optimum), FitError> {
     let specs = set_specs(given, &set_keys(terms));
-    let (model, map_fit) = super::request::model_for(p, &specs, warm)?;
+    let (model, map_fit) = model_for(p, &specs, warm)?;
     let options = Options {
         starts: 1,
         global_points: 0,
-        max_evaluations: req.max_evaluations,
-        stop: req.stop.clone(),
-        jacobian: req.jacobian,
+        max_evaluations: search.max_evaluations,
+        stop: stop.clone(),
+        jacobian: search.jacobian,
         // The selection compares sets at the percent level: a looser
         // convergence than the final fit's.
         ftol: 1e-6,
@@ -339,7 +341,7 @@ fn candidates_here(p: &Prepared, given: &[ParamSpec]) -> (Vec<&'static Candidate
         let keys: Vec<&str> = std::iter::once(BASE_KEY)
             .chain(c.keys.iter().copied())
             .collect();
-        match super::request::model_for(p, &set_specs(given, &keys), &[]) {
+        match model_for(p, &set_specs(given, &keys), &[]) {
             Ok(_) => candidates.push(c),
             Err(e) => excluded.push(format!("{}: {e}", c.name)),
         }
@@ -351,9 +353,10 @@ fn candidates_here(p: &Prepared, given: &[ParamSpec]) -> (Vec<&'static Candidate
 /// names after `auto`; `say` receives a line per set tried.
 pub fn select(
     p: &Prepared,
-    req: &FitRequest,
+    search: &SearchSettings,
     given: &[ParamSpec],
     say: &(dyn Fn(&str) + Sync),
+    stop: &crate::interrupt::Stop,
 ) -> Result<Selection, FitError> {
     let wall = std::time::Instant::now();
     let (candidates, excluded) = candidates_here(p, given);
@@ -361,7 +364,7 @@ pub fn select(
         say(&format!("auto: not a candidate on these data: {e}"));
     }
     let data = training_data(p);
-    let (base, mut warm) = try_set(p, &data, req, given, &[], &Vec::new())?;
+    let (base, mut warm) = try_set(p, &data, search, stop, given, &[], &Vec::new())?;
     say(&format!(
         "auto: base (boundary friction): CV RMS {}",
         cv(&base, p)
@@ -384,7 +387,7 @@ pub fn select(
             .map(|c| {
                 let mut terms = current.terms.clone();
                 terms.push(c.name);
-                let (t, o) = try_set(p, &data, req, given, &terms, &warm)?;
+                let (t, o) = try_set(p, &data, search, stop, given, &terms, &warm)?;
                 say(&format!("auto: + {}: CV RMS {}", c.name, cv(&t, p)));
                 Ok((t, o))
             })
@@ -400,8 +403,8 @@ pub fn select(
         if !(gain.is_finite() && gain > se && gain > TERM_COST * mse) {
             break format!(
                 "the best next term, {name}, lowers the blocks' mean squared error by {} ± {} (standard error), {:.2} % of it: a term must lower it by more than its standard error and by more than {:.0} % (the cost of a term), so it does not pay for itself",
-                super::report::sig(gain),
-                super::report::sig(se),
+                crate::text::Num::sig(gain, 5),
+                crate::text::Num::sig(se, 5),
                 100.0 * gain / mse,
                 100.0 * TERM_COST
             );
@@ -435,7 +438,11 @@ pub fn select(
 }
 
 fn cv(t: &Tried, p: &Prepared) -> String {
-    format!("{} {}", super::report::sig(t.cv_rms), p.data.units.force())
+    format!(
+        "{} {}",
+        crate::text::Num::sig(t.cv_rms, 5),
+        p.data.units.force()
+    )
 }
 
 /// The selection as a markdown section.
@@ -449,7 +456,7 @@ pub fn report(s: &Selection, units: super::Units) -> String {
         let folds: Vec<String> = t
             .fold_mse
             .iter()
-            .map(|m| super::report::sig(m.sqrt()))
+            .map(|m| crate::text::Num::sig(m.sqrt(), 5).to_string())
             .collect();
         let _ = writeln!(
             md,
@@ -459,7 +466,7 @@ pub fn report(s: &Selection, units: super::Units) -> String {
             } else {
                 t.terms.join(", ")
             },
-            super::report::sig(t.cv_rms),
+            crate::text::Num::sig(t.cv_rms, 5),
             folds.join(" / "),
             t.simulations
         );
@@ -479,6 +486,53 @@ pub fn report(s: &Selection, units: super::Units) -> String {
         s.wall_s
     );
     md
+}
+
+/// `--fit` as `auto`, the names given besides it, and the specs our model
+/// starts with (with `auto`: the base key first; the selection chooses the
+/// rest).
+pub fn initial_specs(params: &[ParamSpec]) -> (bool, Vec<ParamSpec>, Vec<ParamSpec>) {
+    let auto = params.iter().any(|s| s.name == AUTO);
+    let given: Vec<ParamSpec> = params.iter().filter(|s| s.name != AUTO).cloned().collect();
+    // A bound or start given in case its term is chosen fits nothing yet
+    // (the base key's applies at once: it is always fitted).
+    let mut specs: Vec<ParamSpec> = given
+        .iter()
+        .filter(|s| !s.if_chosen || s.name == BASE_KEY)
+        .map(|s| ParamSpec {
+            if_chosen: false,
+            ..s.clone()
+        })
+        .collect();
+    if auto && !specs.iter().any(|s| s.name == BASE_KEY) {
+        specs.insert(
+            0,
+            ParamSpec {
+                name: BASE_KEY.into(),
+                ..Default::default()
+            },
+        );
+    }
+    (auto, given, specs)
+}
+
+/// `--fit auto`: choose the terms (see the module's rule) and set `p`'s
+/// model to the chosen keys; `given` are the names after `auto`; `say`
+/// receives a line per set tried.
+pub fn select_terms(
+    p: &mut Prepared,
+    given: &[ParamSpec],
+    search: &SearchSettings,
+    say: &(dyn Fn(&str) + Sync),
+    stop: &crate::interrupt::Stop,
+) -> Result<Selection, FitError> {
+    let s = select(p, search, given, say, stop)?;
+    let keys: Vec<&str> = s.keys.iter().map(String::as_str).collect();
+    let specs = set_specs(given, &keys);
+    let (model, map_fit) = model_for(p, &specs, &[])?;
+    p.model = model;
+    p.map_fit = map_fit;
+    Ok(s)
 }
 
 #[cfg(test)]

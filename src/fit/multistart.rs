@@ -211,10 +211,10 @@ fn local_runs(problem: &Problem<'_>, options: &Options, starts: &[Vec<f64>]) -> 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fit::local_run::LaterRuns;
-    use crate::fit::params::FittedParameter;
+    use crate::fit::options::LaterRuns;
     use crate::fit::problem::{Data, HoldOut, Model};
     use crate::fit::series::{Mapping, Series, Source};
+    use crate::fit::unknowns::FittedParameter;
     use crate::table::{Delimiter, Table};
     use std::path::Path;
 
@@ -231,7 +231,7 @@ mod tests {
         fn parameters(&self) -> &[FittedParameter] {
             &self.0
         }
-        fn predict(&self, x: &[f64], s: &Series) -> Result<Vec<f64>, String> {
+        fn predict(&self, x: &[f64], s: &Series) -> Result<Vec<f64>, crate::fit::PredictError> {
             let a = x[0];
             let mut out = s.friction.clone();
             out[0] -= a * a - 1.0;
