@@ -14,13 +14,29 @@
 //!   and a temperature the viscosity follows it every step.
 //! - A steady curve is solved point by point with the steady solver, each
 //!   point warm-started from the previous one.
+//!
+//! **The film once per film.** Every friction term but the soft width acts
+//! after the film ([`crate::physics::terms::acts_after_the_film`]): the
+//! pressure, the gap and the film's forces do not depend on it. A
+//! prediction keeps its film trace — per solver step the inputs of the
+//! friction's composition (velocity, load, the film's viscous and asperity
+//! forces) — and a prediction whose values differ from a kept one's only in
+//! such keys, on the same inputs, recomposes the friction along that trace
+//! ([`FrictionTerms::friction`], the pre-sliding bristle advanced step by
+//! step as the solver advances it) instead of solving the film again. The
+//! result is the full simulation's, bit for bit (tested); a fit whose
+//! Jacobian columns are mostly term keys solves the film about once per
+//! Jacobian instead of once per column.
 
 use super::problem::Model;
 use super::series::Series;
 use super::unknowns::{ConfigKeys, DataScale, FittedParameter, ParamSpec};
 use super::{FitError, PredictError};
 use crate::config::{Config, ViscosityLaw};
-use crate::physics::{Solver, Status, ViscosityModel};
+use crate::physics::terms::{acts_after_the_film, BristleMove, FrictionTerms};
+use crate::physics::{Estimate, Solver, Status, ViscosityModel};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
 
 /// The physics model with some configuration keys fitted.
 pub struct PhysicsModel {
@@ -31,6 +47,102 @@ pub struct PhysicsModel {
     /// the contact's speed, and the contact's friction times r is the
     /// data's (N·m). 1 for data in m/s and N.
     lever_m: f64,
+    /// Which parameters the film depends on (the others act after it).
+    film_params: Vec<bool>,
+    /// The latest film traces, newest last.
+    traces: Mutex<Vec<Arc<FilmTrace>>>,
+    /// Film solves so far (predictions that solved the film).
+    film_solves: AtomicUsize,
+}
+
+/// Film traces kept: enough for the sources of one Jacobian's base point
+/// and the film columns beside it.
+const TRACES_KEPT: usize = 16;
+
+/// One film solution along a series: per solver step (the first the steady
+/// start), the inputs of the friction's composition.
+struct FilmTrace {
+    /// The bits of the parameters the film depends on.
+    film_key: Vec<u64>,
+    /// The fingerprint of the series' inputs.
+    inputs: u64,
+    /// A steady curve (each step its own steady state) or a time series.
+    steady: bool,
+    /// Per step: velocity (m/s), load (N), the film's viscous and asperity
+    /// forces (N).
+    steps: Vec<[f64; 4]>,
+    /// Per step, its time (s; a steady curve: unused).
+    times: Vec<f64>,
+    /// The time series' sampling onto the data (see [`transient`]).
+    sampling: Option<Sampling>,
+}
+
+/// Where a time series' samples fall between the solver's steps.
+#[derive(Clone, Copy)]
+struct Sampling {
+    /// The solver's step, s.
+    dt: f64,
+    /// Whether the series starts at rest (its first sample is not the
+    /// steady start's).
+    at_rest: bool,
+}
+
+impl FilmTrace {
+    fn record(e: &Estimate) -> [f64; 4] {
+        [e.velocity, e.load, e.viscous_force, e.asperity_force]
+    }
+
+    /// The friction at the series' samples with `terms` on this film.
+    fn compose(&self, terms: &FrictionTerms, s: &Series) -> Vec<f64> {
+        let mut bristle = 0.0;
+        let mut friction = |st: &[f64; 4], how: BristleMove| {
+            terms
+                .friction((st[0], st[1]), (st[2], st[3]), &mut bristle, how)
+                .1
+        };
+        if self.steady {
+            return self
+                .steps
+                .iter()
+                .map(|st| friction(st, BristleMove::Steady))
+                .collect();
+        }
+        let sampling = self.sampling.expect("a time series is sampled");
+        let f0 = friction(&self.steps[0], BristleMove::Steady);
+        let mut forces = vec![f0];
+        forces.extend(
+            self.steps[1..]
+                .iter()
+                .map(|st| friction(st, BristleMove::Step(sampling.dt))),
+        );
+        onto_samples(s, &self.times, &forces, sampling)
+    }
+}
+
+/// The friction at the samples of `s` from the friction `forces` at the
+/// steps' `times` (the first the start): linear interpolation between
+/// steps, as the solver's run is read.
+fn onto_samples(s: &Series, times: &[f64], forces: &[f64], sampling: Sampling) -> Vec<f64> {
+    let n = s.len();
+    let mut out = vec![f64::NAN; n];
+    let (mut t_prev, mut f_prev) = (times[0], forces[0]);
+    let mut k = 0;
+    if !sampling.at_rest {
+        out[0] = forces[0];
+        k = 1;
+    }
+    for (&t, &f) in times.iter().zip(forces).skip(1) {
+        while k < n && s.t[k] <= t + 1e-12 * sampling.dt {
+            let w = ((s.t[k] - t_prev) / (t - t_prev)).clamp(0.0, 1.0);
+            out[k] = f_prev + w * (f - f_prev);
+            k += 1;
+        }
+        (t_prev, f_prev) = (t, f);
+    }
+    for o in out.iter_mut().skip(k) {
+        *o = f_prev;
+    }
+    out
 }
 
 impl PhysicsModel {
@@ -43,9 +155,15 @@ impl PhysicsModel {
             .collect::<Result<Vec<_>, _>>()?;
         Ok(Self {
             names: params.iter().map(|p| p.name.clone()).collect(),
+            film_params: params
+                .iter()
+                .map(|p| !acts_after_the_film(&p.name))
+                .collect(),
             keys,
             params,
             lever_m: 1.0,
+            traces: Mutex::new(Vec::new()),
+            film_solves: AtomicUsize::new(0),
         })
     }
 
@@ -79,6 +197,70 @@ impl PhysicsModel {
     pub fn config(&self, x: &[f64]) -> Result<Config, crate::config::ConfigError> {
         self.keys.with(&self.names, x)
     }
+
+    /// Film solves so far: the predictions that could not recompose the
+    /// friction along a kept film trace.
+    pub fn film_solves(&self) -> usize {
+        self.film_solves.load(Ordering::Relaxed)
+    }
+
+    /// The bits of the values the film depends on.
+    fn film_key(&self, x: &[f64]) -> Vec<u64> {
+        x.iter()
+            .zip(&self.film_params)
+            .filter(|(_, film)| **film)
+            .map(|(v, _)| v.to_bits())
+            .collect()
+    }
+
+    /// The friction at the samples of `s` (the contact's series) for
+    /// `config`: recomposed along a kept film trace when one matches, else
+    /// solved, its trace kept.
+    fn run(&self, config: &Config, x: &[f64], s: &Series) -> Result<Vec<f64>, PredictError> {
+        let film_key = self.film_key(x);
+        let inputs = inputs_fingerprint(s);
+        let lock = || self.traces.lock().unwrap_or_else(|p| p.into_inner());
+        let kept = lock()
+            .iter()
+            .find(|t| t.inputs == inputs && t.film_key == film_key)
+            .cloned();
+        if let Some(trace) = kept {
+            return Ok(trace.compose(&FrictionTerms::of(&config.model()), s));
+        }
+        self.film_solves.fetch_add(1, Ordering::Relaxed);
+        let (out, trace) = if s.steady {
+            steady(config, s)?
+        } else {
+            transient(config, s)?
+        };
+        let mut traces = lock();
+        if traces.len() >= TRACES_KEPT {
+            traces.remove(0);
+        }
+        traces.push(Arc::new(FilmTrace {
+            film_key,
+            inputs,
+            ..trace
+        }));
+        Ok(out)
+    }
+}
+
+/// A fingerprint (SipHash) of a series' model inputs: time, velocity, load,
+/// temperature and whether it is steady.
+fn inputs_fingerprint(s: &Series) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    s.steady.hash(&mut h);
+    let mut column = |v: &[f64]| {
+        v.len().hash(&mut h);
+        v.iter().for_each(|x| x.to_bits().hash(&mut h));
+    };
+    column(&s.t);
+    column(&s.velocity);
+    column(s.load.as_deref().unwrap_or(&[]));
+    column(s.temperature.as_deref().unwrap_or(&[]));
+    h.finish()
 }
 
 impl Model for PhysicsModel {
@@ -94,22 +276,19 @@ impl Model for PhysicsModel {
         let config = self
             .config(x)
             .map_err(|e| PredictError::Parameters(e.to_string()))?;
-        let run = |s: &Series| {
-            if s.steady {
-                steady(&config, s)
-            } else {
-                transient(&config, s)
-            }
-        };
         if self.lever_m == 1.0 {
-            return run(series);
+            return self.run(&config, x, series);
         }
         let r = self.lever_m;
         let contact = Series {
             velocity: series.velocity.iter().map(|w| r * w).collect(),
             ..series.clone()
         };
-        Ok(run(&contact)?.into_iter().map(|f| r * f).collect())
+        Ok(self
+            .run(&config, x, &contact)?
+            .into_iter()
+            .map(|f| r * f)
+            .collect())
     }
 }
 
@@ -197,7 +376,9 @@ impl Start {
     }
 }
 
-fn transient(config: &Config, s: &Series) -> Result<Vec<f64>, PredictError> {
+/// The friction at the samples of time series `s` and its film trace (the
+/// caller fills in the trace's keys).
+fn transient(config: &Config, s: &Series) -> Result<(Vec<f64>, FilmTrace), PredictError> {
     let settings = config.solver_settings();
     let dt = settings.dt;
     let mut solver =
@@ -218,13 +399,15 @@ fn transient(config: &Config, s: &Series) -> Result<Vec<f64>, PredictError> {
         solver.set_liquid_viscosity(viscosity(&law, temp)?);
     }
     let first = solver.initialize_steady(start.initial_velocity(), f_at.at(t0));
-    let mut out = vec![f64::NAN; n];
-    let (mut t_prev, mut f_prev) = (t0, first.friction_force);
-    let mut k = 0;
-    if !start.at_rest {
-        out[0] = first.friction_force;
-        k = 1;
-    }
+    let len = usize::try_from(steps).unwrap_or(0).saturating_add(1);
+    let (mut trace, mut times, mut forces) = (
+        Vec::with_capacity(len),
+        Vec::with_capacity(len),
+        Vec::with_capacity(len),
+    );
+    trace.push(FilmTrace::record(&first));
+    times.push(t0);
+    forces.push(first.friction_force);
     // Parameters that make the inputs unreachable (a load the contact cannot
     // carry) leave the solver at its iteration bound step after step, each
     // at the cost of its fallbacks: such a run is no prediction.
@@ -257,25 +440,36 @@ fn transient(config: &Config, s: &Series) -> Result<Vec<f64>, PredictError> {
                 t_s: t,
             });
         }
-        while k < n && s.t[k] <= t + 1e-12 * dt {
-            let w = ((s.t[k] - t_prev) / (t - t_prev)).clamp(0.0, 1.0);
-            out[k] = f_prev + w * (e.friction_force - f_prev);
-            k += 1;
-        }
-        (t_prev, f_prev) = (t, e.friction_force);
+        trace.push(FilmTrace::record(&e));
+        times.push(t);
+        forces.push(e.friction_force);
     }
-    for o in out.iter_mut().skip(k) {
-        *o = f_prev;
-    }
-    Ok(out)
+    let sampling = Sampling {
+        dt,
+        at_rest: start.at_rest,
+    };
+    let out = onto_samples(s, &times, &forces, sampling);
+    Ok((
+        out,
+        FilmTrace {
+            film_key: Vec::new(),
+            inputs: 0,
+            steady: false,
+            steps: trace,
+            times,
+            sampling: Some(sampling),
+        },
+    ))
 }
 
-fn steady(config: &Config, s: &Series) -> Result<Vec<f64>, PredictError> {
+/// The friction at the points of steady curve `s` and its film trace.
+fn steady(config: &Config, s: &Series) -> Result<(Vec<f64>, FilmTrace), PredictError> {
     let mut solver = Solver::new(&config.model(), &config.solver_settings())
         .map_err(|e| PredictError::Solver(e.to_string()))?;
     let follows = follows_temperature(config, s);
     let law = ViscosityLaw::of(config);
-    (0..s.len())
+    let mut trace = Vec::with_capacity(s.len());
+    let out = (0..s.len())
         .map(|k| {
             if follows {
                 let temp = s.temperature.as_ref().expect("follows")[k];
@@ -283,6 +477,7 @@ fn steady(config: &Config, s: &Series) -> Result<Vec<f64>, PredictError> {
             }
             let e = solver.steady(s.velocity[k], s.load_at(k, config.contact.load_n));
             if e.status.is_converged() && e.friction_force.is_finite() {
+                trace.push(FilmTrace::record(&e));
                 Ok(e.friction_force)
             } else {
                 Err(PredictError::Steady {
@@ -291,7 +486,18 @@ fn steady(config: &Config, s: &Series) -> Result<Vec<f64>, PredictError> {
                 })
             }
         })
-        .collect()
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok((
+        out,
+        FilmTrace {
+            film_key: Vec::new(),
+            inputs: 0,
+            steady: true,
+            steps: trace,
+            times: Vec::new(),
+            sampling: None,
+        },
+    ))
 }
 
 #[cfg(test)]
@@ -320,7 +526,7 @@ mod tests {
         let t: Vec<f64> = (0..=200).map(|k| k as f64 * 1e-3).collect();
         let v: Vec<f64> = t.iter().map(|t| 0.3 * (6.0 * t).sin() + 0.05).collect();
         let s = series(t.clone(), v.clone(), false);
-        let got = transient(&config, &s).unwrap();
+        let got = transient(&config, &s).unwrap().0;
         let mut solver = Solver::new(&config.model(), &config.solver_settings()).unwrap();
         let first = solver.initialize_steady(v[0], config.contact.load_n);
         assert_eq!(got[0], first.friction_force);
@@ -351,7 +557,7 @@ mod tests {
         }
         let s = series(t, v, false);
         assert!(Start::of(&s).at_rest);
-        let got = transient(&config, &s).unwrap();
+        let got = transient(&config, &s).unwrap().0;
         for (g, e) in got.iter().zip(&f) {
             assert_relative_eq!(g, e, max_relative = 1e-9);
         }
@@ -368,13 +574,79 @@ mod tests {
         assert_relative_eq!(start.t, 0.999, max_relative = 1e-12);
     }
 
+    /// A model of `keys` (each with its bounds and start) on `config`.
+    fn model_of(config: &Config, keys: &[(&str, f64, f64, f64)]) -> PhysicsModel {
+        let specs: Vec<ParamSpec> = keys
+            .iter()
+            .map(|(k, lo, hi, start)| ParamSpec {
+                name: k.to_string(),
+                bounds: Some((*lo, *hi)),
+                start: Some(*start),
+                if_chosen: false,
+            })
+            .collect();
+        let scale = DataScale {
+            friction_n: 1e3,
+            velocity_m_s: 0.1,
+            load_min_n: 1e3,
+            reversal_stiffness_n_m: None,
+        };
+        PhysicsModel::new(config, &specs, &scale).unwrap()
+    }
+
+    #[test]
+    fn a_change_of_keys_that_act_after_the_film_recomposes_its_trace_bit_for_bit() {
+        let mut config = Config::default();
+        config.solver.cells = 32;
+        let keys = [
+            ("lubricant.viscosity_pa_s", 0.01, 1.0, 0.0564),
+            ("contact.boundary_friction", 0.01, 1.0, 0.3),
+            ("contact.presliding_stiffness_n_m", 1e5, 1e9, 2e6),
+            ("contact.presliding_damping_n_s_m", 0.0, 1e5, 10.0),
+            ("contact.boundary_friction_rate", 0.0, 0.5, 0.01),
+            ("drivetrain.coulomb_n", 0.0, 1e3, 40.0),
+            ("drivetrain.viscous_n_s_m", 0.0, 1e4, 300.0),
+            ("drivetrain.quadratic_n_s2_m2", 0.0, 1e4, 800.0),
+            ("drivetrain.coulomb_asymmetry_n", -100.0, 100.0, 5.0),
+        ];
+        // A time series through reversals (at rest at its start) and a
+        // steady curve.
+        let t: Vec<f64> = (1..=400).map(|k| k as f64 * 1e-3).collect();
+        let v: Vec<f64> = t.iter().map(|t| 0.05 * (9.0 * t).sin()).collect();
+        let curve = series(vec![0.0, 1.0, 2.0, 3.0], vec![0.01, -0.05, 0.2, 1.0], true);
+        for s in [series(t, v, false), curve] {
+            let model = model_of(&config, &keys);
+            let x0: Vec<f64> = keys.iter().map(|k| k.3).collect();
+            model.predict(&x0, &s).unwrap();
+            assert_eq!(model.film_solves(), 1);
+            // Every term key moved: recomposed, not solved.
+            let x1 = vec![0.0564, 0.2, 5e6, 300.0, 0.02, 10.0, 900.0, 100.0, -20.0];
+            let recomposed = model.predict(&x1, &s).unwrap();
+            assert_eq!(model.film_solves(), 1, "recomposed along the kept film");
+            let fresh = model_of(&config, &keys);
+            let solved = fresh.predict(&x1, &s).unwrap();
+            assert_eq!(fresh.film_solves(), 1);
+            for (a, b) in recomposed.iter().zip(&solved) {
+                assert_eq!(a.to_bits(), b.to_bits(), "{a} vs {b}");
+            }
+            // The viscosity moves the film: solved again.
+            let mut x2 = x1.clone();
+            x2[0] = 0.1;
+            model.predict(&x2, &s).unwrap();
+            assert_eq!(model.film_solves(), 2);
+        }
+        // The soft width acts on the film: not a key after it.
+        assert!(!acts_after_the_film("contact.width_load_exponent"));
+        assert!(acts_after_the_film("contact.boundary_friction"));
+    }
+
     #[test]
     fn a_steady_prediction_is_the_steady_solver_point_by_point() {
         let mut config = Config::default();
         config.solver.cells = 64;
         let v = vec![0.01, 0.1, 1.0];
         let s = series(vec![0.0, 1.0, 2.0], v.clone(), true);
-        let got = steady(&config, &s).unwrap();
+        let got = steady(&config, &s).unwrap().0;
         let mut solver = Solver::new(&config.model(), &config.solver_settings()).unwrap();
         for (k, v) in v.iter().enumerate() {
             let e = solver.steady(*v, config.contact.load_n);

@@ -153,6 +153,20 @@ pub fn term_key(key: &str) -> Option<&'static TermKey> {
     catalogue().find(|k| k.key == key)
 }
 
+/// Whether configuration key `key` acts after the film: a friction term's
+/// key that the film's solution (pressure, gap, the film's forces) does not
+/// depend on. Every term's keys are, but the soft width's, which scale the
+/// film's forces. A change of such keys alone leaves the film as it was,
+/// and the friction follows from the film's forces step by step through
+/// [`FrictionTerms::friction`] (what a calibration uses to evaluate them
+/// without solving the film again).
+pub fn acts_after_the_film(key: &str) -> bool {
+    [boundary_film::KEYS, presliding::KEYS, drivetrain::KEYS]
+        .into_iter()
+        .flatten()
+        .any(|k| k.key == key)
+}
+
 /// The friction terms of one contact, composed in the order of the module
 /// documentation. All off by default.
 #[derive(Debug, Clone, Copy, PartialEq)]
