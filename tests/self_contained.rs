@@ -83,6 +83,12 @@ const UP: &str = concat!("..", "/");
 /// machine's work tree).
 const MACHINE_TOPS: &[&str] = &["work", "home", "root", "Users"];
 
+/// A path inside the clone's build output (`target/`, `out/`): made by a
+/// build or a run, so it need not exist in a fresh clone to stay inside.
+fn generated(p: &Path) -> bool {
+    p.starts_with("target") || p.starts_with("out")
+}
+
 fn path_char(c: char) -> bool {
     c.is_ascii_alphanumeric() || "_./-".contains(c)
 }
@@ -103,7 +109,7 @@ fn outside(text: &str, file: &Path, exists: &dyn Fn(&Path) -> bool) -> Vec<Strin
         if token.starts_with(UP) {
             let inside = file.ancestors().skip(1).any(|dir| {
                 normalise(&dir.join(&token))
-                    .is_some_and(|p| !p.as_os_str().is_empty() && exists(&p))
+                    .is_some_and(|p| !p.as_os_str().is_empty() && (exists(&p) || generated(&p)))
             });
             if !inside {
                 found.push(token);
@@ -166,6 +172,9 @@ fn the_guard_finds_a_path_that_climbs_out_and_a_machines_path_and_passes_one_tha
     let example = format!("root.join(\"{UP}examples/c/friction_step.c\")");
     let test = Path::new("capi/tests/c_example.rs");
     assert_eq!(outside(&example, test, &exists), Vec::<String>::new());
+    // A build's output inside the clone, absent from a fresh one.
+    let lib = format!("{UP}{UP}target/release/libx.a");
+    assert_eq!(outside(&lib, c, &exists), Vec::<String>::new());
     let machine = format!("/{}/shared/data", MACHINE_TOPS[0]);
     let text = format!("data in {machine}");
     assert_eq!(outside(&text, f, &exists), [machine]);
