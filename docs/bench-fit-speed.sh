@@ -5,9 +5,10 @@
 # term on, 1 % noise, the velocity read 5 % fast and the force offset by
 # 5 N (the two maps). Fits it three ways: `--jacobian differences
 # --later-runs full` (finite differences at every iteration, every local
-# run walked to its end), `--jacobian secant --later-runs full`, and the
-# defaults (`secant`, `valley`: later runs stop in the first optimum's
-# valley); prints simulations, wall time and training RMS of each.
+# run walked to its end), `--jacobian secant --later-runs full` (the
+# defaults), and the opt-in shortcut `--later-runs valley` (later runs stop
+# in the first optimum's valley); prints simulations, wall time and
+# training RMS of each.
 #
 # Usage: docs/bench-fit-speed.sh [OUT_DIR] [BINARY]   (default: out/bench-fit-speed)
 set -euo pipefail

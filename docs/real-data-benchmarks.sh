@@ -94,7 +94,6 @@ for s in sets:
     wall = open(f"{out}/{s}.wall").read().strip()
     unit = "N·m" if s.startswith("lead") else "N"
     chosen = re.search(r"^Chosen: (.*?)\. Stopped", md, re.M)
-    cv = re.findall(r"^\| ([^|]*) \| ([0-9.e-]+) \| [^|]* \| \d+ \|$", md, re.M)
     table = [l for l in md.splitlines() if re.match(r"^\| (friction-node|Coulomb|Stribeck|LuGre)", l)]
     if not table:
         log = open(f"{out}/{s}.log").read().strip().splitlines()
@@ -102,15 +101,12 @@ for s in sets:
         continue
     for row in table:
         c = [x.strip() for x in row.strip("|").split("|")]
-        model, n, params, fit, train, held, rel = c[:7]
+        model, n, params, fit, train, cv, held, rel = c[:8]
         ours = model == "friction-node"
         what = chosen.group(1) if (ours and chosen) else f"{n} parameters"
-        cv_ours = ""
-        if ours and chosen:
-            picked = chosen.group(1).replace("boundary friction", "").strip(", ")
-            for terms, rms in cv:
-                if terms.strip() == (picked or "—"):
-                    cv_ours = rms
         fitted = "converged" if fit == "converged" else "not converged"
-        print(f"| {labels[s]} | {model} | {what} | {train} {unit} | {cv_ours} | {held} {unit} | {rel} | {fitted} | {wall if ours else ''} |")
+        print(f"| {labels[s]} | {model} | {what} | {train} {unit} | {cv} {unit} | {held} {unit} | {rel} | {fitted} | {wall if ours else ''} |")
+    verdict = re.search(r"^\*\*Verdict.*$", md, re.M)
+    if verdict:
+        print(f"| {labels[s]} | | {verdict.group(0).replace('|', '/')} | | | | | | |")
 PY

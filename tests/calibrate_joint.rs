@@ -86,7 +86,8 @@ fn a_rotary_joint_is_fitted_in_rad_s_and_newton_metres_and_its_file_drives_the_c
         out.to_str().unwrap(),
     ]);
     assert_eq!(code, 0, "{err}");
-    assert!(err.contains("rotary joint: lever arm"), "{err}");
+    assert!(err.contains("the contact's scale: gain"), "{err}");
+    assert!(err.contains(" m, contact load"), "{err}");
     assert!(
         stdout.contains("training RMS") && stdout.contains(" N·m"),
         "{stdout}"
@@ -240,7 +241,7 @@ fn a_bound_that_excludes_the_value_the_chosen_scale_rests_on_is_an_error_naming_
     assert_eq!(code, 2, "{err}");
     // The bound, the configured boundary friction 0.3 and the chosen scale.
     assert!(
-        err.contains("0.5:1 excludes 0.3") && err.contains("lever arm"),
+        err.contains("0.5:1 excludes 0.3") && err.contains("gain"),
         "{err}"
     );
     assert!(!d.join("x.yaml").exists());
@@ -462,5 +463,98 @@ fn one_joint_state_topic_gives_both_the_velocity_and_the_effort_of_a_bag() {
         };
         // The JointState's effort is the same friction as the Float64 topic.
         assert_eq!(fit("/joint_states"), fit("/slider/friction"), "{bag}");
+    }
+}
+
+/// (steady joint torque, N·m) of the fitted file at joint speeds `omega`
+/// (rad/s): its contact's steady friction at gain × ω, times the gain.
+fn fitted_torque(d: &Path, fitted: &Path, omega: &[f64]) -> Vec<f64> {
+    let c = Config::load(Some(fitted), &[]).unwrap();
+    let contacts = c.resolved_contacts();
+    let gain = contacts[0].gain;
+    let contact = d.join("contact.yaml");
+    std::fs::write(&contact, contacts[0].config.to_yaml()).unwrap();
+    omega
+        .iter()
+        .map(|w| {
+            let out = d.join("point.csv");
+            let (v, v2) = ((gain * w).to_string(), (2.0 * gain * w).to_string());
+            let (code, _, err) = run(&[
+                "stribeck",
+                "--config",
+                contact.to_str().unwrap(),
+                "--v-min",
+                &v,
+                "--v-max",
+                &v2,
+                "--points",
+                "2",
+                "--out",
+                out.to_str().unwrap(),
+            ]);
+            assert_eq!(code, 0, "{err}");
+            let text = std::fs::read_to_string(&out).unwrap();
+            let mut lines = text.lines();
+            let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+            let col = head.iter().position(|h| *h == "friction_n").unwrap();
+            let f: f64 = lines
+                .next()
+                .unwrap()
+                .split(',')
+                .nth(col)
+                .unwrap()
+                .parse()
+                .unwrap();
+            gain * f
+        })
+        .collect()
+}
+
+#[test]
+fn a_joint_fitted_at_slow_speeds_predicts_neither_a_collapse_nor_a_sign_change_up_to_five_times_faster(
+) {
+    let d = dir("past-the-data");
+    // A joint whose friction rises and saturates (a Stribeck curve with its
+    // static level below its Coulomb level) plus a viscous part, measured
+    // steadily at 0.5 to 20 deg/s.
+    let torque = |w: f64| 0.5 + 0.3 * (1.0 - (-(w / 0.05).powi(2)).exp()) + 0.2 * w;
+    let mut text = String::from("velocity_rad_s,torque_nm\n");
+    for k in 0..12 {
+        let deg = 0.5 * (40.0f64).powf(k as f64 / 11.0);
+        let w = deg.to_radians();
+        text += &format!("{w},{}\n", torque(w));
+    }
+    let data = d.join("steady.csv");
+    std::fs::write(&data, text).unwrap();
+    let fitted = d.join("joint.yaml");
+    let (code, stdout, err) = run(&[
+        "fit",
+        data.to_str().unwrap(),
+        "--rotary",
+        "--set",
+        "solver.cells=32",
+        "--fit",
+        "auto",
+        "--out",
+        fitted.to_str().unwrap(),
+    ]);
+    assert!(code == 0 || code == 4, "{err}");
+    assert!(stdout.contains("Chosen:"), "{stdout}");
+    // Up to 100 deg/s, five times the fastest point: no collapse, no sign
+    // change, no explosion.
+    let omega: Vec<f64> = [20.0, 35.0, 50.0, 75.0, 100.0]
+        .iter()
+        .map(|d: &f64| d.to_radians())
+        .collect();
+    let t = fitted_torque(&d, &fitted, &omega);
+    let at_20 = torque(omega[0]);
+    approx::assert_relative_eq!(t[0], at_20, max_relative = 0.02);
+    for (w, got) in omega.iter().zip(&t) {
+        assert!(
+            *got > 0.5 * at_20 && *got < 2.0 * torque(*w),
+            "at {} deg/s: {got} N·m (the curve there: {} N·m)",
+            w.to_degrees(),
+            torque(*w)
+        );
     }
 }

@@ -83,11 +83,11 @@ pub struct FitArgs {
     /// (finite differences at every iteration; slower).
     #[arg(long, default_value = "secant", value_parser = JacobianRule::parse)]
     pub jacobian: JacobianRule,
-    /// How the local runs after the first end: `valley` (a run whose
-    /// straight line to an earlier optimum falls all the way stops there)
-    /// or `full` (every run walks to its end; slower). The classic models
-    /// always walk to the end.
-    #[arg(long, default_value = "valley", value_parser = LaterRuns::parse)]
+    /// How the local runs after the first end: `full` (every run walks to
+    /// its end, the default) or `valley` (a run whose straight line to an
+    /// earlier optimum falls all the way stops there: faster, but it can
+    /// miss a better optimum). The classic models always walk to the end.
+    #[arg(long, default_value = "full", value_parser = LaterRuns::parse)]
     pub later_runs: LaterRuns,
     /// Column names of headerless CSV data (comma-separated).
     #[arg(long, value_name = "NAME,...", value_delimiter = ',')]

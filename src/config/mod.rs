@@ -161,6 +161,8 @@ impl Config {
                 load_coefficient: self.drivetrain.load_coefficient,
                 quadratic: self.drivetrain.quadratic_n_s2_m2,
                 coulomb_asymmetry: self.drivetrain.coulomb_asymmetry_n,
+                stribeck: self.drivetrain.stribeck_n,
+                stribeck_speed: self.drivetrain.stribeck_speed_m_s,
             },
             contact: Contact {
                 mass: c.mass_kg,

@@ -175,7 +175,7 @@ pub enum ViscosityModelKind {
 
 /// `drivetrain.*`: losses beside the contact, added to its friction (all
 /// zero by default).
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct DrivetrainConfig {
     /// Constant friction, signed with the velocity, N.
@@ -189,6 +189,27 @@ pub struct DrivetrainConfig {
     /// Half the difference between the forward and backward constant
     /// levels, N (forward F_c + this, backward F_c − this).
     pub coulomb_asymmetry_n: f64,
+    /// The static level's excess over the Coulomb level (Stribeck), N;
+    /// negative: a friction that rises with speed to the Coulomb level.
+    pub stribeck_n: f64,
+    /// The Stribeck speed, m/s: the excess decays as e^(−(v/v_s)²).
+    pub stribeck_speed_m_s: f64,
+}
+
+impl Default for DrivetrainConfig {
+    /// Every term off.
+    fn default() -> Self {
+        let d = crate::physics::Drivetrain::default();
+        Self {
+            coulomb_n: d.coulomb,
+            viscous_n_s_m: d.viscous,
+            load_coefficient: d.load_coefficient,
+            quadratic_n_s2_m2: d.quadratic,
+            coulomb_asymmetry_n: d.coulomb_asymmetry,
+            stribeck_n: d.stribeck,
+            stribeck_speed_m_s: d.stribeck_speed,
+        }
+    }
 }
 
 /// `roughness.*`: GW contact and flow factors.

@@ -21,25 +21,26 @@ pub struct OursFitted {
     pub map: Vec<(String, f64)>,
 }
 
-/// Fit our model.
+/// Fit our model; `cross_validated`: also its error on the folds of the
+/// training data (`cross_validate.rs`), the yardstick the classic models
+/// are compared on.
 pub fn fit_ours(
     p: &Prepared,
     search: &SearchSettings,
     progress: Option<&LabelledProgress>,
     stop: &Stop,
+    cross_validated: bool,
 ) -> Result<OursFitted, FitError> {
-    let outcome = fit(
-        &p.model,
-        &p.data,
-        p.map_fit.clone(),
-        &search.options("friction-node", progress, stop),
-    )?;
-    let mut outcome = outcome;
-    outcome.joint = p.lever.clone();
+    let options = search.options("friction-node", progress, stop);
+    let mut outcome = fit(&p.model, &p.data, p.map_fit.clone(), &options)?;
+    if cross_validated {
+        outcome.fold_mse = Some(fold_errors(p, &p.model, &p.map_fit, &outcome, &options)?);
+    }
+    outcome.contact_scale = p.contact_scale.clone();
     let n_model = p.model.parameters_len();
     let mut config = p.model.config(&outcome.best[..n_model])?;
-    if let Some(l) = &p.lever {
-        config = super::rotary::on_joint(config, &p.joint, l.lever_m);
+    if let Some(l) = &p.contact_scale {
+        config = super::contact_scale::on_joint(config, &p.joint, l.gain);
     }
     let mut map = p
         .data
@@ -56,6 +57,20 @@ pub fn fit_ours(
         config,
         map,
     })
+}
+
+/// `o`'s error on each fold of `p`'s training data: `model` refitted
+/// without it, from `o`'s optimum.
+fn fold_errors(
+    p: &Prepared,
+    model: &dyn Model,
+    map_fit: &[(usize, FittedParameter)],
+    o: &FitOutcome,
+    options: &Options,
+) -> Result<Vec<f64>, FitError> {
+    let data = p.data.training_only();
+    let folds = super::cross_validate::folds_for(&data);
+    super::cross_validate::cross_validate(model, &data, map_fit, &o.best, folds, options)
 }
 
 /// The optimiser's options for classic model `kind`.
@@ -108,9 +123,10 @@ pub fn fit_baselines(
         .data
         .train
         .iter()
-        .map(|s| {
+        .enumerate()
+        .map(|(i, s)| {
             let mut se = s.series(&p.data.map_values)?;
-            p.data.holdout.apply(&mut se);
+            p.data.holdout.apply(&mut se, i);
             Ok(se)
         })
         .collect::<Result<Vec<_>, FitError>>()?;
@@ -152,7 +168,8 @@ pub fn fit_baselines(
                 .chain(map_fit.iter().map(|(i, _)| p.data.map_values[*i]))
                 .collect(),
         );
-        let o = fit(&model, &p.data, map_fit.clone(), &opts)?;
+        let mut o = fit(&model, &p.data, map_fit.clone(), &opts)?;
+        o.fold_mse = Some(fold_errors(p, &model, &map_fit, &o, &opts)?);
         out.push(o.clone());
         previous = Some((model, o));
     }

@@ -27,9 +27,9 @@ pub struct FitOutcome {
     pub converged: bool,
     /// Standard errors, intervals and correlations at the best point.
     pub statistics: super::stats::Statistics,
-    /// One-step blocked cross-validation: each block's mean squared
-    /// held-out residual (`Options::cv_blocks` > 0).
-    pub block_mse: Option<Vec<f64>>,
+    /// Cross-validation: each fold's mean squared held-out residual
+    /// (`cross_validate.rs`; None until computed).
+    pub fold_mse: Option<Vec<f64>>,
     /// The training sources with the prediction.
     pub train: Vec<SeriesFit>,
     /// The held-out parts of the training files with the prediction.
@@ -50,14 +50,17 @@ pub struct FitOutcome {
     pub validate_failure: Option<String>,
     /// Model evaluations (simulations of a source).
     pub simulations: usize,
+    /// Of those, the film solves (the others recomposed the friction along
+    /// a kept film); None for a model without a film.
+    pub film_solves: Option<usize>,
     /// Mean wall time of one, s.
     pub simulation_mean_s: f64,
     /// Wall time of the whole fit, s.
     pub wall_s: f64,
-    /// Our model on a rotary joint's data: the lever arm and load it runs
-    /// through (None: linear data, or a classic model, which is fitted in
-    /// the joint's own units).
-    pub joint: Option<super::rotary::Lever>,
+    /// Our model through a gain: the contact's gain and load (None: the
+    /// data are the contact's own, or a classic model, fitted in the data's
+    /// own units).
+    pub contact_scale: Option<super::contact_scale::ContactScale>,
 }
 
 impl FitOutcome {
@@ -88,17 +91,18 @@ pub fn fit(
     options: &Options,
 ) -> Result<FitOutcome, super::FitError> {
     let wall = Instant::now();
+    let films_before = model.film_solves();
     let mut problem = Problem::new(model, data, map_fit)?;
     problem.stop = options.stop.clone();
     let optima = super::multistart::search(&problem, options);
     options.stop.check()?;
     let best = optima[0].clone();
-    let (r0, jac) = super::stats::jacobian(&problem, &best.x);
-    let statistics = super::stats::from_jacobian(&problem, &best.x, &r0, &jac);
-    let block_mse = (options.cv_blocks > 0).then(|| {
-        let blocks = problem.residual_blocks(options.cv_blocks);
-        super::stats::block_cv(&r0, &jac, &blocks, options.cv_blocks)
-    });
+    let statistics = if options.statistics {
+        let (r0, jac) = super::stats::jacobian(&problem, &best.x);
+        super::stats::from_jacobian(&problem, &best.x, &r0, &jac)
+    } else {
+        super::stats::Statistics::default()
+    };
     let collect = |v: Vec<Result<SeriesFit, super::PredictError>>| -> Result<Vec<SeriesFit>, super::FitError> {
         v.into_iter()
             .map(|r| {
@@ -133,7 +137,7 @@ pub fn fit(
         converged: best.converged,
         optima,
         statistics,
-        block_mse,
+        fold_mse: None,
         train,
         held_out,
         validate,
@@ -143,9 +147,13 @@ pub fn fit(
         validate_rms,
         validate_failure,
         simulations,
+        film_solves: model
+            .film_solves()
+            .zip(films_before)
+            .map(|(after, before)| after - before),
         simulation_mean_s: ns as f64 / 1e9 / simulations.max(1) as f64,
         wall_s: wall.elapsed().as_secs_f64(),
-        joint: None,
+        contact_scale: None,
     })
 }
 
@@ -160,7 +168,7 @@ pub(crate) fn tests_outcome(train: Vec<SeriesFit>) -> FitOutcome {
         optima: Vec::new(),
         converged: true,
         statistics: Default::default(),
-        block_mse: None,
+        fold_mse: None,
         train,
         held_out: Vec::new(),
         validate: Vec::new(),
@@ -170,8 +178,9 @@ pub(crate) fn tests_outcome(train: Vec<SeriesFit>) -> FitOutcome {
         validate_rms: None,
         validate_failure: None,
         simulations: 0,
+        film_solves: None,
         simulation_mean_s: 0.0,
         wall_s: 0.0,
-        joint: None,
+        contact_scale: None,
     }
 }

@@ -10,7 +10,7 @@
 //! |---|---|
 //! | scaling | each parameter on its log scale (positive bounds) or linear scale, mapped to an unbounded variable by the sine transform s = lo + (hi − lo)(1 + sin u)/2 |
 //! | global phase | a seeded Latin-hypercube set of starts over the scaled bounds, each scored by one simulation |
-//! | local phase | Levenberg–Marquardt (MINPACK, `levenberg-marquardt` on nalgebra) from the given start, then the best distinct global starts side by side, each stopped inside the first optimum's 95 % confidence region or, with `--later-runs valley` (the default), as soon as a straight line from it falls all the way to that optimum (the valley test); Jacobian by forward differences of whole simulations run in parallel, kept up to date between them by Broyden's secant update and polished on differences at the end |
+//! | local phase | Levenberg–Marquardt (MINPACK, `levenberg-marquardt` on nalgebra) from the given start, then the best distinct global starts side by side, each stopped inside the first optimum's 95 % confidence region or, with `--later-runs valley` (opt-in), as soon as a straight line from it falls all the way to that optimum (the valley test); Jacobian by forward differences of whole simulations run in parallel, kept up to date between them by Broyden's secant update and polished on differences at the end |
 //! | statistics | standard errors s²(JᵀJ)⁻¹ and correlations from the Jacobian in scaled coordinates at the optimum; flags at bounds and for |corr| > 0.95 |
 //!
 //! Transient data are simulated from the steady state of the first sample
@@ -24,21 +24,24 @@
 //! | file | content |
 //! |---|---|
 //! | `request.rs` | a calibration as data ([`request::FitRequest`]) and its one flow, `run`, for the command line and Python: prepare → select → fit ours → the fitted file → the classic models → the report |
-//! | `prepare.rs` | data → our model: the sources (the held-out part cut off first), scales, keys, maps, a rotary joint's lever |
-//! | `select.rs` | `--fit auto`: the terms chosen by blocked cross-validation, and the keys it starts from |
+//! | `prepare.rs` | data → our model: the sources (the held-out part cut off first), scales, keys, maps, the contact's scale |
+//! | `select.rs` | `--fit auto`'s rule: stepwise with removal on cross-validation, terms that pay, dead terms dropped; its report |
+//! | `trial.rs` | one set of terms tried: fitted on the training data, scored by cross-validation |
+//! | `candidates.rs` | the candidate terms, the keys of a set, which candidates the data allow, the keys `--fit auto` starts from |
 //! | `compare.rs` | ours and the classic models fitted on the same data with the same optimiser |
 //! | `report.rs` | the summary, the tables, plots, the fitted YAML |
 //! | `by_direction.rs` | the residual by direction of motion: level and offset errors |
+//! | `cross_validate.rs` | cross-validation by what a calibration is used for: the folds (files, time blocks, speed ranges) and each fold's refit |
 //! | `prepared.rs` | what `prepare` makes: the data and our model for them; our model for another set of keys |
 //! | `driver.rs` | one model's whole fit: global phase, local runs, statistics, predictions |
 //! | `multistart.rs` | the global phase, then local runs from the best distinct starts; the distinct optima |
 //! | `local_run.rs` | one Levenberg–Marquardt run: secant or difference Jacobians, the stop inside an earlier optimum's confidence region or valley, what was still moving |
-//! | `stats.rs` | standard errors, correlations, flags; one-step blocked cross-validation |
+//! | `stats.rs` | standard errors, correlations, flags |
 //! | `options.rs` | how a fit searches: the user's settings, each fit's options, the Jacobian and later-run rules |
 //! | `physics_model.rs` | our model as a predictor (transient and steady) |
 //! | `baselines.rs` | Coulomb + viscous, Stribeck, LuGre |
 //! | `problem.rs` | the problem: model, data (training, held out, validation), map coefficients, residuals, predictions |
-//! | `rotary.rs` | a rotary joint (rad/s, N·m): the lever arm and load chosen from the data; a key's value as it acts on the joint |
+//! | `contact_scale.rs` | the contact's gain and load chosen from the data (a joint's lever, a linear axis's gain); a key's value as it acts on the joint |
 //! | `unknowns.rs` | the fitted parameters: bounds, scales, configuration keys; the data's scales |
 //! | `reversals.rs` | velocity reversals in the data and the stiffness through them (pre-sliding starts) |
 //! | `inputs.rs` | what is read: the data files, held out and validation files, their mapping, a bag's topics; one file into a table |
@@ -53,7 +56,10 @@
 pub mod bag_input;
 pub mod baselines;
 pub mod by_direction;
+pub mod candidates;
 pub mod compare;
+pub mod contact_scale;
+pub mod cross_validate;
 pub mod driver;
 pub mod error;
 mod expr;
@@ -68,11 +74,11 @@ pub mod problem;
 pub mod report;
 pub mod request;
 pub mod reversals;
-pub mod rotary;
 pub mod select;
 pub mod series;
 pub mod stats;
 pub mod synthetic;
+pub mod trial;
 pub mod units;
 pub mod unknowns;
 

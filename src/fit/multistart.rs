@@ -79,7 +79,6 @@ pub fn search(problem: &Problem<'_>, options: &Options) -> Vec<LocalRun> {
 /// model's optimum, whatever the count), then the best points of the
 /// global phase that are not close to a start already taken.
 fn starts(problem: &Problem<'_>, options: &Options) -> Vec<Vec<f64>> {
-    let mut starts = vec![problem.start()];
     let clamp = |x: &[f64]| -> Vec<f64> {
         problem
             .params
@@ -88,6 +87,11 @@ fn starts(problem: &Problem<'_>, options: &Options) -> Vec<Vec<f64>> {
             .map(|(p, v)| v.clamp(p.lo, p.hi))
             .collect()
     };
+    let given = match &options.start {
+        Some(x) if x.len() == problem.params.len() => clamp(x),
+        _ => problem.start(),
+    };
+    let mut starts = vec![given];
     let extra: Vec<Vec<f64>> = options
         .extra_starts
         .iter()

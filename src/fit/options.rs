@@ -36,9 +36,12 @@ pub struct Options {
     pub ftol: f64,
     /// See `ftol`.
     pub xtol: f64,
-    /// Blocks of the one-step blocked cross-validation computed at the
-    /// optimum (0: none; see [`super::stats::block_cv`]).
-    pub cv_blocks: usize,
+    /// The given start, replacing the parameters' own (e.g. a fold's fit
+    /// started from the whole data's optimum).
+    pub start: Option<Vec<f64>>,
+    /// Standard errors and correlations at the optimum (one more Jacobian;
+    /// a cross-validation fold needs none).
+    pub statistics: bool,
 }
 
 impl Default for Options {
@@ -55,7 +58,8 @@ impl Default for Options {
             later_runs: Default::default(),
             ftol: 1e-10,
             xtol: 1e-8,
-            cv_blocks: 0,
+            start: None,
+            statistics: true,
         }
     }
 }
@@ -188,10 +192,12 @@ impl JacobianRule {
 pub enum LaterRuns {
     /// Each stops when a straight line from its point falls all the way
     /// to an earlier optimum (the valley test), or inside that optimum's
-    /// confidence region.
-    #[default]
+    /// confidence region. Faster, but it can stop short of a better
+    /// optimum whose basin holds such a line: opt-in only.
     Valley,
-    /// Each stops only inside an earlier optimum's confidence region.
+    /// Each stops only inside an earlier optimum's confidence region (the
+    /// default: no optimum is lost to save evaluations).
+    #[default]
     Full,
 }
 

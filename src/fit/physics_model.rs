@@ -43,27 +43,78 @@ pub struct PhysicsModel {
     keys: ConfigKeys,
     names: Vec<String>,
     params: Vec<FittedParameter>,
-    /// The joint's lever arm r, m: the data's velocity (rad/s) times r is
-    /// the contact's speed, and the contact's friction times r is the
-    /// data's (N·m). 1 for data in m/s and N.
-    lever_m: f64,
-    /// Which parameters the film depends on (the others act after it).
-    film_params: Vec<bool>,
-    /// The latest film traces, newest last.
-    traces: Mutex<Vec<Arc<FilmTrace>>>,
-    /// Film solves so far (predictions that solved the film).
-    film_solves: AtomicUsize,
+    /// The gain g through which the data's axis drives the contact: the
+    /// data's velocity times g is the contact's speed, the contact's
+    /// friction times g the data's (a joint's lever arm, m; 1: the data
+    /// are the contact's own).
+    gain: f64,
+    /// The film traces kept (shared by the models of one calibration:
+    /// every set of keys `--fit auto` tries on the same film reuses it).
+    traces: Arc<FilmTraces>,
+    /// This model's own film solves.
+    solves: AtomicUsize,
+    /// What the film of this model's base configuration is, and what its
+    /// terms are: a prediction looks its film up and composes its friction
+    /// without building a configuration.
+    base: FilmBase,
+}
+
+/// A model's base: the fingerprint of its base configuration's film, its
+/// fitted keys that the film depends on (index and base value), and its
+/// friction terms.
+struct FilmBase {
+    fingerprint: u64,
+    film_params: Vec<(usize, u64)>,
+    terms: FrictionTerms,
+}
+
+/// The film traces of a calibration, newest last, and the film solves so
+/// far.
+#[derive(Default)]
+pub struct FilmTraces {
+    kept: Mutex<Vec<Arc<FilmTrace>>>,
+    solves: AtomicUsize,
+}
+
+impl FilmTraces {
+    /// Film solves so far: the predictions that could not recompose the
+    /// friction along a kept trace.
+    pub fn solves(&self) -> usize {
+        self.solves.load(Ordering::Relaxed)
+    }
 }
 
 /// Film traces kept: enough for the sources of one Jacobian's base point
 /// and the film columns beside it.
 const TRACES_KEPT: usize = 16;
 
+/// A fingerprint of what the film depends on in `config`: the
+/// configuration with every friction term off but the soft width (its
+/// model and solver settings), and the load a series without its own runs
+/// at.
+fn film_fingerprint(config: &Config) -> u64 {
+    let mut m = config.model();
+    let terms_off = crate::physics::ModelParams::default();
+    m.contact.boundary_friction = terms_off.contact.boundary_friction;
+    m.contact.sign_regularization = terms_off.contact.sign_regularization;
+    m.contact.boundary_rate = terms_off.contact.boundary_rate;
+    m.contact.presliding = terms_off.contact.presliding;
+    m.drivetrain = terms_off.drivetrain;
+    let text = format!(
+        "{m:?} {:?} {:?} {}",
+        config.solver_settings(),
+        config.lubricant,
+        config.contact.load_n.to_bits()
+    );
+    name_hash(&text)
+}
+
 /// One film solution along a series: per solver step (the first the steady
 /// start), the inputs of the friction's composition.
 struct FilmTrace {
-    /// The bits of the parameters the film depends on.
-    film_key: Vec<u64>,
+    /// The fingerprint of the configuration the film depends on (every key
+    /// but those acting after the film) and of the gain.
+    film_key: u64,
     /// The fingerprint of the series' inputs.
     inputs: u64,
     /// A steady curve (each step its own steady state) or a time series.
@@ -153,24 +204,31 @@ impl PhysicsModel {
             .iter()
             .map(|s| keys.parameter(s, scale))
             .collect::<Result<Vec<_>, _>>()?;
+        let film_params = params
+            .iter()
+            .enumerate()
+            .filter(|(_, p)| !acts_after_the_film(&p.name))
+            .map(|(i, p)| Ok((i, keys.value(&p.name)?.to_bits())))
+            .collect::<Result<Vec<_>, FitError>>()?;
+        let base = FilmBase {
+            fingerprint: film_fingerprint(base),
+            film_params,
+            terms: FrictionTerms::of(&base.model()),
+        };
         Ok(Self {
             names: params.iter().map(|p| p.name.clone()).collect(),
-            film_params: params
-                .iter()
-                .map(|p| !acts_after_the_film(&p.name))
-                .collect(),
             keys,
             params,
-            lever_m: 1.0,
-            traces: Mutex::new(Vec::new()),
-            film_solves: AtomicUsize::new(0),
+            gain: 1.0,
+            traces: Arc::new(FilmTraces::default()),
+            solves: AtomicUsize::new(0),
+            base,
         })
     }
 
-    /// The model of a rotary joint through lever arm `lever_m` (m): data
-    /// in rad/s and N·m (see `rotary.rs`).
-    pub fn with_lever(self, lever_m: f64) -> Self {
-        Self { lever_m, ..self }
+    /// The model driven through gain `gain` (see `contact_scale.rs`).
+    pub fn with_gain(self, gain: f64) -> Self {
+        Self { gain, ..self }
     }
 
     /// Start every fitted key named in `values` at its value there (kept
@@ -183,9 +241,9 @@ impl PhysicsModel {
         }
     }
 
-    /// The lever arm, m (1: data in m/s and N).
-    pub fn lever_m(&self) -> f64 {
-        self.lever_m
+    /// The gain (1: the data are the contact's own).
+    pub fn gain(&self) -> f64 {
+        self.gain
     }
 
     /// Number of fitted configuration keys.
@@ -198,36 +256,67 @@ impl PhysicsModel {
         self.keys.with(&self.names, x)
     }
 
-    /// Film solves so far: the predictions that could not recompose the
-    /// friction along a kept film trace.
+    /// This model's film solves so far: its predictions that could not
+    /// recompose the friction along a kept film trace.
     pub fn film_solves(&self) -> usize {
-        self.film_solves.load(Ordering::Relaxed)
+        self.solves.load(Ordering::Relaxed)
     }
 
-    /// The bits of the values the film depends on.
-    fn film_key(&self, x: &[f64]) -> Vec<u64> {
-        x.iter()
-            .zip(&self.film_params)
-            .filter(|(_, film)| **film)
-            .map(|(v, _)| v.to_bits())
-            .collect()
+    /// The film traces this model keeps.
+    pub fn traces(&self) -> Arc<FilmTraces> {
+        self.traces.clone()
     }
 
-    /// The friction at the samples of `s` (the contact's series) for
-    /// `config`: recomposed along a kept film trace when one matches, else
+    /// The model keeping its film traces in `traces` (shared with others
+    /// on the same data).
+    pub fn with_traces(self, traces: Arc<FilmTraces>) -> Self {
+        Self { traces, ..self }
+    }
+
+    /// The fingerprint of the film at values `x`: the base's, the gain, and
+    /// the fitted keys the film depends on that differ from the base (a
+    /// model that does not fit such a key, and one at its base value, name
+    /// the same film).
+    fn film_key(&self, x: &[f64]) -> u64 {
+        let mut h = mix(self.base.fingerprint, self.gain.to_bits());
+        for (i, base) in &self.base.film_params {
+            let bits = x[*i].to_bits();
+            if bits != *base {
+                h = mix(mix(h, *i as u64 ^ name_hash(&self.names[*i])), bits);
+            }
+        }
+        h
+    }
+
+    /// The friction terms at values `x`: the base's with every fitted term
+    /// key set.
+    fn terms_at(&self, x: &[f64]) -> FrictionTerms {
+        let mut t = self.base.terms;
+        for (name, v) in self.names.iter().zip(x) {
+            t.set(name, *v);
+        }
+        t
+    }
+
+    /// The friction at the samples of `s` (the contact's series) at values
+    /// `x`: recomposed along a kept film trace when one matches, else
     /// solved, its trace kept.
-    fn run(&self, config: &Config, x: &[f64], s: &Series) -> Result<Vec<f64>, PredictError> {
+    fn run(&self, x: &[f64], s: &Series) -> Result<Vec<f64>, PredictError> {
         let film_key = self.film_key(x);
         let inputs = inputs_fingerprint(s);
-        let lock = || self.traces.lock().unwrap_or_else(|p| p.into_inner());
+        let lock = || self.traces.kept.lock().unwrap_or_else(|p| p.into_inner());
         let kept = lock()
             .iter()
             .find(|t| t.inputs == inputs && t.film_key == film_key)
             .cloned();
         if let Some(trace) = kept {
-            return Ok(trace.compose(&FrictionTerms::of(&config.model()), s));
+            return Ok(trace.compose(&self.terms_at(x), s));
         }
-        self.film_solves.fetch_add(1, Ordering::Relaxed);
+        let config = &self
+            .config(x)
+            .map_err(|e| PredictError::Parameters(e.to_string()))?;
+        self.traces.solves.fetch_add(1, Ordering::Relaxed);
+        self.solves.fetch_add(1, Ordering::Relaxed);
         let (out, trace) = if s.steady {
             steady(config, s)?
         } else {
@@ -246,21 +335,36 @@ impl PhysicsModel {
     }
 }
 
-/// A fingerprint (SipHash) of a series' model inputs: time, velocity, load,
+/// One step of the fingerprints' hash: FNV-1a's multiply on a 64-bit word,
+/// then an xor-shift that folds the high bits into the low ones. Both are
+/// bijections of the state, so two inputs of equal length that differ in a
+/// single word never collide; fast on long columns.
+fn mix(h: u64, w: u64) -> u64 {
+    let h = (h ^ w).wrapping_mul(0x0000_0100_0000_01b3);
+    h ^ (h >> 29)
+}
+
+/// A key name's hash (FNV-1a on its bytes).
+fn name_hash(name: &str) -> u64 {
+    name.bytes()
+        .fold(0xcbf2_9ce4_8422_2325, |h, b| mix(h, u64::from(b)))
+}
+
+/// A fingerprint of a series' model inputs: time, velocity, load,
 /// temperature and whether it is steady.
 fn inputs_fingerprint(s: &Series) -> u64 {
-    use std::hash::{Hash, Hasher};
-    let mut h = std::collections::hash_map::DefaultHasher::new();
-    s.steady.hash(&mut h);
+    let mut h = mix(0xcbf2_9ce4_8422_2325, u64::from(s.steady));
     let mut column = |v: &[f64]| {
-        v.len().hash(&mut h);
-        v.iter().for_each(|x| x.to_bits().hash(&mut h));
+        h = mix(h, v.len() as u64);
+        for x in v {
+            h = mix(h, x.to_bits());
+        }
     };
     column(&s.t);
     column(&s.velocity);
     column(s.load.as_deref().unwrap_or(&[]));
     column(s.temperature.as_deref().unwrap_or(&[]));
-    h.finish()
+    h
 }
 
 impl Model for PhysicsModel {
@@ -272,23 +376,20 @@ impl Model for PhysicsModel {
         &self.params
     }
 
+    fn film_solves(&self) -> Option<usize> {
+        Some(self.solves.load(Ordering::Relaxed))
+    }
+
     fn predict(&self, x: &[f64], series: &Series) -> Result<Vec<f64>, PredictError> {
-        let config = self
-            .config(x)
-            .map_err(|e| PredictError::Parameters(e.to_string()))?;
-        if self.lever_m == 1.0 {
-            return self.run(&config, x, series);
+        if self.gain == 1.0 {
+            return self.run(x, series);
         }
-        let r = self.lever_m;
+        let r = self.gain;
         let contact = Series {
             velocity: series.velocity.iter().map(|w| r * w).collect(),
             ..series.clone()
         };
-        Ok(self
-            .run(&config, x, &contact)?
-            .into_iter()
-            .map(|f| r * f)
-            .collect())
+        Ok(self.run(x, &contact)?.into_iter().map(|f| r * f).collect())
     }
 }
 
@@ -452,7 +553,7 @@ fn transient(config: &Config, s: &Series) -> Result<(Vec<f64>, FilmTrace), Predi
     Ok((
         out,
         FilmTrace {
-            film_key: Vec::new(),
+            film_key: 0,
             inputs: 0,
             steady: false,
             steps: trace,
@@ -490,7 +591,7 @@ fn steady(config: &Config, s: &Series) -> Result<(Vec<f64>, FilmTrace), PredictE
     Ok((
         out,
         FilmTrace {
-            film_key: Vec::new(),
+            film_key: 0,
             inputs: 0,
             steady: true,
             steps: trace,
@@ -638,6 +739,54 @@ mod tests {
         // The soft width acts on the film: not a key after it.
         assert!(!acts_after_the_film("contact.width_load_exponent"));
         assert!(acts_after_the_film("contact.boundary_friction"));
+    }
+
+    #[test]
+    fn every_key_that_acts_after_the_film_can_be_set_on_the_terms_as_the_configuration_sets_it() {
+        let base = Config::default();
+        let keys = ConfigKeys::new(&base);
+        for k in crate::physics::terms::catalogue() {
+            let mut t = FrictionTerms::of(&base.model());
+            let v = keys.value(k.key).unwrap();
+            let moved = if v == 0.0 { 0.25 } else { v * 0.75 };
+            assert_eq!(t.set(k.key, moved), acts_after_the_film(k.key), "{}", k.key);
+            if acts_after_the_film(k.key) {
+                let c = keys.with(&[k.key.to_string()], &[moved]).unwrap();
+                assert_eq!(t, FrictionTerms::of(&c.model()), "{}", k.key);
+            }
+        }
+    }
+
+    #[test]
+    fn the_films_fingerprint_ignores_exactly_the_keys_that_act_after_the_film() {
+        let mut config = Config::default();
+        config.contact.width_load_exponent = 0.5;
+        let base = film_fingerprint(&config);
+        let keys = ConfigKeys::new(&config);
+        for k in crate::physics::terms::catalogue() {
+            let v = keys.value(k.key).unwrap();
+            let moved = if v == 0.0 { 0.5 } else { v * 0.9 };
+            let c = keys.with(&[k.key.to_string()], &[moved]).unwrap();
+            assert_eq!(
+                film_fingerprint(&c) == base,
+                acts_after_the_film(k.key),
+                "{}",
+                k.key
+            );
+        }
+        let mut viscous = config.clone();
+        viscous.lubricant.viscosity_pa_s *= 2.0;
+        assert_ne!(film_fingerprint(&viscous), base);
+        // The load a series without its own runs at.
+        let mut loaded = config.clone();
+        loaded.contact.load_n *= 2.0;
+        assert_ne!(film_fingerprint(&loaded), base);
+        // A model that fits the viscosity names the base film at its base
+        // value, as one that does not fit it.
+        let fits = model_of(&config, &[("lubricant.viscosity_pa_s", 0.01, 1.0, 0.0564)]);
+        let not = model_of(&config, &[("contact.boundary_friction", 0.01, 1.0, 0.3)]);
+        assert_eq!(fits.film_key(&[0.0564]), not.film_key(&[0.3]));
+        assert_ne!(fits.film_key(&[0.06]), not.film_key(&[0.3]));
     }
 
     #[test]

@@ -1,8 +1,10 @@
 //! Data → our model: read the sources (the held-out part cut off first),
-//! the data's scales, the fitted keys and map coefficients, a rotary
-//! joint's lever, everything checked before any simulation. What it makes
+//! the data's scales, the fitted keys and map coefficients, the contact's
+//! scale (chosen from the data for a joint, and under `--fit auto` when the
+//! data give no load), everything checked before any simulation. What it makes
 //! is [`Prepared`] (`prepared.rs`).
 
+use super::contact_scale::ContactScale;
 use super::inputs::DataRequest;
 use super::prepared::{split_specs, Prepared};
 use super::unknowns::DataScale;
@@ -48,29 +50,38 @@ pub fn data_scale(
     Ok((scale, sum_abs / n.max(1) as f64, lmax > 1.01 * lmin))
 }
 
-/// The configuration our model runs on, a rotary joint's lever, and the
-/// data's scales as the model sees them (through the lever).
+/// The configuration our model runs on, the contact's scale (see
+/// `contact_scale.rs`), and the data's scales as the model sees them
+/// (through the gain).
+#[allow(clippy::too_many_arguments)]
 fn model_setup(
     config: &Config,
-    rotary: bool,
+    units: super::Units,
+    choose_scale: bool,
     train: &[Source],
     map_values: &[f64],
     key_specs: &[ParamSpec],
     scale: DataScale,
     notes: &mut Vec<String>,
-) -> Result<(Config, Option<super::rotary::Lever>, DataScale), FitError> {
-    if !rotary {
-        return Ok((config.clone(), None, scale));
-    }
-    let (c, l) = super::rotary::setup(config, train, map_values, key_specs)?;
+) -> Result<(Config, Option<ContactScale>, DataScale), FitError> {
+    let (c, chosen) =
+        super::contact_scale::setup(config, train, map_values, key_specs, units, choose_scale)?;
+    let Some(l) = chosen else {
+        return Ok((c, None, scale));
+    };
     notes.push(format!(
-        "rotary joint: lever arm {} m, contact load {} N ({})",
-        crate::text::Num(l.lever_m),
+        "the contact's scale: gain {} {}, contact load {} N ({})",
+        crate::text::Num(l.gain),
+        if units == super::Units::Rotary {
+            "m"
+        } else {
+            ""
+        },
         crate::text::Num(l.load_n),
         l.how
     ));
     let load_min = load_range(train, map_values, c.contact.load_n)?.0;
-    let contact_scale = scale.through_lever(l.lever_m, load_min);
+    let contact_scale = scale.through_gain(l.gain, load_min);
     Ok((c, Some(l), contact_scale))
 }
 
@@ -133,6 +144,7 @@ pub fn prepare(
     config: &Config,
     req: &DataRequest,
     params: &[ParamSpec],
+    auto: bool,
 ) -> Result<Prepared, FitError> {
     req.check()?;
     let mut notes = Vec::new();
@@ -194,21 +206,25 @@ pub fn prepare(
             crate::text::Num(scale.velocity_m_s.to_degrees().round())
         ));
     }
-    let (model_config, lever, model_scale) = model_setup(
+    // The scale is chosen for a joint's data, and under --fit auto for
+    // data that do not give the load (the contact's load is then unknown).
+    let choose_scale = req.rotary || (auto && !load_given);
+    let (model_config, contact_scale, model_scale) = model_setup(
         config,
-        req.rotary,
+        req.units(),
+        choose_scale,
         &train,
         &map_values,
         &key_specs,
         scale,
         &mut notes,
     )?;
-    let lever_m = lever.as_ref().map_or(1.0, |l| l.lever_m);
-    let model = PhysicsModel::new(&model_config, &key_specs, &model_scale)?.with_lever(lever_m);
+    let gain = contact_scale.as_ref().map_or(1.0, |l| l.gain);
+    let model = PhysicsModel::new(&model_config, &key_specs, &model_scale)?.with_gain(gain);
     Ok(Prepared {
         model_config,
         model_scale,
-        lever,
+        contact_scale,
         joint: req.topics.joint.clone().unwrap_or_else(|| "joint".into()),
         names: req.files.iter().map(|p| p.display().to_string()).collect(),
         data: Data {

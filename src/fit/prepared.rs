@@ -1,9 +1,9 @@
 //! A calibration's data and our model as prepared for it: the sources
 //! (training, held out, validation), the data's scales, the fitted keys and
-//! map coefficients, a rotary joint's lever; and our model for another set
+//! map coefficients, the contact's scale; and our model for another set
 //! of keys on the same data (what `--fit auto` tries).
 
-use super::rotary::Lever;
+use super::contact_scale::ContactScale;
 use super::unknowns::{map_parameter, DataScale};
 use super::{Data, FitError, FittedParameter, ParamSpec, PhysicsModel};
 use crate::config::Config;
@@ -29,14 +29,15 @@ pub struct Prepared {
     pub names: Vec<String>,
     /// What was read from each bag (topics used, warnings).
     pub notes: Vec<String>,
-    /// A rotary joint's lever arm and load (`--rotary`).
-    pub lever: Option<Lever>,
+    /// The contact's gain and load when the data's axis drives it through
+    /// one (chosen from the data, or configured).
+    pub contact_scale: Option<ContactScale>,
     /// The joint's name in the fitted file (`--joint`, else `joint`).
     pub joint: String,
     /// The configuration our model runs on (a rotary joint's contact with
     /// its chosen load).
     pub model_config: Config,
-    /// The data's scales as our model sees them (through the lever).
+    /// The data's scales as our model sees them (through the gain).
     pub model_scale: DataScale,
 }
 
@@ -69,7 +70,7 @@ pub(super) fn split_specs(
     Ok((key_specs, map_fit))
 }
 
-/// Our model for `specs` on `p`'s data (a rotary joint's lever included)
+/// Our model for `specs` on `p`'s data (the contact's gain included)
 /// and its fitted map coefficients, every parameter started at its value
 /// in `warm` when it has one (the bounds stay those of `specs`).
 pub fn model_for(
@@ -78,9 +79,10 @@ pub fn model_for(
     warm: &[(String, f64)],
 ) -> Result<(PhysicsModel, MapFit), FitError> {
     let (key_specs, mut map_fit) = split_specs(specs, &p.data.map_names, &p.data.map_values)?;
-    let lever_m = p.lever.as_ref().map_or(1.0, |l| l.lever_m);
-    let mut model =
-        PhysicsModel::new(&p.model_config, &key_specs, &p.model_scale)?.with_lever(lever_m);
+    let gain = p.contact_scale.as_ref().map_or(1.0, |l| l.gain);
+    let mut model = PhysicsModel::new(&p.model_config, &key_specs, &p.model_scale)?
+        .with_gain(gain)
+        .with_traces(p.model.traces());
     model.warm(warm);
     for (_, q) in &mut map_fit {
         if let Some((_, v)) = warm.iter().find(|(n, _)| *n == q.name) {

@@ -22,6 +22,11 @@ pub trait Model: Sync {
     /// measured friction or which samples are fitted: a prediction is
     /// reused when only those change (a map coefficient of the friction).
     fn predict(&self, x: &[f64], series: &Series) -> Result<Vec<f64>, PredictError>;
+    /// The film solves so far, for a model that solves a film (None: a
+    /// model whose every evaluation costs the same).
+    fn film_solves(&self) -> Option<usize> {
+        None
+    }
 }
 
 /// The data of a fit: training sources, the parts of the given training
@@ -41,7 +46,7 @@ pub struct Data {
     /// Validation sources (not fitted).
     pub validate: Vec<Source>,
     /// Which samples of each training source are left out of the cost (a
-    /// block of cross-validation; [`HoldOut::None`] in a plain fit).
+    /// fold of cross-validation; [`HoldOut::None`] in a plain fit).
     pub holdout: HoldOut,
     /// Map coefficient names and their values (fixed or starts).
     pub map_names: Vec<String>,
@@ -98,6 +103,47 @@ impl Data {
     }
 }
 
+/// How the training data are cut into folds for cross-validation: by what
+/// a calibration is asked to predict.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Folds {
+    /// Each training file is a fold: predicted from the others (several
+    /// files, loads or temperatures).
+    Files(usize),
+    /// Each source cut into this many folds by its kind: a time series
+    /// into contiguous time blocks, a steady curve into contiguous speed
+    /// ranges (its points ranked by |v|: the slowest and the fastest are
+    /// predicted from the rest).
+    Within(usize),
+}
+
+impl Folds {
+    /// How many folds there are.
+    pub fn count(self) -> usize {
+        match self {
+            Self::Files(n) | Self::Within(n) => n,
+        }
+    }
+
+    /// The fold of every sample of `s`, the training source `source`.
+    pub fn of(self, source: usize, s: &Series) -> Vec<usize> {
+        let n = s.len();
+        match self {
+            Self::Files(_) => vec![source; n],
+            Self::Within(count) if s.steady => {
+                let mut order: Vec<usize> = (0..n).collect();
+                order.sort_by(|&a, &b| s.velocity[a].abs().total_cmp(&s.velocity[b].abs()));
+                let mut fold = vec![0; n];
+                for (rank, &k) in order.iter().enumerate() {
+                    fold[k] = rank * count / n.max(1);
+                }
+                fold
+            }
+            Self::Within(count) => (0..n).map(|k| k * count / n.max(1)).collect(),
+        }
+    }
+}
+
 /// Which samples of each training source are left out of the cost
 /// (scored, not fitted): a fold of cross-validation.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -105,31 +151,24 @@ pub enum HoldOut {
     /// Nothing.
     #[default]
     None,
-    /// Block `index` of `count` contiguous blocks of a time series (of a
-    /// steady curve: the points whose index is `index` modulo `count`):
-    /// a fold of blocked cross-validation.
-    Block {
-        /// Which block, from 0.
+    /// Fold `index` of `folds`.
+    Fold {
+        /// Which fold, from 0.
         index: usize,
-        /// How many.
-        count: usize,
+        /// How the data are cut.
+        folds: Folds,
     },
 }
 
 impl HoldOut {
-    /// Mark the held-out samples of `s`.
-    pub fn apply(self, s: &mut Series) {
+    /// Mark the held-out samples of `s`, the training source `source`.
+    pub fn apply(self, s: &mut Series, source: usize) {
         match self {
             Self::None => {}
-            Self::Block { index, count } => {
-                let n = s.len();
-                let steady = s.steady;
-                for (k, f) in s.fit.iter_mut().enumerate() {
-                    *f = if steady {
-                        k % count != index
-                    } else {
-                        k * count / n.max(1) != index
-                    };
+            Self::Fold { index, folds } => {
+                let fold = folds.of(source, s);
+                for (f, b) in s.fit.iter_mut().zip(fold) {
+                    *f = b != index;
                 }
             }
         }
@@ -240,9 +279,9 @@ impl<'a> Problem<'a> {
         params.extend(map_fit.iter().map(|(_, p)| p.clone()));
         let mut fitted_samples = 0;
         let mut scale = 0.0f64;
-        for s in &data.train {
+        for (i, s) in data.train.iter().enumerate() {
             let mut series = s.series(&data.map_values)?;
-            data.holdout.apply(&mut series);
+            data.holdout.apply(&mut series, i);
             fitted_samples += series.fit.iter().filter(|f| **f).count();
             scale = series.friction.iter().fold(scale, |m, f| m.max(f.abs()));
         }
@@ -265,9 +304,10 @@ impl<'a> Problem<'a> {
             let all = |sources: &[Source], holdout: HoldOut| {
                 sources
                     .iter()
-                    .map(|s| {
+                    .enumerate()
+                    .map(|(i, s)| {
                         let mut se = s.series(&data.map_values)?;
-                        holdout.apply(&mut se);
+                        holdout.apply(&mut se, i);
                         Ok(se)
                     })
                     .collect::<Result<Vec<_>, super::FitError>>()
@@ -397,11 +437,12 @@ impl<'a> Problem<'a> {
         let computed: Arc<Vec<Result<Series, PredictError>>> = Arc::new(
             sources
                 .par_iter()
-                .map(|s| {
+                .enumerate()
+                .map(|(i, s)| {
                     let mut se = s
                         .series(map)
                         .map_err(|e| PredictError::Inputs(e.to_string()))?;
-                    holdout.apply(&mut se);
+                    holdout.apply(&mut se, i);
                     Ok(se)
                 })
                 .collect(),
@@ -441,24 +482,6 @@ impl<'a> Problem<'a> {
     /// ½ Σ r².
     pub fn cost(&self, x: &[f64]) -> f64 {
         0.5 * self.residuals(x).iter().map(|r| r * r).sum::<f64>()
-    }
-
-    /// The block (0..count) of every residual row: contiguous blocks of
-    /// each training time series (a steady curve: interleaved points), as
-    /// [`HoldOut::Block`] cuts them.
-    pub fn residual_blocks(&self, count: usize) -> Vec<usize> {
-        let mut out = Vec::with_capacity(self.fitted_samples);
-        for s in &self.data.train {
-            let Ok(mut se) = s.series(&self.data.map_values) else {
-                continue;
-            };
-            self.data.holdout.apply(&mut se);
-            let n = se.len().max(1);
-            for k in (0..se.len()).filter(|&k| se.fit[k]) {
-                out.push(if se.steady { k % count } else { k * count / n });
-            }
-        }
-        out
     }
 
     /// Samples the cost sums over.

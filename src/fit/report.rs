@@ -12,13 +12,13 @@ use crate::text::Num;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-/// A parameter's value as it acts on a rotary joint (our model behind a
-/// lever arm), e.g. `2.1e-4 N·m`; empty for a property of the contact
-/// itself or without a joint.
+/// A parameter's value as it acts on the data's axis (our model behind a
+/// gain), e.g. `2.1e-4 N·m` on a joint; empty for a property of the
+/// contact itself or without a gain.
 fn on_joint(o: &FitOutcome, name: &str, value: f64) -> String {
-    o.joint
+    o.contact_scale
         .as_ref()
-        .and_then(|j| super::rotary::joint_equivalent(name, value, j.lever_m))
+        .and_then(|j| super::contact_scale::joint_equivalent(name, value, j.gain, o.units))
         .map_or(String::new(), |(v, unit)| {
             format!("{} {unit}", Num::sig(v, 5))
         })
@@ -27,10 +27,14 @@ fn on_joint(o: &FitOutcome, name: &str, value: f64) -> String {
 /// Parameters: value, SE, 95 % interval, bounds, flags (and, on a rotary
 /// joint, each value as it acts on the joint).
 pub fn parameter_table(o: &FitOutcome) -> String {
-    let joint = o.joint.is_some();
+    let joint = o.contact_scale.is_some();
     let mut s = String::from("| parameter | value | std. error | 95 % interval | bounds | flag |");
     if joint {
-        s.push_str(" on the joint |");
+        s.push_str(if o.units == super::Units::Rotary {
+            " on the joint |"
+        } else {
+            " on the axis |"
+        });
     }
     s.push_str("\n|---|---|---|---|---|---|");
     s.push_str(if joint { "---|\n" } else { "\n" });
@@ -57,16 +61,25 @@ pub fn parameter_table(o: &FitOutcome) -> String {
     s
 }
 
-/// The joint a rotary fit ran through: lever arm, load and how they were
-/// found (empty for linear data).
+/// The gain our model ran through: gain, load and how they were found
+/// (empty when the data are the contact's own).
 pub fn joint_lines(o: &FitOutcome) -> String {
-    o.joint.as_ref().map_or(String::new(), |j| {
-        format!(
-            "\n## The joint\n\nThe data are a rotary joint's (rad/s, N·m). The model's contact slides at r ω and puts r F on the joint: lever arm r = {} m (the fitted file's `gain`), contact load F_N = {} N; {}. Every table below is in the joint's units; the parameter table also gives each term as it acts on the joint.\n",
-            Num::sig(j.lever_m, 5),
-            Num::sig(j.load_n, 5),
-            j.how
-        )
+    o.contact_scale.as_ref().map_or(String::new(), |j| {
+        if o.units == super::Units::Rotary {
+            format!(
+                "\n## The joint\n\nThe data are a rotary joint's (rad/s, N·m). The model's contact slides at r ω and puts r F on the joint: lever arm r = {} m (the fitted file's `gain`), contact load F_N = {} N; {}. Every table below is in the joint's units; the parameter table also gives each term as it acts on the joint.\n",
+                Num::sig(j.gain, 5),
+                Num::sig(j.load_n, 5),
+                j.how
+            )
+        } else {
+            format!(
+                "\n## The contact's scale\n\nThe model's contact slides at g v and puts g F on the axis: gain g = {} (the fitted file's `gain`: the axis is written as a joint, driven by its JointState), contact load F_N = {} N; {}. The tables are in the data's units; the parameter table also gives each term as it acts on the axis.\n",
+                Num::sig(j.gain, 5),
+                Num::sig(j.load_n, 5),
+                j.how
+            )
+        }
     })
 }
 
@@ -170,8 +183,11 @@ pub fn residual_lines(o: &FitOutcome) -> String {
     }
     let _ = writeln!(
         s,
-        "{} simulations, {:.1} ms each on average, {:.1} s in all",
+        "{} simulations{}, {:.1} ms each on average, {:.1} s in all",
         o.simulations,
+        o.film_solves.map_or(String::new(), |f| format!(
+            " ({f} solved the film, the others recomposed its friction)"
+        )),
         1e3 * o.simulation_mean_s,
         o.wall_s
     );
@@ -190,6 +206,8 @@ pub struct ModelRow {
     pub units: super::Units,
     /// RMS residual on the training samples, N.
     pub train_rms: f64,
+    /// Cross-validated RMS on the training data's folds, N.
+    pub cv_rms: Option<f64>,
     /// RMS residual on the held-out samples, N.
     pub held_out_rms: Option<f64>,
     /// Why there is no held-out prediction, when there is none.
@@ -214,8 +232,12 @@ impl From<&FitOutcome> for ModelRow {
                 .iter()
                 .zip(&o.best)
                 .map(|(p, v)| {
-                    let joint = on_joint(o, &p.name, *v);
-                    let name = if o.joint.is_some() {
+                    let joint = match on_joint(o, &p.name, *v) {
+                        j if j.is_empty() => j,
+                        j if o.units == super::Units::Rotary => format!("{j} on the joint"),
+                        j => format!("{j} on the axis"),
+                    };
+                    let name = if o.contact_scale.is_some() {
                         p.name.clone()
                     } else {
                         super::baselines::parameter_name(&p.name, o.units)
@@ -224,6 +246,7 @@ impl From<&FitOutcome> for ModelRow {
                 })
                 .collect(),
             train_rms: o.train_rms,
+            cv_rms: o.fold_mse.as_deref().map(super::cross_validate::cv_rms),
             held_out_rms: o.held_out_rms(),
             held_out_failure: o.validate_failure.clone(),
             converged: o.converged,
@@ -241,7 +264,7 @@ impl From<&FitOutcome> for ModelRow {
 pub fn models_table(rows: &[ModelRow], scale_n: f64) -> String {
     let u = rows.first().map_or("N", |r| r.units.force());
     let mut s = format!(
-        "| model | n | parameters | fit | training RMS ({u}) | held-out RMS ({u}) | held-out / friction scale |\n|---|---|---|---|---|---|---|\n",
+        "| model | n | parameters | fit | training RMS ({u}) | CV RMS ({u}) | held-out RMS ({u}) | held-out / friction scale |\n|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         let params: Vec<String> = r
@@ -251,13 +274,13 @@ pub fn models_table(rows: &[ModelRow], scale_n: f64) -> String {
                 if joint.is_empty() {
                     format!("{n}={}", Num::sig(*v, 4))
                 } else {
-                    format!("{n}={} ({joint} on the joint)", Num::sig(*v, 4))
+                    format!("{n}={} ({joint})", Num::sig(*v, 4))
                 }
             })
             .collect();
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} |",
             r.label,
             r.parameters.len(),
             params.join(", "),
@@ -272,6 +295,8 @@ pub fn models_table(rows: &[ModelRow], scale_n: f64) -> String {
                 )
             },
             Num::sig(r.train_rms, 5),
+            r.cv_rms
+                .map_or("–".to_string(), |c| Num::sig(c, 5).to_string()),
             match (&r.held_out_rms, &r.held_out_failure) {
                 (Some(h), _) => Num::sig(*h, 5).to_string(),
                 (None, Some(why)) => format!("none: {}", why.replace('|', "/")),
@@ -283,7 +308,7 @@ pub fn models_table(rows: &[ModelRow], scale_n: f64) -> String {
     }
     let _ = writeln!(
         s,
-        "\nheld-out / friction scale: the held-out RMS divided by the RMS of the measured friction on the held-out samples ({} {u}), the same for every model.",
+        "\nCV RMS: the training data's folds, each predicted by the model refitted without it (the same folds for every model). held-out / friction scale: the held-out RMS divided by the RMS of the measured friction on the held-out samples ({} {u}), the same for every model.",
         Num::sig(scale_n, 5)
     );
     s
@@ -302,6 +327,49 @@ pub fn held_out_scale(o: &FitOutcome) -> f64 {
         .flat_map(|sf| sf.series.friction.iter())
         .fold((0.0, 0usize), |(ss, n), f| (ss + f * f, n + 1));
     (ss / n.max(1) as f64).sqrt()
+}
+
+/// Which model predicts best, in one sentence for the summary's first
+/// lines: on the held-out data when there are any, else cross-validated
+/// on the training data's folds; said plainly when ours is not the best.
+pub fn verdict(ours: &FitOutcome, classic: &[FitOutcome]) -> String {
+    let held = ours.held_out_rms().is_some();
+    let score = |o: &FitOutcome| -> Option<f64> {
+        if held {
+            o.held_out_rms()
+        } else {
+            o.fold_mse.as_deref().map(super::cross_validate::cv_rms)
+        }
+    };
+    let what = if held { "held-out" } else { "cross-validated" };
+    let u = ours.units.force();
+    let Some(mine) = score(ours) else {
+        return String::new();
+    };
+    let best = classic
+        .iter()
+        .filter_map(|o| score(o).map(|s| (o, s)))
+        .min_by(|a, b| a.1.total_cmp(&b.1));
+    let Some((b, theirs)) = best else {
+        return String::new();
+    };
+    if mine <= theirs {
+        format!(
+            "**Verdict:** ours predicts best: {what} RMS {} {u}, the best classic model ({}) {} {u} ({:.1} % lower).",
+            Num::sig(mine, 5),
+            b.label,
+            Num::sig(theirs, 5),
+            100.0 * (1.0 - mine / theirs)
+        )
+    } else {
+        format!(
+            "**Verdict: ours is not the best here.** {} predicts better: {what} RMS {} {u} against ours {} {u} ({:.1} % higher). Use it, or the terms it points at (see the models table).",
+            b.label,
+            Num::sig(theirs, 5),
+            Num::sig(mine, 5),
+            100.0 * (mine / theirs - 1.0)
+        )
+    }
 }
 
 /// The models table of ours and the classic models fitted beside it.
@@ -402,11 +470,16 @@ fn write_samples(path: &Path, o: &FitOutcome) -> Result<PathBuf, OutputError> {
 }
 
 /// The whole markdown summary of one fit.
-pub fn summary(o: &FitOutcome, extra: &str) -> String {
+pub fn summary(o: &FitOutcome, verdict: &str, extra: &str) -> String {
     format!(
-        "# Fit of {}: {}\n\n{}{}\n## Parameters\n\n{}\n## Correlations\n\n{}\n## Distinct optima (best first)\n\n{}\n## Residual by direction of motion\n\n{}\n{}",
+        "# Fit of {}: {}\n\n{}{}{}\n## Parameters\n\n{}\n## Correlations\n\n{}\n## Distinct optima (best first)\n\n{}\n## Residual by direction of motion\n\n{}\n{}",
         o.label,
         if o.converged { "converged" } else { "NOT converged (best point found)" },
+        if verdict.is_empty() {
+            String::new()
+        } else {
+            format!("{verdict}\n\n")
+        },
         residual_lines(o),
         joint_lines(o),
         parameter_table(o),
@@ -418,9 +491,17 @@ pub fn summary(o: &FitOutcome, extra: &str) -> String {
 }
 
 /// Write `summary.md`, `fit.csv` and the plots into `dir` (which exists).
-pub fn write_report(dir: &Path, o: &FitOutcome, extra: &str) -> Result<Vec<PathBuf>, OutputError> {
+pub fn write_report(
+    dir: &Path,
+    o: &FitOutcome,
+    verdict: &str,
+    extra: &str,
+) -> Result<Vec<PathBuf>, OutputError> {
     let files = vec![
-        crate::output::write_file(&dir.join("summary.md"), summary(o, extra).as_bytes())?,
+        crate::output::write_file(
+            &dir.join("summary.md"),
+            summary(o, verdict, extra).as_bytes(),
+        )?,
         write_samples(&dir.join("fit.csv"), o)?,
     ];
     #[cfg(feature = "plots")]
@@ -437,15 +518,16 @@ pub fn write_models_report(
     dir: &Path,
     ours: &FitOutcome,
     classic: &[FitOutcome],
+    verdict: &str,
     extra: &str,
 ) -> Result<Vec<PathBuf>, OutputError> {
     let mut files = Vec::new();
     for b in classic {
         let sub = dir.join(slug(&b.label));
         crate::output::prepare_dir(&sub)?;
-        files.extend(write_report(&sub, b, "")?);
+        files.extend(write_report(&sub, b, "", "")?);
     }
-    files.extend(write_report(dir, ours, extra)?);
+    files.extend(write_report(dir, ours, verdict, extra)?);
     #[cfg(feature = "plots")]
     if !classic.is_empty() {
         let all: Vec<&FitOutcome> = std::iter::once(ours).chain(classic).collect();

@@ -12,13 +12,14 @@
 //! and its own summary; the files are written here, each when it is
 //! complete (the fitted file before the classic models start).
 
+use super::candidates::initial_specs;
 use super::compare::{fit_baselines, fit_ours, OursFitted};
 use super::driver::FitOutcome;
 use super::inputs::DataRequest;
 use super::options::{LabelledProgress, SearchSettings};
 use super::prepare::prepare;
 use super::prepared::Prepared;
-use super::select::{initial_specs, select_terms, Selection};
+use super::select::{select_terms, Selection};
 use super::{FitError, ParamSpec};
 use crate::config::Config;
 use crate::interrupt::Stop;
@@ -51,7 +52,7 @@ pub struct FitOutputs {
 
 /// What a calibration found.
 pub struct Calibration {
-    /// The data and our model as prepared (notes, scale, lever).
+    /// The data and our model as prepared (notes, scales, the contact's gain).
     pub prepared: Prepared,
     /// `--fit auto`'s selection.
     pub selection: Option<Selection>,
@@ -63,6 +64,9 @@ pub struct Calibration {
     pub skipped: Vec<String>,
     /// The fitted parameter file's text.
     pub yaml: String,
+    /// With the classic models: which model predicts best, in a sentence
+    /// (the summary's first lines).
+    pub verdict: String,
     /// The sections after ours in the summary: the selection's and (with
     /// the classic models) the models table and their errors by direction.
     pub extra_md: String,
@@ -73,7 +77,7 @@ pub struct Calibration {
 impl Calibration {
     /// Our summary with every section (what `summary.md` holds).
     pub fn summary_md(&self) -> String {
-        super::report::summary(&self.ours.outcome, &self.extra_md)
+        super::report::summary(&self.ours.outcome, &self.verdict, &self.extra_md)
     }
 }
 
@@ -112,7 +116,7 @@ impl FitRequest {
         // With `auto`: the base key and the names given; the selection adds
         // terms to them.
         let (auto, given, specs) = initial_specs(&self.params);
-        let mut p = prepare(config, &self.data, &specs)?;
+        let mut p = prepare(config, &self.data, &specs, auto)?;
         for n in &p.notes {
             say(n);
         }
@@ -142,7 +146,7 @@ impl FitRequest {
             self.search.starts,
             self.search.global_points
         ));
-        let ours = fit_ours(&p, &self.search, progress, stop)?;
+        let ours = fit_ours(&p, &self.search, progress, stop, self.baselines)?;
         let yaml = super::report::fitted_yaml(&ours.config, &ours.outcome, &p.names, &ours.map);
         if let Some(o) = &outputs.fitted {
             crate::output::write_file(o, yaml.as_bytes())?;
@@ -157,13 +161,21 @@ impl FitRequest {
         for s in &skipped {
             say(s);
         }
-        if self.baselines {
+        let verdict = if self.baselines {
             extra_md.push_str(&super::report::models_section(&ours.outcome, &classic));
-        }
+            super::report::verdict(&ours.outcome, &classic)
+        } else {
+            String::new()
+        };
         let mut report_files = Vec::new();
         if let Some(r) = &outputs.report {
-            report_files =
-                super::report::write_models_report(r, &ours.outcome, &classic, &extra_md)?;
+            report_files = super::report::write_models_report(
+                r,
+                &ours.outcome,
+                &classic,
+                &verdict,
+                &extra_md,
+            )?;
             say(&format!(
                 "report in {} ({} files)",
                 r.display(),
@@ -180,6 +192,7 @@ impl FitRequest {
             classic,
             skipped,
             yaml,
+            verdict,
             extra_md,
             report_files,
         })
@@ -197,8 +210,8 @@ fn spec_for<'a>(
     if let Some(i) = specs.iter().position(|s| s.name == name) {
         return Ok(&mut specs[i]);
     }
-    let auto = specs.iter().any(|s| s.name == super::select::AUTO);
-    if auto && super::select::may_choose(name) {
+    let auto = specs.iter().any(|s| s.name == super::candidates::AUTO);
+    if auto && super::candidates::may_choose(name) {
         specs.push(ParamSpec {
             name: name.to_string(),
             if_chosen: true,
@@ -209,7 +222,7 @@ fn spec_for<'a>(
     let message = if auto {
         format!(
             "`{name}` is neither in --fit nor a key --fit auto may choose ({})",
-            super::select::choosable_keys().join(", ")
+            super::candidates::choosable_keys().join(", ")
         )
     } else {
         format!("`{name}` is not in --fit")

@@ -149,15 +149,15 @@ pub struct DataScale {
 }
 
 impl DataScale {
-    /// The scales of a rotary joint's data (rad/s, N·m) on the contact
-    /// behind lever arm `lever_m` (m/s, N), whose smallest load is
-    /// `load_min_n`: v = r ω, F = τ / r, k = k_joint / r².
-    pub fn through_lever(&self, lever_m: f64, load_min_n: f64) -> Self {
+    /// The scales of the data (m/s or rad/s, N or N·m) on the contact
+    /// behind gain `gain` (m/s, N), whose smallest load is `load_min_n`:
+    /// v = g ẋ, F = F_data / g, k = k_data / g².
+    pub fn through_gain(&self, gain: f64, load_min_n: f64) -> Self {
         Self {
-            friction_n: self.friction_n / lever_m,
-            velocity_m_s: self.velocity_m_s * lever_m,
+            friction_n: self.friction_n / gain,
+            velocity_m_s: self.velocity_m_s * gain,
             load_min_n,
-            reversal_stiffness_n_m: self.reversal_stiffness_n_m.map(|k| k / (lever_m * lever_m)),
+            reversal_stiffness_n_m: self.reversal_stiffness_n_m.map(|k| k / (gain * gain)),
         }
     }
 }
@@ -282,6 +282,13 @@ impl ConfigKeys {
         start: f64,
         scale: &DataScale,
     ) -> Result<(f64, f64), FitError> {
+        // A speed or a stiffness: its physical range, from the data's
+        // scales, whatever its start.
+        if let Some(range) =
+            crate::physics::terms::term_key(key).and_then(|k| physical_range(k, scale))
+        {
+            return Ok(range);
+        }
         if start > 0.0 {
             let shrink = |factor: f64| -> f64 {
                 // start·factor^(2^-k), the first that is valid.
@@ -320,7 +327,7 @@ impl ConfigKeys {
                     }
                     Some(h)
                 }
-                FitScale::FromStart => None,
+                FitScale::FromStart | FitScale::Speed { .. } | FitScale::Stiffness { .. } => None,
             },
             None => None,
         };
@@ -334,6 +341,29 @@ impl ConfigKeys {
             }),
         }
     }
+}
+
+/// The range of a speed or a stiffness key from the data's scales, kept
+/// inside the key's valid range (None: another kind of key, or data that
+/// give no scale).
+fn physical_range(k: &crate::physics::terms::TermKey, scale: &DataScale) -> Option<(f64, f64)> {
+    let (lo, hi) = match k.fit {
+        FitScale::Speed { lo, hi } => (lo * scale.velocity_m_s, hi * scale.velocity_m_s),
+        FitScale::Stiffness { x_lo, x_hi } => (scale.friction_n / x_hi, scale.friction_n / x_lo),
+        _ => return None,
+    };
+    let inside = |v: f64| {
+        let (a, b) = (k.lo.value(), k.hi.value());
+        // An open end is kept a part in a million inside.
+        let a = if matches!(k.lo, crate::physics::terms::End::Open(_)) {
+            a + 1e-6 * a.abs().max(f64::MIN_POSITIVE)
+        } else {
+            a
+        };
+        v.clamp(a, b)
+    };
+    let (lo, hi) = (inside(lo), inside(hi));
+    (lo.is_finite() && hi.is_finite() && lo > 0.0 && lo < hi).then_some((lo, hi))
 }
 
 /// Bounds must be finite and increasing.
@@ -461,7 +491,7 @@ mod tests {
         assert_eq!((p.lo, p.hi, p.log), (0.0, 400.0, false));
         // The boundary film's rate: up to twice the data's friction
         // coefficient (100 N over 1000 N) per e-fold; its activation speed
-        // a decade either side of 1 mm/s.
+        // from 1e-4 of the data's top speed (0.5 m/s) to the top speed.
         let p = keys
             .parameter(&spec("contact.boundary_friction_rate"), &SCALE)
             .unwrap();
@@ -470,8 +500,15 @@ mod tests {
         let p = keys
             .parameter(&spec("contact.boundary_activation_speed_m_s"), &SCALE)
             .unwrap();
-        assert_relative_eq!(p.lo, 1e-4, max_relative = 1e-12);
-        assert_relative_eq!(p.hi, 1e-2, max_relative = 1e-12);
+        assert_relative_eq!(p.lo, 5e-5, max_relative = 1e-12);
+        assert_relative_eq!(p.hi, 0.5, max_relative = 1e-12);
+        assert!(p.log);
+        // The Stribeck speed: from 1e-3 of the top speed to 3 times it.
+        let p = keys
+            .parameter(&spec("drivetrain.stribeck_speed_m_s"), &SCALE)
+            .unwrap();
+        assert_relative_eq!(p.lo, 5e-4, max_relative = 1e-12);
+        assert_relative_eq!(p.hi, 1.5, max_relative = 1e-12);
         let c = keys.with(&["roughness.sigma_m".into()], &[3.5e-6]).unwrap();
         assert_eq!(c.roughness.sigma_m, 3.5e-6);
     }

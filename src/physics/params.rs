@@ -344,5 +344,13 @@ fn check_drivetrain(d: &super::terms::drivetrain::Drivetrain) -> Result<(), Setu
             "must be finite",
         ));
     }
+    if !d.stribeck.is_finite() {
+        return Err(SetupError::invalid(
+            "drivetrain.stribeck",
+            d.stribeck,
+            "must be finite",
+        ));
+    }
+    positive("drivetrain.stribeck_speed", d.stribeck_speed)?;
     Ok(())
 }

@@ -87,7 +87,7 @@ fn outcome_dict<'py>(py: Python<'py>, o: &FitOutcome) -> PyResult<Bound<'py, PyD
     }
     d.set_item("parameters", params)?;
     d.set_item("correlation", o.statistics.correlation.clone())?;
-    d.set_item("summary", report::summary(o, ""))?;
+    d.set_item("summary", report::summary(o, "", ""))?;
     Ok(d)
 }
 

@@ -78,7 +78,7 @@ pub const KEYS: &[TermKey] = &[
         lo: End::Open(1e-12),
         hi: End::Closed(100.0),
         live: true,
-        fit: FitScale::FromStart,
+        fit: FitScale::Speed { lo: 1e-4, hi: 1.0 },
         meaning: "the rate term's activation speed: linear below, logarithmic above",
     },
 ];

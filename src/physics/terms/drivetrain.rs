@@ -3,7 +3,7 @@
 //! gear mesh), which no contact model should be asked to absorb.
 //!
 //! ```text
-//! F_dt = (F_c + c_N F_ext) tanh(v / v_reg) + ΔF_c |tanh(v / v_reg)| + b v + c_q v |v|
+//! F_dt = (F_c + c_N F_ext + ΔF_s e^(−(v/v_s)²)) tanh(v / v_reg) + ΔF_c |tanh(v / v_reg)| + b v + c_q v |v|
 //! F_total = F_f + F_dt
 //! ```
 //!
@@ -12,15 +12,23 @@
 //! | F_c | constant (Coulomb) drivetrain friction | N |
 //! | ΔF_c | direction asymmetry: the level is F_c + ΔF_c moving forward, F_c − ΔF_c backward (a screw lifting or lowering a load, a seal's lip) | N |
 //! | c_N | friction proportional to the normal load (rolling elements carrying it) | – |
+//! | ΔF_s | the static level's excess over the Coulomb level (Stribeck): F_c + ΔF_s at rest, decaying to F_c over v_s; negative: a friction that rises with speed to F_c | N |
+//! | v_s | the Stribeck speed | m/s |
 //! | b | viscous drivetrain friction | N·s/m |
 //! | c_q | loss growing with the square of the speed (churning, windage, iron and eddy losses of a motor, reflected to the slider) | N·s²/m² |
 //! | v_reg | the contact's sign regularisation (the same tanh) | m/s |
 //!
 //! All zero by default: the estimate is then the contact's alone, bit for bit.
 //! With pre-sliding on (`presliding.rs`) the terms that act at zero speed,
-//! (F_c + c_N F_ext) sgn v + ΔF_c |sgn v|, are part of the bristle's level
-//! (a reversal's compliance is the whole axis's), and only b v + c_q v|v|
-//! is added beside it.
+//! (F_c + c_N F_ext + ΔF_s e^(−(v/v_s)²)) sgn v + ΔF_c |sgn v|, are part of
+//! the bristle's level (a reversal's compliance is the whole axis's), and
+//! only b v + c_q v|v| is added beside it.
+//!
+//! With these terms the classic models are special cases of ours: Coulomb +
+//! viscous (F_c, b), Stribeck with its static level above or below the
+//! Coulomb level (F_c, ΔF_s, v_s, b), and LuGre (the same on the pre-sliding
+//! bristle, σ0 and σ1): a calibration can always reach the best classic's
+//! training error, and the data say where the film adds to it.
 
 use super::{End, FitScale, TermKey};
 
@@ -82,6 +90,34 @@ pub const KEYS: &[TermKey] = &[
         meaning: "loss growing with the square of speed (churning, windage, a motor's iron losses)",
     },
     TermKey {
+        key: "drivetrain.stribeck_n",
+        symbol: "ΔF_s",
+        unit: "N",
+        lo: End::Closed(-1e9),
+        hi: End::Closed(1e9),
+        live: true,
+        fit: FitScale::Data {
+            factor: 1.0,
+            speed_power: 0,
+            per_load: false,
+            symmetric: true,
+        },
+        meaning: "Stribeck: the static level's excess over the Coulomb level, decaying over v_s (negative: rising to it)",
+    },
+    TermKey {
+        key: "drivetrain.stribeck_speed_m_s",
+        symbol: "v_s",
+        unit: "m/s",
+        lo: End::Open(1e-9),
+        hi: End::Closed(100.0),
+        live: true,
+        fit: FitScale::Speed {
+            lo: 1e-3,
+            hi: 3.0,
+        },
+        meaning: "the Stribeck speed: the static excess decays as e^(−(v/v_s)²)",
+    },
+    TermKey {
         key: "drivetrain.coulomb_asymmetry_n",
         symbol: "ΔF_c",
         unit: "N",
@@ -99,7 +135,7 @@ pub const KEYS: &[TermKey] = &[
 ];
 
 /// The drivetrain terms.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Drivetrain {
     /// F_c, N.
     pub coulomb: f64,
@@ -111,6 +147,28 @@ pub struct Drivetrain {
     pub quadratic: f64,
     /// ΔF_c, N.
     pub coulomb_asymmetry: f64,
+    /// ΔF_s, N.
+    pub stribeck: f64,
+    /// v_s, m/s.
+    pub stribeck_speed: f64,
+}
+
+/// The Stribeck speed when none is set, m/s.
+pub const DEFAULT_STRIBECK_SPEED_M_S: f64 = 0.01;
+
+impl Default for Drivetrain {
+    /// Every term off.
+    fn default() -> Self {
+        Self {
+            coulomb: 0.0,
+            viscous: 0.0,
+            load_coefficient: 0.0,
+            quadratic: 0.0,
+            coulomb_asymmetry: 0.0,
+            stribeck: 0.0,
+            stribeck_speed: DEFAULT_STRIBECK_SPEED_M_S,
+        }
+    }
 }
 
 impl Drivetrain {
@@ -121,24 +179,40 @@ impl Drivetrain {
             && self.load_coefficient == 0.0
             && self.quadratic == 0.0
             && self.coulomb_asymmetry == 0.0
+            && self.stribeck == 0.0
+    }
+
+    /// The Coulomb level at speed `v` and load `load` (N): F_c + c_N F +
+    /// ΔF_s e^(−(v/v_s)²) (the Stribeck part only when it is on: off, the
+    /// level is the one before it, bit for bit).
+    #[inline(always)]
+    fn level(&self, v: f64, load: f64) -> f64 {
+        let base = self.coulomb + self.load_coefficient * load;
+        if self.stribeck == 0.0 {
+            base
+        } else {
+            let x = v / self.stribeck_speed;
+            base + self.stribeck * (-x * x).exp()
+        }
     }
 
     /// F_dt at velocity `v` (m/s) and load `load` (N), with the contact's
     /// sign regularisation `v_reg` (m/s).
     pub fn force(&self, v: f64, load: f64, v_reg: f64) -> f64 {
         let s = (v / v_reg).tanh();
-        (self.coulomb + self.load_coefficient * load) * s
+        self.level(v, load) * s
             + self.coulomb_asymmetry * s.abs()
             + self.viscous * v
             + self.quadratic * v * v.abs()
     }
 
-    /// The terms that act at zero speed, with the sign `s` of gross sliding
-    /// (−1, 0 or 1): (F_c + c_N F) s + ΔF_c |s|. With pre-sliding on they
-    /// are part of the bristle's level: the compliance at a reversal is the
-    /// whole axis's, not the contact's alone.
-    pub fn level_at_rest(&self, s: f64, load: f64) -> f64 {
-        (self.coulomb + self.load_coefficient * load) * s + self.coulomb_asymmetry * s.abs()
+    /// The terms that act at zero speed, at speed `v` with the sign `s` of
+    /// gross sliding (−1, 0 or 1): (F_c + c_N F + ΔF_s e^(−(v/v_s)²)) s +
+    /// ΔF_c |s|. With pre-sliding on they are part of the bristle's level:
+    /// the compliance at a reversal is the whole axis's, not the contact's
+    /// alone.
+    pub fn level_at_rest(&self, v: f64, s: f64, load: f64) -> f64 {
+        self.level(v, load) * s + self.coulomb_asymmetry * s.abs()
     }
 
     /// The terms that vanish with the speed: b v + c_q v |v| (outside the
@@ -184,5 +258,37 @@ mod tests {
         approx::assert_relative_eq!(d.force(-1e-3, 0.0, 1e-6), -3.0 - 1e-4, max_relative = 1e-12);
         assert_eq!(d.force(0.0, 0.0, 1e-6), 0.0);
         assert!(!d.is_zero());
+    }
+
+    #[test]
+    fn a_stribeck_term_starts_at_its_static_level_and_decays_to_the_coulomb_level_over_v_s() {
+        for excess in [3.0, -3.0] {
+            let d = Drivetrain {
+                coulomb: 10.0,
+                stribeck: excess,
+                stribeck_speed: 0.01,
+                ..Default::default()
+            };
+            // At rest (well past v_reg): F_c + ΔF_s; at v_s: e^-1 of the excess.
+            approx::assert_relative_eq!(
+                d.force(1e-5, 0.0, 1e-9),
+                10.0 + excess,
+                max_relative = 1e-5
+            );
+            approx::assert_relative_eq!(
+                d.force(0.01, 0.0, 1e-9),
+                10.0 + excess / std::f64::consts::E,
+                max_relative = 1e-12
+            );
+            approx::assert_relative_eq!(d.force(0.1, 0.0, 1e-9), 10.0, max_relative = 1e-12);
+            approx::assert_relative_eq!(d.force(-0.01, 0.0, 1e-9), -d.force(0.01, 0.0, 1e-9));
+            approx::assert_relative_eq!(d.level_at_rest(0.0, 1.0, 0.0), 10.0 + excess);
+        }
+        // Off, the level is the one before the term, bit for bit.
+        let off = Drivetrain {
+            coulomb: 10.0,
+            ..Default::default()
+        };
+        assert_eq!(off.force(0.003, 0.0, 1e-4), 10.0 * (0.003f64 / 1e-4).tanh());
     }
 }

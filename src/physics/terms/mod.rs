@@ -113,6 +113,22 @@ pub enum FitScale {
         /// Bounds either side of zero (a signed term).
         symmetric: bool,
     },
+    /// A speed: [lo · v, hi · v], v the data's largest speed (log scale).
+    Speed {
+        /// The lower bound as a fraction of the data's largest speed.
+        lo: f64,
+        /// The upper bound as a multiple of it.
+        hi: f64,
+    },
+    /// A stiffness: [F / x_hi, F / x_lo], F the data's largest friction:
+    /// the displacement |F|/k at which the force builds lies within
+    /// [x_lo, x_hi] (m).
+    Stiffness {
+        /// The smallest displacement, m.
+        x_lo: f64,
+        /// The largest displacement, m.
+        x_hi: f64,
+    },
 }
 
 /// One configuration key of a friction term.
@@ -200,6 +216,34 @@ impl FrictionTerms {
     }
 }
 
+impl FrictionTerms {
+    /// Set the term key `key` (one that acts after the film, see
+    /// [`acts_after_the_film`]) to `value`; false for any other key. The
+    /// value is taken as it is (the caller keeps it in the key's valid
+    /// range).
+    pub fn set(&mut self, key: &str, value: f64) -> bool {
+        let d = &mut self.drivetrain;
+        let slot = match key {
+            "contact.boundary_friction" => &mut self.boundary_friction,
+            "contact.sign_regularization_m_s" => &mut self.sign_regularization,
+            "contact.boundary_friction_rate" => &mut self.boundary_rate.sensitivity,
+            "contact.boundary_activation_speed_m_s" => &mut self.boundary_rate.activation_speed,
+            "contact.presliding_stiffness_n_m" => &mut self.presliding.stiffness,
+            "contact.presliding_damping_n_s_m" => &mut self.presliding.damping,
+            "drivetrain.coulomb_n" => &mut d.coulomb,
+            "drivetrain.viscous_n_s_m" => &mut d.viscous,
+            "drivetrain.load_coefficient" => &mut d.load_coefficient,
+            "drivetrain.quadratic_n_s2_m2" => &mut d.quadratic,
+            "drivetrain.stribeck_n" => &mut d.stribeck,
+            "drivetrain.stribeck_speed_m_s" => &mut d.stribeck_speed,
+            "drivetrain.coulomb_asymmetry_n" => &mut d.coulomb_asymmetry,
+            _ => return false,
+        };
+        *slot = value;
+        true
+    }
+}
+
 /// What the composition produced at one state.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Composed {
@@ -266,7 +310,7 @@ impl FrictionTerms {
         }
         // What acts at zero speed rides on the bristle; the contact's share
         // of its force is its share of the level.
-        let level = level_c + dt.level_at_rest(sgn(v), load);
+        let level = level_c + dt.level_at_rest(v, sgn(v), load);
         let f = self.bristle(level, v, bristle, how);
         let contact = if level == 0.0 {
             f

@@ -59,9 +59,14 @@ pub const KEYS: &[TermKey] = &[
         lo: End::Closed(0.0),
         hi: End::Closed(1e15),
         live: true,
-        // A stiffness that is off starts at the data's stiffness through
-        // its reversals (the fit's own rule), else a decade either side.
-        fit: FitScale::FromStart,
+        // Searched over its physical range: the force builds over a
+        // displacement between 0.1 µm (hard metal asperities) and 1 mm (an
+        // elastomer's body); a stiffness that is off starts at the data's
+        // stiffness through its reversals (the fit's own rule).
+        fit: FitScale::Stiffness {
+            x_lo: 1e-7,
+            x_hi: 1e-3,
+        },
         meaning: "tangential stiffness before gross sliding (a bristle on the model's own level); 0 = rigid",
     },
     TermKey {

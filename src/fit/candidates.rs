@@ -1,0 +1,282 @@
+//! The candidate terms of `--fit auto` ([`CANDIDATES`]): the groups of
+//! configuration keys a recording can show, the keys that are not
+//! candidates and why, the keys of a set, and which candidates the data at
+//! hand allow. The rule that chooses among them is `select.rs`'s.
+
+use super::prepared::{model_for, Prepared};
+use super::unknowns::ParamSpec;
+
+/// The word in `--fit` that asks for the selection.
+pub const AUTO: &str = "auto";
+
+/// A term the selection may add.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Candidate {
+    /// Its name in the report.
+    pub name: &'static str,
+    /// The keys it fits.
+    pub keys: &'static [&'static str],
+    /// A candidate that must be chosen first.
+    pub requires: Option<&'static str>,
+    /// Only when the training loads vary.
+    pub needs_varying_load: bool,
+}
+
+/// The candidate terms, in the order they are tried.
+pub const CANDIDATES: &[Candidate] = &[
+    Candidate {
+        name: "film",
+        keys: &["lubricant.viscosity_pa_s"],
+        requires: None,
+        needs_varying_load: false,
+    },
+    Candidate {
+        name: "boundary rate",
+        keys: &[
+            "contact.boundary_friction_rate",
+            "contact.boundary_activation_speed_m_s",
+        ],
+        requires: None,
+        needs_varying_load: false,
+    },
+    Candidate {
+        name: "pre-sliding",
+        keys: &["contact.presliding_stiffness_n_m"],
+        requires: None,
+        needs_varying_load: false,
+    },
+    Candidate {
+        name: "pre-sliding damping",
+        keys: &["contact.presliding_damping_n_s_m"],
+        requires: Some("pre-sliding"),
+        needs_varying_load: false,
+    },
+    Candidate {
+        name: "drivetrain Coulomb",
+        keys: &["drivetrain.coulomb_n"],
+        requires: None,
+        needs_varying_load: false,
+    },
+    Candidate {
+        name: "drivetrain viscous",
+        keys: &["drivetrain.viscous_n_s_m"],
+        requires: None,
+        needs_varying_load: false,
+    },
+    Candidate {
+        name: "drivetrain quadratic",
+        keys: &["drivetrain.quadratic_n_s2_m2"],
+        requires: None,
+        needs_varying_load: false,
+    },
+    Candidate {
+        // The classic Stribeck curve on our level: the static excess, its
+        // speed and the viscous rise (a dip needs the rise beside it; alone
+        // neither pays).
+        name: "drivetrain Stribeck",
+        keys: &[
+            "drivetrain.stribeck_n",
+            "drivetrain.stribeck_speed_m_s",
+            "drivetrain.viscous_n_s_m",
+        ],
+        requires: None,
+        needs_varying_load: false,
+    },
+    Candidate {
+        name: "drivetrain asymmetry",
+        keys: &["drivetrain.coulomb_asymmetry_n"],
+        requires: None,
+        needs_varying_load: false,
+    },
+    Candidate {
+        name: "drivetrain load",
+        keys: &["drivetrain.load_coefficient"],
+        requires: None,
+        needs_varying_load: true,
+    },
+];
+
+/// The keys of the catalogue that are not candidates, and why.
+pub const NOT_CANDIDATES: &[(&str, &str)] = &[
+    (
+        "contact.boundary_friction",
+        "always fitted: the contact's sliding level",
+    ),
+    (
+        "contact.sign_regularization_m_s",
+        "a numerical device, not a property of the contact",
+    ),
+    (
+        "contact.width_load_exponent",
+        "the contact's material (rigid or soft): set in the configuration",
+    ),
+    (
+        "contact.width_reference_load_n",
+        "the contact's material (rigid or soft): set in the configuration",
+    ),
+];
+
+/// The key always fitted.
+pub const BASE_KEY: &str = "contact.boundary_friction";
+
+/// Whether the selection may fit configuration key `key` (the base key,
+/// or a key of a candidate): a bound or start on it is accepted under
+/// `--fit auto`, and used if its term is chosen.
+pub fn may_choose(key: &str) -> bool {
+    key == BASE_KEY || CANDIDATES.iter().any(|c| c.keys.contains(&key))
+}
+
+/// Every key the selection may fit, the base key first.
+pub fn choosable_keys() -> Vec<&'static str> {
+    std::iter::once(BASE_KEY)
+        .chain(CANDIDATES.iter().flat_map(|c| c.keys.iter().copied()))
+        .collect()
+}
+
+/// Whether `--fit` asks for the selection; the names besides `auto`.
+pub fn split(keys: &[String]) -> (bool, Vec<String>) {
+    let auto = keys.iter().any(|k| k.trim() == AUTO);
+    (
+        auto,
+        keys.iter().filter(|k| k.trim() != AUTO).cloned().collect(),
+    )
+}
+
+/// The specs of a set: the set's keys, then the given names' specs (a
+/// given spec replaces a key's default one; a spec given only in case its
+/// term is chosen, [`ParamSpec::if_chosen`], is used only then).
+pub fn set_specs(given: &[ParamSpec], keys: &[&str]) -> Vec<ParamSpec> {
+    let mut specs: Vec<ParamSpec> = keys
+        .iter()
+        .map(|k| ParamSpec {
+            name: k.to_string(),
+            ..Default::default()
+        })
+        .collect();
+    for g in given {
+        if let Some(s) = specs.iter_mut().find(|s| s.name == g.name) {
+            *s = ParamSpec {
+                if_chosen: false,
+                ..g.clone()
+            };
+        } else if !g.if_chosen {
+            specs.push(g.clone());
+        }
+    }
+    specs
+}
+
+/// The keys of a set of candidates, the base key first, each once (two
+/// candidates may share one: the Stribeck curve's viscous rise).
+pub(super) fn set_keys(terms: &[&'static str]) -> Vec<&'static str> {
+    let mut keys = vec![BASE_KEY];
+    for t in terms {
+        if let Some(c) = CANDIDATES.iter().find(|c| c.name == *t) {
+            keys.extend(
+                c.keys
+                    .iter()
+                    .filter(|k| !keys.contains(k))
+                    .collect::<Vec<_>>(),
+            );
+        }
+    }
+    keys
+}
+
+/// The candidates on `p`'s data: those whose keys can be set up (a
+/// candidate without bounds to derive, pre-sliding without a reversal, is
+/// not one here, and is returned with why), that the loads allow and that
+/// no given name already fits.
+pub(super) fn candidates_here(
+    p: &Prepared,
+    given: &[ParamSpec],
+) -> (Vec<&'static Candidate>, Vec<String>) {
+    let mut excluded: Vec<String> = Vec::new();
+    let mut candidates = Vec::new();
+    let no_reversal = p.scale.reversal_stiffness_n_m.is_none();
+    for c in CANDIDATES {
+        if c.needs_varying_load && !p.loads_vary {
+            continue;
+        }
+        // A name given to --fit already fits it (a bound or start given in
+        // case it is chosen does not).
+        let fitted = |k: &&str| given.iter().any(|g| g.name == *k && !g.if_chosen);
+        if c.keys.iter().any(fitted) {
+            continue;
+        }
+        if no_reversal && c.keys.iter().any(|k| k.contains("presliding_")) {
+            excluded.push(format!(
+                "{}: the data hold no velocity reversal, and pre-sliding shows only through one",
+                c.name
+            ));
+            continue;
+        }
+        let keys: Vec<&str> = std::iter::once(BASE_KEY)
+            .chain(c.keys.iter().copied())
+            .collect();
+        match model_for(p, &set_specs(given, &keys), &[]) {
+            Ok(_) => candidates.push(c),
+            Err(e) => excluded.push(format!("{}: {e}", c.name)),
+        }
+    }
+    (candidates, excluded)
+}
+
+/// The candidate named `film` (the viscosity), and its key.
+pub(super) const FILM: &str = "film";
+/// See [`FILM`].
+pub(super) const FILM_KEY: &str = "lubricant.viscosity_pa_s";
+
+/// `--fit` as `auto`, the names given besides it, and the specs our model
+/// starts with (with `auto`: the base key first; the selection chooses the
+/// rest).
+pub fn initial_specs(params: &[ParamSpec]) -> (bool, Vec<ParamSpec>, Vec<ParamSpec>) {
+    let auto = params.iter().any(|s| s.name == AUTO);
+    let given: Vec<ParamSpec> = params.iter().filter(|s| s.name != AUTO).cloned().collect();
+    // A bound or start given in case its term is chosen fits nothing yet
+    // (the base key's applies at once: it is always fitted).
+    let mut specs: Vec<ParamSpec> = given
+        .iter()
+        .filter(|s| !s.if_chosen || s.name == BASE_KEY)
+        .map(|s| ParamSpec {
+            if_chosen: false,
+            ..s.clone()
+        })
+        .collect();
+    if auto && !specs.iter().any(|s| s.name == BASE_KEY) {
+        specs.insert(
+            0,
+            ParamSpec {
+                name: BASE_KEY.into(),
+                ..Default::default()
+            },
+        );
+    }
+    (auto, given, specs)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_key_of_the_term_catalogue_is_a_candidate_or_says_why_not() {
+        for k in crate::physics::terms::catalogue() {
+            let candidate = CANDIDATES.iter().any(|c| c.keys.contains(&k.key));
+            let excluded = NOT_CANDIDATES.iter().any(|(n, _)| *n == k.key);
+            assert!(
+                candidate ^ excluded,
+                "{}: a candidate of --fit auto, or in NOT_CANDIDATES with a reason",
+                k.key
+            );
+        }
+    }
+
+    #[test]
+    fn auto_is_found_among_the_names_and_the_rest_kept() {
+        let (auto, rest) = split(&["auto".into(), "a_eff".into(), "f0".into()]);
+        assert!(auto);
+        assert_eq!(rest, vec!["a_eff".to_string(), "f0".to_string()]);
+        assert!(!split(&["contact.boundary_friction".into()]).0);
+    }
+}

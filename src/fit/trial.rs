@@ -1,0 +1,242 @@
+//! One set of candidate terms tried by `--fit auto`: fitted on the
+//! training data (warm-started from the set before it, speed-like keys of
+//! a new term also started where the data could bend the curve), then
+//! scored by cross-validation, each fold predicted by the set refitted
+//! without it.
+
+use super::candidates::{set_keys, set_specs, CANDIDATES, FILM, FILM_KEY};
+use super::cross_validate::cross_validate;
+use super::driver::fit;
+use super::options::{Options, SearchSettings};
+use super::prepared::{model_for, Prepared};
+use super::problem::{Data, Folds, Model};
+use super::unknowns::ParamSpec;
+use super::FitError;
+
+/// One set tried: its candidates, CV error per fold and pooled.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Tried {
+    /// The candidates in the set (besides the base).
+    pub terms: Vec<&'static str>,
+    /// Held-out mean squared error per fold.
+    pub fold_mse: Vec<f64>,
+    /// The pooled CV RMS.
+    pub cv_rms: f64,
+    /// Model evaluations it took.
+    pub simulations: usize,
+}
+
+/// A candidate set's fit, for warm starts and the report.
+pub(super) type Optimum = Vec<(String, f64)>;
+
+/// A set fitted and scored: its report line, its optimum (by name) and
+/// what its fit says of each key.
+pub(super) struct Scored {
+    pub(super) tried: Tried,
+    pub(super) optimum: Optimum,
+    /// Per fitted parameter: (name, at a bound or at zero, the largest
+    /// |correlation| with another parameter).
+    pub(super) flags: Vec<(String, bool, f64)>,
+}
+
+/// What a selection's fits share: the data, the settings, the names given.
+pub(super) struct Ctx<'a> {
+    pub(super) p: &'a Prepared,
+    pub(super) data: Data,
+    pub(super) folds: Folds,
+    pub(super) search: &'a SearchSettings,
+    pub(super) stop: &'a crate::interrupt::Stop,
+    pub(super) given: &'a [ParamSpec],
+}
+
+/// The viscosities that put the film's transition inside the data, when
+/// the contact's scale put it far above them (`contact_scale.rs`): at the
+/// top speed, the slowest sliding speed and between (the transition speed
+/// goes as 1/μ at a given load, the Hersey number). Empty otherwise.
+fn film_placements(p: &Prepared) -> Vec<f64> {
+    let Some(scale) = p.contact_scale.as_ref().filter(|s| s.chosen) else {
+        return Vec::new();
+    };
+    let top = p.model_scale.velocity_m_s;
+    let slow = slow_speed(p).unwrap_or(0.1 * top) * scale.gain;
+    let mu0 = p.model_config.lubricant.viscosity_pa_s;
+    let v_t = super::contact_scale::TRANSITION_FAR * top;
+    [top, (slow * top).sqrt(), slow]
+        .iter()
+        .map(|target| (mu0 * v_t / target).min(MAX_PLACED_VISCOSITY_PA_S))
+        .collect()
+}
+
+/// Where a new term's speed-like key starts besides its own start: the
+/// film's viscosity at [`film_placements`]; a Stribeck speed or a boundary
+/// film's activation speed at the data's slowest sliding speed, its top
+/// speed and between (contact units). A term that bends the curve at a
+/// speed has as many optima as the data have places to bend it: one start
+/// finds one of them.
+fn placements(p: &Prepared, key: &str) -> Vec<f64> {
+    match key {
+        FILM_KEY => film_placements(p),
+        "drivetrain.stribeck_speed_m_s" | "contact.boundary_activation_speed_m_s" => {
+            let gain = p.contact_scale.as_ref().map_or(1.0, |s| s.gain);
+            let top = p.model_scale.velocity_m_s;
+            let slow = slow_speed(p).map_or(0.1 * top, |v| v * gain);
+            vec![slow, (slow * top).sqrt(), top]
+        }
+        _ => Vec::new(),
+    }
+}
+
+/// The largest viscosity a placement asks for (the key's valid range ends
+/// at 100 Pa·s).
+const MAX_PLACED_VISCOSITY_PA_S: f64 = 99.0;
+
+/// The slowest sliding speed of the training data (the tenth percentile of
+/// |v| over the samples faster than a hundredth of the top speed), in the
+/// data's units.
+fn slow_speed(p: &Prepared) -> Option<f64> {
+    let mut v: Vec<f64> = p
+        .data
+        .train
+        .iter()
+        .filter_map(|s| s.series(&p.data.map_values).ok())
+        .flat_map(|s| s.velocity.into_iter().map(f64::abs))
+        .collect();
+    let top = v.iter().copied().fold(0.0f64, f64::max);
+    v.retain(|x| *x > 0.01 * top);
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 10).copied()
+}
+
+impl Ctx<'_> {
+    /// Fit the set `terms` on the training data, warm-started from `warm`,
+    /// and score it by cross-validation (each fold refitted without it).
+    pub(super) fn try_set(
+        &self,
+        terms: &[&'static str],
+        warm: &Optimum,
+    ) -> Result<Scored, FitError> {
+        let mut specs = set_specs(self.given, &set_keys(terms));
+        let placements = if terms.contains(&FILM) {
+            film_placements(self.p)
+        } else {
+            Vec::new()
+        };
+        if !placements.is_empty() {
+            // Bounds wide enough for every placement, unless given.
+            if let Some(s) = specs
+                .iter_mut()
+                .find(|s| s.name == FILM_KEY && s.bounds.is_none())
+            {
+                let mu0 = self.p.model_config.lubricant.viscosity_pa_s;
+                s.bounds = Some((mu0 / 10.0, 100.0));
+            }
+        }
+        let (model, map_fit) = model_for(self.p, &specs, warm)?;
+        let new_keys: Vec<&str> = terms
+            .iter()
+            .filter_map(|t| CANDIDATES.iter().find(|c| c.name == *t))
+            .flat_map(|c| c.keys.iter().copied())
+            .filter(|k| warm.iter().all(|(n, _)| n != k))
+            .collect();
+        let mut options = Options {
+            starts: 1,
+            global_points: 0,
+            max_evaluations: self.search.max_evaluations,
+            stop: self.stop.clone(),
+            jacobian: self.search.jacobian,
+            // The selection compares sets at the percent level: a looser
+            // convergence than the final fit's.
+            ftol: 1e-6,
+            xtol: 1e-5,
+            ..Default::default()
+        };
+        let start: Vec<f64> = model
+            .parameters()
+            .iter()
+            .map(|q| q.start)
+            .chain(map_fit.iter().map(|(_, q)| q.start))
+            .collect();
+        for (i, q) in model.parameters().iter().enumerate() {
+            if !new_keys.contains(&q.name.as_str()) {
+                continue;
+            }
+            let values = if q.name == FILM_KEY {
+                placements.clone()
+            } else {
+                self::placements(self.p, &q.name)
+            };
+            for v in values {
+                let mut x = start.clone();
+                x[i] = v.clamp(q.lo, q.hi);
+                options.extra_starts.push(x);
+            }
+        }
+        let fitted = match fit(&model, &self.data, map_fit.clone(), &options) {
+            Ok(o) => o,
+            Err(FitError::Interrupted(i)) => return Err(FitError::Interrupted(i)),
+            Err(_) => {
+                return Ok(Scored {
+                    tried: Tried {
+                        terms: terms.to_vec(),
+                        fold_mse: vec![f64::INFINITY; self.folds.count()],
+                        cv_rms: f64::INFINITY,
+                        simulations: 0,
+                    },
+                    optimum: Vec::new(),
+                    flags: Vec::new(),
+                })
+            }
+        };
+        let fold_mse = cross_validate(
+            &model,
+            &self.data,
+            &map_fit,
+            &fitted.best,
+            self.folds,
+            &options,
+        )?;
+        let cv_rms = super::cross_validate::cv_rms(&fold_mse);
+        let flags = flags_of(&fitted);
+        Ok(Scored {
+            tried: Tried {
+                terms: terms.to_vec(),
+                fold_mse,
+                cv_rms,
+                simulations: model.film_solves(),
+            },
+            optimum: fitted
+                .params
+                .iter()
+                .map(|q| q.name.clone())
+                .zip(fitted.best.iter().copied())
+                .collect(),
+            flags,
+        })
+    }
+}
+
+/// Per fitted parameter of `o`: its name, whether it ended at a bound or
+/// at zero, and its largest |correlation| with another parameter.
+fn flags_of(o: &super::driver::FitOutcome) -> Vec<(String, bool, f64)> {
+    let st = &o.statistics;
+    o.params
+        .iter()
+        .enumerate()
+        .map(|(j, q)| {
+            let at_bound = st.at_bound.get(j).copied().unwrap_or(false);
+            let zero = o.best[j] == 0.0;
+            let rho = st
+                .correlation
+                .get(j)
+                .map(|row| {
+                    row.iter()
+                        .enumerate()
+                        .filter(|(i, _)| *i != j)
+                        .map(|(_, r)| if r.is_nan() { 1.0 } else { r.abs() })
+                        .fold(0.0, f64::max)
+                })
+                .unwrap_or(0.0);
+            (q.name.clone(), at_bound || zero, rho)
+        })
+        .collect()
+}
