@@ -333,6 +333,46 @@ fn a_rotary_report_speaks_in_the_joints_units_and_names_its_lever() {
 }
 
 #[test]
+fn friction_whose_sign_opposes_the_velocity_is_refused_naming_the_sign_not_fitted() {
+    let d = dir("sign");
+    let joint = joint_record(&d, 0.5, 2.0);
+    let fit = |friction: &str| {
+        run(&[
+            "fit",
+            joint.to_str().unwrap(),
+            "--rotary",
+            "--velocity",
+            "velocity_rad_s",
+            "--friction",
+            friction,
+            "--set",
+            "solver.cells=32",
+            "--fit",
+            "auto",
+            "--starts",
+            "1",
+            "--global-points",
+            "0",
+            "--max-evaluations",
+            "10",
+            "--out",
+            d.join("f.yaml").to_str().unwrap(),
+        ])
+    };
+    // The recording's torque as a drive would log the reaction: negated.
+    let (code, _, err) = fit("-torque_nm");
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("its sign opposes the velocity's") && err.contains("--friction '-(EXPR)'"),
+        "{err}"
+    );
+    assert!(!d.join("f.yaml").exists());
+    // The same record with its own sign is fitted.
+    let (code, _, err) = fit("torque_nm");
+    assert!(code == 0 || code == 4, "{err}");
+}
+
+#[test]
 fn a_fast_joint_is_asked_whether_its_velocity_is_in_degrees_per_second() {
     let d = dir("deg-s");
     // 0.5 rad/s written as deg/s: 28.6 "rad/s".
