@@ -331,8 +331,12 @@ class FitResult:
     model's level and offset error per held-out source, markdown; the level
     error is the friction too large or small in magnitude, the offset error
     the part that is the same in both directions of motion), ``fitted_yaml``
-    (the complete fitted parameter file), ``summary`` (the command's summary
-    text), ``raw``.
+    (the complete fitted parameter file), ``calibrated_range`` (dict: where
+    the calibration holds, as the fitted file's ``calibrated_range``: the
+    speeds by direction, loads and temperatures where they were inputs, a
+    time series' largest acceleration, in the contact's units, and the
+    training error with its sample count; None when the data give no
+    range), ``summary`` (the command's summary text), ``raw``.
     """
 
     def __init__(self, raw: dict):
@@ -344,6 +348,7 @@ class FitResult:
         self.train_rms_n = raw["train_rms_n"]
         self.held_out_rms_n = raw["held_out_rms_n"]
         self.fitted_yaml = raw["fitted_yaml"]
+        self.calibrated_range = raw.get("calibrated_range")
         self.summary = raw["summary"]
         self.notes = raw["notes"]
         rows = []

@@ -111,6 +111,11 @@ def test_fit_recovers_boundary_friction_and_equals_the_cli(cli, tmp_path):
     assert r.converged
     assert r.value("contact.boundary_friction") == pytest.approx(0.22, rel=1e-3)
     assert r.train_rms_n < 1.0
+    # Where it was calibrated: the sine's speeds each way, 2001 samples.
+    assert r.calibrated_range["speed_forward_max_m_s"] == pytest.approx(1.0, rel=1e-3)
+    assert r.calibrated_range["speed_backward_max_m_s"] == pytest.approx(1.0, rel=1e-3)
+    assert r.calibrated_range["training_samples"] == 2001
+    assert "calibrated_range:" in r.fitted_yaml
     out = tmp_path / "cli.yaml"
     cli("--set", "solver.cells=32", "fit", data, "--fit", "contact.boundary_friction",
         "--starts", "1", "--global-points", "0", "--out", out)

@@ -24,7 +24,7 @@
 //! after loading (so `to_yaml` writes every key of every contact).
 
 use super::model::{ContactConfig, LubricantConfig, RoughnessConfig, TextureConfig};
-use super::{Config, ConfigError};
+use super::{CalibratedRange, Config, ConfigError};
 use serde::de::{MapAccess, Visitor};
 use serde::ser::SerializeMap;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
@@ -62,6 +62,8 @@ pub struct ContactEntry {
     pub roughness: RoughnessConfig,
     /// Overrides of the `solver` section (its grid).
     pub solver: ContactSolverConfig,
+    /// Where this contact was calibrated (absent: not watched).
+    pub calibrated_range: Option<CalibratedRange>,
 }
 
 /// `contacts.NAME.solver.*`: what a contact may change of the solver.
@@ -98,6 +100,8 @@ struct ContactBody {
     roughness: RoughnessConfig,
     #[serde(default)]
     solver: ContactSolverConfig,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    calibrated_range: Option<CalibratedRange>,
 }
 
 fn unit_gain() -> f64 {
@@ -128,6 +132,7 @@ impl Serialize for ContactList {
                 lubricant: e.lubricant.clone(),
                 roughness: e.roughness.clone(),
                 solver: e.solver.clone(),
+                calibrated_range: e.calibrated_range.clone(),
             };
             map.serialize_entry(&e.name, &body)?;
         }
@@ -156,6 +161,7 @@ impl<'de> Deserialize<'de> for ContactList {
                         lubricant: b.lubricant,
                         roughness: b.roughness,
                         solver: b.solver,
+                        calibrated_range: b.calibrated_range,
                     });
                 }
                 Ok(ContactList(out))
@@ -302,6 +308,7 @@ impl Config {
             texture: e.texture.clone(),
             lubricant: e.lubricant.clone(),
             roughness: e.roughness.clone(),
+            calibrated_range: e.calibrated_range.clone(),
             ..self.clone()
         };
         config.solver.cells = e.solver.cells;
@@ -375,6 +382,17 @@ impl Config {
                 .and_then(|_| c.validate_roughness())
                 .and_then(|_| c.validate_solver())
                 .map_err(|err| prefix_key(err, &format!("contacts.{}.", e.name)))?;
+            if let Some(r) = &e.calibrated_range {
+                r.validate(&key("calibrated_range"))?;
+            }
+        }
+        if self.calibrated_range.is_some() && !self.contacts.0.is_empty() {
+            return Err(ConfigError::InvalidValue {
+                key: "calibrated_range".into(),
+                message:
+                    "with `contacts`, each contact has its own: contacts.NAME.calibrated_range"
+                        .into(),
+            });
         }
         Ok(())
     }

@@ -28,6 +28,7 @@
 //! | `validate_node.rs` | ranges and names of the node's sections (`node`, `ros`, `iceoryx2`, `recording`), the snapshot ring's memory |
 //! | `ros_names.rs` | the ROS 2 naming rules for topics, node names and namespaces |
 //! | `contacts.rs` | `contacts.*`: several contacts, each overriding the top-level sections |
+//! | `calibrated_range.rs` | where a fitted file was calibrated ([`CalibratedRange`]): speeds by direction, loads, temperatures, the training error |
 //! | `error.rs` | [`ConfigError`] and the [`Origin`] of a configuration |
 //! | `envelope.rs` | the inputs every entry point accepts: velocity, load, temperature ([`Envelope`]) |
 //! | `parameters.rs` | the live-parameter catalogue (declared keys, types, ranges, writability) and [`parameters::apply_set`] |
@@ -35,6 +36,7 @@
 //! | `ros_args.rs` | `--ros-args` as rcl parses them (a `launch_ros` Node action) |
 //! | `tests.rs` | unit tests of loading, overrides and validation |
 
+mod calibrated_range;
 mod contacts;
 mod envelope;
 mod error;
@@ -48,6 +50,7 @@ pub mod topics;
 mod validate;
 mod validate_node;
 
+pub use calibrated_range::{CalibratedRange, RangeSide};
 pub use contacts::{
     ContactEntry, ContactList, ContactSolverConfig, OutputPlan, ResolvedContact, CONTACT_SECTIONS,
     MAX_CONTACTS, MAX_JOINT_NAME_BYTES, SINGLE_CONTACT_NAME,
@@ -104,6 +107,10 @@ pub struct Config {
     pub iceoryx2: Iceoryx2Config,
     /// `recording`: MCAP, ROS 2 profile (run --record FILE enables it)
     pub recording: RecordingConfig,
+    /// `calibrated_range`: where the one contact was calibrated (written
+    /// by `fit`; absent: not watched).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub calibrated_range: Option<CalibratedRange>,
     /// Several contacts, each overriding the top-level sections (last, so
     /// that a top-level mistake is reported first).
     #[serde(skip_serializing_if = "ContactList::is_empty")]

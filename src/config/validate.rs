@@ -136,6 +136,9 @@ impl Config {
         self.validate_ros()?;
         self.validate_iceoryx2()?;
         self.validate_recording()?;
+        if let Some(r) = &self.calibrated_range {
+            r.validate("calibrated_range")?;
+        }
         self.validate_contacts()
     }
 

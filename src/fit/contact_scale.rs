@@ -396,9 +396,11 @@ pub fn on_joint(config: Config, joint: &str, gain: f64) -> Config {
         solver: ContactSolverConfig {
             cells: config.solver.cells,
         },
+        calibrated_range: config.calibrated_range.clone(),
     };
     Config {
         contacts: ContactList(vec![entry]),
+        calibrated_range: None,
         ..config
     }
 }

@@ -31,6 +31,7 @@
 //! | `compare.rs` | ours and the classic models fitted on the same data with the same optimiser |
 //! | `report.rs` | the summary, the tables, plots, the fitted YAML |
 //! | `by_direction.rs` | the residual by direction of motion: level and offset errors |
+//! | `calibrated_range.rs` | the calibrated range from the training samples (into the fitted file); where held-out data lie against it, the error inside and outside |
 //! | `cross_validate.rs` | cross-validation by what a calibration is used for: the folds (files, time blocks, speed ranges) and each fold's refit |
 //! | `prepared.rs` | what `prepare` makes: the data and our model for them; our model for another set of keys |
 //! | `driver.rs` | one model's whole fit: global phase, local runs, statistics, predictions |
@@ -56,6 +57,7 @@
 pub mod bag_input;
 pub mod baselines;
 pub mod by_direction;
+pub mod calibrated_range;
 pub mod candidates;
 pub mod compare;
 pub mod contact_scale;

@@ -146,7 +146,21 @@ impl FitRequest {
             self.search.starts,
             self.search.global_points
         ));
-        let ours = fit_ours(&p, &self.search, progress, stop, self.baselines)?;
+        let mut ours = fit_ours(&p, &self.search, progress, stop, self.baselines)?;
+        // The range the calibration saw, into the fitted file and the report.
+        let gain = p.contact_scale.as_ref().map_or(1.0, |s| s.gain);
+        let range =
+            super::calibrated_range::of_training(&ours.outcome.train, ours.outcome.train_rms, gain);
+        if range.validate("calibrated_range").is_ok() {
+            match ours.config.contacts.0.first_mut() {
+                Some(contact) => contact.calibrated_range = Some(range.clone()),
+                None => ours.config.calibrated_range = Some(range.clone()),
+            }
+            extra_md.insert_str(
+                0,
+                &super::calibrated_range::section(&ours.outcome, &range, gain),
+            );
+        }
         let yaml = super::report::fitted_yaml(&ours.config, &ours.outcome, &p.names, &ours.map);
         if let Some(o) = &outputs.fitted {
             crate::output::write_file(o, yaml.as_bytes())?;

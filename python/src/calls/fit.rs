@@ -202,6 +202,44 @@ pub fn fit<'py>(
     }
     d.set_item("notes", notes)?;
     d.set_item("summary_md", c.summary_md())?;
+    let range = c.ours.config.calibrated_range.as_ref().or_else(|| {
+        c.ours
+            .config
+            .contacts
+            .0
+            .first()
+            .and_then(|e| e.calibrated_range.as_ref())
+    });
+    d.set_item(
+        "calibrated_range",
+        range.map(|r| range_dict(py, r)).transpose()?,
+    )?;
+    Ok(d)
+}
+
+/// A calibrated range as a dict of its keys (None where a range was not
+/// an input).
+fn range_dict<'py>(
+    py: Python<'py>,
+    r: &friction_node::config::CalibratedRange,
+) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let pairs = [
+        ("speed_forward_min_m_s", r.speed_forward_min_m_s),
+        ("speed_forward_max_m_s", r.speed_forward_max_m_s),
+        ("speed_backward_min_m_s", r.speed_backward_min_m_s),
+        ("speed_backward_max_m_s", r.speed_backward_max_m_s),
+        ("load_min_n", r.load_min_n),
+        ("load_max_n", r.load_max_n),
+        ("temperature_min_c", r.temperature_min_c),
+        ("temperature_max_c", r.temperature_max_c),
+        ("acceleration_max_m_s2", r.acceleration_max_m_s2),
+    ];
+    for (k, v) in pairs {
+        d.set_item(k, v)?;
+    }
+    d.set_item("training_rms_n", r.training_rms_n)?;
+    d.set_item("training_samples", r.training_samples)?;
     Ok(d)
 }
 

@@ -1,0 +1,306 @@
+//! The calibrated range of a fit ([`CalibratedRange`], written into the
+//! fitted file) from the training samples, and where the held-out and
+//! validation data lie against it: the share outside, how far, and the
+//! error inside and outside separately.
+//!
+//! The data are in the axis's units (m/s and N, or rad/s and N·m); the
+//! range is in the contact's, through the gain g (contact speed g ẋ,
+//! contact force F_axis / g).
+
+use super::problem::SeriesFit;
+use super::{FitOutcome, Units};
+use crate::config::{CalibratedRange, RangeSide};
+use crate::text::Num;
+use std::fmt::Write as _;
+
+/// The samples of `s` that the fit used (all, when none is marked).
+fn used(s: &SeriesFit) -> impl Iterator<Item = usize> + '_ {
+    let all = s.series.fit.iter().all(|f| !*f);
+    (0..s.series.len()).filter(move |k| all || s.series.fit.get(*k).copied().unwrap_or(true))
+}
+
+/// (min, max) of `values`, None when empty.
+fn span(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
+    values.fold(None, |acc, v| match acc {
+        None => Some((v, v)),
+        Some((lo, hi)) => Some((lo.min(v), hi.max(v))),
+    })
+}
+
+/// The range of the training samples `train` (fitted with RMS error
+/// `train_rms`, axis units) through gain `gain`.
+pub fn of_training(train: &[SeriesFit], train_rms: f64, gain: f64) -> CalibratedRange {
+    let samples = || train.iter().flat_map(|s| used(s).map(move |k| (s, k)));
+    let speeds = |forward: bool| {
+        span(
+            samples()
+                .map(|(s, k)| s.series.velocity[k])
+                .filter(|v| if forward { *v > 0.0 } else { *v < 0.0 })
+                .map(|v| gain * v.abs()),
+        )
+    };
+    let column = |pick: fn(&SeriesFit) -> Option<&Vec<f64>>| {
+        span(samples().filter_map(|(s, k)| pick(s).map(|c| c[k])))
+    };
+    let load = column(|s| s.series.load.as_ref());
+    let temperature = column(|s| s.series.temperature.as_ref());
+    let acceleration = train
+        .iter()
+        .filter(|s| !s.series.steady)
+        .flat_map(|s| {
+            let (t, v) = (&s.series.t, &s.series.velocity);
+            (1..v.len()).filter_map(move |k| {
+                let dt = t[k] - t[k - 1];
+                (dt > 0.0).then(|| gain * ((v[k] - v[k - 1]) / dt).abs())
+            })
+        })
+        .fold(None, |m: Option<f64>, a| Some(m.map_or(a, |m| m.max(a))));
+    let (fwd, bwd) = (speeds(true), speeds(false));
+    CalibratedRange {
+        speed_forward_min_m_s: fwd.map(|r| r.0),
+        speed_forward_max_m_s: fwd.map(|r| r.1),
+        speed_backward_min_m_s: bwd.map(|r| r.0),
+        speed_backward_max_m_s: bwd.map(|r| r.1),
+        load_min_n: load.map(|r| r.0),
+        load_max_n: load.map(|r| r.1),
+        temperature_min_c: temperature.map(|r| r.0),
+        temperature_max_c: temperature.map(|r| r.1),
+        acceleration_max_m_s2: acceleration,
+        training_rms_n: train_rms / gain,
+        training_samples: samples().count() as u64,
+    }
+}
+
+/// Where one held-out or validation series lies against the range.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Placement {
+    /// The series' name.
+    pub name: String,
+    /// Samples compared, and those outside the range.
+    pub samples: usize,
+    /// See `samples`.
+    pub outside: usize,
+    /// The furthest excursion: the input, its value and the edge it left
+    /// (axis units for a speed), as a factor beyond the edge.
+    pub furthest: Option<(&'static str, f64, f64)>,
+    /// RMS error inside and outside the range (None: no sample there).
+    pub rms_inside: Option<f64>,
+    /// See `rms_inside`.
+    pub rms_outside: Option<f64>,
+}
+
+/// How far beyond its range `value` lies, as a factor (> 1 beyond the
+/// top, value/lo < 1 below the bottom is given as lo/value).
+fn factor(value: f64, lo: f64, hi: f64) -> f64 {
+    if value > hi {
+        if hi > 0.0 {
+            value / hi
+        } else {
+            f64::INFINITY
+        }
+    } else if value > 0.0 {
+        lo / value
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// Each series of `fits` against `range` through gain `gain`.
+pub fn place(fits: &[SeriesFit], range: &CalibratedRange, gain: f64) -> Vec<Placement> {
+    fits.iter()
+        .map(|s| {
+            let se = &s.series;
+            let (mut n, mut out) = (0usize, 0usize);
+            let (mut ss_in, mut n_in, mut ss_out, mut n_out) = (0.0, 0usize, 0.0, 0usize);
+            let mut furthest: Option<(&'static str, f64, f64)> = None;
+            for k in 0..se.len() {
+                let r = s.predicted[k] - se.friction[k];
+                if !r.is_finite() {
+                    continue;
+                }
+                n += 1;
+                let load = se.load.as_ref().map(|l| l[k]);
+                let temperature = se.temperature.as_ref().map(|t| t[k]);
+                match range.side(gain * se.velocity[k], load, temperature) {
+                    RangeSide::Inside => {
+                        ss_in += r * r;
+                        n_in += 1;
+                    }
+                    RangeSide::Outside {
+                        input,
+                        value,
+                        lo,
+                        hi,
+                    } => {
+                        out += 1;
+                        ss_out += r * r;
+                        n_out += 1;
+                        let f = factor(value, lo, hi);
+                        let speed = input.starts_with("speed");
+                        let shown = if speed { value / gain } else { value };
+                        if furthest.is_none_or(|(_, _, g)| f > g) {
+                            furthest = Some((input, shown, f));
+                        }
+                    }
+                }
+            }
+            let rms = |ss: f64, m: usize| (m > 0).then(|| (ss / m as f64).sqrt());
+            Placement {
+                name: se.name.clone(),
+                samples: n,
+                outside: out,
+                furthest,
+                rms_inside: rms(ss_in, n_in),
+                rms_outside: rms(ss_out, n_out),
+            }
+        })
+        .collect()
+}
+
+/// The range in the axis's units, as a sentence.
+fn describe(range: &CalibratedRange, gain: f64, units: Units) -> String {
+    let v = units.speed();
+    let speed = |lo: Option<f64>, hi: Option<f64>| match (lo, hi) {
+        (Some(lo), Some(hi)) => {
+            format!("{}–{} {v}", Num::sig(lo / gain, 4), Num::sig(hi / gain, 4))
+        }
+        _ => "never".into(),
+    };
+    let mut s = format!(
+        "speed forward {}, backward {}",
+        speed(range.speed_forward_min_m_s, range.speed_forward_max_m_s),
+        speed(range.speed_backward_min_m_s, range.speed_backward_max_m_s)
+    );
+    if let (Some(lo), Some(hi)) = (range.load_min_n, range.load_max_n) {
+        let _ = write!(s, ", load {}–{} N", Num::sig(lo, 4), Num::sig(hi, 4));
+    }
+    if let (Some(lo), Some(hi)) = (range.temperature_min_c, range.temperature_max_c) {
+        let _ = write!(
+            s,
+            ", temperature {}–{} °C",
+            Num::sig(lo, 4),
+            Num::sig(hi, 4)
+        );
+    }
+    if let Some(a) = range.acceleration_max_m_s2 {
+        let _ = write!(s, ", acceleration up to {} {v}/s", Num::sig(a / gain, 4));
+    }
+    s
+}
+
+/// The report's section: the range, then where each held-out and
+/// validation series lies and its error inside and outside.
+pub fn section(o: &FitOutcome, range: &CalibratedRange, gain: f64) -> String {
+    let units = o.units;
+    let f = units.force();
+    let mut md = format!(
+        "## Where the calibration holds\n\nCalibrated on {} training samples: {}; training RMS {} {f}. The fitted file holds this range (`calibrated_range`, in the contact's units); outside it the parameters are an extrapolation.\n",
+        range.training_samples,
+        describe(range, gain, units),
+        Num::sig(o.train_rms, 5)
+    );
+    let placed: Vec<(&str, Placement)> = [("held out", &o.held_out), ("validation", &o.validate)]
+        .into_iter()
+        .flat_map(|(role, fits)| place(fits, range, gain).into_iter().map(move |p| (role, p)))
+        .collect();
+    if placed.is_empty() {
+        return md;
+    }
+    let _ = write!(
+        md,
+        "\n| source | role | samples | outside the range | furthest | RMS inside ({f}) | RMS outside ({f}) |\n|---|---|---|---|---|---|---|\n"
+    );
+    let cell = |x: Option<f64>| x.map_or("—".to_string(), |v| Num::sig(v, 5).to_string());
+    for (role, p) in &placed {
+        let furthest = p.furthest.map_or("—".to_string(), |(input, value, f)| {
+            let unit = match input {
+                "load" => " N".to_string(),
+                "temperature" => " °C".to_string(),
+                _ => format!(" {}", units.speed()),
+            };
+            if f.is_finite() {
+                format!(
+                    "{input} {}{unit} ({}× past its edge)",
+                    Num::sig(value, 4),
+                    Num::sig(f, 3)
+                )
+            } else {
+                format!("{input} {}{unit} (never trained)", Num::sig(value, 4))
+            }
+        });
+        let _ = writeln!(
+            md,
+            "| {} | {role} | {} | {} ({:.1} %) | {furthest} | {} | {} |",
+            p.name,
+            p.samples,
+            p.outside,
+            100.0 * p.outside as f64 / p.samples.max(1) as f64,
+            cell(p.rms_inside),
+            cell(p.rms_outside)
+        );
+    }
+    md
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fit::Series;
+
+    fn fit(name: &str, v: &[f64], f: &[f64], predicted: &[f64]) -> SeriesFit {
+        SeriesFit {
+            series: Series {
+                name: name.into(),
+                steady: false,
+                t: (0..v.len()).map(|k| k as f64 * 0.1).collect(),
+                velocity: v.to_vec(),
+                friction: f.to_vec(),
+                load: None,
+                temperature: None,
+                fit: vec![true; v.len()],
+            },
+            predicted: predicted.to_vec(),
+        }
+    }
+
+    #[test]
+    fn the_range_is_the_training_speeds_by_direction_through_the_gain_and_held_out_error_splits_at_it(
+    ) {
+        // Training: forward 0.1..0.5, backward 0.2..0.3 (axis units), gain 0.02.
+        let train = fit(
+            "train",
+            &[0.1, 0.5, -0.2, -0.3],
+            &[1.0, 1.0, -1.0, -1.0],
+            &[1.1, 0.9, -1.0, -1.0],
+        );
+        let r = of_training(&[train], 0.0707, 0.02);
+        assert_eq!(r.speed_forward_min_m_s, Some(0.02 * 0.1));
+        assert_eq!(r.speed_forward_max_m_s, Some(0.02 * 0.5));
+        assert_eq!(r.speed_backward_max_m_s, Some(0.02 * 0.3));
+        assert_eq!(r.training_samples, 4);
+        approx::assert_relative_eq!(r.training_rms_n, 0.0707 / 0.02);
+        // acceleration: |Δv/Δt| largest between 0.5 and -0.2: 7 per s.
+        approx::assert_relative_eq!(
+            r.acceleration_max_m_s2.unwrap(),
+            0.02 * 7.0,
+            max_relative = 1e-12
+        );
+        assert!(r.validate("calibrated_range").is_ok());
+        // Validation: two samples inside (errors 0.1), two beyond (errors 2): one
+        // at 2.5 (5× the top speed forward), one backward at 0.25 (inside).
+        let val = fit(
+            "val",
+            &[0.3, 2.5, -0.25, -0.6],
+            &[1.0, 1.0, -1.0, -1.0],
+            &[1.1, 3.0, -1.1, -3.0],
+        );
+        let p = &place(&[val], &r, 0.02)[0];
+        assert_eq!((p.samples, p.outside), (4, 2));
+        approx::assert_relative_eq!(p.rms_inside.unwrap(), 0.1, max_relative = 1e-9);
+        approx::assert_relative_eq!(p.rms_outside.unwrap(), 2.0, max_relative = 1e-9);
+        let (input, value, f) = p.furthest.unwrap();
+        assert_eq!(input, "speed forward");
+        approx::assert_relative_eq!(value, 2.5, max_relative = 1e-9);
+        approx::assert_relative_eq!(f, 5.0, max_relative = 1e-9);
+    }
+}
