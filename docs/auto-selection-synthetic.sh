@@ -29,7 +29,7 @@ with open(sys.argv[2], "w") as fh:
         fh.write(f"{r['t_s']},{r['velocity_m_s']},{x + random.gauss(0, 0.01 * rms)}\n")
 PY
     local chosen
-    chosen=$("$BIN" fit "$OUT/$name.csv" "${COMMON[@]}" --fit auto --out "$OUT/$name.yaml" 2>/dev/null | grep '^Chosen:' | sed 's/\. Stopped:.*//; s/^Chosen: //')
+    chosen=$("$BIN" fit "$OUT/$name.csv" "${COMMON[@]}" --fit auto --out "$OUT/$name.yaml" 2>/dev/null | grep '^Chosen:' | sed 's/\. Stopped:.*//; s/^Chosen: //' || true)
     echo "| $name | $truth | $chosen |"
 }
 echo "| case | terms in the data (besides boundary friction) | chosen by --fit auto |"

@@ -598,3 +598,62 @@ fn a_joint_fitted_at_slow_speeds_predicts_neither_a_collapse_nor_a_sign_change_u
         );
     }
 }
+
+#[test]
+fn under_auto_a_load_set_in_the_configuration_is_kept_and_without_one_the_scale_is_chosen() {
+    let d = dir("configured-load");
+    let c = d.join("contact.csv");
+    let (code, _, err) = run(&[
+        "simulate",
+        "--velocity",
+        "sine:0,0.05,1",
+        "--duration",
+        "1",
+        "--set",
+        "solver.cells=32",
+        "--set",
+        "contact.load_n=2000",
+        "--out",
+        c.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    // The data without their load column: the load is not an input.
+    let mut text = String::from("t_s,velocity_m_s,friction_n\n");
+    for (t, v, f) in simulated(&c) {
+        text += &format!("{t},{v},{f}\n");
+    }
+    let data = d.join("no-load.csv");
+    std::fs::write(&data, text).unwrap();
+    let fit = |extra: &[&str]| {
+        let out = d.join("f.yaml");
+        let mut args = vec![
+            "fit",
+            data.to_str().unwrap(),
+            "--set",
+            "solver.cells=32",
+            "--fit",
+            "auto",
+            "--starts",
+            "1",
+            "--global-points",
+            "0",
+            "--max-evaluations",
+            "10",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let (code, _, err) = run(&args);
+        assert!(code == 0 || code == 4, "{err}");
+        (err, Config::load(Some(&out), &[]).unwrap())
+    };
+    let (err, kept) = fit(&["--set", "contact.load_n=2000"]);
+    assert!(!err.contains("the contact's scale: gain"), "{err}");
+    assert_eq!(kept.contact.load_n, 2000.0);
+    assert!(kept.contacts.is_empty());
+    let (err, chosen) = fit(&[]);
+    assert!(err.contains("the contact's scale: gain"), "{err}");
+    // The chosen gain is written as the one listed contact's.
+    assert_eq!(chosen.contacts.0.len(), 1, "{err}");
+    assert!(chosen.contacts.0[0].gain != 1.0);
+}

@@ -31,6 +31,10 @@ fn span(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
 /// `train_rms`, axis units) through gain `gain`.
 pub fn of_training(train: &[SeriesFit], train_rms: f64, gain: f64) -> CalibratedRange {
     let samples = || train.iter().flat_map(|s| used(s).map(move |k| (s, k)));
+    // A time series starts, stops and reverses through zero speed: its
+    // slow end is covered down to zero. A steady curve's slowest point is
+    // where its evidence ends.
+    let through_zero = train.iter().any(|s| !s.series.steady);
     let speeds = |forward: bool| {
         span(
             samples()
@@ -38,6 +42,7 @@ pub fn of_training(train: &[SeriesFit], train_rms: f64, gain: f64) -> Calibrated
                 .filter(|v| if forward { *v > 0.0 } else { *v < 0.0 })
                 .map(|v| gain * v.abs()),
         )
+        .map(|(lo, hi)| (if through_zero { 0.0 } else { lo }, hi))
     };
     let column = |pick: fn(&SeriesFit) -> Option<&Vec<f64>>| {
         span(samples().filter_map(|(s, k)| pick(s).map(|c| c[k])))
@@ -183,7 +188,11 @@ fn describe(range: &CalibratedRange, gain: f64, units: Units) -> String {
         );
     }
     if let Some(a) = range.acceleration_max_m_s2 {
-        let _ = write!(s, ", acceleration up to {} {v}/s", Num::sig(a / gain, 4));
+        let unit = match units {
+            Units::Linear => "m/s²",
+            Units::Rotary => "rad/s²",
+        };
+        let _ = write!(s, ", acceleration up to {} {unit}", Num::sig(a / gain, 4));
     }
     s
 }
@@ -204,6 +213,7 @@ pub fn section(o: &FitOutcome, range: &CalibratedRange, gain: f64) -> String {
         .flat_map(|(role, fits)| place(fits, range, gain).into_iter().map(move |p| (role, p)))
         .collect();
     if placed.is_empty() {
+        md.push('\n');
         return md;
     }
     let _ = write!(
@@ -239,6 +249,7 @@ pub fn section(o: &FitOutcome, range: &CalibratedRange, gain: f64) -> String {
             cell(p.rms_outside)
         );
     }
+    md.push('\n');
     md
 }
 
@@ -273,8 +284,20 @@ mod tests {
             &[1.0, 1.0, -1.0, -1.0],
             &[1.1, 0.9, -1.0, -1.0],
         );
-        let r = of_training(&[train], 0.0707, 0.02);
-        assert_eq!(r.speed_forward_min_m_s, Some(0.02 * 0.1));
+        let r = of_training(&[train.clone()], 0.0707, 0.02);
+        // A time series passes through zero speed: its slow end is zero.
+        assert_eq!(r.speed_forward_min_m_s, Some(0.0));
+        let steady = SeriesFit {
+            series: Series {
+                steady: true,
+                ..train.series.clone()
+            },
+            ..train.clone()
+        };
+        let curve = of_training(&[steady], 0.0707, 0.02);
+        assert_eq!(curve.speed_forward_min_m_s, Some(0.02 * 0.1));
+        assert_eq!(curve.speed_backward_min_m_s, Some(0.02 * 0.2));
+        assert_eq!(curve.acceleration_max_m_s2, None);
         assert_eq!(r.speed_forward_max_m_s, Some(0.02 * 0.5));
         assert_eq!(r.speed_backward_max_m_s, Some(0.02 * 0.3));
         assert_eq!(r.training_samples, 4);

@@ -241,8 +241,11 @@ pub fn prepare(
         ));
     }
     // The scale is chosen for a joint's data, and under --fit auto for
-    // data that do not give the load (the contact's load is then unknown).
-    let choose_scale = req.rotary || (auto && !load_given);
+    // data that do not give the load when the configuration does not
+    // either: a `contact.load_n` other than the default is the user's
+    // statement of the contact's scale, and is kept.
+    let load_configured = config.contact.load_n != Config::default().contact.load_n;
+    let choose_scale = req.rotary || (auto && !load_given && !load_configured);
     let (model_config, contact_scale, model_scale) = model_setup(
         config,
         req.units(),
