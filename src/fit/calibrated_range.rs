@@ -284,7 +284,7 @@ mod tests {
             &[1.0, 1.0, -1.0, -1.0],
             &[1.1, 0.9, -1.0, -1.0],
         );
-        let r = of_training(&[train.clone()], 0.0707, 0.02);
+        let r = of_training(std::slice::from_ref(&train), 0.0707, 0.02);
         // A time series passes through zero speed: its slow end is zero.
         assert_eq!(r.speed_forward_min_m_s, Some(0.0));
         let steady = SeriesFit {

@@ -19,7 +19,9 @@
 //! 2. Stepwise selection: each step fits every candidate not yet chosen
 //!    (whose prerequisite is chosen), warm-started from the current set's
 //!    optimum with the new keys at their starts, and adds the one with the
-//!    lowest cross-validated error; then a term chosen earlier that no
+//!    lowest cross-validated error — or, among the candidates that predict
+//!    as well as it (within one standard error of the folds' paired
+//!    difference), the one with the fewest keys; then a term chosen earlier that no
 //!    longer pays beside the new one is removed (so a first choice does not
 //!    block a better pair).
 //! 3. The cost of a term: it pays only if it lowers the folds' mean squared
@@ -79,6 +81,32 @@ pub struct Selection {
     pub why: String,
     /// Wall time, s.
     pub wall_s: f64,
+}
+
+/// The step's choice: the candidate with the lowest CV error, or, among
+/// those that predict as well as it (their folds' mean squared error above
+/// the best's by no more than the standard error of that difference: the
+/// one-standard-error rule), the one with the fewest keys, so that a
+/// superset (the Stribeck curve around a viscous rise) is not chosen for
+/// what the smaller term does alone.
+fn simplest_within_one_se(step: Vec<Scored>) -> Scored {
+    let lowest = step
+        .iter()
+        .min_by(|a, b| a.tried.cv_rms.total_cmp(&b.tried.cv_rms))
+        .map(|t| t.tried.clone())
+        .expect("a candidate was open");
+    let keys = |t: &Tried| set_keys(&t.terms).len();
+    step.into_iter()
+        .filter(|t| {
+            let (excess, se) = paired(&t.tried.fold_mse, &lowest.fold_mse);
+            t.tried.cv_rms == lowest.cv_rms || (excess.is_finite() && excess <= se)
+        })
+        .min_by(|a, b| {
+            keys(&a.tried)
+                .cmp(&keys(&b.tried))
+                .then(a.tried.cv_rms.total_cmp(&b.tried.cv_rms))
+        })
+        .expect("the lowest is within one standard error of itself")
 }
 
 /// Mean and standard error of the folds' paired differences a − b.
@@ -158,10 +186,7 @@ pub fn select(
             })
             .collect::<Result<_, FitError>>()?;
         tried.extend(step.iter().map(|t| t.tried.clone()));
-        let best = step
-            .into_iter()
-            .min_by(|a, b| a.tried.cv_rms.total_cmp(&b.tried.cv_rms))
-            .expect("a candidate was open");
+        let best = simplest_within_one_se(step);
         let (ok, gain, se, share) = pays(&current.tried, &best.tried);
         let name = best.tried.terms.last().copied().unwrap_or_default();
         if !ok {
@@ -353,7 +378,7 @@ fn cv(t: &Tried, p: &Prepared) -> String {
 pub fn report(s: &Selection, units: super::Units) -> String {
     let u = units.force();
     let mut md = format!(
-        "## Terms chosen by the data (`--fit auto`)\n\nRule: stepwise selection on cross-validation of the training data ({}; each fold predicted by the set refitted without it); a term is added only if it lowers the folds' mean squared error by more than the standard error of that lowering and by more than {:.0} % of it (the cost of a term), and a term chosen earlier goes when it no longer pays beside a later one; a term that ends at zero or at a bound, or that the data cannot tell from another (|ρ| > 0.95), is dropped and the set fitted again. The --validate data are not used.\n\n| set (boundary friction +) | CV RMS ({u}) | RMS per fold ({u}) | film solves |\n|---|---|---|---|\n",
+        "## Terms chosen by the data (`--fit auto`)\n\nRule: stepwise selection on cross-validation of the training data ({}; each fold predicted by the set refitted without it); each step takes the candidate with the lowest CV error, or the one with the fewest keys among those within one standard error of it; a term is added only if it lowers the folds' mean squared error by more than the standard error of that lowering and by more than {:.0} % of it (the cost of a term), and a term chosen earlier goes when it no longer pays beside a later one; a term that ends at zero or at a bound, or that the data cannot tell from another (|ρ| > 0.95), is dropped and the set fitted again unless that predicts worse. Neither --validate nor --holdout data are used.\n\n| set (boundary friction +) | CV RMS ({u}) | RMS per fold ({u}) | film solves |\n|---|---|---|---|\n",
         s.folds,
         100.0 * TERM_COST
     );
@@ -418,6 +443,44 @@ pub fn select_terms(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn scored(terms: &[&'static str], fold_mse: &[f64]) -> Scored {
+        let n = fold_mse.len() as f64;
+        Scored {
+            tried: Tried {
+                terms: terms.to_vec(),
+                fold_mse: fold_mse.to_vec(),
+                cv_rms: (fold_mse.iter().sum::<f64>() / n).sqrt(),
+                simulations: 0,
+            },
+            optimum: Vec::new(),
+            flags: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn a_step_takes_the_smallest_term_that_predicts_as_well_as_the_best() {
+        // Stribeck (3 keys) a hair below viscous (1 key), within the folds'
+        // spread: viscous.
+        let step = vec![
+            scored(&["drivetrain Stribeck"], &[4.0, 5.1, 3.9, 4.4]),
+            scored(&["drivetrain viscous"], &[4.1, 4.9, 4.0, 4.5]),
+            scored(&["drivetrain quadratic"], &[9.0, 9.5, 8.7, 9.1]),
+        ];
+        assert_eq!(
+            simplest_within_one_se(step).tried.terms,
+            ["drivetrain viscous"]
+        );
+        // Lower on every fold by a clear margin: the larger term.
+        let step = vec![
+            scored(&["drivetrain Stribeck"], &[2.0, 2.1, 1.9, 2.0]),
+            scored(&["drivetrain viscous"], &[4.1, 5.0, 4.0, 4.5]),
+        ];
+        assert_eq!(
+            simplest_within_one_se(step).tried.terms,
+            ["drivetrain Stribeck"]
+        );
+    }
 
     #[test]
     fn a_term_pays_only_beyond_the_folds_spread() {
