@@ -14,7 +14,7 @@ struct Outcome {
 }
 
 /// A fresh directory for test `name`.
-fn dir(name: &str) -> std::path::PathBuf {
+fn dir(name: &str) -> common::cli::FreshDir {
     common::cli::fresh_dir("bad", name)
 }
 

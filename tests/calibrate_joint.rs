@@ -9,7 +9,7 @@ use friction_node::config::Config;
 use std::path::Path;
 
 /// A fresh directory for test `name`.
-fn dir(name: &str) -> std::path::PathBuf {
+fn dir(name: &str) -> common::cli::FreshDir {
     common::cli::fresh_dir("joint", name)
 }
 

@@ -7,9 +7,9 @@ mod common;
 use common::cli::run;
 
 use friction_node::config::Config;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-fn dir(name: &str) -> PathBuf {
+fn dir(name: &str) -> common::cli::FreshDir {
     common::cli::fresh_dir("calibrated-range", name)
 }
 

@@ -3,7 +3,7 @@
 mod common;
 
 /// A fresh directory for test `name`.
-fn dir(name: &str) -> std::path::PathBuf {
+fn dir(name: &str) -> common::cli::FreshDir {
     common::cli::fresh_dir("cli", name)
 }
 

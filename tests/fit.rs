@@ -223,7 +223,7 @@ fn each_classic_model_recovers_its_own_parameters() {
 // ---- the command line ----
 
 /// A fresh directory for test `name`.
-fn dir(name: &str) -> std::path::PathBuf {
+fn dir(name: &str) -> common::cli::FreshDir {
     common::cli::fresh_dir("fit", name)
 }
 

@@ -6,9 +6,9 @@
 mod common;
 use common::cli::run;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-fn dir(name: &str) -> PathBuf {
+fn dir(name: &str) -> common::cli::FreshDir {
     common::cli::fresh_dir("held-out", name)
 }
 

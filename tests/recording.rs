@@ -139,7 +139,7 @@ fn a_60_s_run_split_every_5_s_loses_and_repeats_no_message_and_replays_as_one_ba
         &cfg,
         RecordPlan {
             path: Some(bag.clone()),
-            snapshot_dir: d.clone(),
+            snapshot_dir: d.to_path_buf(),
         },
         60,
         None,
@@ -209,7 +209,7 @@ fn a_disk_budget_deletes_the_oldest_split_files_and_metadata_forgets_them() {
         &cfg,
         RecordPlan {
             path: Some(d.join("probe")),
-            snapshot_dir: d.clone(),
+            snapshot_dir: d.to_path_buf(),
         },
         10,
         None,
@@ -220,7 +220,7 @@ fn a_disk_budget_deletes_the_oldest_split_files_and_metadata_forgets_them() {
         &cfg,
         RecordPlan {
             path: Some(bag.clone()),
-            snapshot_dir: d.clone(),
+            snapshot_dir: d.to_path_buf(),
         },
         60,
         None,
@@ -260,7 +260,7 @@ fn a_snapshot_holds_the_last_seconds_of_every_topic() {
         &cfg,
         RecordPlan {
             path: None,
-            snapshot_dir: d.clone(),
+            snapshot_dir: d.to_path_buf(),
         },
         12,
         Some(10),
@@ -291,8 +291,8 @@ fn a_split_recording_refuses_a_directory_that_is_not_empty() {
     std::fs::write(d.join("something"), "x").unwrap();
     let e = Recorder::start(
         RecordPlan {
-            path: Some(d.clone()),
-            snapshot_dir: d.clone(),
+            path: Some(d.to_path_buf()),
+            snapshot_dir: d.to_path_buf(),
         },
         &cfg,
         &TopicNames::from_config(&cfg),
@@ -321,7 +321,7 @@ fn a_run_whose_parameters_changed_midway_replays_bit_identically() {
     let rec = Recorder::start(
         RecordPlan {
             path: Some(bag.clone()),
-            snapshot_dir: d.clone(),
+            snapshot_dir: d.to_path_buf(),
         },
         &cfg,
         &TopicNames::from_config(&cfg),

@@ -19,7 +19,7 @@ const FOREIGN_BAG: &str = concat!(
 );
 
 /// A fresh directory for test `name`.
-fn dir(name: &str) -> std::path::PathBuf {
+fn dir(name: &str) -> common::cli::FreshDir {
     common::cli::fresh_dir("replay", name)
 }
 

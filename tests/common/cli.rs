@@ -1,7 +1,8 @@
 //! Running the binary from a test: the command, a fresh directory per
 //! test, and a run's exit code and output.
 
-use std::path::PathBuf;
+use std::ops::Deref;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 /// The `friction-node` binary this test suite was built with.
@@ -9,13 +10,38 @@ pub fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_friction-node"))
 }
 
+/// A test's own directory, removed with everything in it when the test
+/// ends (passing or panicking), so a test run leaves nothing in the
+/// temporary directory.
+pub struct FreshDir(PathBuf);
+
+impl Deref for FreshDir {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl AsRef<Path> for FreshDir {
+    fn as_ref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for FreshDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
 /// An empty directory of its own for test `name` of `suite`:
-/// `<temp>/fn-<suite>-<pid>-<name>`, emptied if it was there.
-pub fn fresh_dir(suite: &str, name: &str) -> PathBuf {
+/// `<temp>/fn-<suite>-<pid>-<name>`, emptied if it was there, removed
+/// when the returned guard drops.
+pub fn fresh_dir(suite: &str, name: &str) -> FreshDir {
     let d = std::env::temp_dir().join(format!("fn-{suite}-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
-    d
+    FreshDir(d)
 }
 
 /// Runs the binary with `args`: (exit code, stdout, stderr); the code is
