@@ -10,6 +10,7 @@
 //! |---|---|
 //! | [`physics`] | the model and its solvers: Reynolds + cavitation + GW + load balance |
 //! | [`config`] | the YAML parameter files: schema, defaults, overrides, validation, input envelope |
+//! | [`range_watch`] | where a step's input lies against a contact's calibrated range; what is published outside it |
 //! | [`signal`] | velocity, load and temperature inputs of offline runs |
 //! | [`table`] | numeric tables from text (the csv crate): delimiters, columns, line numbers |
 //! | [`expression`] | size and depth limits on the column expressions people write |
@@ -53,6 +54,7 @@ pub mod output;
 pub mod physics;
 #[cfg(feature = "plots")]
 pub mod plot;
+pub mod range_watch;
 #[cfg(feature = "mcap")]
 pub mod record;
 #[cfg(feature = "mcap")]

@@ -34,6 +34,9 @@ pub struct LoopSettings {
     pub command_timeout_ns: u64,
     /// What a timed-out command does (`node.timeout_behaviour`).
     pub timeout_behaviour: TimeoutBehaviour,
+    /// What a contact publishes outside its calibrated range
+    /// (`node.outside_envelope`).
+    pub outside_envelope: crate::config::OutsideEnvelope,
     /// The ramp to zero after a command timeout, m/s².
     pub deceleration_m_s2: f64,
     /// The velocity and load commands accepted.
@@ -81,6 +84,7 @@ impl LoopSettings {
             dt_ns,
             command_timeout_ns: secs_to_ns(c.node.command_timeout_s),
             timeout_behaviour: c.node.timeout_behaviour,
+            outside_envelope: c.node.outside_envelope,
             deceleration_m_s2: c.node.timeout_deceleration_m_s2,
             limits: crate::config::InputLimits::of(c),
             film_profile_every_steps: every(c.node.profile_rate_hz),

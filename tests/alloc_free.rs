@@ -409,3 +409,58 @@ fn a_loop_of_several_contacts_allocates_nothing_per_joint_state() {
         "{worst} allocations in a batch of 20 steps of 3 contacts"
     );
 }
+
+#[test]
+fn the_calibrated_range_watch_allocates_nothing_inside_outside_or_holding() {
+    use friction_node::config::{CalibratedRange, Config, OutsideEnvelope, StepMode};
+    use friction_node::link::LiveStatus;
+    use friction_node::msgs::{Command, CommandKind};
+    use friction_node::node::Loop;
+    use friction_node::transport::memory::MemoryQueues;
+    use std::sync::Arc;
+    for policy in [
+        OutsideEnvelope::Warn,
+        OutsideEnvelope::Hold,
+        OutsideEnvelope::Zero,
+    ] {
+        let mut cfg = Config::default();
+        cfg.solver.cells = 32;
+        cfg.node.step_mode = StepMode::Lockstep;
+        cfg.node.statistics_rate_hz = 1000.0;
+        cfg.node.outside_envelope = policy;
+        cfg.calibrated_range = Some(CalibratedRange {
+            speed_forward_min_m_s: Some(0.0),
+            speed_forward_max_m_s: Some(0.3),
+            speed_backward_min_m_s: Some(0.0),
+            speed_backward_max_m_s: Some(0.3),
+            training_rms_n: 1.0,
+            training_samples: 10,
+            ..Default::default()
+        });
+        let link = MemoryQueues::new(1000);
+        let mut l = Loop::new(
+            &cfg,
+            vec![Box::new(link.node())],
+            None,
+            None,
+            Arc::new(LiveStatus::default()),
+        )
+        .unwrap();
+        let v = |k: u64, value: f64| Command {
+            kind: CommandKind::Velocity,
+            value,
+            stamp_ns: k * 1_000_000,
+        };
+        for k in 1..=5 {
+            l.feed(v(k, 0.1));
+        }
+        let mut worst = 0;
+        for k in 6..=40 {
+            // In, out forward, out backward, back in.
+            let x = [0.1, 0.9, -0.9, 0.2][(k % 4) as usize];
+            worst = worst.max(allocations(|| l.feed(v(k, x))));
+        }
+        assert_eq!(worst, 0, "{policy:?}");
+        assert!(l.summary().steps_outside_calibrated_range > 10);
+    }
+}

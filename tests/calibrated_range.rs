@@ -142,3 +142,83 @@ fn a_hand_edited_range_that_is_inverted_non_finite_or_half_given_is_an_error_nam
         None
     );
 }
+
+/// The number of contact steps outside on a summary line
+/// (`calibrated range N contact steps outside`).
+fn outside_count(text: &str) -> u64 {
+    let line = text
+        .lines()
+        .find(|l| l.trim_start().starts_with("calibrated range"))
+        .unwrap_or_else(|| panic!("no calibrated range line in {text}"));
+    line.split_whitespace()
+        .nth(2)
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no count in {line}"))
+}
+
+#[test]
+fn replay_counts_the_steps_outside_the_calibrated_range_as_the_node_did_on_the_same_bag() {
+    let d = dir("replay-count");
+    let cfg = d.join("fitted.yaml");
+    std::fs::write(
+        &cfg,
+        "/**:\n  ros__parameters:\n    calibrated_range:\n      speed_forward_min_m_s: 0.0\n      \
+         speed_forward_max_m_s: 0.5\n      speed_backward_min_m_s: 0.0\n      \
+         speed_backward_max_m_s: 0.7\n      training_rms_n: 1.0\n      training_samples: 100\n",
+    )
+    .unwrap();
+    let bag = d.join("run.mcap");
+    let (code, out, err) = run(&[
+        "run",
+        "--config",
+        cfg.to_str().unwrap(),
+        "--demo",
+        "2",
+        "--transport",
+        "iceoryx2",
+        "--set",
+        "solver.cells=32",
+        "--set",
+        &format!(
+            "iceoryx2.cmd_velocity_service=fn_cr_{}/cmd_velocity",
+            std::process::id()
+        ),
+        "--set",
+        &format!(
+            "iceoryx2.friction_service=fn_cr_{}/friction",
+            std::process::id()
+        ),
+        "--set",
+        &format!(
+            "iceoryx2.normal_load_service=fn_cr_{}/load",
+            std::process::id()
+        ),
+        "--set",
+        &format!(
+            "iceoryx2.cmd_event_service=fn_cr_{}/event",
+            std::process::id()
+        ),
+        "--set",
+        &format!(
+            "iceoryx2.loop_statistics_service=fn_cr_{}/stats",
+            std::process::id()
+        ),
+        "--record",
+        bag.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let node = outside_count(&out);
+    // The demo's 1 m/s sine spends about half of its time above 0.5 m/s
+    // forward and 0.7 m/s backward.
+    assert!(node > 200, "{out}");
+    let replay_out = d.join("replay.csv");
+    let (code, replayed, err) = run(&[
+        "replay",
+        bag.to_str().unwrap(),
+        "--out",
+        replay_out.to_str().unwrap(),
+        "--expect-identical",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(outside_count(&replayed), node, "{replayed}");
+}

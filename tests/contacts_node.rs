@@ -534,3 +534,48 @@ fn a_configuration_with_one_listed_contact_publishes_its_joint_effort_as_several
         assert_eq!(ef.stamp_ns, e.stamp_ns);
     }
 }
+
+#[test]
+fn each_contact_is_watched_by_its_own_calibrated_range_and_one_without_is_not() {
+    let yaml = THREE.replace(
+        "left: {joint: j_left, contact: {load_n: 4000.0}}",
+        "left: {joint: j_left, contact: {load_n: 4000.0}, calibrated_range: \
+         {speed_forward_min_m_s: 0.0, speed_forward_max_m_s: 0.5, speed_backward_min_m_s: 0.0, \
+         speed_backward_max_m_s: 0.5, training_rms_n: 1.0, training_samples: 10}}",
+    ) + "    node: {step_mode: timer, statistics_rate_hz: 100.0, command_timeout_s: 0.05, outside_envelope: zero}\n";
+    let yaml = yaml.replacen(
+        "    node: {step_mode: timer, statistics_rate_hz: 100.0, command_timeout_s: 0.05}\n",
+        "",
+        1,
+    );
+    let cfg = Config::from_yaml(&yaml, &Origin::Embedded, &[]).unwrap();
+    let per = lockstep(&cfg, 300, profile);
+    let left = &per[0];
+    let outside = left
+        .iter()
+        .filter(|e| e.calibrated_range == codes::RANGE_OUTSIDE)
+        .count();
+    // |1.0 sin| > 0.5 for two thirds of the cycle; 300 steps hold 0.3 of it.
+    assert!(outside > 50, "{outside}");
+    for e in left {
+        let out = e.velocity_m_s.abs() > 0.5;
+        assert_eq!(
+            e.calibrated_range,
+            if out {
+                codes::RANGE_OUTSIDE
+            } else {
+                codes::RANGE_INSIDE
+            },
+            "v = {}",
+            e.velocity_m_s
+        );
+        if out || e.velocity_m_s != 0.0 {
+            assert_eq!(e.friction_force_n == 0.0, out, "v = {}", e.velocity_m_s);
+        }
+    }
+    for other in &per[1..] {
+        assert!(other
+            .iter()
+            .all(|e| e.calibrated_range == codes::RANGE_NOT_WATCHED && e.friction_force_n != 0.0));
+    }
+}

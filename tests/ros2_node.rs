@@ -40,9 +40,15 @@ impl Drop for Running {
 
 /// Start `run` with `ros_args`; returns when its loop runs.
 fn start(domain: u32, ros_args: &[&str]) -> Running {
+    start_with(domain, &[], ros_args)
+}
+
+/// Start `run` with `args`, then `ros_args`; returns when its loop runs.
+fn start_with(domain: u32, args: &[&str], ros_args: &[&str]) -> Running {
     let mut child = Command::new(env!("CARGO_BIN_EXE_friction-node"))
+        .arg("run")
+        .args(args)
         .args([
-            "run",
             "--duration",
             "120",
             "--quiet",
@@ -507,7 +513,14 @@ fn log_lines_reach_rosout_and_health_reaches_diagnostics_in_the_standard_layouts
         .collect();
     assert_eq!(
         names,
-        ["loop timing", "solver", "commands", "outputs", "recorder"]
+        [
+            "loop timing",
+            "solver",
+            "commands",
+            "outputs",
+            "recorder",
+            "calibrated range"
+        ]
     );
     assert!(a.status.iter().all(|s| s.level <= 2));
     let steps: u64 = a.status[0]
@@ -528,6 +541,82 @@ fn log_lines_reach_rosout_and_health_reaches_diagnostics_in_the_standard_layouts
         a.status[2].message
     );
     assert!(a.header.stamp.sec > 0 && a.header.stamp.nanosec < 1_000_000_000);
+}
+
+#[test]
+fn a_speed_outside_the_calibrated_range_warns_on_diagnostics_naming_it_and_clears_when_back() {
+    let pid = std::process::id();
+    let domain = 150 + (pid + 63) % 80;
+    let name = format!("fnr_{pid}");
+    let dir = std::env::temp_dir().join(format!("fn-ros2-range-{pid}"));
+    std::fs::create_dir_all(&dir).unwrap();
+    let cfg = dir.join("fitted.yaml");
+    std::fs::write(
+        &cfg,
+        "/**:\n  ros__parameters:\n    calibrated_range:\n      speed_forward_min_m_s: 0.0\n      \
+         speed_forward_max_m_s: 0.35\n      speed_backward_min_m_s: 0.0\n      \
+         speed_backward_max_m_s: 0.35\n      training_rms_n: 1.0\n      training_samples: 100\n",
+    )
+    .unwrap();
+    let _node = start_with(
+        domain,
+        &["--config", cfg.to_str().unwrap()],
+        &["-r", &format!("__node:={name}")],
+    );
+    let (_ctx, mut node) = client_node(domain, &format!("fnr_client_{pid}"));
+    let cmd_topic = node
+        .create_topic(
+            &Name::parse(&format!("/{name}/cmd_velocity")).unwrap(),
+            MessageTypeName::new("std_msgs", "Float64"),
+            &QosProfile::publisher_default(),
+        )
+        .unwrap();
+    let cmd = node
+        .create_publisher::<friction_node::msgs::Float64>(&cmd_topic, None)
+        .unwrap();
+    let diag_topic = node
+        .create_topic(
+            &Name::parse("/diagnostics").unwrap(),
+            MessageTypeName::new("diagnostic_msgs", "DiagnosticArray"),
+            &QosProfile::subscription_default(),
+        )
+        .unwrap();
+    let diag = node
+        .create_subscription::<diagnostic_msgs::DiagnosticArray>(&diag_topic, None)
+        .unwrap();
+    // Command `v` every 5 ms until the node's "calibrated range" status
+    // has `level`; that status.
+    let until_level = |v: f64, level: u8| {
+        within("the calibrated range's status", async {
+            loop {
+                let _ = cmd.publish(friction_node::msgs::Float64 { data: v });
+                while let Ok(Some((a, _))) = diag.take() {
+                    let s = a.status.into_iter().find(|s| {
+                        s.hardware_id.ends_with(&name) && s.name.ends_with(": calibrated range")
+                    });
+                    if let Some(s) = s.filter(|s| s.level == level) {
+                        return s;
+                    }
+                }
+                futures_timer(Duration::from_millis(5)).await;
+            }
+        })
+    };
+    let warn = until_level(1.57, 1);
+    assert!(
+        warn.message
+            .starts_with("speed forward 1.57 m/s outside the calibrated 0 to 0.35 m/s"),
+        "{}",
+        warn.message
+    );
+    println!("{}: {}", warn.name, warn.message);
+    let ok = until_level(0.2, 0);
+    assert!(
+        ok.message.starts_with("every input inside"),
+        "{}",
+        ok.message
+    );
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]

@@ -366,6 +366,104 @@ fn a_flood_through_ros2_is_accounted_for_exactly() {
     );
 }
 
+/// The calibrated range over `spec`: each estimate's flag, and the
+/// statistics' count and latest input outside, as a commanded speed leaves
+/// the range (0–0.3 m/s) and comes back.
+fn calibrated_range_travels(spec: BackendSpec, mut cfg: Config) {
+    cfg.node.statistics_rate_hz = 1000.0; // one LoopStatistics per step
+    cfg.calibrated_range = Some(friction_node::config::CalibratedRange {
+        speed_forward_min_m_s: Some(0.0),
+        speed_forward_max_m_s: Some(0.3),
+        speed_backward_min_m_s: Some(0.0),
+        speed_backward_max_m_s: Some(0.3),
+        training_rms_n: 1.0,
+        training_samples: 100,
+        ..Default::default()
+    });
+    let stop = Arc::new(AtomicBool::new(false));
+    let node = start_node(
+        spec.clone(),
+        cfg.clone(),
+        stop.clone(),
+        Arc::new(LiveStatus::default()),
+    );
+    let mut peer = spec.open_peer().expect("open a peer");
+    transport::wait_matched(peer.as_mut(), Duration::from_secs(20)).expect("discovery");
+    let mut stats: Vec<StatisticsRecord> = Vec::new();
+    let mut k = 0u64;
+    let mut phase = |peer: &mut dyn transport::PeerPort, v: f64, flag: u8| -> StatisticsRecord {
+        for _ in 0..10 {
+            k += 1;
+            peer.send(&Command {
+                kind: CommandKind::Velocity,
+                value: v,
+                stamp_ns: STAMP0 + k * 1_000_000,
+            })
+            .unwrap();
+            let got = transport::recv_timeout(peer, Duration::from_secs(10))
+                .unwrap()
+                .unwrap_or_else(|| panic!("{}: no estimate for step {k}", spec.name()));
+            assert_eq!(got.calibrated_range, flag, "{}: step {k}", spec.name());
+        }
+        wait_for_then(
+            "the statistics of the phase's last step",
+            || {
+                while let Ok(Some(s)) = peer.try_recv_statistics() {
+                    stats.push(s);
+                }
+                stats.iter().any(|s| s.steps == k)
+            },
+            || spec.name().to_string(),
+        );
+        *stats.iter().find(|s| s.steps == k).unwrap()
+    };
+    let inside = phase(peer.as_mut(), 0.2, codes::RANGE_INSIDE);
+    assert_eq!(inside.steps_outside_calibrated_range, 0);
+    assert_eq!(inside.last_outside, None);
+    let outside = phase(peer.as_mut(), 1.0, codes::RANGE_OUTSIDE);
+    assert_eq!(
+        outside.steps_outside_calibrated_range,
+        10,
+        "{}",
+        spec.name()
+    );
+    let o = outside.last_outside.expect("the input outside is named");
+    assert_eq!(
+        (o.contact, o.input, o.value, o.lo, o.hi),
+        (0, "speed forward", 1.0, 0.0, 0.3),
+        "{}",
+        spec.name()
+    );
+    let back = phase(peer.as_mut(), 0.2, codes::RANGE_INSIDE);
+    assert_eq!(back.steps_outside_calibrated_range, 10);
+    assert_eq!(back.last_outside, None, "{}: cleared", spec.name());
+    stop.store(true, Ordering::Relaxed);
+    assert_eq!(node.join().unwrap().steps_outside_calibrated_range, 10);
+}
+
+#[test]
+fn memory_transport_carries_the_calibrated_range() {
+    let link = transport::memory::MemoryQueues::new(4096);
+    calibrated_range_travels(BackendSpec::Memory(link), lockstep_config());
+}
+
+#[cfg(feature = "iceoryx2")]
+#[test]
+fn iceoryx2_transport_carries_the_calibrated_range() {
+    let cfg = lockstep_config();
+    let spec = BackendSpec::Iceoryx2((&cfg.iceoryx2).into());
+    calibrated_range_travels(spec, cfg);
+}
+
+#[cfg(feature = "ros2")]
+#[test]
+fn ros2_transport_carries_the_calibrated_range() {
+    let mut cfg = lockstep_config();
+    cfg.ros.command_type = CommandType::TwistStamped;
+    let spec = BackendSpec::Ros2(transport::ros2::Ros2Spec::from_config(&cfg).unwrap());
+    calibrated_range_travels(spec, cfg);
+}
+
 #[test]
 fn memory_transport_conforms() {
     let link = transport::memory::MemoryQueues::new(4096);

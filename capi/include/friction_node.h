@@ -62,6 +62,18 @@
 // handled as `FN_STATUS_NON_FINITE_INPUT`.
 #define FN_STATUS_INPUT_OUT_OF_RANGE 6
 
+// `FnEstimate.calibrated_range`: the contact's configuration has no
+// `calibrated_range` (hand-written parameters): nothing is judged.
+#define FN_RANGE_NOT_WATCHED 0
+
+// The step's speed, load and temperature lie inside the range the contact
+// was calibrated on.
+#define FN_RANGE_INSIDE 1
+
+// An input lies outside it: the friction is as `node.outside_envelope`
+// says (warn: the model's; hold: the model's at the nearest edge; zero: 0).
+#define FN_RANGE_OUTSIDE 2
+
 // `FnEstimate.regime`: asperities carry at least 95 % of the load.
 #define FN_REGIME_BOUNDARY 0
 
@@ -110,6 +122,9 @@ typedef struct FnEstimate {
   uint8_t status;
   // `FN_REGIME_*`.
   uint8_t regime;
+  // `FN_RANGE_*`: where the step's input lay against the contact's
+  // calibrated range.
+  uint8_t calibrated_range;
 } FnEstimate;
 
 #ifdef __cplusplus

@@ -6,7 +6,8 @@ use crate::codes::*;
 use crate::handle::*;
 use friction_node::config::parameters::set_from_text;
 use friction_node::config::{Config, Origin, ViscosityLaw};
-use friction_node::physics::{Estimate, Solver};
+use friction_node::physics::Solver;
+use friction_node::range_watch::RangeWatch;
 use std::ffi::{c_char, CStr};
 use std::panic::catch_unwind;
 
@@ -105,9 +106,18 @@ pub unsafe extern "C" fn fn_model_step(
                 ),
             );
         };
-        let e = step_one(solver, &m.contacts[0].config, velocity_m_s, load_n, dt_s);
+        let t = m.temperature_c;
+        let e = step_one(
+            solver,
+            &m.contacts[0].config,
+            &m.watches[0],
+            t,
+            velocity_m_s,
+            load_n,
+            dt_s,
+        );
         // SAFETY: checked non-null; the caller provides the storage.
-        unsafe { *out = FnEstimate::from(&e) };
+        unsafe { *out = e };
         FN_OK
     })
 }
@@ -117,14 +127,28 @@ pub unsafe extern "C" fn fn_model_step(
 /// (`node.max_abs_velocity_m_s`, `node.min_load_n`…`node.max_load_n`, the
 /// rule every entry point checks) are refused with the status
 /// `input_out_of_range`, as the node rejects such commands.
-fn step_one(s: &mut Solver, config: &Config, v: f64, load: f64, dt_s: f64) -> Estimate {
+/// Then the contact's calibrated range judges the input (`temperature_c`:
+/// the last set, else the configuration's reference), and the estimate says
+/// where it lay, with the friction `node.outside_envelope` gives.
+fn step_one(
+    s: &mut Solver,
+    config: &Config,
+    watch: &RangeWatch,
+    temperature_c: Option<f64>,
+    v: f64,
+    load: f64,
+    dt_s: f64,
+) -> FnEstimate {
     let limits = friction_node::config::InputLimits::of(config);
     // Non-finite inputs go on to the solver, whose status names them.
     let finite = v.is_finite() && load.is_finite();
     if finite && (limits.check_velocity(v).is_err() || limits.check_load(load).is_err()) {
-        return s.refuse_step();
+        return FnEstimate::from(&s.refuse_step());
     }
-    s.step_by(v, load, dt_s)
+    let t = temperature_c.unwrap_or(config.lubricant.reference_temperature_c);
+    let w = watch.watch(v, load, t);
+    let e = s.step_by(w.velocity_m_s, w.load_n, dt_s);
+    FnEstimate::watched(&e, watch, &w)
 }
 
 /// Advance every contact by `dt_s`: contact i driven by its joint's
@@ -178,9 +202,11 @@ pub unsafe extern "C" fn fn_model_step_contacts(
             // SAFETY: non-null; `count` values.
             unsafe { std::slice::from_raw_parts(loads, n) }
         });
+        let t = m.temperature_c;
         for (i, (s, c)) in m.solvers.iter_mut().zip(&m.contacts).enumerate() {
             let load = loads.map_or(c.config.contact.load_n, |l| l[i]);
-            let e = FnEstimate::from(&step_one(s, &c.config, c.gain * v[i], load, dt_s));
+            let w = &m.watches[i];
+            let e = step_one(s, &c.config, w, t, c.gain * v[i], load, dt_s);
             out[i] = e;
             if !efforts.is_null() {
                 // SAFETY: non-null; `count` values.
@@ -406,6 +432,7 @@ pub unsafe extern "C" fn fn_model_set_parameter(
         for (s, p) in m.solvers.iter_mut().zip(prepared.iter_mut()) {
             let _ = s.swap_model(p);
         }
+        m.watches = crate::handle::watches(&new, &contacts);
         m.config = new;
         m.contacts = contacts;
         if let Some(t) = m.temperature_c {

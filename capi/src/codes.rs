@@ -1,8 +1,22 @@
 //! The codes a C caller sees: `FN_*` return codes, the estimate's status
 //! and regime codes, and `FnEstimate`, one step's estimate.
 
-use friction_node::msgs::{regime_code, status_code};
+use friction_node::msgs::{range_code, regime_code, status_code};
 use friction_node::physics::Estimate;
+use friction_node::range_watch::{RangeWatch, Watched};
+
+impl FnEstimate {
+    /// The estimate of a step whose input the watch judged: its flag, and
+    /// the friction as `node.outside_envelope` says.
+    pub(crate) fn watched(e: &Estimate, watch: &RangeWatch, w: &Watched) -> Self {
+        Self {
+            friction_force_n: watch.published(w.flag, e.friction_force),
+            contact_friction_force_n: watch.published(w.flag, e.contact_friction_force),
+            calibrated_range: range_code(w.flag),
+            ..Self::from(e)
+        }
+    }
+}
 
 /// Success.
 pub const FN_OK: i32 = 0;
@@ -40,6 +54,16 @@ pub const FN_STATUS_NON_FINITE_INPUT: u8 = 3;
 /// (0, 3600] s;
 /// handled as `FN_STATUS_NON_FINITE_INPUT`.
 pub const FN_STATUS_INPUT_OUT_OF_RANGE: u8 = 6;
+
+/// `FnEstimate.calibrated_range`: the contact's configuration has no
+/// `calibrated_range` (hand-written parameters): nothing is judged.
+pub const FN_RANGE_NOT_WATCHED: u8 = 0;
+/// The step's speed, load and temperature lie inside the range the contact
+/// was calibrated on.
+pub const FN_RANGE_INSIDE: u8 = 1;
+/// An input lies outside it: the friction is as `node.outside_envelope`
+/// says (warn: the model's; hold: the model's at the nearest edge; zero: 0).
+pub const FN_RANGE_OUTSIDE: u8 = 2;
 
 /// `FnEstimate.regime`: asperities carry at least 95 % of the load.
 pub const FN_REGIME_BOUNDARY: u8 = 0;
@@ -85,6 +109,9 @@ pub struct FnEstimate {
     pub status: u8,
     /// `FN_REGIME_*`.
     pub regime: u8,
+    /// `FN_RANGE_*`: where the step's input lay against the contact's
+    /// calibrated range.
+    pub calibrated_range: u8,
 }
 
 impl From<&Estimate> for FnEstimate {
@@ -106,6 +133,7 @@ impl From<&Estimate> for FnEstimate {
             substeps: e.diagnostics.substeps,
             status: status_code(e.status),
             regime: regime_code(e.regime),
+            calibrated_range: FN_RANGE_NOT_WATCHED,
         }
     }
 }

@@ -7,6 +7,7 @@ use crate::codes::*;
 use friction_node::config::parameters::{declare, Declared};
 use friction_node::config::{Config, ResolvedContact, ViscosityLaw};
 use friction_node::physics::Solver;
+use friction_node::range_watch::RangeWatch;
 use std::cell::RefCell;
 use std::ffi::{c_char, CStr};
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -26,6 +27,22 @@ pub struct FnModel {
     pub(crate) declared: Vec<Declared>,
     /// The last temperature set, °C (re-applied after a parameter change).
     pub(crate) temperature_c: Option<f64>,
+    /// Each contact's calibrated-range watch, in the contacts' order.
+    pub(crate) watches: Vec<RangeWatch>,
+}
+
+/// Each contact's watch of its calibrated range under `config`'s
+/// `node.outside_envelope`.
+pub(crate) fn watches(config: &Config, contacts: &[ResolvedContact]) -> Vec<RangeWatch> {
+    contacts
+        .iter()
+        .map(|c| {
+            RangeWatch::new(
+                c.config.calibrated_range.clone(),
+                config.node.outside_envelope,
+            )
+        })
+        .collect()
 }
 
 impl FnModel {
@@ -45,9 +62,18 @@ impl FnModel {
                 }
             })?;
         }
-        for ((s, c), mu) in self.solvers.iter_mut().zip(&self.contacts).zip(viscosities) {
-            if ViscosityLaw::of(&c.config).follows_temperature() {
-                s.set_liquid_viscosity(mu);
+        for (k, ((s, c), mu)) in self
+            .solvers
+            .iter_mut()
+            .zip(&self.contacts)
+            .zip(viscosities)
+            .enumerate()
+        {
+            let law = ViscosityLaw::of(&c.config);
+            if law.follows_temperature() {
+                // Under `node.outside_envelope: hold`, at the calibrated range's edge.
+                let held = law.viscosity_at(self.watches[k].temperature_c(t));
+                s.set_liquid_viscosity(held.unwrap_or(mu));
             }
         }
         Ok(())
@@ -132,6 +158,7 @@ pub(crate) fn build(config: Config, out: *mut *mut FnModel) -> i32 {
     let m = Box::new(FnModel {
         magic: LIVE,
         solvers,
+        watches: watches(&config, &contacts),
         contacts,
         declared: declare(&config),
         config,

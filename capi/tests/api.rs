@@ -536,3 +536,56 @@ fn the_real_drive_terms_are_in_the_c_api_bit_for_bit() {
     }
     unsafe { fn_model_free(m) };
 }
+
+#[test]
+fn each_estimate_says_where_its_input_lay_against_the_calibrated_range_and_zero_publishes_none() {
+    let yaml = |policy: &str| {
+        format!(
+            "/**:\n  ros__parameters:\n    solver: {{cells: 32}}\n    node: {{outside_envelope: {policy}}}\n    \
+             calibrated_range: {{speed_forward_min_m_s: 0.0, speed_forward_max_m_s: 0.3, \
+             speed_backward_min_m_s: 0.0, speed_backward_max_m_s: 0.3, training_rms_n: 1.0, \
+             training_samples: 10}}\n"
+        )
+    };
+    let plain = new_model("/**:\n  ros__parameters:\n    solver: {cells: 32}\n").unwrap();
+    assert_eq!(
+        step(plain, 1.0, 20_762.0, 1e-3).calibrated_range,
+        FN_RANGE_NOT_WATCHED
+    );
+    let warn = new_model(&yaml("warn")).unwrap();
+    let zero = new_model(&yaml("zero")).unwrap();
+    let hold = new_model(&yaml("hold")).unwrap();
+    let edge = new_model("/**:\n  ros__parameters:\n    solver: {cells: 32}\n").unwrap();
+    for (k, v) in [0.1, 0.2, 1.0, 1.0, 0.2].into_iter().enumerate() {
+        let (w, z, h) = (
+            step(warn, v, 20_762.0, 1e-3),
+            step(zero, v, 20_762.0, 1e-3),
+            step(hold, v, 20_762.0, 1e-3),
+        );
+        let e = step(edge, v.min(0.3), 20_762.0, 1e-3);
+        let want = if v > 0.3 {
+            FN_RANGE_OUTSIDE
+        } else {
+            FN_RANGE_INSIDE
+        };
+        for x in [w, z, h] {
+            assert_eq!(x.calibrated_range, want, "step {k}");
+        }
+        assert_eq!(
+            h.friction_force_n, e.friction_force_n,
+            "hold: the edge's, step {k}"
+        );
+        if v > 0.3 {
+            assert_eq!(z.friction_force_n, 0.0, "step {k}");
+            assert!(w.friction_force_n > 0.0);
+        } else {
+            assert_eq!(z.friction_force_n, w.friction_force_n, "step {k}");
+        }
+    }
+    // The policy is a parameter like the other node.* keys.
+    set(warn, "node.outside_envelope", "zero").unwrap();
+    assert_eq!(step(warn, 1.0, 20_762.0, 1e-3).friction_force_n, 0.0);
+    for m in [plain, warn, zero, hold, edge] {
+        unsafe { fn_model_free(m) };
+    }
+}

@@ -221,7 +221,7 @@ class Model:
 
 
 def _columns(d: dict) -> dict:
-    for k in ("status", "regime", "command_status", "contact"):
+    for k in ("status", "regime", "command_status", "calibrated_range", "contact"):
         if k in d:
             d[k] = np.asarray(d[k], dtype=object)
     return d
@@ -257,9 +257,10 @@ class ReplayResult:
     """What ``replay`` returns.
 
     Attributes: ``estimates`` (DataFrame: the ``simulate`` columns,
-    ``stamp_ns`` and ``command_status``, one row per step), ``cycles``
-    (DataFrame of loop metrics per cycle), ``summary`` (dict: steps, span_s,
-    wall_s, commands_rejected, ...), ``identical`` (True/False when the bag
+    ``stamp_ns``, ``command_status`` and ``calibrated_range``, one row per
+    step), ``cycles`` (DataFrame of loop metrics per cycle), ``summary``
+    (dict: steps, span_s, wall_s, commands_rejected,
+    steps_outside_calibrated_range, outside_share by contact, ...), ``identical`` (True/False when the bag
     holds recorded estimates to compare with, else None) and
     ``deviations`` (field, largest difference, step) when not identical.
     A recording of several contacts replays every contact: ``estimates``

@@ -31,6 +31,7 @@ class Estimate:
     substeps: int
     status: str
     regime: str
+    calibrated_range: str
 
 class Model:
     def __init__(

@@ -181,6 +181,8 @@ def _replay_one(bag: str, stem: str, options: Mapping[str, Any], out_dir: Option
             model_wall_s=s["model_wall_s"],
             real_time_factor=s["span_s"] / s["wall_s"] if s["wall_s"] > 0 else math.nan,
             commands_rejected=s["commands_rejected"],
+            outside_share=max((x for x in s["outside_share"].values() if x == x), default=math.nan),
+            outside_by_joint=", ".join(f"{k} {v:.3f}" for k, v in s["outside_share"].items()),
             identical=s["identical"],
             input=s["input"],
             cycles=len(r.cycles),
@@ -201,7 +203,8 @@ def _replay_one(bag: str, stem: str, options: Mapping[str, Any], out_dir: Option
 #: Columns of FleetReplay.bags, in order.
 BAG_COLUMNS = [
     "bag", "ok", "error", "steps", "span_s", "wall_s", "model_wall_s", "real_time_factor",
-    "commands_rejected", "identical", "input", "cycles", "friction_mean_abs_n",
+    "commands_rejected", "outside_share", "outside_by_joint", "identical", "input", "cycles",
+    "friction_mean_abs_n",
     "friction_max_abs_n", "mean_friction_loop_area_n_m_s", "out", "task_s",
 ]
 #: Columns of FleetReplay.cycles, in order.

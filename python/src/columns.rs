@@ -16,6 +16,7 @@ pub struct Columns {
     regime: Vec<&'static str>,
     stamp_ns: Vec<u64>,
     command_status: Vec<&'static str>,
+    calibrated_range: Vec<&'static str>,
 }
 
 /// Names of the float columns, in `Columns::f` order.
@@ -83,10 +84,17 @@ impl Columns {
         self.regime.push(e.regime.as_str());
     }
 
-    /// Replay's extra columns (the stamp and the command's state).
-    pub fn push_stamp(&mut self, stamp_ns: u64, command_status: &'static str) {
+    /// Replay's extra columns (the stamp, the command's state and where
+    /// the input lay against the calibrated range).
+    pub fn push_stamp(
+        &mut self,
+        stamp_ns: u64,
+        command_status: &'static str,
+        calibrated_range: &'static str,
+    ) {
         self.stamp_ns.push(stamp_ns);
         self.command_status.push(command_status);
+        self.calibrated_range.push(calibrated_range);
     }
 
     /// A dict of numpy arrays (strings as lists).
@@ -102,6 +110,7 @@ impl Columns {
         if !self.stamp_ns.is_empty() {
             d.set_item("stamp_ns", PyArray1::from_vec(py, self.stamp_ns))?;
             d.set_item("command_status", self.command_status)?;
+            d.set_item("calibrated_range", self.calibrated_range)?;
         }
         Ok(d)
     }

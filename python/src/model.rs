@@ -5,6 +5,7 @@ use crate::columns::Columns;
 use crate::errors;
 use friction_node::config::{Config, InputLimits, Origin, OutOfEnvelope, ViscosityLaw};
 use friction_node::physics::{Estimate as CoreEstimate, Solver};
+use friction_node::range_watch::{RangeFlag, RangeWatch, Watched};
 use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -60,6 +61,10 @@ pub struct Estimate {
     pub status: &'static str,
     /// `boundary`, `mixed` or `hydrodynamic`.
     pub regime: &'static str,
+    /// Where the step's input lay against the configuration's
+    /// `calibrated_range`: `not_watched` (none given), `inside` or
+    /// `outside` (the friction then as `node.outside_envelope` says).
+    pub calibrated_range: &'static str,
 }
 
 impl From<&CoreEstimate> for Estimate {
@@ -83,6 +88,19 @@ impl From<&CoreEstimate> for Estimate {
             substeps: e.diagnostics.substeps,
             status: e.status.as_str(),
             regime: e.regime.as_str(),
+            calibrated_range: RangeFlag::NotWatched.as_str(),
+        }
+    }
+}
+
+impl Estimate {
+    /// The estimate of a step whose input `watch` judged as `w`.
+    fn watched(e: &CoreEstimate, watch: &RangeWatch, w: &Watched) -> Self {
+        Self {
+            friction_force_n: watch.published(w.flag, e.friction_force),
+            contact_friction_force_n: watch.published(w.flag, e.contact_friction_force),
+            calibrated_range: w.flag.as_str(),
+            ..Self::from(e)
         }
     }
 }
@@ -103,6 +121,16 @@ pub struct Model {
     solver: Solver,
     config: Config,
     temperature_c: f64,
+    /// The configuration's calibrated range and `node.outside_envelope`.
+    watch: RangeWatch,
+}
+
+/// The watch of `config`'s calibrated range.
+fn watch_of(config: &Config) -> RangeWatch {
+    RangeWatch::new(
+        config.calibrated_range.clone(),
+        config.node.outside_envelope,
+    )
 }
 
 /// The values of an optional series, or `default` repeated.
@@ -167,6 +195,15 @@ impl Model {
     fn law(&self) -> ViscosityLaw {
         ViscosityLaw::of(&self.config)
     }
+
+    /// The viscosity at `t` °C, or under `node.outside_envelope: hold` at
+    /// the calibrated range's nearest temperature; `mu` (the one at `t`)
+    /// when the law refuses that.
+    fn held_viscosity(&self, t: f64, mu: f64) -> f64 {
+        self.law()
+            .viscosity_at(self.watch.temperature_c(t))
+            .unwrap_or(mu)
+    }
 }
 
 #[pymethods]
@@ -187,6 +224,7 @@ impl Model {
         solver.initialize_steady(0.0, config.contact.load_n);
         Ok(Self {
             temperature_c: config.lubricant.reference_temperature_c,
+            watch: watch_of(&config),
             solver,
             config,
         })
@@ -217,11 +255,12 @@ impl Model {
             .check_velocity(velocity)
             .and_then(|_| limits.check_load(load))
             .map_err(|e| errors::value(e.to_string()))?;
+        let w = self.watch.watch(velocity, load, self.temperature_c);
         let e = match dt {
-            Some(dt) => self.solver.step_by(velocity, load, dt),
-            None => self.solver.step(velocity, load),
+            Some(dt) => self.solver.step_by(w.velocity_m_s, w.load_n, dt),
+            None => self.solver.step(w.velocity_m_s, w.load_n),
         };
-        Ok(Estimate::from(&e))
+        Ok(Estimate::watched(&e, &self.watch, &w))
     }
 
     #[pyo3(signature = (velocity=0.0, load=None))]
@@ -264,9 +303,11 @@ impl Model {
             )));
         }
         let _ = self.solver.swap_model(&mut prepared);
+        self.watch = watch_of(&new);
         self.config = new;
         if law.follows_temperature() {
-            self.solver.set_liquid_viscosity(mu);
+            self.solver
+                .set_liquid_viscosity(self.held_viscosity(self.temperature_c, mu));
         }
         Ok(())
     }
@@ -278,7 +319,8 @@ impl Model {
             .map_err(|e| errors::value(e.to_string()))?;
         self.temperature_c = temperature_c;
         if law.follows_temperature() {
-            self.solver.set_liquid_viscosity(mu);
+            self.solver
+                .set_liquid_viscosity(self.held_viscosity(temperature_c, mu));
         }
         Ok(())
     }

@@ -69,6 +69,26 @@ def test_step_by_step_equals_a_run():
     assert stepped[-1].status == "converged"
 
 
+RANGE = {
+    "speed_forward_min_m_s": 0.0, "speed_forward_max_m_s": 0.3,
+    "speed_backward_min_m_s": 0.0, "speed_backward_max_m_s": 0.3,
+    "training_rms_n": 1.0, "training_samples": 10,
+}
+
+
+def test_each_estimate_says_where_its_input_lay_against_the_calibrated_range():
+    plain = fn.Model(**{"solver.cells": 32})
+    assert plain.step(1.0).calibrated_range == "not_watched"
+    warn = fn.Model({"calibrated_range": RANGE}, **{"solver.cells": 32})
+    zero = fn.Model({"calibrated_range": RANGE, "node": {"outside_envelope": "zero"}}, **{"solver.cells": 32})
+    steps = [(warn.step(v), zero.step(v)) for v in (0.1, 0.2, 1.0, 1.0, 0.2)]
+    assert [w.calibrated_range for w, _ in steps] == ["inside", "inside", "outside", "outside", "inside"]
+    assert [z.calibrated_range for _, z in steps] == [w.calibrated_range for w, _ in steps]
+    # zero: no feed-forward outside, the model's value inside.
+    assert [z.friction_force_n == 0.0 for _, z in steps] == [False, False, True, True, False]
+    assert steps[0][1].friction_force_n == steps[0][0].friction_force_n
+
+
 def test_configuration_from_a_dict_dotted_keys_or_overrides_is_the_same(repo):
     by_dict = fn.Model({"contact": {"load_n": 5720.0}})
     by_key = fn.Model(**{"contact.load_n": 5720})

@@ -289,6 +289,10 @@ fn print_contacts_and_statuses(s: &friction_node::node::RunSummary) {
         .map(|(c, n)| format!("{} {n}", command_status_name(c as u8)))
         .collect();
     println!("  command statuses {}", commands.join(", "));
+    println!(
+        "  calibrated range {} contact steps outside",
+        s.steps_outside_calibrated_range
+    );
 }
 
 /// How the recording went.

@@ -153,6 +153,10 @@ fn print_outcome(o: &ReplayOutcome) {
         );
     }
     println!("commands         {} rejected", r.commands_rejected);
+    println!(
+        "calibrated range {} contact steps outside",
+        r.steps_outside_calibrated_range
+    );
     if !p.parameter_changes.is_empty() {
         println!(
             "parameters       {} changes re-applied at the steps that used them (recorded /parameter_events)",

@@ -38,6 +38,37 @@ pub enum TimeoutBehaviour {
     RampToZero,
 }
 
+/// `node.outside_envelope`: what a contact publishes while its input lies
+/// outside its `calibrated_range` (a contact without one is not watched).
+/// Every estimate outside carries `RANGE_OUTSIDE` whatever the choice.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum OutsideEnvelope {
+    /// The model's value: physics past the data, which may be right (the
+    /// model's terms are physical) or not (a fitted term extrapolated).
+    #[default]
+    Warn,
+    /// The model's value with the input clamped to the nearest edge of the
+    /// range: bounded by what was calibrated, but blind to a real rise or
+    /// fall beyond it.
+    Hold,
+    /// No feed-forward (friction 0): the controller's feedback carries it
+    /// alone; the conservative choice when a wrong sign or size costs more
+    /// than a missing one.
+    Zero,
+}
+
+impl OutsideEnvelope {
+    /// The name in the configuration.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Warn => "warn",
+            Self::Hold => "hold",
+            Self::Zero => "zero",
+        }
+    }
+}
+
 /// `node.realtime.*`: applied when enabled and permitted, with a warning
 /// otherwise.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -82,6 +113,9 @@ pub struct NodeConfig {
     pub command_timeout_s: f64,
     /// `node.timeout_behaviour`: hold: keep the last velocity; ramp_to_zero: decelerate.
     pub timeout_behaviour: TimeoutBehaviour,
+    /// `node.outside_envelope`: warn | hold | zero — what a contact publishes
+    /// while its input lies outside its calibrated range.
+    pub outside_envelope: OutsideEnvelope,
     /// `node.timeout_deceleration_m_s2`: deceleration of ramp_to_zero — range (0, 1e4]
     pub timeout_deceleration_m_s2: f64,
     /// Commands with |v| above this are rejected, m/s.
@@ -130,6 +164,7 @@ impl Default for NodeConfig {
             initial_velocity_m_s: 0.0,
             command_timeout_s: 0.1,
             timeout_behaviour: TimeoutBehaviour::Hold,
+            outside_envelope: OutsideEnvelope::Warn,
             timeout_deceleration_m_s2: 1.0,
             max_abs_velocity_m_s: 10.0,
             min_load_n: 1.0,

@@ -27,12 +27,13 @@ use serde_norway::Value;
 /// Whether `key` may change while the node runs.
 pub fn is_runtime(key: &str) -> bool {
     // The friction terms' keys say themselves (physics::terms::catalogue).
-    const EXACT: [&str; 11] = [
+    const EXACT: [&str; 12] = [
         "contact.load_n",
         "contact.mass_kg",
         "contact.min_film_m",
         "node.command_timeout_s",
         "node.timeout_behaviour",
+        "node.outside_envelope",
         "node.timeout_deceleration_m_s2",
         "node.max_abs_velocity_m_s",
         "node.min_load_n",

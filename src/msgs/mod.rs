@@ -16,7 +16,7 @@
 //! | `command_codec.rs` | a command as its message and back (Float64, TwistStamped, Temperature, JointState), the stamp rule |
 //! | `ros_interfaces.rs` | standard interfaces: parameters, `/rosout`, diagnostics, `/clock`, Trigger |
 //! | `tests.rs` | round trips of every message through CDR and the records |
-//! | `legacy/` | `.msg` definitions of layouts older bags were recorded in (`FrictionEstimateV1`, read by `types.rs`) |
+//! | `legacy/` | `.msg` definitions of layouts older bags were recorded in (`FrictionEstimateV1`, `V2`, read by `types.rs`) |
 
 mod cdr;
 pub mod command_codec;

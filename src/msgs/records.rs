@@ -1,7 +1,7 @@
 //! Heap-free records the loop produces (Copy), and their conversions to and
 //! from the wire types.
 
-use super::types::{msg_fields, FRICTION_ESTIMATE, FRICTION_ESTIMATE_V1};
+use super::types::{msg_fields, FRICTION_ESTIMATE, FRICTION_ESTIMATE_V1, FRICTION_ESTIMATE_V2};
 use super::wire::{
     estimate_constants as codes, FrictionEstimate, FrictionEstimateV1, Header, LoopStatistics, Time,
 };
@@ -40,6 +40,8 @@ pub struct EstimateRecord {
     pub status: u8,
     /// `COMMAND_*`: the command's state.
     pub command_status: u8,
+    /// `RANGE_*`: where the step's input lies against the calibrated range.
+    pub calibrated_range: u8,
     /// Newton iterations of the step.
     pub iterations: u32,
     /// Wall time of the model step (ns).
@@ -69,6 +71,16 @@ pub fn status_code(s: Status) -> u8 {
     }
 }
 
+/// The wire code of where a step's input lay (`RANGE_*`).
+pub fn range_code(f: crate::range_watch::RangeFlag) -> u8 {
+    use crate::range_watch::RangeFlag;
+    match f {
+        RangeFlag::NotWatched => codes::RANGE_NOT_WATCHED,
+        RangeFlag::Inside => codes::RANGE_INSIDE,
+        RangeFlag::Outside { .. } => codes::RANGE_OUTSIDE,
+    }
+}
+
 /// Name of a solver status code (logs, CSV).
 pub fn status_name(code: u8) -> &'static str {
     match code {
@@ -77,6 +89,17 @@ pub fn status_name(code: u8) -> &'static str {
         codes::STATUS_NON_FINITE => "non_finite",
         codes::STATUS_NON_FINITE_INPUT => "non_finite_input",
         codes::STATUS_INPUT_OUT_OF_RANGE => "input_out_of_range",
+        _ => "unknown",
+    }
+}
+
+/// Name of a calibrated-range code (CSV, Python): `not_watched`,
+/// `inside`, `outside`.
+pub fn range_name(code: u8) -> &'static str {
+    match code {
+        codes::RANGE_NOT_WATCHED => "not_watched",
+        codes::RANGE_INSIDE => "inside",
+        codes::RANGE_OUTSIDE => "outside",
         _ => "unknown",
     }
 }
@@ -113,6 +136,7 @@ impl EstimateRecord {
             regime: regime_code(e.regime),
             status: status_code(e.status),
             command_status: codes::COMMAND_FRESH,
+            calibrated_range: codes::RANGE_NOT_WATCHED,
             iterations: e.diagnostics.iterations,
             compute_time_ns,
             late_ns: 0,
@@ -140,6 +164,7 @@ impl EstimateRecord {
             regime: self.regime,
             status: self.status,
             command_status: self.command_status,
+            calibrated_range: self.calibrated_range,
             iterations: self.iterations,
             compute_time_ns: self.compute_time_ns,
             late_ns: self.late_ns,
@@ -164,6 +189,7 @@ impl EstimateRecord {
             regime: m.regime,
             status: m.status,
             command_status: m.command_status,
+            calibrated_range: m.calibrated_range,
             iterations: m.iterations,
             compute_time_ns: m.compute_time_ns,
             late_ns: m.late_ns,
@@ -198,6 +224,7 @@ impl EstimateRecord {
             regime: m.regime,
             status,
             command_status,
+            calibrated_range: codes::RANGE_NOT_WATCHED,
             iterations: m.iterations,
             compute_time_ns: m.compute_time_ns,
             late_ns: 0,
@@ -209,33 +236,63 @@ fn top_fields(schema_text: &str) -> Vec<(String, String)> {
     msg_fields(schema_text.split("\n====").next().unwrap_or(""))
 }
 
-/// Whether a `ros2msg` schema text is that of `FrictionEstimate`, in the
-/// current layout or the one before `command_status`.
-pub fn check_estimate_schema(schema_text: &str) -> Result<(), String> {
-    let got = top_fields(schema_text);
-    if got == msg_fields(FRICTION_ESTIMATE.definition)
-        || got == msg_fields(FRICTION_ESTIMATE_V1.definition)
-    {
-        Ok(())
-    } else {
+/// The layouts `FrictionEstimate` was recorded in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum EstimateLayout {
+    /// Before `command_status` (`legacy/FrictionEstimateV1.msg`).
+    V1,
+    /// Before `calibrated_range` (`legacy/FrictionEstimateV2.msg`): the
+    /// same bytes (the new field sits in what was padding), read as
+    /// `RANGE_NOT_WATCHED`.
+    V2,
+    /// Today's `msg/msg/FrictionEstimate.msg`.
+    #[default]
+    Current,
+}
+
+impl EstimateLayout {
+    /// The layout of a recorded `ros2msg` schema text, or an error naming
+    /// its fields.
+    pub fn of_schema(schema_text: &str) -> Result<Self, String> {
+        let got = top_fields(schema_text);
+        for (layout, t) in [
+            (Self::Current, &FRICTION_ESTIMATE),
+            (Self::V2, &FRICTION_ESTIMATE_V2),
+            (Self::V1, &FRICTION_ESTIMATE_V1),
+        ] {
+            if got == msg_fields(t.definition) {
+                return Ok(layout);
+            }
+        }
         Err(format!(
-            "fields {:?} are neither those of friction_msgs/msg/FrictionEstimate nor of its earlier layout",
+            "fields {:?} are neither those of friction_msgs/msg/FrictionEstimate nor of an earlier layout",
             got.iter().map(|(_, n)| n.as_str()).collect::<Vec<_>>()
         ))
     }
 }
 
-/// Whether a recorded estimate schema is the layout before `command_status`.
-pub fn is_legacy_estimate_schema(schema_text: &str) -> bool {
-    top_fields(schema_text) == msg_fields(FRICTION_ESTIMATE_V1.definition)
+/// Whether a `ros2msg` schema text is that of `FrictionEstimate`, in the
+/// current layout or an earlier one.
+pub fn check_estimate_schema(schema_text: &str) -> Result<(), String> {
+    EstimateLayout::of_schema(schema_text).map(|_| ())
 }
 
-/// Decode a recorded `FrictionEstimate` of either layout.
-pub fn decode_estimate(bytes: &[u8], legacy: bool) -> Result<EstimateRecord, super::CdrError> {
-    if legacy {
-        super::from_cdr::<FrictionEstimateV1>(bytes).map(|m| EstimateRecord::from_wire_v1(&m))
-    } else {
-        super::from_cdr::<FrictionEstimate>(bytes).map(|m| EstimateRecord::from_wire(&m))
+/// Decode a recorded `FrictionEstimate` of `layout`.
+pub fn decode_estimate(
+    bytes: &[u8],
+    layout: EstimateLayout,
+) -> Result<EstimateRecord, super::CdrError> {
+    match layout {
+        EstimateLayout::V1 => {
+            super::from_cdr::<FrictionEstimateV1>(bytes).map(|m| EstimateRecord::from_wire_v1(&m))
+        }
+        EstimateLayout::V2 => super::from_cdr::<FrictionEstimate>(bytes).map(|m| EstimateRecord {
+            calibrated_range: codes::RANGE_NOT_WATCHED,
+            ..EstimateRecord::from_wire(&m)
+        }),
+        EstimateLayout::Current => {
+            super::from_cdr::<FrictionEstimate>(bytes).map(|m| EstimateRecord::from_wire(&m))
+        }
     }
 }
 
@@ -341,6 +398,45 @@ pub struct StatisticsRecord {
     pub slowest_contact: u32,
     /// That contact's longest step compute time since the previous LoopStatistics (ns).
     pub slowest_contact_compute_ns: u64,
+    /// Contact steps whose input lay outside the contact's calibrated range.
+    pub steps_outside_calibrated_range: u64,
+    /// The latest step outside a calibrated range since the previous
+    /// statistics (`/diagnostics` names it).
+    pub last_outside: Option<OutsideEvent>,
+}
+
+/// A contact's input outside its calibrated range (Copy, no heap).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OutsideEvent {
+    /// The contact (configured order).
+    pub contact: u32,
+    /// The input: `speed forward`, `speed backward`, `load`, `temperature`.
+    pub input: &'static str,
+    /// Its value, in the contact's units.
+    pub value: f64,
+    /// The range it left: lowest …
+    pub lo: f64,
+    /// … and highest.
+    pub hi: f64,
+}
+
+impl OutsideEvent {
+    /// The inputs a calibrated range watches, by their code (1-based; 0 is none).
+    pub const INPUTS: [&'static str; 4] =
+        ["speed forward", "speed backward", "load", "temperature"];
+
+    /// The code of an input name (0 for a name not watched).
+    pub fn input_code(input: &str) -> u8 {
+        Self::INPUTS
+            .iter()
+            .position(|i| *i == input)
+            .map_or(0, |k| k as u8 + 1)
+    }
+
+    /// The input of a code (None for 0 or an unknown code).
+    pub fn input_of_code(code: u8) -> Option<&'static str> {
+        Self::INPUTS.get(usize::from(code).checked_sub(1)?).copied()
+    }
 }
 
 impl StatisticsRecord {
@@ -382,6 +478,14 @@ impl StatisticsRecord {
             contacts: self.contacts,
             slowest_contact: self.slowest_contact,
             slowest_contact_compute_ns: self.slowest_contact_compute_ns,
+            steps_outside_calibrated_range: self.steps_outside_calibrated_range,
+            outside_input: self
+                .last_outside
+                .map_or(String::new(), |o| o.input.to_string()),
+            outside_contact: self.last_outside.map_or(0, |o| o.contact),
+            outside_value: self.last_outside.map_or(0.0, |o| o.value),
+            outside_min: self.last_outside.map_or(0.0, |o| o.lo),
+            outside_max: self.last_outside.map_or(0.0, |o| o.hi),
         }
     }
 
@@ -426,6 +530,15 @@ impl StatisticsRecord {
             contacts: m.contacts,
             slowest_contact: m.slowest_contact,
             slowest_contact_compute_ns: m.slowest_contact_compute_ns,
+            steps_outside_calibrated_range: m.steps_outside_calibrated_range,
+            last_outside: OutsideEvent::input_of_code(OutsideEvent::input_code(&m.outside_input))
+                .map(|input| OutsideEvent {
+                    contact: m.outside_contact,
+                    input,
+                    value: m.outside_value,
+                    lo: m.outside_min,
+                    hi: m.outside_max,
+                }),
         }
     }
 }

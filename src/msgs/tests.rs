@@ -85,15 +85,41 @@ fn a_bag_estimate_of_the_earlier_layout_maps_its_command_flags_to_command_status
     let bytes = to_cdr(&old).unwrap();
     let schema = FRICTION_ESTIMATE_V1.ros2msg_schema();
     assert!(check_estimate_schema(&schema).is_ok());
-    assert!(is_legacy_estimate_schema(&schema));
-    assert!(!is_legacy_estimate_schema(
-        &FRICTION_ESTIMATE.ros2msg_schema()
-    ));
-    let r = decode_estimate(&bytes, true).unwrap();
+    assert_eq!(EstimateLayout::of_schema(&schema), Ok(EstimateLayout::V1));
+    assert_eq!(
+        EstimateLayout::of_schema(&FRICTION_ESTIMATE.ros2msg_schema()),
+        Ok(EstimateLayout::Current)
+    );
+    let r = decode_estimate(&bytes, EstimateLayout::V1).unwrap();
     assert_eq!(r.status, estimate_constants::STATUS_CONVERGED);
     assert_eq!(r.command_status, estimate_constants::COMMAND_TIMED_OUT);
     assert_eq!((r.velocity_m_s, r.iterations), (0.5, 2));
     assert!(check_estimate_schema("float64 x\n").is_err());
+}
+
+#[test]
+fn a_bag_estimate_recorded_before_calibrated_range_reads_as_not_watched() {
+    // The layout before `calibrated_range`: the same bytes, the new field
+    // where padding was (here made non-zero to show it is not read).
+    let mut bytes = to_cdr(
+        &EstimateRecord {
+            command_status: estimate_constants::COMMAND_HELD,
+            iterations: 4,
+            ..Default::default()
+        }
+        .to_wire("slider"),
+    )
+    .unwrap();
+    let schema = FRICTION_ESTIMATE_V2.ros2msg_schema();
+    assert_eq!(EstimateLayout::of_schema(&schema), Ok(EstimateLayout::V2));
+    let at = bytes.len() - 8 - 8 - 4 - 1; // late, compute, iterations, then the pad byte
+    bytes[at] = estimate_constants::RANGE_OUTSIDE;
+    let r = decode_estimate(&bytes, EstimateLayout::V2).unwrap();
+    assert_eq!(r.calibrated_range, estimate_constants::RANGE_NOT_WATCHED);
+    assert_eq!(r.command_status, estimate_constants::COMMAND_HELD);
+    assert_eq!(r.iterations, 4);
+    let now = decode_estimate(&bytes, EstimateLayout::Current).unwrap();
+    assert_eq!(now.calibrated_range, estimate_constants::RANGE_OUTSIDE);
 }
 
 #[test]
@@ -112,6 +138,9 @@ fn msg_constants_match_the_rust_constants() {
         ("COMMAND_FRESH", COMMAND_FRESH),
         ("COMMAND_HELD", COMMAND_HELD),
         ("COMMAND_TIMED_OUT", COMMAND_TIMED_OUT),
+        ("RANGE_NOT_WATCHED", RANGE_NOT_WATCHED),
+        ("RANGE_INSIDE", RANGE_INSIDE),
+        ("RANGE_OUTSIDE", RANGE_OUTSIDE),
         ("COMMAND_REJECTED", COMMAND_REJECTED),
     ] {
         assert!(
@@ -148,6 +177,7 @@ fn cdr_round_trips_with_the_encapsulation_header() {
         iterations: 3,
         status: estimate_constants::STATUS_INPUT_OUT_OF_RANGE,
         command_status: estimate_constants::COMMAND_TIMED_OUT,
+        calibrated_range: estimate_constants::RANGE_OUTSIDE,
         late_ns: 7,
         ..Default::default()
     };

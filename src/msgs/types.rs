@@ -172,6 +172,14 @@ pub static FRICTION_ESTIMATE_V1: MsgType = MsgType {
     dependencies: &[&HEADER],
 };
 
+/// `FrictionEstimate` before `calibrated_range` (bags recorded until then).
+pub static FRICTION_ESTIMATE_V2: MsgType = MsgType {
+    package: "friction_msgs",
+    name: "FrictionEstimate",
+    definition: include_str!("legacy/FrictionEstimateV2.msg"),
+    dependencies: &[&HEADER],
+};
+
 /// Fields of a `.msg` text, in order: (type, name). Comments, blank lines
 /// and constants are skipped.
 pub fn msg_fields(definition: &str) -> Vec<(String, String)> {

@@ -177,6 +177,13 @@ pub mod estimate_constants {
     pub const COMMAND_TIMED_OUT: u8 = 2;
     /// A command since the previous step was rejected (non-finite, beyond limits, out of order).
     pub const COMMAND_REJECTED: u8 = 3;
+    /// The contact's configuration has no calibrated_range (hand-written parameters).
+    pub const RANGE_NOT_WATCHED: u8 = 0;
+    /// The step's speed, load and temperature lie inside the range the contact was calibrated on.
+    pub const RANGE_INSIDE: u8 = 1;
+    /// An input lies outside it: the friction is as node.outside_envelope says (warn: the
+    /// model's; hold: the model's at the nearest edge; zero: 0).
+    pub const RANGE_OUTSIDE: u8 = 2;
     /// Status codes of bags written before `command_status` existed.
     pub const LEGACY_STATUS_COMMAND_TIMEOUT: u8 = 4;
     /// Status 5 in bags written before command_status existed: the command was rejected.
@@ -216,6 +223,8 @@ pub struct FrictionEstimate {
     pub status: u8,
     /// COMMAND_*: the command's state.
     pub command_status: u8,
+    /// RANGE_*: where the step's input lies against the calibrated range.
+    pub calibrated_range: u8,
     /// Newton iterations of the step.
     pub iterations: u32,
     /// Wall time of the model step (ns).
@@ -340,6 +349,20 @@ pub struct LoopStatistics {
     pub slowest_contact: u32,
     /// That contact's longest step compute time since the previous LoopStatistics (ns).
     pub slowest_contact_compute_ns: u64,
+    /// Contact steps whose input lay outside the contact's calibrated range (FrictionEstimate
+    /// RANGE_OUTSIDE).
+    pub steps_outside_calibrated_range: u64,
+    /// The latest input outside a calibrated range since the previous LoopStatistics: speed
+    /// forward, speed backward, load or temperature ("" none).
+    pub outside_input: String,
+    /// Its contact (configured order).
+    pub outside_contact: u32,
+    /// Its value, in the contact's units (m/s, N, degC).
+    pub outside_value: f64,
+    /// The calibrated range it left.
+    pub outside_min: f64,
+    /// See `outside_min`.
+    pub outside_max: f64,
 }
 
 #[cfg(feature = "ros2")]

@@ -144,7 +144,9 @@ impl Loop {
         self.temperature_c = t_c;
         for k in 0..self.viscosity.len() {
             let law = self.viscosity[k];
-            if let (true, Ok(mu)) = (law.follows_temperature(), law.viscosity_at(t_c)) {
+            // Under `node.outside_envelope: hold`, at the calibrated range's edge.
+            let t_model = self.watches[k].temperature_c(t_c);
+            if let (true, Ok(mu)) = (law.follows_temperature(), law.viscosity_at(t_model)) {
                 self.contacts.with_solver(k, |s| s.set_liquid_viscosity(mu));
             }
         }

@@ -119,6 +119,10 @@ pub struct RunSummary {
     pub slowest_contact_ns: u64,
     /// The longest contact step since the previous statistics: (contact, ns).
     pub window_slowest: (usize, u64),
+    /// Contact steps whose input lay outside the contact's calibrated range.
+    pub steps_outside_calibrated_range: u64,
+    /// The latest such step since the previous statistics.
+    pub window_outside: Option<crate::msgs::OutsideEvent>,
 }
 
 /// Errors of the node layer (setup only: a running loop never fails).
@@ -140,6 +144,10 @@ pub struct Loop {
     contacts: ContactSet,
     /// Command state per contact (index = contact).
     cmd: Vec<commands::ContactCommand>,
+    /// Each contact's calibrated-range watch (index = contact).
+    watches: Vec<crate::range_watch::RangeWatch>,
+    /// Where each contact's input lay in the step being taken.
+    flags: Vec<crate::range_watch::RangeFlag>,
     /// Per-step scratch (no allocation per step): inputs and efforts.
     velocities: Vec<f64>,
     loads: Vec<f64>,
@@ -217,12 +225,23 @@ impl Loop {
             .iter()
             .map(|c| crate::config::ViscosityLaw::of(&c.config))
             .collect();
+        let watches = resolved
+            .iter()
+            .map(|c| {
+                crate::range_watch::RangeWatch::new(
+                    c.config.calibrated_range.clone(),
+                    config.node.outside_envelope,
+                )
+            })
+            .collect();
         let n = contacts.len();
         let window = (settings.statistics_every_steps as usize).clamp(16, 1 << 16);
         let clock: Arc<dyn Clock> = Arc::new(SystemClock::new());
         Ok(Self {
             contacts,
             cmd,
+            watches,
+            flags: vec![Default::default(); n],
             velocities: vec![v0; n],
             loads: resolved.iter().map(|c| c.config.contact.load_n).collect(),
             efforts: vec![0.0; n],

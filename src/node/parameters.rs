@@ -40,6 +40,9 @@ impl super::Loop {
             return;
         }
         self.settings = u.settings.clone();
+        for w in &mut self.watches {
+            w.set_policy(self.settings.outside_envelope);
+        }
         for (i, c) in u.contacts.iter_mut().enumerate() {
             let _ = self.contacts.with_solver(i, |s| s.swap_model(&mut c.model));
             self.viscosity[i] = c.viscosity;
@@ -48,7 +51,7 @@ impl super::Loop {
                 // gives the law's reference viscosity.
                 let mu = c
                     .viscosity
-                    .viscosity_at(self.temperature_c)
+                    .viscosity_at(self.watches[i].temperature_c(self.temperature_c))
                     .unwrap_or(c.viscosity.mu_ref);
                 self.contacts.with_solver(i, |s| s.set_liquid_viscosity(mu));
             }

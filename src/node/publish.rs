@@ -4,8 +4,9 @@
 use super::Loop;
 use crate::config::StepMode;
 use crate::link::RecordItem;
-use crate::msgs::{EstimateRecord, StatisticsRecord};
+use crate::msgs::{EstimateRecord, OutsideEvent, StatisticsRecord};
 use crate::physics::Estimate;
+use crate::range_watch::RangeFlag;
 use std::sync::atomic::Ordering;
 
 impl Loop {
@@ -23,8 +24,10 @@ impl Loop {
     fn step_contacts(&mut self, jump_s: Option<f64>, stamp_ns: u64, late_ns: u64) {
         self.apply_parameters(stamp_ns);
         for (k, c) in self.cmd.iter().enumerate() {
-            self.velocities[k] = c.applied;
-            self.loads[k] = c.load;
+            let w = self.watches[k].watch(c.applied, c.load, self.temperature_c);
+            self.velocities[k] = w.velocity_m_s;
+            self.loads[k] = w.load_n;
+            self.flags[k] = w.flag;
         }
         let start = self.clock.now_ns();
         let timing = self.contacts.step(&self.velocities, &self.loads, jump_s);
@@ -41,7 +44,7 @@ impl Loop {
                 compute
             };
             self.publish(k, &e, stamp_ns, own, late_ns);
-            self.efforts[k] = self.contacts.effort(k);
+            self.efforts[k] = self.watches[k].published(self.flags[k], self.contacts.effort(k));
         }
         if self.by_joint {
             for p in self.ports.iter_mut() {
@@ -63,6 +66,7 @@ impl Loop {
         rec.temperature_c = self.temperature_c;
         rec.command_status = self.take_command_status(k);
         rec.late_ns = late_ns;
+        self.watched(k, &mut rec);
         self.summary.status_counts[usize::from(rec.status).min(7)] += 1;
         self.summary.command_status_counts[usize::from(rec.command_status).min(3)] += 1;
         for p in self.ports.iter_mut() {
@@ -91,6 +95,32 @@ impl Loop {
             l.cof_bits.store(rec.cof.to_bits(), Ordering::Relaxed);
             l.h0_bits.store(rec.h0_m.to_bits(), Ordering::Relaxed);
             l.status.store(u64::from(rec.status), Ordering::Relaxed);
+        }
+    }
+
+    /// Contact `k`'s calibrated-range flag on its record, the friction as
+    /// `node.outside_envelope` says, and the count of steps outside.
+    fn watched(&mut self, k: usize, rec: &mut EstimateRecord) {
+        let flag = self.flags[k];
+        rec.calibrated_range = crate::msgs::range_code(flag);
+        if let RangeFlag::Outside {
+            input,
+            value,
+            lo,
+            hi,
+        } = flag
+        {
+            let w = &self.watches[k];
+            rec.friction_force_n = w.published(flag, rec.friction_force_n);
+            rec.contact_friction_force_n = w.published(flag, rec.contact_friction_force_n);
+            self.summary.steps_outside_calibrated_range += 1;
+            self.summary.window_outside = Some(OutsideEvent {
+                contact: u32::try_from(k).unwrap_or(u32::MAX),
+                input,
+                value,
+                lo,
+                hi,
+            });
         }
     }
 
@@ -182,8 +212,11 @@ impl Loop {
             contacts: u32::try_from(self.contacts.len()).unwrap_or(u32::MAX),
             slowest_contact: u32::try_from(total.window_slowest.0).unwrap_or(u32::MAX),
             slowest_contact_compute_ns: total.window_slowest.1,
+            steps_outside_calibrated_range: total.steps_outside_calibrated_range,
+            last_outside: total.window_outside,
         };
         self.summary.window_slowest = (0, 0);
+        self.summary.window_outside = None;
         self.window_compute.clear();
         self.window_jitter.clear();
         for p in self.ports.iter_mut() {

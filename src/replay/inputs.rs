@@ -72,8 +72,8 @@ struct Readers<'s> {
     /// The recorded estimates driving the replay (the first contact's
     /// channel with several).
     estimates: Option<&'s ChannelInfo>,
-    /// The estimates were recorded with the schema before `command_status`.
-    legacy: bool,
+    /// The layout the estimates were recorded in.
+    layout: msgs::EstimateLayout,
     /// Several contacts from a JointState topic: one decoder per joint.
     joints: Vec<TopicDecoder>,
     /// Several contacts: each contact's estimate topic.
@@ -165,7 +165,9 @@ impl<'s> Readers<'s> {
             velocity,
             load,
             temperature,
-            legacy: estimates.is_some_and(|c| msgs::is_legacy_estimate_schema(&c.schema_text)),
+            layout: estimates
+                .and_then(|c| msgs::EstimateLayout::of_schema(&c.schema_text).ok())
+                .unwrap_or_default(),
             estimates,
             joints,
             contact_topics,
@@ -196,7 +198,7 @@ impl<'s> Readers<'s> {
             self.take_event(c, view.data, s)
         } else if let Some(k) = self.contact_topics.iter().position(|t| *t == view.topic) {
             s.estimate_index += 1;
-            let r = msgs::decode_estimate(view.data, false).map_err(|m| {
+            let r = msgs::decode_estimate(view.data, self.layout).map_err(|m| {
                 estimate_error(
                     view.topic,
                     "friction_msgs/msg/FrictionEstimate",
@@ -208,7 +210,7 @@ impl<'s> Readers<'s> {
             Ok(())
         } else if let Some(c) = self.estimates.filter(|c| c.topic == view.topic) {
             s.estimate_index += 1;
-            let r = msgs::decode_estimate(view.data, self.legacy)
+            let r = msgs::decode_estimate(view.data, self.layout)
                 .map_err(|m| estimate_error(&c.topic, &c.schema_name, s.estimate_index, m))?;
             s.recorded.push(r);
             Ok(())

@@ -183,6 +183,10 @@ fn summary_table(bag: &Path, p: &PreparedReplay, r: &ReplayResult, wall_s: f64) 
         "| commands rejected | {} |\n",
         r.commands_rejected
     ));
+    md.push_str(&format!(
+        "| contact steps outside the calibrated range | {} |\n",
+        r.steps_outside_calibrated_range
+    ));
     if !p.gaps.is_empty() {
         md.push_str(&format!(
             "| velocity gaps | {} longer than the command timeout ({} s; the node's timeout rule applied): {} |\n",

@@ -20,6 +20,9 @@ pub struct ReplayResult {
     pub estimates: Vec<(Estimate, EstimateRecord)>,
     /// Commands the loop rejected.
     pub commands_rejected: u64,
+    /// Contact steps whose input lay outside the contact's calibrated range
+    /// (counted as the node counts them).
+    pub steps_outside_calibrated_range: u64,
     /// Every contact's verdict together (all identical, deviations of all).
     pub oracle: Option<Oracle>,
     /// Several contacts: each contact's name, estimates and oracle.
@@ -190,6 +193,7 @@ pub fn run(
     Ok(ReplayResult {
         estimates: out.first,
         commands_rejected: l.summary().commands_rejected,
+        steps_outside_calibrated_range: l.summary().steps_outside_calibrated_range,
         oracle,
         contacts,
     })

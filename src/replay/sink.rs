@@ -63,6 +63,10 @@ impl Sink for CsvSink {
             let t0 = *self.t0.get_or_insert(rec.stamp_ns);
             let mut e = *e;
             e.time = rec.stamp_ns.saturating_sub(t0) as f64 / 1e9;
+            // What was published (0 outside the calibrated range under
+            // `node.outside_envelope: zero`).
+            e.friction_force = rec.friction_force_n;
+            e.contact_friction_force = rec.contact_friction_force_n;
             let row = crate::offline::simulate_row_with_status(
                 &e,
                 msgs::status_name(rec.status),
@@ -79,9 +83,10 @@ impl Sink for CsvSink {
                 None => String::new(),
             };
             self.file.line(format_args!(
-                "{row},{},{}{contact}",
+                "{row},{},{},{}{contact}",
                 rec.stamp_ns,
-                msgs::command_status_name(rec.command_status)
+                msgs::command_status_name(rec.command_status),
+                msgs::range_name(rec.calibrated_range)
             ))?;
         }
         Ok(())
@@ -227,7 +232,7 @@ impl CsvSink {
             Vec::new()
         };
         file.line(format_args!(
-            "{},stamp_ns,command_status{}",
+            "{},stamp_ns,command_status,calibrated_range{}",
             crate::offline::SIMULATE_COLUMNS,
             if contacts.is_empty() {
                 ""

@@ -48,7 +48,7 @@ def main() -> int:
     for field in ("velocity_m_s", "load_n", "temperature_c", "friction_force_n",
                   "contact_friction_force_n", "cof", "h0_m", "h_min_m",
                   "hydrodynamic_force_n", "asperity_force_n", "asperity_load_share",
-                  "regime", "status", "command_status", "iterations", "compute_time_ns",
+                  "regime", "status", "command_status", "calibrated_range", "iterations", "compute_time_ns",
                   "late_ns"):
         assert hasattr(e, field), f"FrictionEstimate lacks {field}"
     assert 0.0 < e.cof < 1.0 and e.h0_m > 0.0, e

@@ -112,7 +112,11 @@ fn estimate_columns<'py>(
         for (e, rec) in estimates.iter() {
             let t = rec.stamp_ns.saturating_sub(t0) as f64 / 1e9;
             c.push(e, t, msgs::status_name(rec.status), rec.temperature_c);
-            c.push_stamp(rec.stamp_ns, msgs::command_status_name(rec.command_status));
+            c.push_stamp(
+                rec.stamp_ns,
+                msgs::command_status_name(rec.command_status),
+                msgs::range_name(rec.calibrated_range),
+            );
             if !result.contacts.is_empty() {
                 names.push(name.to_string());
             }
@@ -154,6 +158,44 @@ fn cycle_columns<'py>(
     Ok(cd)
 }
 
+/// Each contact's share of steps whose input lay outside its calibrated
+/// range (NaN for a contact with none), by contact name.
+fn outside_shares<'py>(
+    py: Python<'py>,
+    r: &friction_node::replay::ReplayResult,
+) -> PyResult<Bound<'py, PyDict>> {
+    use friction_node::msgs::estimate_constants::{RANGE_NOT_WATCHED, RANGE_OUTSIDE};
+    let share = |est: &[(
+        friction_node::physics::Estimate,
+        friction_node::msgs::EstimateRecord,
+    )]| {
+        let watched = est
+            .iter()
+            .filter(|(_, rec)| rec.calibrated_range != RANGE_NOT_WATCHED)
+            .count();
+        let outside = est
+            .iter()
+            .filter(|(_, rec)| rec.calibrated_range == RANGE_OUTSIDE)
+            .count();
+        if watched == 0 {
+            f64::NAN
+        } else {
+            outside as f64 / est.len() as f64
+        }
+    };
+    let d = PyDict::new(py);
+    if r.contacts.is_empty() {
+        d.set_item(
+            friction_node::config::SINGLE_CONTACT_NAME,
+            share(&r.estimates),
+        )?;
+    }
+    for c in &r.contacts {
+        d.set_item(&c.name, share(&c.estimates))?;
+    }
+    Ok(d)
+}
+
 /// The command line's summary lines as a dict.
 fn replay_summary<'py>(
     py: Python<'py>,
@@ -171,6 +213,11 @@ fn replay_summary<'py>(
     s.set_item("wall_s", o.wall_s)?;
     s.set_item("model_wall_s", o.model_wall_s)?;
     s.set_item("commands_rejected", result.commands_rejected)?;
+    s.set_item(
+        "steps_outside_calibrated_range",
+        result.steps_outside_calibrated_range,
+    )?;
+    s.set_item("outside_share", outside_shares(py, result)?)?;
     s.set_item("gaps", prepared.gaps.len())?;
     s.set_item("files", prepared.scan.files.len())?;
     s.set_item(

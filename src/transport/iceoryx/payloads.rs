@@ -21,7 +21,7 @@ pub struct CommandPayload {
 /// One estimate (the fields of `friction_msgs/FrictionEstimate`).
 #[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
 #[repr(C)]
-#[type_name("friction_node::FrictionEstimate_v2")]
+#[type_name("friction_node::FrictionEstimate_v3")]
 pub struct EstimatePayload {
     /// The header's stamp, ns.
     pub stamp_ns: u64,
@@ -60,14 +60,14 @@ pub struct EstimatePayload {
     pub status: u8,
     /// COMMAND_*: the command's state.
     pub command_status: u8,
-    /// Padding (0).
-    pub reserved: u8,
+    /// RANGE_*: where the step's input lies against the calibrated range.
+    pub calibrated_range: u8,
 }
 
 /// Loop statistics (the fields of `friction_msgs/LoopStatistics`).
 #[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
 #[repr(C)]
-#[type_name("friction_node::LoopStatistics_v5")]
+#[type_name("friction_node::LoopStatistics_v6")]
 pub struct StatisticsPayload {
     /// The header's stamp, ns.
     pub stamp_ns: u64,
@@ -128,6 +128,19 @@ pub struct StatisticsPayload {
     pub slowest_contact: u32,
     /// That contact's longest step compute time since the previous LoopStatistics.
     pub slowest_contact_compute_ns: u64,
+    /// Contact steps whose input lay outside the contact's calibrated range.
+    pub steps_outside_calibrated_range: u64,
+    /// The latest step outside since the previous statistics: its input
+    /// (0 none, 1 speed forward, 2 speed backward, 3 load, 4 temperature) …
+    pub outside_input: u8,
+    /// … its contact …
+    pub outside_contact: u32,
+    /// … its value (contact units) …
+    pub outside_value: f64,
+    /// … and the range it left.
+    pub outside_lo: f64,
+    /// See `outside_lo`.
+    pub outside_hi: f64,
 }
 
 impl From<&StatisticsRecord> for StatisticsPayload {
@@ -167,6 +180,14 @@ impl From<&StatisticsRecord> for StatisticsPayload {
             contacts: s.contacts,
             slowest_contact: s.slowest_contact,
             slowest_contact_compute_ns: s.slowest_contact_compute_ns,
+            steps_outside_calibrated_range: s.steps_outside_calibrated_range,
+            outside_input: s
+                .last_outside
+                .map_or(0, |o| crate::msgs::OutsideEvent::input_code(o.input)),
+            outside_contact: s.last_outside.map_or(0, |o| o.contact),
+            outside_value: s.last_outside.map_or(0.0, |o| o.value),
+            outside_lo: s.last_outside.map_or(0.0, |o| o.lo),
+            outside_hi: s.last_outside.map_or(0.0, |o| o.hi),
         }
     }
 }
@@ -207,6 +228,16 @@ impl From<&StatisticsPayload> for StatisticsRecord {
             contacts: s.contacts,
             slowest_contact: s.slowest_contact,
             slowest_contact_compute_ns: s.slowest_contact_compute_ns,
+            steps_outside_calibrated_range: s.steps_outside_calibrated_range,
+            last_outside: crate::msgs::OutsideEvent::input_of_code(s.outside_input).map(|input| {
+                crate::msgs::OutsideEvent {
+                    contact: s.outside_contact,
+                    input,
+                    value: s.outside_value,
+                    lo: s.outside_lo,
+                    hi: s.outside_hi,
+                }
+            }),
         }
     }
 }
@@ -232,7 +263,7 @@ impl From<&EstimateRecord> for EstimatePayload {
             regime: e.regime,
             status: e.status,
             command_status: e.command_status,
-            reserved: 0,
+            calibrated_range: e.calibrated_range,
         }
     }
 }
@@ -255,6 +286,7 @@ impl From<&EstimatePayload> for EstimateRecord {
             regime: p.regime,
             status: p.status,
             command_status: p.command_status,
+            calibrated_range: p.calibrated_range,
             iterations: p.iterations,
             compute_time_ns: p.compute_time_ns,
             late_ns: p.late_ns,

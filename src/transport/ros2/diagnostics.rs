@@ -9,6 +9,7 @@
 //! | `<node>: commands` | nothing rejected, overwritten or timed out | any of them | (never) |
 //! | `<node>: outputs` | nothing dropped or failed | any output dropped or not sent | (never) |
 //! | `<node>: recorder` | recording everything (or not recording) | messages dropped by a full queue | messages lost (a write failed) |
+//! | `<node>: calibrated range` | every input inside its contact's calibrated range (or none given) | an input outside it in the period: which contact, input, value and range | (never) |
 //!
 //! "The period" is the time since the previous statistics (1 s by
 //! default). Values carry the cumulative counters and the period's.
@@ -228,6 +229,54 @@ fn recorder(p: &Period) -> DiagnosticStatus {
     )
 }
 
+/// The unit an input of a calibrated range is given in.
+fn unit_of(input: &str) -> &'static str {
+    match input {
+        "load" => "N",
+        "temperature" => "°C",
+        _ => "m/s",
+    }
+}
+
+fn calibrated_range(p: &Period) -> DiagnosticStatus {
+    let s = p.now;
+    let outside = p.delta(|r| r.steps_outside_calibrated_range);
+    let (lvl, msg) = match s.last_outside.filter(|_| outside > 0) {
+        Some(o) => {
+            let u = unit_of(o.input);
+            let contact = if s.contacts > 1 {
+                format!("contact {}: ", o.contact)
+            } else {
+                String::new()
+            };
+            (
+                level::WARN,
+                format!(
+                    "{contact}{} {} {u} outside the calibrated {} to {} {u} ({outside} of {} contact steps outside)",
+                    o.input,
+                    crate::text::Num(o.value),
+                    crate::text::Num(o.lo),
+                    crate::text::Num(o.hi),
+                    p.steps * u64::from(s.contacts.max(1)),
+                ),
+            )
+        }
+        None => (
+            level::OK,
+            "every input inside its contact's calibrated range (or none given)".into(),
+        ),
+    };
+    p.status(
+        "calibrated range",
+        lvl,
+        msg,
+        vec![
+            kv("steps outside", s.steps_outside_calibrated_range),
+            kv("steps outside in the period", outside),
+        ],
+    )
+}
+
 impl HealthReporter {
     /// The array for `s` (compared with the previous statistics).
     pub fn update(&mut self, s: &StatisticsRecord, node: &str, frame_id: &str) -> DiagnosticArray {
@@ -250,6 +299,7 @@ impl HealthReporter {
                 commands(&period),
                 outputs(&period),
                 recorder(&period),
+                calibrated_range(&period),
             ],
         }
     }
@@ -258,6 +308,47 @@ impl HealthReporter {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_input_outside_the_calibrated_range_warns_naming_it_and_clears_when_it_returns() {
+        let mut d = HealthReporter::default();
+        let mut s = StatisticsRecord {
+            steps: 1000,
+            contacts: 1,
+            ..Default::default()
+        };
+        let find = |a: &DiagnosticArray| {
+            a.status
+                .iter()
+                .find(|x| x.name == "/n: calibrated range")
+                .unwrap()
+                .clone()
+        };
+        assert_eq!(find(&d.update(&s, "/n", "f")).level, level::OK);
+        s.steps = 2000;
+        s.steps_outside_calibrated_range = 250;
+        s.last_outside = Some(crate::msgs::OutsideEvent {
+            contact: 0,
+            input: "speed forward",
+            value: 1.57,
+            lo: 0.0,
+            hi: 0.35,
+        });
+        let w = find(&d.update(&s, "/n", "f"));
+        assert_eq!(w.level, level::WARN);
+        assert!(
+            w.message
+                .contains("speed forward 1.57 m/s outside the calibrated 0 to 0.35 m/s"),
+            "{}",
+            w.message
+        );
+        assert!(w.message.contains("250 of 1000"), "{}", w.message);
+        // Back inside: no new step outside in the period.
+        s.steps = 3000;
+        s.last_outside = None;
+        let ok = find(&d.update(&s, "/n", "f"));
+        assert_eq!(ok.level, level::OK, "{}", ok.message);
+    }
 
     #[test]
     fn levels_follow_the_documented_thresholds_per_period() {
