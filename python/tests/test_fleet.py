@@ -45,6 +45,25 @@ def test_fleet_replay_of_a_glob_with_options_gives_per_cycle_metrics(bag_dir, cl
     )
 
 
+def test_fleet_replay_lists_each_joints_share_of_time_outside_its_calibrated_range(bag_dir, cluster_client):
+    rng = {"calibrated_range.speed_forward_min_m_s": 0.0, "calibrated_range.speed_forward_max_m_s": 0.5,
+           "calibrated_range.speed_backward_min_m_s": 0.0, "calibrated_range.speed_backward_max_m_s": 0.5,
+           "calibrated_range.training_rms_n": 1.0, "calibrated_range.training_samples": 10}
+    r = fleet.replay([str(bag_dir / "node_a.mcap")], client=cluster_client, overrides=rng, progress=False)
+    one = fn.replay(bag_dir / "node_a.mcap", overrides=rng)
+    outside = one.summary["steps_outside_calibrated_range"]
+    assert outside == (one.estimates["calibrated_range"] == "outside").sum() > 0
+    share = outside / one.summary["steps"]
+    # The 1 m/s sine spends 2/3 of its time above 0.5 m/s.
+    assert abs(share - 2 / 3) < 0.01
+    row = r.bags.iloc[0]
+    assert row["outside_share"] == share
+    assert row["outside_by_joint"] == f"contact {share:.3f}"
+    # Without a range: nothing is watched.
+    plain = fleet.replay([str(bag_dir / "node_a.mcap")], client=cluster_client, progress=False)
+    assert np.isnan(plain.bags.iloc[0]["outside_share"])
+
+
 def test_fleet_replay_as_a_dask_dataframe_computes_to_the_same_table(bag_dir, cluster_client):
     pytest.importorskip("dask.dataframe")
     bags = [str(bag_dir / "node_a.mcap"), str(bag_dir / "truncated.mcap")]
