@@ -433,7 +433,7 @@ fn the_calibrated_range_watch_allocates_nothing_inside_outside_or_holding() {
             speed_forward_max_m_s: Some(0.3),
             speed_backward_min_m_s: Some(0.0),
             speed_backward_max_m_s: Some(0.3),
-            training_rms_n: 1.0,
+            training_rms_n: Some(1.0),
             training_samples: 10,
             ..Default::default()
         });

@@ -99,6 +99,15 @@ fn a_rotary_joint_is_fitted_in_rad_s_and_newton_metres_and_its_file_drives_the_c
     assert_eq!(contacts[0].joint, "elbow");
     let gain = contacts[0].gain;
     assert!(gain > 0.0 && gain < 1.0, "lever arm {gain} m");
+    // Its calibrated range is the joint's, in rad/s and N·m: the sine of
+    // 0.05 m/s at 20 mm reaches 2.5 rad/s. The contact's own configuration
+    // holds it in m/s through the gain.
+    let range = contacts[0].joint_range.clone().expect("a joint's range");
+    let top = range.speed_forward_max_rad_s.unwrap();
+    assert!(top > 2.45 && top <= 2.5 + 1e-9, "{range:?}");
+    assert!(range.training_rms_n_m.is_some() && range.training_rms_n.is_none());
+    let own = contacts[0].config.calibrated_range.clone().unwrap();
+    approx::assert_relative_eq!(own.speed_forward_max_m_s.unwrap(), gain * top);
     // Driven by the joint's velocity through that gain, the contact gives
     // the joint's torque: simulate the contact at gain × ω, effort = gain × F.
     let mut v = String::from("t_s,v\n");

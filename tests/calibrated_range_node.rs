@@ -22,7 +22,7 @@ fn range() -> CalibratedRange {
         speed_backward_max_m_s: Some(0.3),
         load_min_n: Some(15_000.0),
         load_max_n: Some(25_000.0),
-        training_rms_n: 1.0,
+        training_rms_n: Some(1.0),
         training_samples: 100,
         ..Default::default()
     }

@@ -548,6 +548,13 @@ fn each_contact_is_watched_by_its_own_calibrated_range_and_one_without_is_not() 
         "",
         1,
     );
+    // The wrist (a rotary joint, gain 0.02 m/rad) in the joint's rad/s.
+    let yaml = yaml.replace(
+        "wrist: {joint: j_wrist, gain: 0.02, solver: {cells: 16}}",
+        "wrist: {joint: j_wrist, gain: 0.02, solver: {cells: 16}, calibrated_range: \
+         {speed_forward_min_rad_s: 0.0, speed_forward_max_rad_s: 1.0, speed_backward_min_rad_s: 0.0, \
+         speed_backward_max_rad_s: 1.0, training_rms_n_m: 0.01, training_samples: 10}}",
+    );
     let cfg = Config::from_yaml(&yaml, &Origin::Embedded, &[]).unwrap();
     let per = lockstep(&cfg, 300, profile);
     let left = &per[0];
@@ -573,9 +580,26 @@ fn each_contact_is_watched_by_its_own_calibrated_range_and_one_without_is_not() 
             assert_eq!(e.friction_force_n == 0.0, out, "v = {}", e.velocity_m_s);
         }
     }
-    for other in &per[1..] {
-        assert!(other
-            .iter()
-            .all(|e| e.calibrated_range == codes::RANGE_NOT_WATCHED && e.friction_force_n != 0.0));
-    }
+    assert!(per[1]
+        .iter()
+        .all(|e| e.calibrated_range == codes::RANGE_NOT_WATCHED && e.friction_force_n != 0.0));
+    // The wrist: judged on the joint's speed, the contact's ÷ 0.02.
+    let wrist_outside = per[2]
+        .iter()
+        .filter(|e| {
+            let out = (e.velocity_m_s / 0.02).abs() > 1.0;
+            assert_eq!(
+                e.calibrated_range,
+                if out {
+                    codes::RANGE_OUTSIDE
+                } else {
+                    codes::RANGE_INSIDE
+                },
+                "wrist at {} rad/s",
+                e.velocity_m_s / 0.02
+            );
+            out
+        })
+        .count();
+    assert!(wrist_outside > 20, "{wrist_outside}");
 }

@@ -376,7 +376,7 @@ fn calibrated_range_travels(spec: BackendSpec, mut cfg: Config) {
         speed_forward_max_m_s: Some(0.3),
         speed_backward_min_m_s: Some(0.0),
         speed_backward_max_m_s: Some(0.3),
-        training_rms_n: 1.0,
+        training_rms_n: Some(1.0),
         training_samples: 100,
         ..Default::default()
     });

@@ -36,12 +36,7 @@ pub struct FnModel {
 pub(crate) fn watches(config: &Config, contacts: &[ResolvedContact]) -> Vec<RangeWatch> {
     contacts
         .iter()
-        .map(|c| {
-            RangeWatch::new(
-                c.config.calibrated_range.clone(),
-                config.node.outside_envelope,
-            )
-        })
+        .map(|c| RangeWatch::of_contact(c, config.node.outside_envelope))
         .collect()
 }
 

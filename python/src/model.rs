@@ -130,6 +130,7 @@ fn watch_of(config: &Config) -> RangeWatch {
     RangeWatch::new(
         config.calibrated_range.clone(),
         config.node.outside_envelope,
+        1.0,
     )
 }
 

@@ -6,8 +6,14 @@
 //! inputs, a time series' largest acceleration, and the training error
 //! with the number of samples behind it. Outside it the parameters are an
 //! extrapolation, not evidence. A configuration without it (hand-written)
-//! is not watched. Every value is in the contact's units (a joint's: its
-//! speed × `gain`, its torque ÷ `gain`), as every other key of a contact.
+//! is not watched.
+//!
+//! The range is in the units of what the node receives for the contact:
+//! the one contact's velocity command (m/s, N); under `contacts.NAME`, its
+//! joint's `JointState` velocity and effort — `*_rad_s` keys and
+//! `training_rms_n_m` for a rotary joint, `*_m_s` and `training_rms_n` for
+//! a linear axis (the contact slides at `gain` × the joint's speed). The
+//! load is the contact's load command in N, the temperature the sump's.
 //!
 //! ```yaml
 //! calibrated_range:
@@ -19,13 +25,23 @@
 //!   load_max_n: 2000.0
 //!   training_rms_n: 1.2            # the training error, N
 //!   training_samples: 25000
+//! contacts:
+//!   elbow:
+//!     joint: elbow
+//!     gain: 0.02
+//!     calibrated_range:            # a rotary joint's: rad/s, N·m
+//!       speed_forward_min_rad_s: 0.0
+//!       speed_forward_max_rad_s: 0.35
+//!       training_rms_n_m: 0.05
+//!       training_samples: 4000
 //! ```
 
 use super::ConfigError;
 use crate::text::Num;
 use serde::{Deserialize, Serialize};
 
-/// Where a fitted configuration was calibrated (contact units).
+/// Where a fitted configuration was calibrated (the units of the
+/// contact's input: see the module's doc).
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CalibratedRange {
@@ -41,6 +57,19 @@ pub struct CalibratedRange {
     /// Largest |v| of the training samples moving backward, m/s.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub speed_backward_max_m_s: Option<f64>,
+    /// A rotary joint's: smallest |ω| moving forward, rad/s (instead of
+    /// the m/s keys).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub speed_forward_min_rad_s: Option<f64>,
+    /// A rotary joint's: largest |ω| moving forward, rad/s.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub speed_forward_max_rad_s: Option<f64>,
+    /// A rotary joint's: smallest |ω| moving backward, rad/s.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub speed_backward_min_rad_s: Option<f64>,
+    /// A rotary joint's: largest |ω| moving backward, rad/s.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub speed_backward_max_rad_s: Option<f64>,
     /// Smallest training load, N (where the load was an input).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub load_min_n: Option<f64>,
@@ -56,8 +85,15 @@ pub struct CalibratedRange {
     /// A time series' largest |dv/dt| between samples, m/s².
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub acceleration_max_m_s2: Option<f64>,
+    /// A rotary joint's time series: largest |dω/dt|, rad/s².
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub acceleration_max_rad_s2: Option<f64>,
     /// The training RMS error, N.
-    pub training_rms_n: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub training_rms_n: Option<f64>,
+    /// A rotary joint's training RMS error, N·m (instead of `training_rms_n`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub training_rms_n_m: Option<f64>,
     /// The number of training samples behind it.
     pub training_samples: u64,
 }
@@ -71,70 +107,199 @@ pub enum RangeSide {
     Outside {
         /// `speed forward`, `speed backward`, `load`, `temperature`.
         input: &'static str,
-        /// The value, in the contact's units.
+        /// The value, in the range's units.
         value: f64,
         /// The range it left.
         lo: f64,
         /// See `lo`.
         hi: f64,
+        /// `m/s`, `rad/s`, `N` or `°C`.
+        unit: &'static str,
     },
 }
 
+/// One range of a [`CalibratedRange`]: (name, key stem, key unit suffix,
+/// unit, lo, hi).
+type Pair = (
+    &'static str,
+    &'static str,
+    &'static str,
+    &'static str,
+    Option<f64>,
+    Option<f64>,
+);
+
 impl CalibratedRange {
-    /// The ranges as (name, key stem, lo, hi), each given pair.
-    fn pairs(&self) -> [(&'static str, &'static str, Option<f64>, Option<f64>); 4] {
+    /// Whether the speeds are a rotary joint's (rad/s keys given).
+    pub fn is_rotary(&self) -> bool {
         [
-            (
-                "speed forward",
-                "speed_forward",
-                self.speed_forward_min_m_s,
-                self.speed_forward_max_m_s,
-            ),
-            (
-                "speed backward",
-                "speed_backward",
-                self.speed_backward_min_m_s,
-                self.speed_backward_max_m_s,
-            ),
-            ("load", "load", self.load_min_n, self.load_max_n),
+            self.speed_forward_min_rad_s,
+            self.speed_forward_max_rad_s,
+            self.speed_backward_min_rad_s,
+            self.speed_backward_max_rad_s,
+            self.acceleration_max_rad_s2,
+            self.training_rms_n_m,
+        ]
+        .iter()
+        .any(Option::is_some)
+    }
+
+    /// The speeds' unit: `rad/s` or `m/s`.
+    pub fn speed_unit(&self) -> &'static str {
+        if self.is_rotary() {
+            "rad/s"
+        } else {
+            "m/s"
+        }
+    }
+
+    /// The training error's unit: `N·m` or `N`.
+    pub fn force_unit(&self) -> &'static str {
+        if self.is_rotary() {
+            "N·m"
+        } else {
+            "N"
+        }
+    }
+
+    /// The speed range in one direction, in [`Self::speed_unit`].
+    pub fn speeds(&self, forward: bool) -> (Option<f64>, Option<f64>) {
+        match (self.is_rotary(), forward) {
+            (false, true) => (self.speed_forward_min_m_s, self.speed_forward_max_m_s),
+            (false, false) => (self.speed_backward_min_m_s, self.speed_backward_max_m_s),
+            (true, true) => (self.speed_forward_min_rad_s, self.speed_forward_max_rad_s),
+            (true, false) => (self.speed_backward_min_rad_s, self.speed_backward_max_rad_s),
+        }
+    }
+
+    /// The largest acceleration, in [`Self::speed_unit`] per second.
+    pub fn acceleration_max(&self) -> Option<f64> {
+        self.acceleration_max_rad_s2.or(self.acceleration_max_m_s2)
+    }
+
+    /// The training RMS error, in [`Self::force_unit`].
+    pub fn training_rms(&self) -> Option<f64> {
+        self.training_rms_n_m.or(self.training_rms_n)
+    }
+
+    /// A joint's range in its contact's own units: the contact slides at
+    /// `gain` × the joint's speed and pushes the joint with `gain` × its
+    /// friction, so speeds and accelerations × `gain` (m/s), the training
+    /// error ÷ `gain` (N); loads and temperatures as they are. (The one
+    /// contact's range, gain 1, is unchanged.)
+    pub fn in_contact_units(&self, gain: f64) -> CalibratedRange {
+        let g = |x: Option<f64>| x.map(|v| gain * v);
+        let (f, b) = (self.speeds(true), self.speeds(false));
+        CalibratedRange {
+            speed_forward_min_m_s: g(f.0),
+            speed_forward_max_m_s: g(f.1),
+            speed_backward_min_m_s: g(b.0),
+            speed_backward_max_m_s: g(b.1),
+            speed_forward_min_rad_s: None,
+            speed_forward_max_rad_s: None,
+            speed_backward_min_rad_s: None,
+            speed_backward_max_rad_s: None,
+            acceleration_max_m_s2: g(self.acceleration_max()),
+            acceleration_max_rad_s2: None,
+            training_rms_n: self.training_rms().map(|e| e / gain),
+            training_rms_n_m: None,
+            ..self.clone()
+        }
+    }
+
+    /// The ranges as [`Pair`]s, the speeds in their unit.
+    fn pairs(&self) -> [Pair; 4] {
+        let (suffix, unit) = if self.is_rotary() {
+            ("rad_s", "rad/s")
+        } else {
+            ("m_s", "m/s")
+        };
+        let (f, b) = (self.speeds(true), self.speeds(false));
+        [
+            ("speed forward", "speed_forward", suffix, unit, f.0, f.1),
+            ("speed backward", "speed_backward", suffix, unit, b.0, b.1),
+            ("load", "load", "n", "N", self.load_min_n, self.load_max_n),
             (
                 "temperature",
                 "temperature",
+                "c",
+                "°C",
                 self.temperature_min_c,
                 self.temperature_max_c,
             ),
         ]
     }
 
-    /// Each range given as a pair, finite and not inverted, speeds and
-    /// loads not negative, at least one speed range; the training error
-    /// finite and not negative, at least one sample. Errors name the key,
-    /// below `prefix` (`calibrated_range` or
-    /// `contacts.NAME.calibrated_range`).
-    pub fn validate(&self, prefix: &str) -> Result<(), ConfigError> {
-        let suffix = |stem: &str, end: &str| match stem {
-            "load" => format!("{prefix}.load_{end}_n"),
-            "temperature" => format!("{prefix}.temperature_{end}_c"),
-            _ => format!("{prefix}.{stem}_{end}_m_s"),
+    /// A rotary key given with an m/s one (a range is in one unit), or
+    /// outside a joint's range (`joint` false: the one contact's range is in
+    /// m/s): the offending key.
+    fn unit_error(&self, prefix: &str, joint: bool) -> Option<ConfigError> {
+        let linear = [
+            ("speed_forward_min_m_s", self.speed_forward_min_m_s),
+            ("speed_forward_max_m_s", self.speed_forward_max_m_s),
+            ("speed_backward_min_m_s", self.speed_backward_min_m_s),
+            ("speed_backward_max_m_s", self.speed_backward_max_m_s),
+            ("acceleration_max_m_s2", self.acceleration_max_m_s2),
+            ("training_rms_n", self.training_rms_n),
+        ];
+        let rotary = [
+            ("speed_forward_min_rad_s", self.speed_forward_min_rad_s),
+            ("speed_forward_max_rad_s", self.speed_forward_max_rad_s),
+            ("speed_backward_min_rad_s", self.speed_backward_min_rad_s),
+            ("speed_backward_max_rad_s", self.speed_backward_max_rad_s),
+            ("acceleration_max_rad_s2", self.acceleration_max_rad_s2),
+            ("training_rms_n_m", self.training_rms_n_m),
+        ];
+        let given = |keys: &[(&'static str, Option<f64>)]| {
+            keys.iter()
+                .find(|(_, v)| v.is_some())
+                .map(|(k, v)| (*k, v.unwrap_or_default()))
         };
+        let (Some((key, value)), l) = (given(&rotary), given(&linear)) else {
+            return None;
+        };
+        let range = if !joint {
+            "only in a joint's range (contacts.NAME.calibrated_range): the one contact's range is in m/s and N".to_string()
+        } else if let Some((other, _)) = l {
+            format!("not with `{other}`: a range is in one unit, rad/s and N·m for a rotary joint, m/s and N for a linear one")
+        } else {
+            return None;
+        };
+        Some(ConfigError::OutOfRange {
+            key: format!("{prefix}.{key}"),
+            value: Num(value).to_string(),
+            range,
+        })
+    }
+
+    /// Each range given as a pair, finite and not inverted, speeds and
+    /// loads not negative, at least one speed range, in one unit (rad/s
+    /// only in a joint's range, `joint`); the training error finite and not
+    /// negative, at least one sample. Errors name the key, below `prefix`
+    /// (`calibrated_range` or `contacts.NAME.calibrated_range`).
+    pub fn validate(&self, prefix: &str, joint: bool) -> Result<(), ConfigError> {
+        if let Some(e) = self.unit_error(prefix, joint) {
+            return Err(e);
+        }
+        let key = |stem: &str, end: &str, suffix: &str| format!("{prefix}.{stem}_{end}_{suffix}");
         let bad = |key: String, value: String, range: &str| ConfigError::OutOfRange {
             key,
             value,
             range: range.into(),
         };
-        for (_, stem, lo, hi) in self.pairs() {
+        for (_, stem, suffix, _, lo, hi) in self.pairs() {
             match (lo, hi) {
                 (None, None) => {}
                 (Some(_), None) => {
                     return Err(bad(
-                        suffix(stem, "max"),
+                        key(stem, "max", suffix),
                         "missing".into(),
                         "given with its min (a range is a pair)",
                     ))
                 }
                 (None, Some(_)) => {
                     return Err(bad(
-                        suffix(stem, "min"),
+                        key(stem, "min", suffix),
                         "missing".into(),
                         "given with its max (a range is a pair)",
                     ))
@@ -144,7 +309,7 @@ impl CalibratedRange {
                         let negative = stem != "temperature" && v < 0.0;
                         if !v.is_finite() || negative {
                             return Err(bad(
-                                suffix(stem, end),
+                                key(stem, end, suffix),
                                 Num(v).to_string(),
                                 "a finite number, not negative",
                             ));
@@ -152,7 +317,7 @@ impl CalibratedRange {
                     }
                     if lo > hi {
                         return Err(bad(
-                            suffix(stem, "min"),
+                            key(stem, "min", suffix),
                             Num(lo).to_string(),
                             &format!("at most its max {} (the range is inverted)", Num(hi)),
                         ));
@@ -160,28 +325,49 @@ impl CalibratedRange {
                 }
             }
         }
-        if self.speed_forward_max_m_s.is_none() && self.speed_backward_max_m_s.is_none() {
+        let speed_suffix = if self.is_rotary() { "rad_s" } else { "m_s" };
+        if self.speeds(true).1.is_none() && self.speeds(false).1.is_none() {
             return Err(bad(
-                format!("{prefix}.speed_forward_max_m_s"),
+                format!("{prefix}.speed_forward_max_{speed_suffix}"),
                 "missing".into(),
                 "a speed range in at least one direction",
             ));
         }
-        if let Some(a) = self.acceleration_max_m_s2 {
+        let accel_key = if self.is_rotary() {
+            "acceleration_max_rad_s2"
+        } else {
+            "acceleration_max_m_s2"
+        };
+        if let Some(a) = self.acceleration_max() {
             if !(a.is_finite() && a >= 0.0) {
                 return Err(bad(
-                    format!("{prefix}.acceleration_max_m_s2"),
+                    format!("{prefix}.{accel_key}"),
                     Num(a).to_string(),
                     "a finite number, not negative",
                 ));
             }
         }
-        if !(self.training_rms_n.is_finite() && self.training_rms_n >= 0.0) {
-            return Err(bad(
-                format!("{prefix}.training_rms_n"),
-                Num(self.training_rms_n).to_string(),
-                "a finite number, not negative",
-            ));
+        let rms_key = if self.is_rotary() {
+            "training_rms_n_m"
+        } else {
+            "training_rms_n"
+        };
+        match self.training_rms() {
+            None => {
+                return Err(bad(
+                    format!("{prefix}.{rms_key}"),
+                    "missing".into(),
+                    "the training error (a range says how well it was fitted)",
+                ))
+            }
+            Some(e) if !(e.is_finite() && e >= 0.0) => {
+                return Err(bad(
+                    format!("{prefix}.{rms_key}"),
+                    Num(e).to_string(),
+                    "a finite number, not negative",
+                ))
+            }
+            Some(_) => {}
         }
         if self.training_samples == 0 {
             return Err(bad(
@@ -193,17 +379,14 @@ impl CalibratedRange {
         Ok(())
     }
 
-    /// Where velocity `v` (m/s), load (N) and temperature (°C) lie: the
-    /// first input outside its range, or inside. A speed is judged in its
-    /// direction's range; a direction the training data never moved in is
-    /// outside from any speed above zero. Allocates nothing.
+    /// Where velocity `v` (in [`Self::speed_unit`]), load (N) and
+    /// temperature (°C) lie: the first input outside its range, or inside.
+    /// A speed is judged in its direction's range; a direction the
+    /// training data never moved in is outside from any speed above zero.
+    /// Allocates nothing.
     pub fn side(&self, v: f64, load_n: Option<f64>, temperature_c: Option<f64>) -> RangeSide {
         let [fwd, bwd, load, temp] = self.pairs();
-        let (name, lo, hi) = if v > 0.0 {
-            (fwd.0, fwd.2, fwd.3)
-        } else {
-            (bwd.0, bwd.2, bwd.3)
-        };
+        let (name, _, _, unit, lo, hi) = if v > 0.0 { fwd } else { bwd };
         let speed = v.abs();
         if speed > 0.0 {
             match (lo, hi) {
@@ -213,6 +396,7 @@ impl CalibratedRange {
                         value: speed,
                         lo,
                         hi,
+                        unit,
                     }
                 }
                 (None, _) | (_, None) => {
@@ -221,12 +405,13 @@ impl CalibratedRange {
                         value: speed,
                         lo: 0.0,
                         hi: 0.0,
+                        unit,
                     }
                 }
                 _ => {}
             }
         }
-        for ((input, _, lo, hi), value) in [(load, load_n), (temp, temperature_c)] {
+        for ((input, _, _, unit, lo, hi), value) in [(load, load_n), (temp, temperature_c)] {
             if let (Some(lo), Some(hi), Some(x)) = (lo, hi, value) {
                 if x < lo || x > hi {
                     return RangeSide::Outside {
@@ -234,6 +419,7 @@ impl CalibratedRange {
                         value: x,
                         lo,
                         hi,
+                        unit,
                     };
                 }
             }
@@ -254,7 +440,7 @@ mod tests {
             speed_backward_max_m_s: Some(0.04),
             load_min_n: Some(500.0),
             load_max_n: Some(2000.0),
-            training_rms_n: 1.5,
+            training_rms_n: Some(1.5),
             training_samples: 100,
             ..Default::default()
         }
@@ -292,8 +478,12 @@ mod tests {
 
     #[test]
     fn an_empty_inverted_or_non_finite_range_is_an_error_naming_its_key() {
-        let e = |r: CalibratedRange| r.validate("calibrated_range").unwrap_err().to_string();
-        assert!(range().validate("calibrated_range").is_ok());
+        let e = |r: CalibratedRange| {
+            r.validate("calibrated_range", false)
+                .unwrap_err()
+                .to_string()
+        };
+        assert!(range().validate("calibrated_range", false).is_ok());
         let inverted = CalibratedRange {
             load_min_n: Some(3000.0),
             ..range()
@@ -310,7 +500,7 @@ mod tests {
         };
         assert!(e(half).contains("calibrated_range.temperature_max_c"));
         let empty = CalibratedRange {
-            training_rms_n: 1.0,
+            training_rms_n: Some(1.0),
             training_samples: 10,
             ..Default::default()
         };
@@ -320,5 +510,59 @@ mod tests {
             ..range()
         };
         assert!(e(none).contains("calibrated_range.training_samples"));
+    }
+
+    #[test]
+    fn a_rotary_joints_range_is_in_rad_s_and_only_a_joint_may_have_one() {
+        let rotary = CalibratedRange {
+            speed_forward_min_rad_s: Some(0.0),
+            speed_forward_max_rad_s: Some(0.35),
+            training_rms_n_m: Some(0.05),
+            training_samples: 10,
+            ..Default::default()
+        };
+        assert!(rotary
+            .validate("contacts.elbow.calibrated_range", true)
+            .is_ok());
+        assert_eq!((rotary.speed_unit(), rotary.force_unit()), ("rad/s", "N·m"));
+        assert!(matches!(
+            rotary.side(1.57, None, None),
+            RangeSide::Outside { input: "speed forward", hi, unit: "rad/s", .. } if hi == 0.35
+        ));
+        let e = rotary
+            .validate("calibrated_range", false)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("calibrated_range.speed_forward_min_rad_s"),
+            "{e}"
+        );
+        assert!(e.contains("only in a joint's range"), "{e}");
+        let mixed = CalibratedRange {
+            speed_backward_min_m_s: Some(0.0),
+            speed_backward_max_m_s: Some(0.1),
+            ..rotary.clone()
+        };
+        let e = mixed
+            .validate("contacts.elbow.calibrated_range", true)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("speed_backward_min_m_s") && e.contains("one unit"),
+            "{e}"
+        );
+        let no_error = CalibratedRange {
+            training_rms_n_m: None,
+            speed_forward_max_rad_s: Some(0.35),
+            ..rotary
+        };
+        let e = no_error
+            .validate("contacts.elbow.calibrated_range", true)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("contacts.elbow.calibrated_range.training_rms_n_m"),
+            "{e}"
+        );
     }
 }

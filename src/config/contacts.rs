@@ -229,8 +229,13 @@ pub struct ResolvedContact {
     pub joint: String,
     /// Friction force → joint effort (1, or the lever arm in m).
     pub gain: f64,
-    /// The whole configuration of this contact (its sections over the top level).
+    /// The whole configuration of this contact (its sections over the top
+    /// level; its `calibrated_range` in the contact's own m/s and N).
     pub config: Config,
+    /// A joint's calibrated range as configured, in the joint's units
+    /// (`contacts.NAME.calibrated_range`); None for the one contact, whose
+    /// range is `config.calibrated_range`.
+    pub joint_range: Option<CalibratedRange>,
 }
 
 /// The name of the one contact of a configuration without `contacts`.
@@ -292,6 +297,7 @@ impl Config {
                     contacts: ContactList::default(),
                     ..self.clone()
                 },
+                joint_range: None,
             }];
         }
         self.contacts
@@ -308,7 +314,10 @@ impl Config {
             texture: e.texture.clone(),
             lubricant: e.lubricant.clone(),
             roughness: e.roughness.clone(),
-            calibrated_range: e.calibrated_range.clone(),
+            calibrated_range: e
+                .calibrated_range
+                .as_ref()
+                .map(|r| r.in_contact_units(e.gain)),
             ..self.clone()
         };
         config.solver.cells = e.solver.cells;
@@ -317,6 +326,7 @@ impl Config {
             joint: e.joint.clone(),
             gain: e.gain,
             config,
+            joint_range: e.calibrated_range.clone(),
         }
     }
 
@@ -383,7 +393,7 @@ impl Config {
                 .and_then(|_| c.validate_solver())
                 .map_err(|err| prefix_key(err, &format!("contacts.{}.", e.name)))?;
             if let Some(r) = &e.calibrated_range {
-                r.validate(&key("calibrated_range"))?;
+                r.validate(&key("calibrated_range"), true)?;
             }
         }
         if self.calibrated_range.is_some() && !self.contacts.0.is_empty() {

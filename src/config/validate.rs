@@ -137,7 +137,7 @@ impl Config {
         self.validate_iceoryx2()?;
         self.validate_recording()?;
         if let Some(r) = &self.calibrated_range {
-            r.validate("calibrated_range")?;
+            r.validate("calibrated_range", false)?;
         }
         self.validate_contacts()
     }

@@ -3,9 +3,10 @@
 //! validation data lie against it: the share outside, how far, and the
 //! error inside and outside separately.
 //!
-//! The data are in the axis's units (m/s and N, or rad/s and N·m); the
-//! range is in the contact's, through the gain g (contact speed g ẋ,
-//! contact force F_axis / g).
+//! The data and the range are in the axis's units (m/s and N, or rad/s
+//! and N·m): a joint's range is its joint's (the node judges the joint's
+//! speed, the contact's ÷ its gain); the one contact's is in m/s and N
+//! ([`for_file`]).
 
 use super::problem::SeriesFit;
 use super::{FitOutcome, Units};
@@ -28,8 +29,8 @@ fn span(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
 }
 
 /// The range of the training samples `train` (fitted with RMS error
-/// `train_rms`, axis units) through gain `gain`.
-pub fn of_training(train: &[SeriesFit], train_rms: f64, gain: f64) -> CalibratedRange {
+/// `train_rms`), in the axis's `units`.
+pub fn of_training(train: &[SeriesFit], train_rms: f64, units: Units) -> CalibratedRange {
     let samples = || train.iter().flat_map(|s| used(s).map(move |k| (s, k)));
     // A time series starts, stops and reverses through zero speed: its
     // slow end is covered down to zero. A steady curve's slowest point is
@@ -40,7 +41,7 @@ pub fn of_training(train: &[SeriesFit], train_rms: f64, gain: f64) -> Calibrated
             samples()
                 .map(|(s, k)| s.series.velocity[k])
                 .filter(|v| if forward { *v > 0.0 } else { *v < 0.0 })
-                .map(|v| gain * v.abs()),
+                .map(f64::abs),
         )
         .map(|(lo, hi)| (if through_zero { 0.0 } else { lo }, hi))
     };
@@ -56,23 +57,48 @@ pub fn of_training(train: &[SeriesFit], train_rms: f64, gain: f64) -> Calibrated
             let (t, v) = (&s.series.t, &s.series.velocity);
             (1..v.len()).filter_map(move |k| {
                 let dt = t[k] - t[k - 1];
-                (dt > 0.0).then(|| gain * ((v[k] - v[k - 1]) / dt).abs())
+                (dt > 0.0).then(|| ((v[k] - v[k - 1]) / dt).abs())
             })
         })
         .fold(None, |m: Option<f64>, a| Some(m.map_or(a, |m| m.max(a))));
     let (fwd, bwd) = (speeds(true), speeds(false));
-    CalibratedRange {
-        speed_forward_min_m_s: fwd.map(|r| r.0),
-        speed_forward_max_m_s: fwd.map(|r| r.1),
-        speed_backward_min_m_s: bwd.map(|r| r.0),
-        speed_backward_max_m_s: bwd.map(|r| r.1),
+    let common = CalibratedRange {
         load_min_n: load.map(|r| r.0),
         load_max_n: load.map(|r| r.1),
         temperature_min_c: temperature.map(|r| r.0),
         temperature_max_c: temperature.map(|r| r.1),
-        acceleration_max_m_s2: acceleration,
-        training_rms_n: train_rms / gain,
         training_samples: samples().count() as u64,
+        ..Default::default()
+    };
+    match units {
+        Units::Linear => CalibratedRange {
+            speed_forward_min_m_s: fwd.map(|r| r.0),
+            speed_forward_max_m_s: fwd.map(|r| r.1),
+            speed_backward_min_m_s: bwd.map(|r| r.0),
+            speed_backward_max_m_s: bwd.map(|r| r.1),
+            acceleration_max_m_s2: acceleration,
+            training_rms_n: Some(train_rms),
+            ..common
+        },
+        Units::Rotary => CalibratedRange {
+            speed_forward_min_rad_s: fwd.map(|r| r.0),
+            speed_forward_max_rad_s: fwd.map(|r| r.1),
+            speed_backward_min_rad_s: bwd.map(|r| r.0),
+            speed_backward_max_rad_s: bwd.map(|r| r.1),
+            acceleration_max_rad_s2: acceleration,
+            training_rms_n_m: Some(train_rms),
+            ..common
+        },
+    }
+}
+
+/// `range` (axis units) as the fitted file holds it: a joint's (`joint`)
+/// as it is; the one contact's in its m/s and N, through gain `gain`.
+pub fn for_file(range: &CalibratedRange, joint: bool, gain: f64) -> CalibratedRange {
+    if joint {
+        range.clone()
+    } else {
+        range.in_contact_units(gain)
     }
 }
 
@@ -110,8 +136,8 @@ fn factor(value: f64, lo: f64, hi: f64) -> f64 {
     }
 }
 
-/// Each series of `fits` against `range` through gain `gain`.
-pub fn place(fits: &[SeriesFit], range: &CalibratedRange, gain: f64) -> Vec<Placement> {
+/// Each series of `fits` against `range` (both in the axis's units).
+pub fn place(fits: &[SeriesFit], range: &CalibratedRange) -> Vec<Placement> {
     fits.iter()
         .map(|s| {
             let se = &s.series;
@@ -126,7 +152,7 @@ pub fn place(fits: &[SeriesFit], range: &CalibratedRange, gain: f64) -> Vec<Plac
                 n += 1;
                 let load = se.load.as_ref().map(|l| l[k]);
                 let temperature = se.temperature.as_ref().map(|t| t[k]);
-                match range.side(gain * se.velocity[k], load, temperature) {
+                match range.side(se.velocity[k], load, temperature) {
                     RangeSide::Inside => {
                         ss_in += r * r;
                         n_in += 1;
@@ -136,15 +162,14 @@ pub fn place(fits: &[SeriesFit], range: &CalibratedRange, gain: f64) -> Vec<Plac
                         value,
                         lo,
                         hi,
+                        ..
                     } => {
                         out += 1;
                         ss_out += r * r;
                         n_out += 1;
                         let f = factor(value, lo, hi);
-                        let speed = input.starts_with("speed");
-                        let shown = if speed { value / gain } else { value };
                         if furthest.is_none_or(|(_, _, g)| f > g) {
-                            furthest = Some((input, shown, f));
+                            furthest = Some((input, value, f));
                         }
                     }
                 }
@@ -162,19 +187,19 @@ pub fn place(fits: &[SeriesFit], range: &CalibratedRange, gain: f64) -> Vec<Plac
         .collect()
 }
 
-/// The range in the axis's units, as a sentence.
-fn describe(range: &CalibratedRange, gain: f64, units: Units) -> String {
+/// The range (axis units), as a sentence.
+fn describe(range: &CalibratedRange, units: Units) -> String {
     let v = units.speed();
-    let speed = |lo: Option<f64>, hi: Option<f64>| match (lo, hi) {
+    let speed = |(lo, hi): (Option<f64>, Option<f64>)| match (lo, hi) {
         (Some(lo), Some(hi)) => {
-            format!("{}–{} {v}", Num::sig(lo / gain, 4), Num::sig(hi / gain, 4))
+            format!("{}–{} {v}", Num::sig(lo, 4), Num::sig(hi, 4))
         }
         _ => "never".into(),
     };
     let mut s = format!(
         "speed forward {}, backward {}",
-        speed(range.speed_forward_min_m_s, range.speed_forward_max_m_s),
-        speed(range.speed_backward_min_m_s, range.speed_backward_max_m_s)
+        speed(range.speeds(true)),
+        speed(range.speeds(false))
     );
     if let (Some(lo), Some(hi)) = (range.load_min_n, range.load_max_n) {
         let _ = write!(s, ", load {}–{} N", Num::sig(lo, 4), Num::sig(hi, 4));
@@ -187,30 +212,30 @@ fn describe(range: &CalibratedRange, gain: f64, units: Units) -> String {
             Num::sig(hi, 4)
         );
     }
-    if let Some(a) = range.acceleration_max_m_s2 {
+    if let Some(a) = range.acceleration_max() {
         let unit = match units {
             Units::Linear => "m/s²",
             Units::Rotary => "rad/s²",
         };
-        let _ = write!(s, ", acceleration up to {} {unit}", Num::sig(a / gain, 4));
+        let _ = write!(s, ", acceleration up to {} {unit}", Num::sig(a, 4));
     }
     s
 }
 
 /// The report's section: the range, then where each held-out and
 /// validation series lies and its error inside and outside.
-pub fn section(o: &FitOutcome, range: &CalibratedRange, gain: f64) -> String {
+pub fn section(o: &FitOutcome, range: &CalibratedRange) -> String {
     let units = o.units;
     let f = units.force();
     let mut md = format!(
-        "## Where the calibration holds\n\nCalibrated on {} training samples: {}; training RMS {} {f}. The fitted file holds this range (`calibrated_range`, in the contact's units); outside it the parameters are an extrapolation.\n",
+        "## Where the calibration holds\n\nCalibrated on {} training samples: {}; training RMS {} {f}. The fitted file holds this range (`calibrated_range`: a joint's in the joint's units, the one contact's in m/s and N); outside it the parameters are an extrapolation.\n",
         range.training_samples,
-        describe(range, gain, units),
+        describe(range, units),
         Num::sig(o.train_rms, 5)
     );
     let placed: Vec<(&str, Placement)> = [("held out", &o.held_out), ("validation", &o.validate)]
         .into_iter()
-        .flat_map(|(role, fits)| place(fits, range, gain).into_iter().map(move |p| (role, p)))
+        .flat_map(|(role, fits)| place(fits, range).into_iter().map(move |p| (role, p)))
         .collect();
     if placed.is_empty() {
         md.push('\n');
@@ -277,16 +302,16 @@ mod tests {
     #[test]
     fn the_range_is_the_training_speeds_by_direction_through_the_gain_and_held_out_error_splits_at_it(
     ) {
-        // Training: forward 0.1..0.5, backward 0.2..0.3 (axis units), gain 0.02.
+        // Training: forward 0.1..0.5, backward 0.2..0.3 rad/s (a joint).
         let train = fit(
             "train",
             &[0.1, 0.5, -0.2, -0.3],
             &[1.0, 1.0, -1.0, -1.0],
             &[1.1, 0.9, -1.0, -1.0],
         );
-        let r = of_training(std::slice::from_ref(&train), 0.0707, 0.02);
+        let r = of_training(std::slice::from_ref(&train), 0.0707, Units::Rotary);
         // A time series passes through zero speed: its slow end is zero.
-        assert_eq!(r.speed_forward_min_m_s, Some(0.0));
+        assert_eq!(r.speed_forward_min_rad_s, Some(0.0));
         let steady = SeriesFit {
             series: Series {
                 steady: true,
@@ -294,21 +319,27 @@ mod tests {
             },
             ..train.clone()
         };
-        let curve = of_training(&[steady], 0.0707, 0.02);
-        assert_eq!(curve.speed_forward_min_m_s, Some(0.02 * 0.1));
-        assert_eq!(curve.speed_backward_min_m_s, Some(0.02 * 0.2));
-        assert_eq!(curve.acceleration_max_m_s2, None);
-        assert_eq!(r.speed_forward_max_m_s, Some(0.02 * 0.5));
-        assert_eq!(r.speed_backward_max_m_s, Some(0.02 * 0.3));
+        let curve = of_training(&[steady], 0.0707, Units::Rotary);
+        assert_eq!(curve.speed_forward_min_rad_s, Some(0.1));
+        assert_eq!(curve.speed_backward_min_rad_s, Some(0.2));
+        assert_eq!(curve.acceleration_max(), None);
+        assert_eq!(r.speed_forward_max_rad_s, Some(0.5));
+        assert_eq!(r.speed_backward_max_rad_s, Some(0.3));
         assert_eq!(r.training_samples, 4);
-        approx::assert_relative_eq!(r.training_rms_n, 0.0707 / 0.02);
-        // acceleration: |Δv/Δt| largest between 0.5 and -0.2: 7 per s.
+        assert_eq!(r.training_rms_n_m, Some(0.0707));
+        // acceleration: |Δω/Δt| largest between 0.5 and -0.2: 7 rad/s per s.
         approx::assert_relative_eq!(
-            r.acceleration_max_m_s2.unwrap(),
-            0.02 * 7.0,
+            r.acceleration_max_rad_s2.unwrap(),
+            7.0,
             max_relative = 1e-12
         );
-        assert!(r.validate("calibrated_range").is_ok());
+        assert!(r.validate("contacts.axis.calibrated_range", true).is_ok());
+        // The one contact's file holds it in m/s and N through the gain.
+        let contact = for_file(&r, false, 0.02);
+        assert_eq!(contact.speed_forward_max_m_s, Some(0.02 * 0.5));
+        approx::assert_relative_eq!(contact.training_rms_n.unwrap(), 0.0707 / 0.02);
+        assert!(!contact.is_rotary());
+        assert!(contact.validate("calibrated_range", false).is_ok());
         // Validation: two samples inside (errors 0.1), two beyond (errors 2): one
         // at 2.5 (5× the top speed forward), one backward at 0.25 (inside).
         let val = fit(
@@ -317,7 +348,7 @@ mod tests {
             &[1.0, 1.0, -1.0, -1.0],
             &[1.1, 3.0, -1.1, -3.0],
         );
-        let p = &place(&[val], &r, 0.02)[0];
+        let p = &place(&[val], &r)[0];
         assert_eq!((p.samples, p.outside), (4, 2));
         approx::assert_relative_eq!(p.rms_inside.unwrap(), 0.1, max_relative = 1e-9);
         approx::assert_relative_eq!(p.rms_outside.unwrap(), 2.0, max_relative = 1e-9);

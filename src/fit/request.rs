@@ -149,17 +149,20 @@ impl FitRequest {
         let mut ours = fit_ours(&p, &self.search, progress, stop, self.baselines)?;
         // The range the calibration saw, into the fitted file and the report.
         let gain = p.contact_scale.as_ref().map_or(1.0, |s| s.gain);
-        let range =
-            super::calibrated_range::of_training(&ours.outcome.train, ours.outcome.train_rms, gain);
-        if range.validate("calibrated_range").is_ok() {
+        let units = ours.outcome.units;
+        let range = super::calibrated_range::of_training(
+            &ours.outcome.train,
+            ours.outcome.train_rms,
+            units,
+        );
+        let joint = !ours.config.contacts.0.is_empty();
+        let in_file = super::calibrated_range::for_file(&range, joint, gain);
+        if in_file.validate("calibrated_range", joint).is_ok() {
             match ours.config.contacts.0.first_mut() {
-                Some(contact) => contact.calibrated_range = Some(range.clone()),
-                None => ours.config.calibrated_range = Some(range.clone()),
+                Some(contact) => contact.calibrated_range = Some(in_file),
+                None => ours.config.calibrated_range = Some(in_file),
             }
-            extra_md.insert_str(
-                0,
-                &super::calibrated_range::section(&ours.outcome, &range, gain),
-            );
+            extra_md.insert_str(0, &super::calibrated_range::section(&ours.outcome, &range));
         }
         let yaml = super::report::fitted_yaml(&ours.config, &ours.outcome, &p.names, &ours.map);
         if let Some(o) = &outputs.fitted {

@@ -412,12 +412,14 @@ pub struct OutsideEvent {
     pub contact: u32,
     /// The input: `speed forward`, `speed backward`, `load`, `temperature`.
     pub input: &'static str,
-    /// Its value, in the contact's units.
+    /// Its value, in the range's units (a joint's speed: the joint's).
     pub value: f64,
     /// The range it left: lowest …
     pub lo: f64,
     /// … and highest.
     pub hi: f64,
+    /// `m/s`, `rad/s`, `N` or `°C`.
+    pub unit: &'static str,
 }
 
 impl OutsideEvent {
@@ -436,6 +438,19 @@ impl OutsideEvent {
     /// The input of a code (None for 0 or an unknown code).
     pub fn input_of_code(code: u8) -> Option<&'static str> {
         Self::INPUTS.get(usize::from(code).checked_sub(1)?).copied()
+    }
+
+    /// The units of a range's inputs, by their code (0-based).
+    pub const UNITS: [&'static str; 4] = ["m/s", "rad/s", "N", "°C"];
+
+    /// The code of a unit (0, m/s, for one not listed).
+    pub fn unit_code(unit: &str) -> u8 {
+        Self::UNITS.iter().position(|u| *u == unit).unwrap_or(0) as u8
+    }
+
+    /// The unit of a code (m/s for an unknown one).
+    pub fn unit_of_code(code: u8) -> &'static str {
+        Self::UNITS.get(usize::from(code)).copied().unwrap_or("m/s")
     }
 }
 
@@ -486,6 +501,9 @@ impl StatisticsRecord {
             outside_value: self.last_outside.map_or(0.0, |o| o.value),
             outside_min: self.last_outside.map_or(0.0, |o| o.lo),
             outside_max: self.last_outside.map_or(0.0, |o| o.hi),
+            outside_unit: self
+                .last_outside
+                .map_or(String::new(), |o| o.unit.to_string()),
         }
     }
 
@@ -538,6 +556,7 @@ impl StatisticsRecord {
                     value: m.outside_value,
                     lo: m.outside_min,
                     hi: m.outside_max,
+                    unit: OutsideEvent::unit_of_code(OutsideEvent::unit_code(&m.outside_unit)),
                 }),
         }
     }

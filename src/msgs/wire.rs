@@ -357,12 +357,14 @@ pub struct LoopStatistics {
     pub outside_input: String,
     /// Its contact (configured order).
     pub outside_contact: u32,
-    /// Its value, in the contact's units (m/s, N, degC).
+    /// Its value, in its range's units (a joint's speed: the joint's).
     pub outside_value: f64,
     /// The calibrated range it left.
     pub outside_min: f64,
     /// See `outside_min`.
     pub outside_max: f64,
+    /// Their unit: m/s, rad/s (a rotary joint's speed), N or degC.
+    pub outside_unit: String,
 }
 
 #[cfg(feature = "ros2")]

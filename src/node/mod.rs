@@ -227,12 +227,7 @@ impl Loop {
             .collect();
         let watches = resolved
             .iter()
-            .map(|c| {
-                crate::range_watch::RangeWatch::new(
-                    c.config.calibrated_range.clone(),
-                    config.node.outside_envelope,
-                )
-            })
+            .map(|c| crate::range_watch::RangeWatch::of_contact(c, config.node.outside_envelope))
             .collect();
         let n = contacts.len();
         let window = (settings.statistics_every_steps as usize).clamp(16, 1 << 16);

@@ -108,6 +108,7 @@ impl Loop {
             value,
             lo,
             hi,
+            unit,
         } = flag
         {
             let w = &self.watches[k];
@@ -120,6 +121,7 @@ impl Loop {
                 value,
                 lo,
                 hi,
+                unit,
             });
         }
     }

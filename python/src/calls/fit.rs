@@ -229,16 +229,22 @@ fn range_dict<'py>(
         ("speed_forward_max_m_s", r.speed_forward_max_m_s),
         ("speed_backward_min_m_s", r.speed_backward_min_m_s),
         ("speed_backward_max_m_s", r.speed_backward_max_m_s),
+        ("speed_forward_min_rad_s", r.speed_forward_min_rad_s),
+        ("speed_forward_max_rad_s", r.speed_forward_max_rad_s),
+        ("speed_backward_min_rad_s", r.speed_backward_min_rad_s),
+        ("speed_backward_max_rad_s", r.speed_backward_max_rad_s),
         ("load_min_n", r.load_min_n),
         ("load_max_n", r.load_max_n),
         ("temperature_min_c", r.temperature_min_c),
         ("temperature_max_c", r.temperature_max_c),
         ("acceleration_max_m_s2", r.acceleration_max_m_s2),
+        ("acceleration_max_rad_s2", r.acceleration_max_rad_s2),
+        ("training_rms_n", r.training_rms_n),
+        ("training_rms_n_m", r.training_rms_n_m),
     ];
     for (k, v) in pairs {
         d.set_item(k, v)?;
     }
-    d.set_item("training_rms_n", r.training_rms_n)?;
     d.set_item("training_samples", r.training_samples)?;
     Ok(d)
 }

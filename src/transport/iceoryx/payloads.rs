@@ -135,7 +135,9 @@ pub struct StatisticsPayload {
     pub outside_input: u8,
     /// … its contact …
     pub outside_contact: u32,
-    /// … its value (contact units) …
+    /// … the unit of its value and range (0 m/s, 1 rad/s, 2 N, 3 °C) …
+    pub outside_unit: u8,
+    /// … its value (its range's units) …
     pub outside_value: f64,
     /// … and the range it left.
     pub outside_lo: f64,
@@ -188,6 +190,9 @@ impl From<&StatisticsRecord> for StatisticsPayload {
             outside_value: s.last_outside.map_or(0.0, |o| o.value),
             outside_lo: s.last_outside.map_or(0.0, |o| o.lo),
             outside_hi: s.last_outside.map_or(0.0, |o| o.hi),
+            outside_unit: s
+                .last_outside
+                .map_or(0, |o| crate::msgs::OutsideEvent::unit_code(o.unit)),
         }
     }
 }
@@ -236,6 +241,7 @@ impl From<&StatisticsPayload> for StatisticsRecord {
                     value: s.outside_value,
                     lo: s.outside_lo,
                     hi: s.outside_hi,
+                    unit: crate::msgs::OutsideEvent::unit_of_code(s.outside_unit),
                 }
             }),
         }

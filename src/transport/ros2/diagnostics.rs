@@ -229,21 +229,12 @@ fn recorder(p: &Period) -> DiagnosticStatus {
     )
 }
 
-/// The unit an input of a calibrated range is given in.
-fn unit_of(input: &str) -> &'static str {
-    match input {
-        "load" => "N",
-        "temperature" => "°C",
-        _ => "m/s",
-    }
-}
-
 fn calibrated_range(p: &Period) -> DiagnosticStatus {
     let s = p.now;
     let outside = p.delta(|r| r.steps_outside_calibrated_range);
     let (lvl, msg) = match s.last_outside.filter(|_| outside > 0) {
         Some(o) => {
-            let u = unit_of(o.input);
+            let u = o.unit;
             let contact = if s.contacts > 1 {
                 format!("contact {}: ", o.contact)
             } else {
@@ -333,6 +324,7 @@ mod tests {
             value: 1.57,
             lo: 0.0,
             hi: 0.35,
+            unit: "m/s",
         });
         let w = find(&d.update(&s, "/n", "f"));
         assert_eq!(w.level, level::WARN);
