@@ -53,6 +53,16 @@ impl RangeFlag {
         matches!(self, RangeFlag::Outside { .. })
     }
 
+    /// The wire code (`FrictionEstimate.RANGE_*`).
+    pub fn code(self) -> u8 {
+        use crate::msgs::estimate_constants as codes;
+        match self {
+            RangeFlag::NotWatched => codes::RANGE_NOT_WATCHED,
+            RangeFlag::Inside => codes::RANGE_INSIDE,
+            RangeFlag::Outside { .. } => codes::RANGE_OUTSIDE,
+        }
+    }
+
     /// `not_watched`, `inside` or `outside` (Python, CSV).
     pub fn as_str(self) -> &'static str {
         match self {

@@ -145,6 +145,7 @@ fn a_hand_edited_range_that_is_inverted_non_finite_or_half_given_is_an_error_nam
 
 /// The number of contact steps outside on a summary line
 /// (`calibrated range N contact steps outside`).
+#[cfg(all(feature = "mcap", feature = "iceoryx2"))]
 fn outside_count(text: &str) -> u64 {
     let line = text
         .lines()
@@ -156,6 +157,7 @@ fn outside_count(text: &str) -> u64 {
         .unwrap_or_else(|| panic!("no count in {line}"))
 }
 
+#[cfg(all(feature = "mcap", feature = "iceoryx2"))]
 #[test]
 fn replay_counts_the_steps_outside_the_calibrated_range_as_the_node_did_on_the_same_bag() {
     let d = dir("replay-count");

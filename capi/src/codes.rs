@@ -1,7 +1,7 @@
 //! The codes a C caller sees: `FN_*` return codes, the estimate's status
 //! and regime codes, and `FnEstimate`, one step's estimate.
 
-use friction_node::msgs::{range_code, regime_code, status_code};
+use friction_node::msgs::{regime_code, status_code};
 use friction_node::physics::Estimate;
 use friction_node::range_watch::{RangeWatch, Watched};
 
@@ -12,7 +12,7 @@ impl FnEstimate {
         Self {
             friction_force_n: watch.published(w.flag, e.friction_force),
             contact_friction_force_n: watch.published(w.flag, e.contact_friction_force),
-            calibrated_range: range_code(w.flag),
+            calibrated_range: w.flag.code(),
             ..Self::from(e)
         }
     }

@@ -107,7 +107,7 @@ fn start_node(
 struct RoundTrip {
     dt: f64,
     stamp0: u64,
-    several: bool,
+    by_joint: bool,
     joint_state: JointStateCommand,
 }
 
@@ -121,7 +121,7 @@ impl RoundTrip {
         Self {
             dt: cfg.solver.dt_s,
             stamp0: crate::clock::system_wall_ns(),
-            several: cfg.output_plan().by_joint(),
+            by_joint: cfg.output_plan().by_joint(),
             joint_state: JointStateCommand {
                 stamp_ns: 0,
                 velocity: vec![0.0; joints.len()],
@@ -142,7 +142,7 @@ impl RoundTrip {
             *x = v * (1.0 - 0.05 * i as f64);
         }
         let start = Instant::now();
-        if self.several {
+        if self.by_joint {
             peer.send_joint_state(js)?;
         } else {
             peer.send(&Command {
@@ -153,7 +153,7 @@ impl RoundTrip {
         }
         // Busy-poll: the peer is a tight control loop waiting for its answer.
         let got = loop {
-            let answer = if self.several {
+            let answer = if self.by_joint {
                 peer.try_recv_efforts()?.map(|_| ())
             } else {
                 peer.try_recv()?.map(|_| ())
@@ -164,7 +164,7 @@ impl RoundTrip {
             std::hint::spin_loop();
         };
         let ns = u64::try_from(start.elapsed().as_nanos()).unwrap_or(u64::MAX);
-        while self.several && peer.try_recv_contact()?.is_some() {}
+        while self.by_joint && peer.try_recv_contact()?.is_some() {}
         Ok(got.map(|_| ns))
     }
 }

@@ -197,15 +197,8 @@ pub enum DiscoveryRange {
     Off,
 }
 
-/// `ros.command_type`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum CommandType {
-    /// std_msgs/msg/Float64, m/s.
-    Float64,
-    /// geometry_msgs/msg/TwistStamped, linear.x in m/s.
-    TwistStamped,
-}
+/// `ros.command_type`: the wire's choice, defined with the messages.
+pub use crate::msgs::command_codec::CommandType;
 
 /// `ros.qos.*`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]

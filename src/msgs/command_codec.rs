@@ -18,7 +18,18 @@
 use super::{
     CdrError, Command, CommandKind, Float64, Header, JointState, Temperature, Time, TwistStamped,
 };
-use crate::config::CommandType;
+use serde::{Deserialize, Serialize};
+
+/// The message a velocity command travels in (`ros.command_type`): the
+/// wire's choice, decided here and read by the configuration.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CommandType {
+    /// std_msgs/msg/Float64, m/s.
+    Float64,
+    /// geometry_msgs/msg/TwistStamped, linear.x in m/s.
+    TwistStamped,
+}
 
 /// A command as the message it travels in.
 #[derive(Debug, Clone, PartialEq)]

@@ -71,16 +71,6 @@ pub fn status_code(s: Status) -> u8 {
     }
 }
 
-/// The wire code of where a step's input lay (`RANGE_*`).
-pub fn range_code(f: crate::range_watch::RangeFlag) -> u8 {
-    use crate::range_watch::RangeFlag;
-    match f {
-        RangeFlag::NotWatched => codes::RANGE_NOT_WATCHED,
-        RangeFlag::Inside => codes::RANGE_INSIDE,
-        RangeFlag::Outside { .. } => codes::RANGE_OUTSIDE,
-    }
-}
-
 /// Name of a solver status code (logs, CSV).
 pub fn status_name(code: u8) -> &'static str {
     match code {

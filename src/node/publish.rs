@@ -102,7 +102,7 @@ impl Loop {
     /// `node.outside_envelope` says, and the count of steps outside.
     fn watched(&mut self, k: usize, rec: &mut EstimateRecord) {
         let flag = self.flags[k];
-        rec.calibrated_range = crate::msgs::range_code(flag);
+        rec.calibrated_range = flag.code();
         if let RangeFlag::Outside {
             input,
             value,

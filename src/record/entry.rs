@@ -54,11 +54,6 @@ impl TopicId {
             TopicId::ContactFriction(k) => BASE_TOPICS + usize::from(k),
         }
     }
-
-    /// How many indices a recording of `contacts` contacts uses.
-    pub fn count(contacts: usize) -> usize {
-        BASE_TOPICS + if contacts > 1 { contacts } else { 0 }
-    }
 }
 
 impl Encoder {

@@ -158,7 +158,7 @@ pub fn run(
     cfg.node.step_mode = crate::config::StepMode::Lockstep;
     let plan = cfg.output_plan();
     let joints = plan.joints();
-    let several = plan.by_joint();
+    let by_joint = plan.by_joint();
     let link = MemoryQueues::new(16).for_plan(&plan);
     let mut peer = link.peer();
     let mut l = Loop::new(
@@ -170,7 +170,7 @@ pub fn run(
     )?;
     let mut out = Collected {
         first: Vec::with_capacity(p.commands.len()),
-        per_contact: if several {
+        per_contact: if by_joint {
             vec![Vec::new(); joints.len()]
         } else {
             Vec::new()

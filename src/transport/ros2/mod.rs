@@ -285,8 +285,8 @@ pub struct Ros2Node {
     thread: Option<std::thread::JoinHandle<()>>,
     /// The services thread (parameters, ~/snapshot).
     services: Option<std::thread::JoinHandle<()>>,
-    /// Several contacts: estimates go to the per-contact topics.
-    several: bool,
+    /// Driven by joints (the output plan): estimates go to the per-contact topics.
+    by_joint: bool,
 }
 
 impl Ros2Node {
@@ -323,7 +323,7 @@ impl Ros2Node {
             counters,
             thread: Some(thread),
             services: None,
-            several: spec.plan.by_joint(),
+            by_joint: spec.plan.by_joint(),
         };
         if let Some(p) = io.parameters {
             let (tx, rx) = std::sync::mpsc::channel();
@@ -370,7 +370,7 @@ impl NodePort for Ros2Node {
     }
 
     fn publish_estimate(&mut self, contact: usize, e: &EstimateRecord) -> bool {
-        if self.several {
+        if self.by_joint {
             self.push(Out::ContactEstimate(contact, *e))
         } else {
             self.push(Out::Estimate(*e))
