@@ -129,6 +129,57 @@ type Pair = (
     Option<f64>,
 );
 
+/// One range of a [`CalibratedRange`]: both ends or neither, finite, not
+/// negative (but a temperature), not inverted; errors name the key
+/// `prefix.stem_{min,max}_suffix`.
+fn check_pair(
+    prefix: &str,
+    stem: &str,
+    suffix: &str,
+    lo: Option<f64>,
+    hi: Option<f64>,
+) -> Result<(), ConfigError> {
+    let key = |end: &str| format!("{prefix}.{stem}_{end}_{suffix}");
+    let bad = |key: String, value: String, range: &str| ConfigError::OutOfRange {
+        key,
+        value,
+        range: range.into(),
+    };
+    match (lo, hi) {
+        (None, None) => Ok(()),
+        (Some(_), None) => Err(bad(
+            key("max"),
+            "missing".into(),
+            "given with its min (a range is a pair)",
+        )),
+        (None, Some(_)) => Err(bad(
+            key("min"),
+            "missing".into(),
+            "given with its max (a range is a pair)",
+        )),
+        (Some(lo), Some(hi)) => {
+            for (end, v) in [("min", lo), ("max", hi)] {
+                let negative = stem != "temperature" && v < 0.0;
+                if !v.is_finite() || negative {
+                    return Err(bad(
+                        key(end),
+                        Num(v).to_string(),
+                        "a finite number, not negative",
+                    ));
+                }
+            }
+            if lo > hi {
+                return Err(bad(
+                    key("min"),
+                    Num(lo).to_string(),
+                    &format!("at most its max {} (the range is inverted)", Num(hi)),
+                ));
+            }
+            Ok(())
+        }
+    }
+}
+
 impl CalibratedRange {
     /// Whether the speeds are a rotary joint's (rad/s keys given).
     pub fn is_rotary(&self) -> bool {
@@ -281,49 +332,13 @@ impl CalibratedRange {
         if let Some(e) = self.unit_error(prefix, joint) {
             return Err(e);
         }
-        let key = |stem: &str, end: &str, suffix: &str| format!("{prefix}.{stem}_{end}_{suffix}");
         let bad = |key: String, value: String, range: &str| ConfigError::OutOfRange {
             key,
             value,
             range: range.into(),
         };
         for (_, stem, suffix, _, lo, hi) in self.pairs() {
-            match (lo, hi) {
-                (None, None) => {}
-                (Some(_), None) => {
-                    return Err(bad(
-                        key(stem, "max", suffix),
-                        "missing".into(),
-                        "given with its min (a range is a pair)",
-                    ))
-                }
-                (None, Some(_)) => {
-                    return Err(bad(
-                        key(stem, "min", suffix),
-                        "missing".into(),
-                        "given with its max (a range is a pair)",
-                    ))
-                }
-                (Some(lo), Some(hi)) => {
-                    for (end, v) in [("min", lo), ("max", hi)] {
-                        let negative = stem != "temperature" && v < 0.0;
-                        if !v.is_finite() || negative {
-                            return Err(bad(
-                                key(stem, end, suffix),
-                                Num(v).to_string(),
-                                "a finite number, not negative",
-                            ));
-                        }
-                    }
-                    if lo > hi {
-                        return Err(bad(
-                            key(stem, "min", suffix),
-                            Num(lo).to_string(),
-                            &format!("at most its max {} (the range is inverted)", Num(hi)),
-                        ));
-                    }
-                }
-            }
+            check_pair(prefix, stem, suffix, lo, hi)?;
         }
         let speed_suffix = if self.is_rotary() { "rad_s" } else { "m_s" };
         if self.speeds(true).1.is_none() && self.speeds(false).1.is_none() {

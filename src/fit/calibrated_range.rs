@@ -102,6 +102,23 @@ pub fn for_file(range: &CalibratedRange, joint: bool, gain: f64) -> CalibratedRa
     }
 }
 
+/// The range of `outcome`'s training samples into `config` (its joint's,
+/// or the one contact's through gain `gain`), and the report's section on
+/// it; nothing, and an empty section, when the data give no valid range.
+pub fn attach(config: &mut crate::config::Config, outcome: &FitOutcome, gain: f64) -> String {
+    let range = of_training(&outcome.train, outcome.train_rms, outcome.units);
+    let joint = !config.contacts.0.is_empty();
+    let in_file = for_file(&range, joint, gain);
+    if in_file.validate("calibrated_range", joint).is_err() {
+        return String::new();
+    }
+    match config.contacts.0.first_mut() {
+        Some(contact) => contact.calibrated_range = Some(in_file),
+        None => config.calibrated_range = Some(in_file),
+    }
+    section(outcome, &range)
+}
+
 /// Where one held-out or validation series lies against the range.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Placement {

@@ -149,21 +149,8 @@ impl FitRequest {
         let mut ours = fit_ours(&p, &self.search, progress, stop, self.baselines)?;
         // The range the calibration saw, into the fitted file and the report.
         let gain = p.contact_scale.as_ref().map_or(1.0, |s| s.gain);
-        let units = ours.outcome.units;
-        let range = super::calibrated_range::of_training(
-            &ours.outcome.train,
-            ours.outcome.train_rms,
-            units,
-        );
-        let joint = !ours.config.contacts.0.is_empty();
-        let in_file = super::calibrated_range::for_file(&range, joint, gain);
-        if in_file.validate("calibrated_range", joint).is_ok() {
-            match ours.config.contacts.0.first_mut() {
-                Some(contact) => contact.calibrated_range = Some(in_file),
-                None => ours.config.calibrated_range = Some(in_file),
-            }
-            extra_md.insert_str(0, &super::calibrated_range::section(&ours.outcome, &range));
-        }
+        let section = super::calibrated_range::attach(&mut ours.config, &ours.outcome, gain);
+        extra_md.insert_str(0, &section);
         let yaml = super::report::fitted_yaml(&ours.config, &ours.outcome, &p.names, &ours.map);
         if let Some(o) = &outputs.fitted {
             crate::output::write_file(o, yaml.as_bytes())?;
