@@ -49,22 +49,47 @@ unsafe impl std::alloc::GlobalAlloc for CountingAlloc {
 #[global_allocator]
 static GLOBAL: CountingAlloc = CountingAlloc;
 
-/// Keep large allocations (MCAP chunk buffers, compression contexts) out of
-/// the heap: glibc raises its mmap threshold each time such a block is freed,
-/// after which they come from the heap, fragment it and keep resident memory
-/// creeping up over hours of recording (measured: +1.5 MB in 8 simulated
-/// hours without this, +0.2 MB with it; `bench-recorder`). A fixed
-/// threshold returns every block above 128 KiB to the system when freed.
-fn fix_malloc_mmap_threshold() {
+/// Tune glibc's allocator for the command's life.
+///
+/// - **Long-running** (`run`, `soak`, `bench-latency`, `bench-recorder`):
+///   large allocations (MCAP chunk buffers, compression contexts) stay out
+///   of the heap. glibc raises its mmap threshold each time such a block is
+///   freed, after which they come from the heap, fragment it and keep
+///   resident memory creeping up over hours of recording (measured: +1.5 MB
+///   in 8 simulated hours without this, +0.2 MB with it; `bench-recorder`).
+///   A fixed threshold returns every block above 128 KiB to the system
+///   when freed.
+/// - **Batch** (`fit`, `replay`, `simulate`, the studies and the other
+///   benches): the opposite. A fit allocates and frees series-sized blocks
+///   (a prediction, a residual vector, a Jacobian) thousands of times; each
+///   mapped, zeroed by the kernel and unmapped again spent 40 % of
+///   `--fit auto`'s wall time on EMPS in the kernel (measured: 135 s, 75 s
+///   of it system time; with these settings 78 s and 0.4 s). Blocks up to
+///   32 MiB come from the heap, and the heap keeps up to 1 GiB of free top
+///   instead of returning it at once; the process gives it all back when it
+///   ends.
+fn tune_malloc(command: &cli::args::Command) {
+    use cli::args::Command as C;
+    let long_running = matches!(
+        command,
+        C::Run { .. } | C::Soak { .. } | C::BenchLatency { .. } | C::BenchRecorder { .. }
+    );
     #[cfg(all(target_os = "linux", target_env = "gnu"))]
-    // SAFETY: mallopt only changes allocator tuning; called before any thread starts.
+    // SAFETY: mallopt only changes allocator tuning; it takes the arenas' locks.
     unsafe {
-        libc::mallopt(libc::M_MMAP_THRESHOLD, 128 * 1024);
+        if long_running {
+            libc::mallopt(libc::M_MMAP_THRESHOLD, 128 * 1024);
+        } else {
+            libc::mallopt(libc::M_MMAP_THRESHOLD, 32 * 1024 * 1024);
+            libc::mallopt(libc::M_TRIM_THRESHOLD, 1024 * 1024 * 1024);
+            libc::mallopt(libc::M_TOP_PAD, 64 * 1024 * 1024);
+        }
     }
+    #[cfg(not(all(target_os = "linux", target_env = "gnu")))]
+    let _ = long_running;
 }
 
 fn main() {
-    fix_malloc_mmap_threshold();
     // `--ros-args ... [--]` sections are rcl's, not clap's: split them off.
     let argv: Vec<String> = std::env::args().collect();
     let (rest, ros_tokens) = friction_node::config::ros_args::split(&argv[1..]);
@@ -92,6 +117,7 @@ fn main() {
             }
         },
     };
+    tune_malloc(&cli.command);
     let allocations = || ALLOCATIONS.with(Cell::get);
     let result = cli::dispatch(cli, ros, &allocations);
     let stop = friction_node::interrupt::Stop::process();

@@ -326,7 +326,7 @@ mod tests {
             .map(|v| 5.0 * (1.0 + level) * sgn(*v))
             .collect();
         SeriesFit {
-            series: Series {
+            series: std::sync::Arc::new(Series {
                 name: "data/stroke.csv".into(),
                 steady: false,
                 t,
@@ -335,7 +335,7 @@ mod tests {
                 friction,
                 load: None,
                 temperature: None,
-            },
+            }),
             predicted,
         }
     }
@@ -362,7 +362,10 @@ mod tests {
         let mut one_back = source(0.0, 0.8);
         // Every backward sample but one becomes a reversal sample.
         let mut kept = false;
-        for v in one_back.series.velocity.iter_mut() {
+        for v in std::sync::Arc::make_mut(&mut one_back.series)
+            .velocity
+            .iter_mut()
+        {
             if *v < -0.001 {
                 if kept {
                     *v = 0.0;

@@ -302,7 +302,7 @@ mod tests {
 
     fn fit(name: &str, v: &[f64], f: &[f64], predicted: &[f64]) -> SeriesFit {
         SeriesFit {
-            series: Series {
+            series: std::sync::Arc::new(Series {
                 name: name.into(),
                 steady: false,
                 t: (0..v.len()).map(|k| k as f64 * 0.1).collect(),
@@ -311,7 +311,7 @@ mod tests {
                 load: None,
                 temperature: None,
                 fit: vec![true; v.len()],
-            },
+            }),
             predicted: predicted.to_vec(),
         }
     }
@@ -330,10 +330,10 @@ mod tests {
         // A time series passes through zero speed: its slow end is zero.
         assert_eq!(r.speed_forward_min_rad_s, Some(0.0));
         let steady = SeriesFit {
-            series: Series {
+            series: std::sync::Arc::new(Series {
                 steady: true,
-                ..train.series.clone()
-            },
+                ..train.series.as_ref().clone()
+            }),
             ..train.clone()
         };
         let curve = of_training(&[steady], 0.0707, Units::Rotary);

@@ -298,9 +298,11 @@ impl PhysicsModel {
         t
     }
 
-    /// The friction at the samples of `s` (the contact's series) at values
-    /// `x`: recomposed along a kept film trace when one matches, else
-    /// solved, its trace kept.
+    /// The contact's friction at the samples of `s` (the data's series;
+    /// the contact's speed is the data's times the gain) at values `x`:
+    /// recomposed along a kept film trace when one matches, else solved,
+    /// its trace kept. The contact's series is built only for a solve (a
+    /// trace's film key holds the gain, its inputs the data's).
     fn run(&self, x: &[f64], s: &Series) -> Result<Vec<f64>, PredictError> {
         let film_key = self.film_key(x);
         let inputs = inputs_fingerprint(s);
@@ -317,10 +319,20 @@ impl PhysicsModel {
             .map_err(|e| PredictError::Parameters(e.to_string()))?;
         self.traces.solves.fetch_add(1, Ordering::Relaxed);
         self.solves.fetch_add(1, Ordering::Relaxed);
-        let (out, trace) = if s.steady {
-            steady(config, s)?
+        let scaled;
+        let contact = if self.gain == 1.0 {
+            s
         } else {
-            transient(config, s)?
+            scaled = Series {
+                velocity: s.velocity.iter().map(|w| self.gain * w).collect(),
+                ..s.clone()
+            };
+            &scaled
+        };
+        let (out, trace) = if s.steady {
+            steady(config, contact)?
+        } else {
+            transient(config, contact)?
         };
         let mut traces = lock();
         if traces.len() >= TRACES_KEPT {
@@ -351,8 +363,9 @@ fn name_hash(name: &str) -> u64 {
 }
 
 /// A fingerprint of a series' model inputs: time, velocity, load,
-/// temperature and whether it is steady.
-fn inputs_fingerprint(s: &Series) -> u64 {
+/// temperature and whether it is steady (the film traces' and the
+/// problem's kept predictions' key).
+pub(super) fn inputs_fingerprint(s: &Series) -> u64 {
     let mut h = mix(0xcbf2_9ce4_8422_2325, u64::from(s.steady));
     let mut column = |v: &[f64]| {
         h = mix(h, v.len() as u64);
@@ -381,15 +394,11 @@ impl Model for PhysicsModel {
     }
 
     fn predict(&self, x: &[f64], series: &Series) -> Result<Vec<f64>, PredictError> {
-        if self.gain == 1.0 {
-            return self.run(x, series);
+        let mut f = self.run(x, series)?;
+        if self.gain != 1.0 {
+            f.iter_mut().for_each(|f| *f *= self.gain);
         }
-        let r = self.gain;
-        let contact = Series {
-            velocity: series.velocity.iter().map(|w| r * w).collect(),
-            ..series.clone()
-        };
-        Ok(self.run(x, &contact)?.into_iter().map(|f| r * f).collect())
+        Ok(f)
     }
 }
 

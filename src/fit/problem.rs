@@ -178,8 +178,9 @@ impl HoldOut {
 /// A model's prediction beside the measurement, for one source.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SeriesFit {
-    /// The data as the model saw them (maps applied).
-    pub series: Series,
+    /// The data as the model saw them (maps applied; shared with the
+    /// problem's kept series, not copied per evaluation).
+    pub series: Arc<Series>,
     /// Model friction at every sample, N (NaN where there is none).
     pub predicted: Vec<f64>,
 }
@@ -203,9 +204,17 @@ impl SeriesFit {
 /// A residual of a failed prediction, times the data's friction scale.
 const PENALTY: f64 = 1e3;
 
+/// A series with the fingerprint of its model inputs (shared: every
+/// evaluation at the same map coefficients reads the same one).
+type Fingerprinted = (Arc<Series>, u64);
+
 /// Series computed for one set of map coefficients: (role, the
 /// coefficients' bits, one series or error per source).
-type SeriesEntry = (Role, Vec<u64>, Arc<Vec<Result<Series, PredictError>>>);
+type SeriesEntry = (
+    Role,
+    Vec<u64>,
+    Arc<Vec<Result<Fingerprinted, PredictError>>>,
+);
 
 /// Map-coefficient values whose series are kept.
 const RECENT_SERIES: usize = 8;
@@ -218,23 +227,6 @@ type PredictionEntry = (Role, usize, Vec<u64>, u64, Arc<Vec<f64>>);
 /// Predictions kept: enough for one Jacobian's columns and its base point.
 fn predictions_kept(params: usize, sources: usize) -> usize {
     2 * (params + 2) * sources.max(1)
-}
-
-/// A fingerprint (SipHash) of the series' model inputs: time, velocity,
-/// load, temperature and whether it is steady.
-fn inputs_fingerprint(s: &Series) -> u64 {
-    use std::hash::{Hash, Hasher};
-    let mut h = std::collections::hash_map::DefaultHasher::new();
-    s.steady.hash(&mut h);
-    let mut column = |v: &[f64]| {
-        v.len().hash(&mut h);
-        v.iter().for_each(|x| x.to_bits().hash(&mut h));
-    };
-    column(&s.t);
-    column(&s.velocity);
-    column(s.load.as_deref().unwrap_or(&[]));
-    column(s.temperature.as_deref().unwrap_or(&[]));
-    h.finish()
 }
 
 /// A model on data, with the map coefficients that are fitted.
@@ -251,7 +243,7 @@ pub struct Problem<'a> {
     friction_scale: f64,
     /// The series of every source (training, held out, validation) when
     /// no map coefficient is fitted (they do not change).
-    fixed: Option<[Vec<Series>; 3]>,
+    fixed: Option<[Vec<Arc<Series>>; 3]>,
     /// The series of the last few map-coefficient values (training or
     /// validation): a Jacobian column that moves only a model parameter
     /// reuses them instead of evaluating the column expressions again.
@@ -308,7 +300,7 @@ impl<'a> Problem<'a> {
                     .map(|(i, s)| {
                         let mut se = s.series(&data.map_values)?;
                         holdout.apply(&mut se, i);
-                        Ok(se)
+                        Ok(Arc::new(se))
                     })
                     .collect::<Result<Vec<_>, super::FitError>>()
             };
@@ -368,31 +360,36 @@ impl<'a> Problem<'a> {
         (0..sources.len())
             .into_par_iter()
             .map(|i| {
-                let series = match (&self.fixed, &computed) {
-                    (Some(fixed), _) => fixed[role as usize][i].clone(),
-                    (None, Some(c)) => c[i].clone()?,
+                let (series, print) = match (&self.fixed, &computed) {
+                    (Some(fixed), _) => (fixed[role as usize][i].clone(), None),
+                    (None, Some(c)) => {
+                        let (s, print) = c[i].clone()?;
+                        (s, Some(print))
+                    }
                     (None, None) => unreachable!("computed when not fixed"),
                 };
-                let predicted = self.predict_one(&x[..n], role, i, &series)?;
+                let predicted = self.predict_one(&x[..n], role, i, &series, print)?;
                 Ok(SeriesFit { series, predicted })
             })
             .collect()
     }
 
     /// The model on one source: a kept prediction when the parameters and
-    /// the series' inputs are those of one, else a simulation (kept when
-    /// map coefficients are fitted, the only case where it is reused).
+    /// the series' inputs (their fingerprint `print`) are those of one,
+    /// else a simulation (kept when map coefficients are fitted, the only
+    /// case where it is reused and the only one with a fingerprint).
     fn predict_one(
         &self,
         x: &[f64],
         role: Role,
         source: usize,
         series: &Series,
+        print: Option<u64>,
     ) -> Result<Vec<f64>, PredictError> {
         let bits: Vec<u64> = x.iter().map(|v| v.to_bits()).collect();
         let lock = || self.predictions.lock().unwrap_or_else(|p| p.into_inner());
-        let keep = self.fixed.is_none();
-        let print = if keep { inputs_fingerprint(series) } else { 0 };
+        let keep = print.is_some();
+        let print = print.unwrap_or(0);
         if keep {
             if let Some(e) = lock()
                 .iter()
@@ -428,13 +425,13 @@ impl<'a> Problem<'a> {
         role: Role,
         sources: &[Source],
         holdout: HoldOut,
-    ) -> Arc<Vec<Result<Series, PredictError>>> {
+    ) -> Arc<Vec<Result<Fingerprinted, PredictError>>> {
         let key: Vec<u64> = map.iter().map(|v| v.to_bits()).collect();
         let lock = || self.recent.lock().unwrap_or_else(|p| p.into_inner());
         if let Some((_, _, s)) = lock().iter().find(|(r, k, _)| *r == role && *k == key) {
             return s.clone();
         }
-        let computed: Arc<Vec<Result<Series, PredictError>>> = Arc::new(
+        let computed: Arc<Vec<Result<Fingerprinted, PredictError>>> = Arc::new(
             sources
                 .par_iter()
                 .enumerate()
@@ -443,7 +440,8 @@ impl<'a> Problem<'a> {
                         .series(map)
                         .map_err(|e| PredictError::Inputs(e.to_string()))?;
                     holdout.apply(&mut se, i);
-                    Ok(se)
+                    let print = super::physics_model::inputs_fingerprint(&se);
+                    Ok((Arc::new(se), print))
                 })
                 .collect(),
         );
@@ -459,22 +457,22 @@ impl<'a> Problem<'a> {
     /// residuals (a step there is rejected).
     pub fn residuals(&self, x: &[f64]) -> Vec<f64> {
         let fits = self.predict_sources(x, Role::Train);
-        let penalty = vec![PENALTY * self.friction_scale; self.fitted_samples];
+        let penalty = || vec![PENALTY * self.friction_scale; self.fitted_samples];
         let mut r = Vec::with_capacity(self.fitted_samples);
         for f in fits {
-            let Ok(f) = f else { return penalty };
+            let Ok(f) = f else { return penalty() };
             for k in 0..f.predicted.len() {
                 if f.series.fit[k] {
                     let d = f.predicted[k] - f.series.friction[k];
                     if !d.is_finite() {
-                        return penalty;
+                        return penalty();
                     }
                     r.push(d);
                 }
             }
         }
         if r.len() != self.fitted_samples {
-            return penalty;
+            return penalty();
         }
         r
     }

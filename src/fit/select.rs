@@ -155,6 +155,7 @@ pub fn select(
         search,
         stop,
         given,
+        scored: std::sync::Mutex::new(Vec::new()),
     };
     let base = ctx.try_set(&[], &Vec::new())?;
     say(&format!(
@@ -205,6 +206,15 @@ pub fn select(
     // A term that ends at zero or at a bound, or that the data cannot tell
     // from another, is dropped and the set fitted again.
     let current = ctx.drop_flagged(current, &mut tried, &mut removed, say)?;
+    // A set come back to (by removal or a flag) is listed once.
+    let mut seen: Vec<Vec<&'static str>> = Vec::new();
+    tried.retain(|t| {
+        let mut key = t.terms.clone();
+        key.sort_unstable();
+        let new = !seen.contains(&key);
+        seen.push(key);
+        new
+    });
     let keys = set_keys(&current.tried.terms)
         .into_iter()
         .map(String::from)

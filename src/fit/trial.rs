@@ -31,6 +31,7 @@ pub(super) type Optimum = Vec<(String, f64)>;
 
 /// A set fitted and scored: its report line, its optimum (by name) and
 /// what its fit says of each key.
+#[derive(Clone)]
 pub(super) struct Scored {
     pub(super) tried: Tried,
     pub(super) optimum: Optimum,
@@ -47,6 +48,10 @@ pub(super) struct Ctx<'a> {
     pub(super) search: &'a SearchSettings,
     pub(super) stop: &'a crate::interrupt::Stop,
     pub(super) given: &'a [ParamSpec],
+    /// Every set scored so far, by its terms in catalogue order: a set
+    /// that the removal or the flag checks come back to is the same
+    /// problem on the same folds, and is not fitted again.
+    pub(super) scored: std::sync::Mutex<Vec<Scored>>,
 }
 
 /// The viscosities that put the film's transition inside the data, when
@@ -115,6 +120,23 @@ impl Ctx<'_> {
         terms: &[&'static str],
         warm: &Optimum,
     ) -> Result<Scored, FitError> {
+        let lock = || self.scored.lock().unwrap_or_else(|p| p.into_inner());
+        let same = |t: &Scored| {
+            t.tried.terms.len() == terms.len() && terms.iter().all(|x| t.tried.terms.contains(x))
+        };
+        if let Some(known) = lock().iter().find(|t| same(t)) {
+            // In the order asked (the last term is the one just added).
+            let mut known = known.clone();
+            known.tried.terms = terms.to_vec();
+            return Ok(known);
+        }
+        let scored = self.score_set(terms, warm)?;
+        lock().push(scored.clone());
+        Ok(scored)
+    }
+
+    /// [`Ctx::try_set`]'s fit and score of a set not scored before.
+    fn score_set(&self, terms: &[&'static str], warm: &Optimum) -> Result<Scored, FitError> {
         let mut specs = set_specs(self.given, &set_keys(terms));
         let placements = if terms.contains(&FILM) {
             film_placements(self.p)
