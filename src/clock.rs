@@ -195,9 +195,6 @@ pub fn utc_stamp(wall_ns: u64) -> String {
 pub struct SimClock {
     mono: AtomicU64,
     wall_offset: AtomicI64,
-    /// Monotonic time added to every `now_ns` read (models a busy machine:
-    /// each read costs this much simulated time).
-    read_cost: AtomicU64,
 }
 
 impl SimClock {
@@ -206,7 +203,6 @@ impl SimClock {
         Self {
             mono: AtomicU64::new(0),
             wall_offset: AtomicI64::new(i64::try_from(wall_start_ns).unwrap_or(i64::MAX)),
-            read_cost: AtomicU64::new(0),
         }
     }
 
@@ -226,17 +222,11 @@ impl SimClock {
     pub fn jump_wall(&self, delta_ns: i64) {
         self.wall_offset.fetch_add(delta_ns, Ordering::SeqCst);
     }
-
-    /// Every later `now_ns` read also advances time by `ns`.
-    pub fn set_read_cost(&self, ns: u64) {
-        self.read_cost.store(ns, Ordering::SeqCst);
-    }
 }
 
 impl Clock for SimClock {
     fn now_ns(&self) -> u64 {
-        let cost = self.read_cost.load(Ordering::SeqCst);
-        self.mono.fetch_add(cost, Ordering::SeqCst) + cost
+        self.mono.load(Ordering::SeqCst)
     }
 
     fn sleep_until_ns(&self, deadline_ns: u64) {

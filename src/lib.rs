@@ -35,6 +35,7 @@
 //! | [`bench`] | step, latency, recorder, accuracy and fit benchmarks |
 
 #![warn(missing_docs)]
+#![warn(unreachable_pub)]
 
 pub mod analysis;
 #[cfg(feature = "mcap")]

@@ -121,11 +121,6 @@ impl RangeWatch {
         }
     }
 
-    /// Whether the contact has a calibrated range.
-    pub fn is_watched(&self) -> bool {
-        self.range.is_some()
-    }
-
     /// What is published outside.
     pub fn policy(&self) -> OutsideEnvelope {
         self.policy

@@ -241,7 +241,7 @@ fn every_path_the_readmes_layout_lists_exists() {
         .split("```")
         .nth(1)
         .expect("the Layout section has a code block");
-    let mut listed = 0;
+    let mut listed = Vec::new();
     let mut missing = Vec::new();
     for line in block.lines() {
         let Some(first) = line.split_whitespace().next() else {
@@ -250,14 +250,36 @@ fn every_path_the_readmes_layout_lists_exists() {
         if line.starts_with(' ') || !(first.contains('/') || first.contains('.')) {
             continue;
         }
-        listed += 1;
-        if !root.join(first.trim_end_matches('/')).exists() {
+        let path = first.trim_end_matches('/');
+        listed.push(path.to_string());
+        if !root.join(path).exists() {
             missing.push(first.to_string());
         }
     }
-    assert!(listed > 20, "{listed} paths");
+    assert!(listed.len() > 20, "{} paths", listed.len());
     assert!(
         missing.is_empty(),
         "listed in the Layout, not there: {missing:?}"
+    );
+    // And the other way: every module of src/ (a file or a folder) is
+    // listed, but the crate's root and the binary's.
+    let mut unlisted = Vec::new();
+    for e in std::fs::read_dir(root.join("src"))
+        .unwrap()
+        .map(Result::unwrap)
+    {
+        let name = e.file_name().to_string_lossy().into_owned();
+        if name == "lib.rs" || name == "main.rs" {
+            continue;
+        }
+        let path = format!("src/{name}");
+        if !listed.contains(&path) {
+            unlisted.push(path);
+        }
+    }
+    unlisted.sort();
+    assert!(
+        unlisted.is_empty(),
+        "in src/, not in the README's Layout: {unlisted:?}"
     );
 }

@@ -57,7 +57,7 @@ fn open(path: &Path) -> Result<Connection, rusqlite::Error> {
 }
 
 /// Whether `bytes` start like an SQLite database.
-pub fn is_sqlite(bytes: &[u8]) -> bool {
+pub(super) fn is_sqlite(bytes: &[u8]) -> bool {
     bytes.starts_with(b"SQLite format 3\0")
 }
 

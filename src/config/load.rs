@@ -220,7 +220,7 @@ fn parse_params(text: &str, origin: &Origin) -> Result<Value, ConfigError> {
 /// | key | before it existed |
 /// |---|---|
 /// | `solver.flux` | `upwind`, the only flux then (the default since is `muscl_van_leer`) |
-pub const RECORDED_BEFORE: &[(&str, &str)] = &[("solver.flux", "upwind")];
+pub(super) const RECORDED_BEFORE: &[(&str, &str)] = &[("solver.flux", "upwind")];
 
 /// The value at a dotted key of a `ros__parameters` tree.
 fn lookup<'a>(params: &'a Value, key: &str) -> Option<&'a Value> {

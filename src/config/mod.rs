@@ -64,7 +64,7 @@ pub use model::*;
 pub use node_sections::*;
 pub use ros_args::RosArgs;
 pub use ros_names::{check_namespace, check_node_name, check_topic};
-pub use validate::{key_ranges, KeyRange};
+pub use validate::{key_ranges, IntervalText, KeyRange};
 pub use validate_node::snapshot_bytes;
 
 use crate::physics::{

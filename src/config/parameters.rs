@@ -18,10 +18,10 @@
 //! the contacts their defaults when the configuration was read, are
 //! read-only.
 
+use super::IntervalText;
 use super::{key_ranges, Config, ConfigError, KeyRange};
 use crate::msgs::ros_interfaces::{parameter_type as ty, ParameterValue};
-use crate::physics::terms::{catalogue, End};
-use crate::text::Num;
+use crate::physics::terms::{catalogue, Interval};
 use serde_norway::Value;
 
 /// Whether `key` may change while the node runs.
@@ -317,22 +317,10 @@ pub fn term_keys_table() -> String {
     let mut s =
         String::from("| key | symbol | unit | valid range | meaning |\n|---|---|---|---|---|\n");
     for k in catalogue() {
-        let (l, lv) = match k.lo {
-            End::Closed(v) => ('[', v),
-            End::Open(v) => ('(', v),
-        };
-        let (h, hv) = match k.hi {
-            End::Closed(v) => (']', v),
-            End::Open(v) => (')', v),
-        };
+        let range = IntervalText(Interval { lo: k.lo, hi: k.hi });
         s.push_str(&format!(
-            "| `{}` | {} | {} | {l}{}, {}{h} | {} |\n",
-            k.key,
-            k.symbol,
-            k.unit,
-            Num(lv),
-            Num(hv),
-            k.meaning
+            "| `{}` | {} | {} | {range} | {} |\n",
+            k.key, k.symbol, k.unit, k.meaning
         ));
     }
     s

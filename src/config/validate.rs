@@ -3,42 +3,40 @@
 //! allowed range (or the rule broken).
 
 use super::{Config, ConfigError, FluxKind, MethodKind};
+use crate::physics::terms::{End, Interval};
 use crate::text::Num;
-
-/// One end of an allowed interval.
-#[derive(Clone, Copy)]
-enum End {
-    /// The value may equal it.
-    Closed(f64),
-    /// The value must not equal it.
-    Open(f64),
-}
 
 /// The documented range of one numeric key (see [`key_ranges`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct KeyRange {
     /// The dotted key.
     pub key: String,
-    /// Lower bound.
-    pub lo: f64,
-    /// Whether the lower bound is excluded.
-    pub lo_open: bool,
-    /// Upper bound.
-    pub hi: f64,
-    /// Whether the upper bound is excluded.
-    pub hi_open: bool,
+    /// Its valid values.
+    pub range: Interval,
 }
 
 impl std::fmt::Display for KeyRange {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "{}{}, {}{}",
-            if self.lo_open { '(' } else { '[' },
-            Num(self.lo),
-            Num(self.hi),
-            if self.hi_open { ')' } else { ']' }
-        )
+        write!(f, "{}", IntervalText(self.range))
+    }
+}
+
+/// An interval as users read it: `[lo, hi)`, the numbers as [`Num`]
+/// writes them (every range in errors, parameter descriptions and the
+/// README's table of the terms' keys).
+pub struct IntervalText(pub Interval);
+
+impl std::fmt::Display for IntervalText {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let (open, lo) = match self.0.lo {
+            End::Closed(v) => ('[', v),
+            End::Open(v) => ('(', v),
+        };
+        let (close, hi) = match self.0.hi {
+            End::Closed(v) => (']', v),
+            End::Open(v) => (')', v),
+        };
+        write!(f, "{open}{}, {}{close}", Num(lo), Num(hi))
     }
 }
 
@@ -59,48 +57,22 @@ pub fn key_ranges() -> Vec<KeyRange> {
 }
 
 fn check(key: &str, value: f64, lo: End, hi: End) -> Result<(), ConfigError> {
+    let range = Interval { lo, hi };
     COLLECT.with(|c| {
         if let Some(v) = c.borrow_mut().as_mut() {
-            let (lo, lo_open) = match lo {
-                End::Closed(l) => (l, false),
-                End::Open(l) => (l, true),
-            };
-            let (hi, hi_open) = match hi {
-                End::Closed(h) => (h, false),
-                End::Open(h) => (h, true),
-            };
             v.push(KeyRange {
                 key: key.to_string(),
-                lo,
-                lo_open,
-                hi,
-                hi_open,
+                range,
             });
         }
     });
-    let above = match lo {
-        End::Closed(l) => value >= l,
-        End::Open(l) => value > l,
-    };
-    let below = match hi {
-        End::Closed(h) => value <= h,
-        End::Open(h) => value < h,
-    };
-    if value.is_finite() && above && below {
+    if range.contains(value) {
         return Ok(());
     }
-    let (lb, l) = match lo {
-        End::Closed(l) => ('[', l),
-        End::Open(l) => ('(', l),
-    };
-    let (hb, h) = match hi {
-        End::Closed(h) => (']', h),
-        End::Open(h) => (')', h),
-    };
     Err(ConfigError::OutOfRange {
         key: key.to_string(),
         value: format!("{value}"),
-        range: format!("{lb}{}, {}{hb}", Num(l), Num(h)),
+        range: IntervalText(range).to_string(),
     })
 }
 
@@ -156,11 +128,7 @@ impl Config {
     /// Every friction term's key against the range its term declares
     /// (`physics::terms`: the catalogue is the one list of them).
     pub(super) fn validate_terms(&self) -> Result<(), ConfigError> {
-        use crate::physics::terms::{catalogue, End as TermEnd};
-        let end = |e: TermEnd| match e {
-            TermEnd::Closed(v) => End::Closed(v),
-            TermEnd::Open(v) => End::Open(v),
-        };
+        use crate::physics::terms::catalogue;
         let tree = serde_norway::to_value(self).expect("a configuration serializes");
         for k in catalogue() {
             let v = k
@@ -169,7 +137,7 @@ impl Config {
                 .try_fold(&tree, |t, part| t.get(part))
                 .and_then(serde_norway::Value::as_f64)
                 .unwrap_or(f64::NAN);
-            check(k.key, v, end(k.lo), end(k.hi))?;
+            check(k.key, v, k.lo, k.hi)?;
         }
         Ok(())
     }

@@ -67,7 +67,7 @@ impl Shared {
     /// # Safety
     /// The caller must own cell `i` under the epoch protocol.
     #[allow(clippy::mut_from_ref)]
-    pub unsafe fn cell(&self, i: usize) -> &mut CellData {
+    pub(super) unsafe fn cell(&self, i: usize) -> &mut CellData {
         // SAFETY: exclusive by the caller's contract.
         unsafe { &mut *self.cells[i].0.get() }
     }
@@ -95,7 +95,7 @@ pub(super) struct Pool {
 impl Pool {
     /// Start one worker per share after the first; `setup(k)` runs first on
     /// worker k (1-based: pinning, scheduling).
-    pub fn start(
+    pub(super) fn start(
         shared: Arc<Shared>,
         setup: Arc<dyn Fn(usize) + Send + Sync>,
     ) -> std::io::Result<Self> {
@@ -123,7 +123,7 @@ impl Pool {
 
     /// One step of every contact: the caller's share here, the others on
     /// their workers; returns when all are done.
-    pub fn step_all(&self) {
+    pub(super) fn step_all(&self) {
         let sh = &self.shared;
         let epoch = sh.epoch.fetch_add(1, Ordering::Release) + 1;
         for t in &self.threads {

@@ -29,7 +29,7 @@
 //! Jacobian instead of once per column.
 
 use super::problem::Model;
-use super::series::Series;
+use super::series::{mix, Series};
 use super::unknowns::{ConfigKeys, DataScale, FittedParameter, ParamSpec};
 use super::{FitError, PredictError};
 use crate::config::{Config, ViscosityLaw};
@@ -305,7 +305,7 @@ impl PhysicsModel {
     /// trace's film key holds the gain, its inputs the data's).
     fn run(&self, x: &[f64], s: &Series) -> Result<Vec<f64>, PredictError> {
         let film_key = self.film_key(x);
-        let inputs = inputs_fingerprint(s);
+        let inputs = s.inputs_fingerprint();
         let lock = || self.traces.kept.lock().unwrap_or_else(|p| p.into_inner());
         let kept = lock()
             .iter()
@@ -347,37 +347,10 @@ impl PhysicsModel {
     }
 }
 
-/// One step of the fingerprints' hash: FNV-1a's multiply on a 64-bit word,
-/// then an xor-shift that folds the high bits into the low ones. Both are
-/// bijections of the state, so two inputs of equal length that differ in a
-/// single word never collide; fast on long columns.
-fn mix(h: u64, w: u64) -> u64 {
-    let h = (h ^ w).wrapping_mul(0x0000_0100_0000_01b3);
-    h ^ (h >> 29)
-}
-
 /// A key name's hash (FNV-1a on its bytes).
 fn name_hash(name: &str) -> u64 {
     name.bytes()
         .fold(0xcbf2_9ce4_8422_2325, |h, b| mix(h, u64::from(b)))
-}
-
-/// A fingerprint of a series' model inputs: time, velocity, load,
-/// temperature and whether it is steady (the film traces' and the
-/// problem's kept predictions' key).
-pub(super) fn inputs_fingerprint(s: &Series) -> u64 {
-    let mut h = mix(0xcbf2_9ce4_8422_2325, u64::from(s.steady));
-    let mut column = |v: &[f64]| {
-        h = mix(h, v.len() as u64);
-        for x in v {
-            h = mix(h, x.to_bits());
-        }
-    };
-    column(&s.t);
-    column(&s.velocity);
-    column(s.load.as_deref().unwrap_or(&[]));
-    column(s.temperature.as_deref().unwrap_or(&[]));
-    h
 }
 
 impl Model for PhysicsModel {

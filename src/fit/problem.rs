@@ -440,7 +440,7 @@ impl<'a> Problem<'a> {
                         .series(map)
                         .map_err(|e| PredictError::Inputs(e.to_string()))?;
                     holdout.apply(&mut se, i);
-                    let print = super::physics_model::inputs_fingerprint(&se);
+                    let print = se.inputs_fingerprint();
                     Ok((Arc::new(se), print))
                 })
                 .collect(),

@@ -618,7 +618,7 @@ mod plots {
     /// One panel per held-out source (validation data, else the training
     /// data), one line per model: its residual against velocity, averaged
     /// in 40 bins of velocity.
-    pub fn residual_by_velocity(
+    pub(super) fn residual_by_velocity(
         dir: &Path,
         models: &[&FitOutcome],
     ) -> Result<Vec<PathBuf>, OutputError> {
@@ -680,7 +680,7 @@ mod plots {
         )?])
     }
 
-    pub fn write(dir: &Path, o: &FitOutcome) -> Result<Vec<PathBuf>, OutputError> {
+    pub(super) fn write(dir: &Path, o: &FitOutcome) -> Result<Vec<PathBuf>, OutputError> {
         let (f, v) = (o.units.force(), o.units.speed());
         let (friction, velocity, residual) = (
             format!("friction ({f})"),

@@ -14,7 +14,6 @@
 use super::expr::{compile, derivative, Affine, Columns, Expr, Var};
 use super::FitError;
 use crate::table::Table;
-use std::path::PathBuf;
 
 /// How the model's inputs come from a table's columns.
 #[derive(Debug, Clone, PartialEq)]
@@ -70,7 +69,34 @@ pub struct Series {
     pub fit: Vec<bool>,
 }
 
+/// One step of the fingerprints' hash: FNV-1a's multiply on a 64-bit word,
+/// then an xor-shift that folds the high bits into the low ones. Both are
+/// bijections of the state, so two inputs of equal length that differ in a
+/// single word never collide; fast on long columns.
+pub(super) fn mix(h: u64, w: u64) -> u64 {
+    let h = (h ^ w).wrapping_mul(0x0000_0100_0000_01b3);
+    h ^ (h >> 29)
+}
+
 impl Series {
+    /// A fingerprint of the series' model inputs: time, velocity, load,
+    /// temperature and whether it is steady (the film traces' and the
+    /// problem's kept predictions' key; [`mix`] over every value).
+    pub fn inputs_fingerprint(&self) -> u64 {
+        let mut h = mix(0xcbf2_9ce4_8422_2325, u64::from(self.steady));
+        let mut column = |v: &[f64]| {
+            h = mix(h, v.len() as u64);
+            for x in v {
+                h = mix(h, x.to_bits());
+            }
+        };
+        column(&self.t);
+        column(&self.velocity);
+        column(self.load.as_deref().unwrap_or(&[]));
+        column(self.temperature.as_deref().unwrap_or(&[]));
+        h
+    }
+
     /// Samples.
     pub fn len(&self) -> usize {
         self.t.len()
@@ -432,11 +458,6 @@ impl Source {
             fit: vec![true; n],
         })
     }
-}
-
-/// The sources a path stands for (one table).
-pub fn source_path(p: &std::path::Path) -> PathBuf {
-    p.to_path_buf()
 }
 
 #[cfg(test)]

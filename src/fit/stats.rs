@@ -56,12 +56,6 @@ impl Statistics {
 /// Relative step of the differences, of each scaled range.
 const STEP: f64 = 1e-4;
 
-/// Statistics at `x`.
-pub fn at_optimum(problem: &Problem<'_>, x: &[f64]) -> Statistics {
-    let (r0, jac) = jacobian(problem, x);
-    from_jacobian(problem, x, &r0, &jac)
-}
-
 /// The residuals at `x` and their Jacobian in scaled coordinates (central
 /// differences, one-sided at a bound).
 pub fn jacobian(problem: &Problem<'_>, x: &[f64]) -> (Vec<f64>, DMatrix<f64>) {

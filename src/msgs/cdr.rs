@@ -69,5 +69,5 @@ pub fn from_cdr<T: serde::de::DeserializeOwned>(bytes: &[u8]) -> Result<T, CdrEr
 }
 
 mod byteorder_le {
-    pub use byteorder::{BigEndian, LittleEndian};
+    pub(super) use byteorder::{BigEndian, LittleEndian};
 }

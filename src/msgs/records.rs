@@ -578,15 +578,7 @@ pub enum CommandKind {
     },
 }
 
-impl CommandKind {
-    /// A velocity, of the one contact or of one joint's contact.
-    pub fn is_velocity(self) -> bool {
-        matches!(
-            self,
-            CommandKind::Velocity | CommandKind::JointVelocity { .. }
-        )
-    }
-}
+impl CommandKind {}
 
 /// A command as received from a transport (Copy, no heap).
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -32,7 +32,7 @@ pub(super) struct ContactCommand {
 }
 
 impl ContactCommand {
-    pub fn new(v0: f64, load: f64) -> Self {
+    pub(super) fn new(v0: f64, load: f64) -> Self {
         Self {
             velocity: v0,
             applied: v0,

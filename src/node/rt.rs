@@ -1,24 +1,7 @@
-//! Real-time helpers: precise sleeping and (when configured and permitted)
+//! Real-time settings of the loop's thread (when configured and permitted):
 //! SCHED_FIFO, mlockall and CPU pinning, with a warning when not permitted.
 
 use crate::config::RealtimeConfig;
-use std::time::{Duration, Instant};
-
-/// Sleep until `deadline`: a kernel sleep to 100 µs before it, then spin.
-pub fn sleep_until(deadline: Instant) {
-    const SPIN: Duration = Duration::from_micros(100);
-    let now = Instant::now();
-    if deadline <= now {
-        return;
-    }
-    let left = deadline - now;
-    if left > SPIN {
-        std::thread::sleep(left - SPIN);
-    }
-    while Instant::now() < deadline {
-        std::hint::spin_loop();
-    }
-}
 
 /// Apply the real-time settings to the calling thread. Returns what was
 /// applied and warnings for what could not be (never fails).

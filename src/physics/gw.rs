@@ -228,11 +228,6 @@ impl Greenwood {
         )
     }
 
-    /// Real contact area ratio A_r/A_0 at film thickness `h`.
-    pub fn area_fraction(&self, h: f64) -> f64 {
-        self.area_scale * self.f1.eval(h * self.inv_sigma).0
-    }
-
     /// Tabulate the contact summed over a fixed film shape `g` (one value per
     /// cell): `Σ_i p_asp(h0 + g_i)` and `Σ_i A_r/A_0(h0 + g_i)` as functions of
     /// h0 alone. The node values and slopes are the exact sums of the

@@ -34,12 +34,12 @@ pub fn offered_qos_yaml(q: &QosConfig) -> String {
 
 /// What each recorded topic is: its name, type and offered QoS.
 #[derive(Debug, Clone)]
-pub struct TopicTable {
+pub(super) struct TopicTable {
     pub topics: Vec<(TopicId, String, &'static MsgType, String)>,
 }
 
 impl TopicTable {
-    pub fn new(config: &Config, names: &TopicNames) -> Self {
+    pub(super) fn new(config: &Config, names: &TopicNames) -> Self {
         let velocity_type = match config.ros.command_type {
             CommandType::Float64 => &msgs::FLOAT64,
             CommandType::TwistStamped => &msgs::TWIST_STAMPED,
@@ -118,7 +118,7 @@ impl TopicTable {
     }
 
     /// Indices [`TopicId::index`] spans for this table.
-    pub fn slots(&self) -> usize {
+    pub(super) fn slots(&self) -> usize {
         self.topics
             .iter()
             .map(|(id, ..)| id.index() + 1)

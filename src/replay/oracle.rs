@@ -19,7 +19,10 @@ pub struct Oracle {
     pub count_mismatch: Option<(usize, usize)>,
 }
 
-pub fn compare(replayed: &[(Estimate, EstimateRecord)], recorded: &[EstimateRecord]) -> Oracle {
+pub(super) fn compare(
+    replayed: &[(Estimate, EstimateRecord)],
+    recorded: &[EstimateRecord],
+) -> Oracle {
     type Field = (&'static str, fn(&EstimateRecord) -> f64);
     let fields: [Field; 13] = [
         ("velocity_m_s", |r| r.velocity_m_s),
@@ -68,7 +71,7 @@ pub fn compare(replayed: &[(Estimate, EstimateRecord)], recorded: &[EstimateReco
 
 /// Several contacts' verdicts as one: identical when all are, every
 /// deviation, the steps compared summed, the first count mismatch.
-pub fn combine<'a>(oracles: impl Iterator<Item = &'a Oracle>) -> Oracle {
+pub(super) fn combine<'a>(oracles: impl Iterator<Item = &'a Oracle>) -> Oracle {
     let mut all = Oracle {
         compared: 0,
         identical: true,

@@ -36,14 +36,14 @@ pub fn gap_list(gaps: &[Silence], t0_ns: u64) -> String {
 /// half-range: a swing must reach this far past the mean on both sides to
 /// count as a cycle, so chatter about a reversal (noise, a controller's
 /// limit cycle at standstill) is not one.
-pub const CYCLE_HYSTERESIS: f64 = 0.25;
+pub(super) const CYCLE_HYSTERESIS: f64 = 0.25;
 
 /// Where the cycles of `velocity` start: at its last upward crossing of
 /// the mean before it rises [`CYCLE_HYSTERESIS`] of its half-range above
 /// the mean, having been as far below it since the last start (a Schmitt
 /// trigger placed on the mean crossing); and at a last upward crossing the
 /// record ends after.
-pub fn cycle_starts(velocity: &[f64]) -> Vec<usize> {
+pub(super) fn cycle_starts(velocity: &[f64]) -> Vec<usize> {
     let n = velocity.len();
     if n < 2 {
         return Vec::new();
@@ -448,7 +448,7 @@ mod plots {
         )
     }
 
-    pub fn write(dir: &Path, r: &ReplayResult) -> Result<Vec<PathBuf>, OutputError> {
+    pub(super) fn write(dir: &Path, r: &ReplayResult) -> Result<Vec<PathBuf>, OutputError> {
         let e = &r.estimates;
         Ok(vec![
             friction_velocity(dir, e)?,

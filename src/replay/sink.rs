@@ -212,7 +212,7 @@ const BATCH: usize = 1024;
 /// and the joint's velocity (v / gain) and effort (gain · friction), in the
 /// joint's units (rad/s and N·m for a revolute joint, as `fit --rotary`
 /// writes it; m/s and N for a prismatic one).
-pub const JOINT_COLUMNS: &str = ",contact,joint,joint_velocity,joint_effort";
+pub(super) const JOINT_COLUMNS: &str = ",contact,joint,joint_velocity,joint_effort";
 
 /// The writer thread hands its sink back with the first write error.
 type SinkOutcome = (Box<dyn Sink>, Result<(), ReplayError>);

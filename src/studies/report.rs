@@ -424,7 +424,7 @@ mod plots {
         )
     }
 
-    pub fn study(dir: &Path, r: &StudyResult) -> Result<Vec<PathBuf>, OutputError> {
+    pub(super) fn study(dir: &Path, r: &StudyResult) -> Result<Vec<PathBuf>, OutputError> {
         let mut files = Vec::new();
         match r.study {
             StudyKind::Stribeck => {
@@ -462,7 +462,7 @@ mod plots {
     use super::*;
 
     /// Built without the `plots` feature: no figures.
-    pub fn study(_dir: &Path, _r: &StudyResult) -> Result<Vec<PathBuf>, OutputError> {
+    pub(super) fn study(_dir: &Path, _r: &StudyResult) -> Result<Vec<PathBuf>, OutputError> {
         Ok(Vec::new())
     }
 }

@@ -18,7 +18,7 @@ impl Solver {
         self.push_history_current(0.0);
         self.push_history_current(0.0);
         self.hist_len = 1;
-        self.p_hist = 0;
+        self.predictor.forget();
         self.last = None;
     }
 
@@ -58,7 +58,7 @@ impl Solver {
 
     pub(super) fn fill_history_with_current(&mut self) {
         self.hist_len = 0;
-        self.p_hist = 0;
+        self.predictor.forget();
         let f_net = self
             .last
             .map_or(0.0, |e| e.hydrodynamic_force + e.asperity_force - e.load);
@@ -88,7 +88,7 @@ impl Solver {
         let (newest, older) = self.hist.split_at_mut(1);
         older[0].copy_from(&newest[0]);
         self.hist_len = self.hist_len.min(1);
-        self.p_hist = 0;
+        self.predictor.forget();
         self.w.hist_term_valid = None;
     }
 }

@@ -59,6 +59,7 @@
 //! | `border.rs` | the load-balance border and the Schur-complement close both solves share |
 //! | `lanes.rs` | lane-wise sums and maxima that vectorise |
 //! | `postprocess.rs` | forces, friction and diagnostics of a solved state |
+//! | `predictor.rs` | the earlier levels the time step's warm start extrapolates from |
 //! | `reference.rs` | the paper's Algorithm 1 (Picard + secant), the verification reference |
 //! | `breakdown.rs` | the cost of each part of an iteration (a benchmark aid) |
 
@@ -73,6 +74,7 @@ mod history;
 mod lanes;
 mod newton;
 mod postprocess;
+mod predictor;
 mod reference;
 mod steady;
 mod step;
@@ -92,6 +94,7 @@ use super::scheme::StepCoefficients;
 use super::settings::{Method, SolverSettings};
 use super::terms::FrictionTerms;
 use newton::CONTRACTION_MAX;
+use predictor::Predictor;
 
 /// The film's model discretised on its grid, immutable between model swaps
 /// (the friction terms, which act after the film, are [`Solver`]'s `terms`).
@@ -202,7 +205,7 @@ pub(crate) struct Ctx {
 }
 
 impl Ctx {
-    pub fn w0(&self) -> f64 {
+    pub(crate) fn w0(&self) -> f64 {
         self.time.map_or(1.0, |(c, _)| c.w[0])
     }
 }
@@ -262,19 +265,10 @@ pub struct Solver {
     /// Number of valid history levels (0, 1 or 2).
     pub(crate) hist_len: usize,
     pub(crate) w: Work,
-    /// Pressure at level n−2 (for the predictor).
-    p_old: Vec<f64>,
-    /// Pressure at level n−3.
-    p_old2: Vec<f64>,
-    /// How many of p_old, p_old2 are valid (0..=2).
-    p_hist: usize,
-    /// h0 at level n−3 (valid when p_hist == 2).
-    h0_n3: f64,
+    /// Earlier levels kept for the time step's warm start.
+    predictor: Predictor,
     /// Newton contraction constant K (see the module doc).
     contraction: f64,
-    /// h0 of the previous state while a solve starts from the predictor's
-    /// extrapolation (the restart's alternative start; taken by the solve).
-    held_h0: Option<f64>,
     anchor: (f64, f64, f64),
     last: Option<Estimate>,
     /// The contact's pre-sliding displacement z, m (see
@@ -413,12 +407,8 @@ impl Solver {
             last_load: None,
             hist_len: 0,
             w: Work::new(n),
-            p_old: vec![p_amb; n],
-            p_old2: vec![p_amb; n],
-            p_hist: 0,
-            h0_n3: 0.0,
+            predictor: Predictor::new(n, p_amb),
             contraction: CONTRACTION_MAX,
-            held_h0: None,
             anchor: (0.0, 0.0, 0.0),
             last: None,
             bristle: 0.0,
@@ -490,16 +480,6 @@ impl Solver {
     /// Film thickness at cell i (cell average), m.
     pub fn film_thickness(&self, i: usize) -> f64 {
         self.h0 + self.d.grid.g_cell[i]
-    }
-
-    /// The last estimate returned, if any.
-    pub fn last_estimate(&self) -> Option<&Estimate> {
-        self.last.as_ref()
-    }
-
-    /// The liquid's dynamic viscosity μl now, Pa·s.
-    pub fn liquid_viscosity(&self) -> f64 {
-        self.d.eos.mu_l
     }
 
     /// The load per reference width of a solve at `load` (N), after

@@ -121,7 +121,7 @@ impl Solver {
             return out;
         }
         // The previous state, when this solve starts from a prediction.
-        let held_h0 = self.held_h0.take();
+        let held_h0 = self.predictor.held_h0.take();
         // Norm of the previous update when it was taken in full.
         let mut previous: Option<f64> = None;
         let mut damped = false;

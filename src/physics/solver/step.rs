@@ -215,8 +215,8 @@ impl Solver {
         self.w.p_backup.copy_from_slice(&self.p);
         let h_backup = self.h0;
         self.predict(gap);
-        let predicted = self.p_hist >= 1 && self.hist_len >= 2;
-        self.held_h0 = predicted.then_some(h_backup);
+        let predicted = self.predictor.levels >= 1 && self.hist_len >= 2;
+        self.predictor.held_h0 = predicted.then_some(h_backup);
         let out = match self.settings.method {
             Method::Newton => self.solve(&ctx),
             Method::Reference => self.reference_solve(&ctx),
@@ -227,11 +227,8 @@ impl Solver {
             self.p.copy_from_slice(&self.w.p_backup);
             self.h0 = h_backup;
         }
-        std::mem::swap(&mut self.p_old2, &mut self.p_old);
-        std::mem::swap(&mut self.p_old, &mut self.w.p_backup);
-        self.p_hist = (self.p_hist + 1).min(2);
-        // Level n−2 now becomes n−3 for the next step.
-        self.h0_n3 = self.hist[1].h0;
+        // The step's start becomes level n−2, and n−2 becomes n−3.
+        self.predictor.push(&mut self.w.p_backup, self.hist[1].h0);
         self.velocity = v;
         self.last_load = Some(load);
         let mut e = self.finish(&ctx, out, true);
@@ -247,14 +244,15 @@ impl Solver {
     /// liquid cell kept out of the vapour ([`PredictionGuard`]).
     #[inline(always)]
     fn predict(&mut self, gap: H0Mode) {
-        let quadratic = self.p_hist == 2 && self.hist_len >= 2;
+        let quadratic = self.predictor.levels == 2 && self.hist_len >= 2;
         let guard = self.d.guard;
         if quadratic {
-            for ((p, o), o2) in self.p.iter_mut().zip(&self.p_old).zip(&self.p_old2) {
+            let old = &self.predictor;
+            for ((p, o), o2) in self.p.iter_mut().zip(&old.p_old).zip(&old.p_old2) {
                 *p = guard.apply(*p, 3.0 * (*p - o) + o2);
             }
-        } else if self.p_hist >= 1 && self.hist_len >= 2 {
-            for (p, o) in self.p.iter_mut().zip(&self.p_old) {
+        } else if self.predictor.levels >= 1 && self.hist_len >= 2 {
+            for (p, o) in self.p.iter_mut().zip(&self.predictor.p_old) {
                 *p = guard.apply(*p, 2.0 * *p - o);
             }
         }
@@ -264,7 +262,7 @@ impl Solver {
                 if self.hist_len >= 2 {
                     let (h1, h2) = (self.hist[0].h0, self.hist[1].h0);
                     let ext = if quadratic {
-                        3.0 * (h1 - h2) + self.h0_n3
+                        3.0 * (h1 - h2) + self.predictor.h0_n3
                     } else {
                         2.0 * h1 - h2
                     };

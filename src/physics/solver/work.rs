@@ -126,7 +126,7 @@ impl RowColumns {
         }
     }
 
-    pub fn len(&self) -> usize {
+    pub(crate) fn len(&self) -> usize {
         self.b.len()
     }
 }

@@ -93,6 +93,32 @@ impl End {
     }
 }
 
+/// An interval of allowed values: a key's valid range (the one interval
+/// type: the catalogue, validation and the parameter descriptors use it;
+/// `config::validate` writes it as `[lo, hi)`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Interval {
+    /// The lower end.
+    pub lo: End,
+    /// The upper end.
+    pub hi: End,
+}
+
+impl Interval {
+    /// Whether `v` is finite and lies in the interval.
+    pub fn contains(self, v: f64) -> bool {
+        let above = match self.lo {
+            End::Closed(l) => v >= l,
+            End::Open(l) => v > l,
+        };
+        let below = match self.hi {
+            End::Closed(h) => v <= h,
+            End::Open(h) => v < h,
+        };
+        v.is_finite() && above && below
+    }
+}
+
 /// The scale of a key's default fit bounds when its start gives none (a
 /// term that is off starts at 0).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -364,6 +390,24 @@ impl FrictionTerms {
 #[allow(clippy::float_cmp)] // the values compared exactly are exact claims
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_interval_holds_its_closed_ends_but_not_its_open_ones_nor_a_non_finite_value() {
+        let r = Interval {
+            lo: End::Open(0.0),
+            hi: End::Closed(1.0),
+        };
+        assert!(!r.contains(0.0));
+        assert!(r.contains(1e-300));
+        assert!(r.contains(1.0));
+        assert!(!r.contains(1.0 + f64::EPSILON));
+        assert!(!r.contains(f64::NAN));
+        let all = Interval {
+            lo: End::Closed(f64::NEG_INFINITY),
+            hi: End::Closed(f64::INFINITY),
+        };
+        assert!(!all.contains(f64::INFINITY));
+    }
 
     #[test]
     fn every_key_of_the_catalogue_is_named_once_with_a_unit_and_an_ordered_range() {

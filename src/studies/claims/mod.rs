@@ -12,7 +12,7 @@
 //! | `loops.rs` | claims about the loops' shape (amplitude, frequency, branches) |
 //! | `parameters.rs` | claims about the operating parameters (load, viscosity, roughness, texture) |
 
-use super::{CaseResult, StudyKind, StudyResult, LOW_SPEED};
+use super::{StudyKind, StudyResult, LOW_SPEED};
 use std::collections::BTreeMap;
 
 /// One check of a claim.
@@ -137,13 +137,6 @@ fn metric(r: &StudyResult, id: &str, f: impl Fn(&crate::analysis::LoopMetrics) -
 fn offsets(r: &StudyResult, id: &str) -> Option<super::SteadyOffsets> {
     let c = r.case(id)?;
     c.steady_offsets(r.steady(&c.case.steady_key)?)
-}
-
-/// Whether a case failed (for reporting).
-pub fn failed_cases(r: &Results) -> Vec<&CaseResult> {
-    r.values()
-        .flat_map(|s| s.cases.iter().filter(|c| c.failed()))
-        .collect()
 }
 
 mod loops;

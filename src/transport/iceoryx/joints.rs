@@ -43,7 +43,7 @@ pub(super) struct JointNode {
 }
 
 impl JointNode {
-    pub fn open(n: &Node<ipc::Service>, spec: &IceoryxSpec) -> Result<Self, TransportError> {
+    pub(super) fn open(n: &Node<ipc::Service>, spec: &IceoryxSpec) -> Result<Self, TransportError> {
         let js = service::<JointStatePayload>(n, &spec.joint_state, JOINT_BUFFER)?;
         let ef = service::<EffortsPayload>(n, &spec.efforts, OUTPUT_BUFFER)?;
         let ce = service::<ContactEstimatePayload>(n, &spec.contact_estimate, OUTPUT_BUFFER)?;
@@ -71,7 +71,7 @@ impl JointNode {
 
     /// The next joint command: from the JointState being expanded, else
     /// from the next received one.
-    pub fn poll(
+    pub(super) fn poll(
         &mut self,
         counters: &SharedCounters,
         record: &RecordQueue,
@@ -149,7 +149,7 @@ impl JointNode {
         self.next = 0;
     }
 
-    pub fn publish_estimate(&self, contact: usize, e: &EstimateRecord) -> bool {
+    pub(super) fn publish_estimate(&self, contact: usize, e: &EstimateRecord) -> bool {
         self.contact_estimate
             .send_copy(ContactEstimatePayload {
                 contact: u32::try_from(contact).unwrap_or(u32::MAX),
@@ -159,7 +159,7 @@ impl JointNode {
             .is_ok()
     }
 
-    pub fn publish_efforts(&self, stamp_ns: u64, efforts: &[f64]) -> bool {
+    pub(super) fn publish_efforts(&self, stamp_ns: u64, efforts: &[f64]) -> bool {
         let e = JointEfforts::new(stamp_ns, efforts);
         self.efforts
             .send_copy(EffortsPayload {
@@ -181,7 +181,7 @@ pub(super) struct JointPeer {
 }
 
 impl JointPeer {
-    pub fn open(n: &Node<ipc::Service>, spec: &IceoryxSpec) -> Result<Self, TransportError> {
+    pub(super) fn open(n: &Node<ipc::Service>, spec: &IceoryxSpec) -> Result<Self, TransportError> {
         let js = service::<JointStatePayload>(n, &spec.joint_state, JOINT_BUFFER)?;
         let ef = service::<EffortsPayload>(n, &spec.efforts, OUTPUT_BUFFER)?;
         let ce = service::<ContactEstimatePayload>(n, &spec.contact_estimate, OUTPUT_BUFFER)?;
@@ -206,7 +206,7 @@ impl JointPeer {
 
     /// Send a JointState; more than [`MAX_CONTACTS`] joints or a name
     /// longer than [`JOINT_NAME_BYTES`] is an error naming it.
-    pub fn send(&mut self, js: &JointStateCommand) -> Result<(), TransportError> {
+    pub(super) fn send(&mut self, js: &JointStateCommand) -> Result<(), TransportError> {
         let too_many = js.name.len().max(js.velocity.len()) > MAX_CONTACTS;
         if too_many {
             return Err(TransportError::TooLarge {
@@ -252,7 +252,7 @@ impl JointPeer {
         Ok(())
     }
 
-    pub fn try_recv_efforts(&mut self) -> Result<Option<JointEfforts>, TransportError> {
+    pub(super) fn try_recv_efforts(&mut self) -> Result<Option<JointEfforts>, TransportError> {
         Ok(self
             .efforts
             .receive()
@@ -263,7 +263,9 @@ impl JointPeer {
             }))
     }
 
-    pub fn try_recv_contact(&mut self) -> Result<Option<(usize, EstimateRecord)>, TransportError> {
+    pub(super) fn try_recv_contact(
+        &mut self,
+    ) -> Result<Option<(usize, EstimateRecord)>, TransportError> {
         Ok(self
             .contact_estimate
             .receive()

@@ -37,7 +37,7 @@ pub(super) struct JointTopics {
 }
 
 impl JointTopics {
-    pub fn open(
+    pub(super) fn open(
         n: &mut Node,
         spec: &Ros2Spec,
         cq: &QosProfile,
@@ -83,7 +83,11 @@ impl JointTopics {
 
     /// Take every pending JointState into the command queue (a full queue
     /// overwrites its oldest command, counted).
-    pub fn take(&mut self, commands: &ArrayQueue<crate::msgs::Command>, counters: &SharedCounters) {
+    pub(super) fn take(
+        &mut self,
+        commands: &ArrayQueue<crate::msgs::Command>,
+        counters: &SharedCounters,
+    ) {
         while let Ok(Some((m, _))) = self.commands.take() {
             let stamp = m.header.stamp.to_ns();
             let stamp = if stamp != 0 { stamp } else { system_wall_ns() };
@@ -112,7 +116,7 @@ impl JointTopics {
     }
 
     /// Contact k's estimate on its topic; false when it failed.
-    pub fn publish_estimate(&self, k: usize, r: &EstimateRecord, frame: &str) -> bool {
+    pub(super) fn publish_estimate(&self, k: usize, r: &EstimateRecord, frame: &str) -> bool {
         self.contacts
             .get(k)
             .is_some_and(|p| p.publish(r.to_wire(frame)).is_ok())
@@ -120,7 +124,7 @@ impl JointTopics {
 
     /// The efforts as a Float64MultiArray and as a JointState; false when
     /// either failed.
-    pub fn publish_efforts(&self, e: &JointEfforts, frame: &str) -> bool {
+    pub(super) fn publish_efforts(&self, e: &JointEfforts, frame: &str) -> bool {
         let data = e.as_slice().to_vec();
         let n = data.len() as u32;
         let array = Float64MultiArray {
@@ -159,7 +163,7 @@ pub(super) struct JointPeer {
 }
 
 impl JointPeer {
-    pub fn open(
+    pub(super) fn open(
         n: &mut Node,
         spec: &Ros2Spec,
         cq: &QosProfile,
@@ -196,7 +200,7 @@ impl JointPeer {
         })
     }
 
-    pub fn send(&mut self, js: &JointStateCommand) -> Result<(), TransportError> {
+    pub(super) fn send(&mut self, js: &JointStateCommand) -> Result<(), TransportError> {
         let m = JointState {
             header: Header {
                 stamp: Time::from_ns(js.stamp_ns),
@@ -211,7 +215,7 @@ impl JointPeer {
             .map_err(|e| err(Operation::Send, "publish a JointState", e))
     }
 
-    pub fn try_recv_efforts(&mut self) -> Result<Option<JointEfforts>, TransportError> {
+    pub(super) fn try_recv_efforts(&mut self) -> Result<Option<JointEfforts>, TransportError> {
         match self.efforts.take() {
             // The stamp travels in the JointState twin; the array has none.
             Ok(m) => Ok(m.map(|(m, _)| JointEfforts::new(0, &m.data))),
@@ -220,7 +224,9 @@ impl JointPeer {
     }
 
     /// The next contact estimate, the contacts' topics taken in turn.
-    pub fn try_recv_contact(&mut self) -> Result<Option<(usize, EstimateRecord)>, TransportError> {
+    pub(super) fn try_recv_contact(
+        &mut self,
+    ) -> Result<Option<(usize, EstimateRecord)>, TransportError> {
         let n = self.contacts.len();
         for i in 0..n {
             let k = (self.next + i) % n;
@@ -238,7 +244,7 @@ impl JointPeer {
 
     /// Whether the node's joint topics are matched (see
     /// [`PeerPort::is_matched`](crate::transport::PeerPort::is_matched)).
-    pub fn is_matched(&self, node: &Node) -> bool {
+    pub(super) fn is_matched(&self, node: &Node) -> bool {
         use futures::FutureExt;
         self.commands
             .wait_for_subscription(node)

@@ -87,13 +87,13 @@ pub fn describe(d: &Declared) -> ParameterDescriptor {
         constraints.push(format!("allowed {r}"));
         match d.r#type {
             ty::DOUBLE => p.floating_point_range.push(FloatingPointRange {
-                from_value: r.lo,
-                to_value: r.hi,
+                from_value: r.range.lo.value(),
+                to_value: r.range.hi.value(),
                 step: 0.0,
             }),
             ty::INTEGER => p.integer_range.push(IntegerRange {
-                from_value: r.lo as i64,
-                to_value: r.hi as i64,
+                from_value: r.range.lo.value() as i64,
+                to_value: r.range.hi.value() as i64,
                 step: 0,
             }),
             _ => {}
