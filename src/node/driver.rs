@@ -2,7 +2,7 @@
 //! velocity profile, in real time (timer mode) or command by command
 //! (lockstep).
 
-use crate::config::StepMode;
+use crate::config::{OutputPlan, StepMode};
 use crate::msgs::{Command, CommandKind};
 use crate::transport::{self, BackendSpec, PeerPort};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -97,8 +97,9 @@ pub struct DemoPlan {
     pub seconds: f64,
     /// The velocity profile.
     pub motion: DemoMotion,
-    /// Several contacts: their joints (empty: one contact).
-    pub joints: Vec<String>,
+    /// The configuration's output plan: one contact driven by velocity
+    /// commands, or joints driven by JointStates.
+    pub output: OutputPlan,
 }
 
 /// Wait up to `timeout` for the efforts of a lockstep step.
@@ -127,7 +128,7 @@ pub fn drive(
         dt_s: dt,
         seconds,
         motion,
-        joints,
+        output,
     } = plan;
     let mut report = DemoReport::default();
     let opened = spec
@@ -164,29 +165,28 @@ pub fn drive(
             value: velocity.at(t, dt),
             stamp_ns: t0 + (t * 1e9) as u64,
         };
-        let sent = if joints.is_empty() {
-            peer.send(&c)
-        } else {
-            peer.send_joint_state(&transport::JointStateCommand {
+        let sent = match &output {
+            OutputPlan::OneContact => peer.send(&c),
+            OutputPlan::Joints(joints) => peer.send_joint_state(&transport::JointStateCommand {
                 stamp_ns: c.stamp_ns,
                 name: joints.clone(),
                 velocity: vec![c.value; joints.len()],
-            })
+            }),
         };
         if let Err(e) = sent {
             report.error.get_or_insert(e.to_string());
             continue;
         }
         report.commands_sent += 1;
-        if mode == StepMode::Lockstep && answered(peer.as_mut(), !joints.is_empty()) {
+        if mode == StepMode::Lockstep && answered(peer.as_mut(), &output) {
             report.estimates_received += 1;
         }
-        report.estimates_received += drain(peer.as_mut(), !joints.is_empty());
+        report.estimates_received += drain(peer.as_mut(), &output);
     }
     // Answers still in flight.
     let until = Instant::now() + Duration::from_millis(300);
     while Instant::now() < until {
-        match drain(peer.as_mut(), !joints.is_empty()) {
+        match drain(peer.as_mut(), &output) {
             0 => std::thread::sleep(Duration::from_millis(5)),
             n => report.estimates_received += n,
         }
@@ -196,8 +196,8 @@ pub fn drive(
 
 /// Whether the answer to one command (an estimate; joint efforts with
 /// joints) arrives within 2 s.
-fn answered(peer: &mut dyn PeerPort, joints: bool) -> bool {
-    if joints {
+fn answered(peer: &mut dyn PeerPort, output: &OutputPlan) -> bool {
+    if output.by_joint() {
         efforts_timeout(peer, Duration::from_secs(2))
     } else {
         matches!(
@@ -209,9 +209,9 @@ fn answered(peer: &mut dyn PeerPort, joints: bool) -> bool {
 
 /// Take every answer waiting (estimates; joint efforts with joints): how
 /// many.
-fn drain(peer: &mut dyn PeerPort, joints: bool) -> u64 {
+fn drain(peer: &mut dyn PeerPort, output: &OutputPlan) -> u64 {
     let mut n = 0;
-    if joints {
+    if output.by_joint() {
         while let Ok(Some(_)) = peer.try_recv_efforts() {
             n += 1;
         }

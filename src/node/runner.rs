@@ -341,7 +341,7 @@ fn start_demo(
         dt_s: config.solver.dt_s,
         seconds,
         motion: opts.motion,
-        joints: config.output_plan().joints().to_vec(),
+        output: config.output_plan(),
     };
     let driver = std::thread::spawn(move || super::driver::drive(spec, plan, tx, driver_stop));
     match rx.recv_timeout(Duration::from_secs(30)) {

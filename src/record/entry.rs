@@ -3,7 +3,7 @@
 //! a snapshot).
 
 use super::WriteError;
-use crate::config::CommandType;
+use crate::config::{CommandType, OutputPlan};
 use crate::link::FilmProfileData;
 use crate::link::RecordItem;
 use crate::msgs::command_codec::CommandMessage;
@@ -62,7 +62,7 @@ impl Encoder {
         Self {
             frame_id: config.node.frame_id.clone(),
             command_type: config.ros.command_type,
-            joints: config.output_plan().joints().to_vec(),
+            plan: config.output_plan(),
         }
     }
 }
@@ -94,10 +94,10 @@ pub struct Encoder {
     pub frame_id: String,
     /// How commanded velocities are recorded (Float64 or TwistStamped).
     pub command_type: CommandType,
-    /// Several contacts: the joint of each contact (configured order); empty
-    /// for one contact. Estimates then go to their contact's topic and joint
-    /// commands to the JointState topic.
-    pub joints: Vec<String>,
+    /// The configuration's output plan, as decided once: with joints,
+    /// estimates go to their contact's topic and joint commands to the
+    /// JointState topic; with one contact, to the friction topics.
+    pub plan: OutputPlan,
 }
 
 fn cdr<T: serde::Serialize>(topic: TopicId, m: &T) -> Result<Vec<u8>, WriteError> {
@@ -118,12 +118,13 @@ impl Encoder {
     fn command(&self, c: &Command, received_ns: u64) -> Result<Entry, WriteError> {
         let joint = match c.kind {
             CommandKind::JointVelocity { contact, .. } => Some(
-                self.joints
+                self.plan
+                    .joints()
                     .get(usize::from(contact))
                     .ok_or(WriteError::NoSuchContact {
                         what: "a joint velocity",
                         contact,
-                        contacts: self.joints.len(),
+                        contacts: self.plan.joints().len(),
                     })?
                     .as_str(),
             ),
@@ -162,12 +163,12 @@ impl Encoder {
                 logged_ns: log_ns,
                 contact,
             } => {
-                if !self.joints.is_empty() {
-                    if usize::from(contact) >= self.joints.len() {
+                if let OutputPlan::Joints(joints) = &self.plan {
+                    if usize::from(contact) >= joints.len() {
                         return Err(WriteError::NoSuchContact {
                             what: "an estimate",
                             contact,
-                            contacts: self.joints.len(),
+                            contacts: joints.len(),
                         });
                     }
                     out.push(Entry {
