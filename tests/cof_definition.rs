@@ -136,3 +136,67 @@ fn with_the_boundary_rate_on_a_symmetric_sine_shows_no_cof_hysteresis_at_rest() 
     );
     assert_relative_eq!(acc, plain.cof_v0_accelerating.unwrap(), max_relative = 0.01);
 }
+
+/// Every shape of the estimate that users read states the COF with the one
+/// definition (`physics::terms::COF_DEFINITION`), and no file of the
+/// project states the stale rigid-only formula (the layouts of bags
+/// recorded before, in `src/msgs/legacy/`, keep the text they were recorded
+/// with).
+#[test]
+fn the_cof_definition_is_written_once_and_every_shape_of_the_estimate_carries_it() {
+    use friction_node::physics::terms::COF_DEFINITION;
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    for file in [
+        "msg/msg/FrictionEstimate.msg",
+        "capi/include/friction_node.h",
+        "capi/src/codes.rs",
+        "src/msgs/wire.rs",
+        "src/msgs/records.rs",
+        "src/transport/iceoryx/payloads.rs",
+        "src/physics/estimate.rs",
+        "python/src/model.rs",
+        "python/friction_node/_core.pyi",
+    ] {
+        let text = std::fs::read_to_string(root.join(file)).unwrap();
+        let text = text.replace("\\|", "|");
+        assert!(
+            text.contains(COF_DEFINITION),
+            "{file} does not state the COF as physics::terms::COF_DEFINITION"
+        );
+    }
+    // Spelt in two halves, so that this file does not hold them whole.
+    let stale = [
+        concat!("mu_bl F_asp)", " / F_ext"),
+        concat!("μ_bl F_asp)", " / F_ext"),
+    ];
+    let mut found = Vec::new();
+    let mut stack = vec![root.to_path_buf()];
+    while let Some(dir) = stack.pop() {
+        for e in std::fs::read_dir(&dir).unwrap().map(Result::unwrap) {
+            let p = e.path();
+            let rel = p.strip_prefix(root).unwrap().to_string_lossy().into_owned();
+            if [
+                ".git",
+                "target",
+                "out",
+                "fuzz",
+                "data",
+                "src/msgs/legacy",
+                "bags",
+            ]
+            .iter()
+            .any(|s| rel == *s)
+            {
+                continue;
+            }
+            if p.is_dir() {
+                stack.push(p);
+            } else if let Ok(text) = std::fs::read_to_string(&p) {
+                if stale.iter().any(|s| text.contains(s)) {
+                    found.push(rel);
+                }
+            }
+        }
+    }
+    assert!(found.is_empty(), "the stale COF formula in {found:?}");
+}

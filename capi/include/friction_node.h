@@ -100,7 +100,7 @@ typedef struct FnEstimate {
   double friction_force_n;
   // The lubricated contact alone, N.
   double contact_friction_force_n;
-  // (|F_visc| + mu_bl F_asp) / F_ext.
+  // contact friction per unit load: rigid (|F_visc| + (mu_bl + mu_r asinh(|v|/v_a)) F_asp) / F_ext; with pre-sliding |F_c| / F_ext; drivetrain terms excluded
   double cof;
   // Minimum nominal separation, m.
   double h0_m;

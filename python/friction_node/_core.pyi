@@ -18,7 +18,7 @@ class Estimate:
     load_n: float
     friction_force_n: float
     contact_friction_force_n: float
-    cof: float
+    cof: float  # contact friction per unit load: rigid (|F_visc| + (mu_bl + mu_r asinh(|v|/v_a)) F_asp) / F_ext; with pre-sliding |F_c| / F_ext; drivetrain terms excluded
     h0_m: float
     h_min_m: float
     hydrodynamic_force_n: float

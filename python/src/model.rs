@@ -45,6 +45,7 @@ pub struct Estimate {
     pub friction_force_n: f64,
     /// The lubricated contact alone, N.
     pub contact_friction_force_n: f64,
+    /// contact friction per unit load: rigid (|F_visc| + (mu_bl + mu_r asinh(|v|/v_a)) F_asp) / F_ext; with pre-sliding |F_c| / F_ext; drivetrain terms excluded
     pub cof: f64,
     pub h0_m: f64,
     pub h_min_m: f64,

@@ -205,7 +205,7 @@ pub struct FrictionEstimate {
     pub friction_force_n: f64,
     /// The lubricated contact alone, signed like the velocity (N).
     pub contact_friction_force_n: f64,
-    /// (|F_visc| + mu_bl F_asp) / F_ext.
+    /// contact friction per unit load: rigid (|F_visc| + (mu_bl + mu_r asinh(|v|/v_a)) F_asp) / F_ext; with pre-sliding |F_c| / F_ext; drivetrain terms excluded
     pub cof: f64,
     /// Minimum nominal separation (m).
     pub h0_m: f64,
@@ -246,7 +246,7 @@ pub struct FrictionEstimateV1 {
     pub load_n: f64,
     /// Total friction: the contact plus the drivetrain terms, signed like the velocity (N).
     pub friction_force_n: f64,
-    /// (|F_visc| + mu_bl F_asp) / F_ext.
+    /// contact friction per unit load: rigid (|F_visc| + (mu_bl + mu_r asinh(|v|/v_a)) F_asp) / F_ext; with pre-sliding |F_c| / F_ext; drivetrain terms excluded
     pub cof: f64,
     /// Minimum nominal separation (m).
     pub h0_m: f64,

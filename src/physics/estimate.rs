@@ -11,7 +11,7 @@
 //! | `viscous_force` | F_visc = B ∫ (−(h/2) ∂x p + μ v / h) dx | N |
 //! | `friction_force` | F_f + F_dt: the contact plus the drivetrain terms | N |
 //! | `contact_friction_force` | F_f = F_visc + μ_bl F_asp tanh(v/v_reg) | N |
-//! | `cof` | (|F_visc| + μ_bl F_asp) / F_ext | – |
+//! | `cof` | contact friction per unit load: rigid (\|F_visc\| + (mu_bl + mu_r asinh(\|v\|/v_a)) F_asp) / F_ext; with pre-sliding \|F_c\| / F_ext; drivetrain terms excluded | – |
 //! | `asperity_load_share` | F_asp / F_ext | – |
 //! | `inertia_force` | m h0'' | N |
 //! | `contact_area_ratio` | mean A_r/A_0 over the slider | – |
@@ -145,7 +145,8 @@ pub struct Estimate {
     /// transmits per unit load. Rigid contact (the paper's):
     /// (|F_visc| + μ F_asp) / F_ext, μ = μ_bl + μ_r asinh(|v|/v_a); with
     /// pre-sliding: |F_contact| / F_ext, the bristle's force (the drivetrain's
-    /// terms are not the contact's and are not in it).
+    /// terms are not the contact's and are not in it). In one line:
+    /// contact friction per unit load: rigid (|F_visc| + (mu_bl + mu_r asinh(|v|/v_a)) F_asp) / F_ext; with pre-sliding |F_c| / F_ext; drivetrain terms excluded
     pub cof: f64,
     /// The boundary rate's part of `cof`, μ_r asinh(|v|/v_a) F_asp / F_ext
     /// (0 when the rate term is off, and with pre-sliding); zero at v = 0.

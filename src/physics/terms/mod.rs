@@ -62,6 +62,14 @@ use drivetrain::Drivetrain;
 use presliding::Presliding;
 use soft_width::WidthLaw;
 
+/// The coefficient of friction as users read it, in one line of ASCII:
+/// the text every shape of the estimate carries beside its `cof` field
+/// (`msg/msg/FrictionEstimate.msg`, the C header, the wire, record and
+/// iceoryx2 structs, Python's stubs); `tests/cof_definition.rs` holds them
+/// to it. [`FrictionTerms::cof`] computes it.
+pub const COF_DEFINITION: &str =
+    "contact friction per unit load: rigid (|F_visc| + (mu_bl + mu_r asinh(|v|/v_a)) F_asp) / F_ext; with pre-sliding |F_c| / F_ext; drivetrain terms excluded";
+
 /// sgn(v): ±1, and 0 at rest (`f64::signum` gives ±1 at ±0). The sign of
 /// gross sliding in the pre-sliding level, and of the classic models'
 /// Coulomb terms.

@@ -35,7 +35,7 @@ pub struct EstimatePayload {
     pub friction_force_n: f64,
     /// The lubricated contact alone, signed like the velocity.
     pub contact_friction_force_n: f64,
-    /// (|F_visc| + mu_bl F_asp) / F_ext.
+    /// contact friction per unit load: rigid (|F_visc| + (mu_bl + mu_r asinh(|v|/v_a)) F_asp) / F_ext; with pre-sliding |F_c| / F_ext; drivetrain terms excluded
     pub cof: f64,
     /// Minimum nominal separation.
     pub h0_m: f64,
