@@ -32,7 +32,7 @@
 //! | [`fit`] | calibration: least squares on any key, classic baselines, reports |
 //! | [`studies`] | the paper's parametric studies and their claims |
 //! | [`plot`] | SVG figures shared by studies, replay and fit |
-//! | [`bench`] | step, latency, recorder, accuracy and fit benchmarks |
+//! | [`mod@bench`] | step, latency, recorder, accuracy and fit benchmarks |
 
 #![warn(missing_docs)]
 #![warn(unreachable_pub)]

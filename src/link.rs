@@ -118,7 +118,7 @@ pub(crate) struct ContactUpdate {
 }
 
 impl ParameterUpdate {
-    /// Prepare `new` (the result of [`apply_set`] on `old`) for the loop:
+    /// Prepare `new` (the result of [`crate::config::parameters::apply_set`] on `old`) for the loop:
     /// the model's tables are built here.
     pub fn prepare(
         old: &Config,

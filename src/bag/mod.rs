@@ -6,7 +6,7 @@
 //! its channels ([`Bag::scan`]), streams its messages in file order
 //! ([`Bag::messages`]), decodes the message types the project reads
 //! ([`decode`]) and puts sampled inputs onto a fixed step grid
-//! ([`resample`]). A truncated or corrupt file stops the stream where the
+//! ([`mod@resample`]). A truncated or corrupt file stops the stream where the
 //! damage starts; what came before stays usable, and [`Damage`] says where.
 //!
 //! | file | content |
@@ -119,7 +119,7 @@ pub enum BagError {
 /// At most this many channels are listed in a message.
 const LISTED: usize = 40;
 
-/// "  topic  [type]  n messages" lines (at most [`LISTED`], then a count).
+/// "  topic  \[type\]  n messages" lines (at most `LISTED`, then a count).
 pub fn listing(v: &[(String, String, u64)]) -> String {
     if v.is_empty() {
         return "  (no channels)".into();

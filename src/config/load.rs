@@ -124,7 +124,7 @@ impl Config {
 
     /// Parse a configuration recorded in a bag (`config_yaml`). A key the
     /// recording predates takes the value that reproduces it (see
-    /// [`RECORDED_BEFORE`]), so that old bags replay to the numbers they
+    /// `RECORDED_BEFORE`), so that old bags replay to the numbers they
     /// hold; then `overrides` apply.
     pub fn from_recorded_yaml(
         text: &str,

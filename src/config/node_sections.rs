@@ -426,7 +426,7 @@ pub struct RecordingConfig {
     /// `recording.enabled`: record every run (`run --record FILE` enables it too).
     pub enabled: bool,
     /// File (no split) or directory (split) to write; empty =
-    /// bags/friction_node_<UTC time>.mcap (or that name without `.mcap`).
+    /// `bags/friction_node_<UTC time>.mcap` (or that name without `.mcap`).
     pub path: String,
     /// Chunk size, bytes: a crash loses at most the open chunk.
     pub chunk_size_bytes: u64,

@@ -5,7 +5,7 @@
 //! load, lubricant and roughness. One call steps them all with one
 //! velocity and load each; with `workers > 0` the contacts are shared out
 //! (balanced by grid size) between the calling thread and a fixed pool of
-//! worker threads ([`pool`]), so that more contacts fit in one period than
+//! worker threads (`pool.rs`), so that more contacts fit in one period than
 //! one core can step. Nothing is allocated and no lock is taken per step.
 //!
 //! Each contact's effort on its joint is `gain · F_f` (`gain` = 1 for a

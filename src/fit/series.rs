@@ -81,7 +81,7 @@ pub(super) fn mix(h: u64, w: u64) -> u64 {
 impl Series {
     /// A fingerprint of the series' model inputs: time, velocity, load,
     /// temperature and whether it is steady (the film traces' and the
-    /// problem's kept predictions' key; [`mix`] over every value).
+    /// problem's kept predictions' key; `mix` over every value).
     pub fn inputs_fingerprint(&self) -> u64 {
         let mut h = mix(0xcbf2_9ce4_8422_2325, u64::from(self.steady));
         let mut column = |v: &[f64]| {

@@ -22,10 +22,10 @@
 //! | E* | `effective_modulus` | effective elastic modulus | Pa |
 //! | m | `Contact::mass` | equivalent slider mass | kg |
 //! | μ_bl | `boundary_friction` | boundary friction coefficient | – |
-//! | μ_r, v_a | `boundary_rate` | the boundary friction's rate sensitivity and activation speed (0 = constant μ_bl; see [`super::boundary`]) | –, m/s |
+//! | μ_r, v_a | `boundary_rate` | the boundary friction's rate sensitivity and activation speed (0 = constant μ_bl; see [`super::terms::boundary_film`]) | –, m/s |
 //! | v_reg | `sign_regularization` | velocity scale of tanh(v/v_reg) | m/s |
 //! | h_floor | `min_film` | optional floor on h0 (0 = off) | m |
-//! | σ0, σ1 | `presliding` | pre-sliding stiffness and damping (0 = rigid; see [`super::presliding`]) | N/m, N·s/m |
+//! | σ0, σ1 | `presliding` | pre-sliding stiffness and damping (0 = rigid; see [`super::terms::presliding`]) | N/m, N·s/m |
 //! | κ, F_ref | `width_law` | soft contact: width B(F) = B (F/F_ref)^κ (κ = 0: rigid) | –, N |
 
 use super::error::SetupError;

@@ -83,7 +83,7 @@ pub(super) fn cycle_starts(velocity: &[f64]) -> Vec<usize> {
     starts
 }
 
-/// Cycles of a replay: segments between the starts [`cycle_starts`]
+/// Cycles of a replay: segments between the starts `cycle_starts`
 /// finds, and their loop metrics.
 pub fn cycles(r: &ReplayResult, mass: f64) -> Vec<crate::analysis::LoopMetrics> {
     use crate::analysis::{metrics::one_cycle, LoopSample};
