@@ -9,8 +9,8 @@
 //! | `hydrodynamic_force` | F_hyd = B ∫ (p − p_amb) dx | N |
 //! | `asperity_force` | F_asp = B ∫ p_asp dx | N |
 //! | `viscous_force` | F_visc = B ∫ (−(h/2) ∂x p + μ v / h) dx | N |
-//! | `friction_force` | F_f + F_dt: the contact plus the drivetrain terms | N |
-//! | `contact_friction_force` | F_f = F_visc + μ_bl F_asp tanh(v/v_reg) | N |
+//! | `friction_force` | F_f = F_c + F_dt: the contact plus the drivetrain terms | N |
+//! | `contact_friction_force` | F_c = F_visc + μ(v) F_asp tanh(v/v_reg), through the pre-sliding bristle when on | N |
 //! | `cof` | contact friction per unit load: rigid (\|F_visc\| + (mu_bl + mu_r asinh(\|v\|/v_a)) F_asp) / F_ext; with pre-sliding \|F_c\| / F_ext; drivetrain terms excluded | – |
 //! | `asperity_load_share` | F_asp / F_ext | – |
 //! | `inertia_force` | m h0'' | N |

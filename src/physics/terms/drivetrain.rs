@@ -3,16 +3,16 @@
 //! gear mesh), which no contact model should be asked to absorb.
 //!
 //! ```text
-//! F_dt = (F_c + c_N F_ext + ΔF_s e^(−(v/v_s)²)) tanh(v / v_reg) + ΔF_c |tanh(v / v_reg)| + b v + c_q v |v|
+//! F_dt = (F_cd + c_N F_ext + ΔF_s e^(−(v/v_s)²)) tanh(v / v_reg) + ΔF_cd |tanh(v / v_reg)| + b v + c_q v |v|
 //! F_total = F_f + F_dt
 //! ```
 //!
 //! | symbol | meaning | unit |
 //! |---|---|---|
-//! | F_c | constant (Coulomb) drivetrain friction | N |
-//! | ΔF_c | direction asymmetry: the level is F_c + ΔF_c moving forward, F_c − ΔF_c backward (a screw lifting or lowering a load, a seal's lip) | N |
+//! | F_cd | constant (Coulomb) drivetrain friction | N |
+//! | ΔF_cd | direction asymmetry: the level is F_cd + ΔF_cd moving forward, F_cd − ΔF_cd backward (a screw lifting or lowering a load, a seal's lip) | N |
 //! | c_N | friction proportional to the normal load (rolling elements carrying it) | – |
-//! | ΔF_s | the static level's excess over the Coulomb level (Stribeck): F_c + ΔF_s at rest, decaying to F_c over v_s; negative: a friction that rises with speed to F_c | N |
+//! | ΔF_s | the static level's excess over the Coulomb level (Stribeck): F_cd + ΔF_s at rest, decaying to F_cd over v_s; negative: a friction that rises with speed to F_cd | N |
 //! | v_s | the Stribeck speed | m/s |
 //! | b | viscous drivetrain friction | N·s/m |
 //! | c_q | loss growing with the square of the speed (churning, windage, iron and eddy losses of a motor, reflected to the slider) | N·s²/m² |
@@ -20,13 +20,13 @@
 //!
 //! All zero by default: the estimate is then the contact's alone, bit for bit.
 //! With pre-sliding on (`presliding.rs`) the terms that act at zero speed,
-//! (F_c + c_N F_ext + ΔF_s e^(−(v/v_s)²)) sgn v + ΔF_c |sgn v|, are part of
+//! (F_cd + c_N F_ext + ΔF_s e^(−(v/v_s)²)) sgn v + ΔF_cd |sgn v|, are part of
 //! the bristle's level (a reversal's compliance is the whole axis's), and
 //! only b v + c_q v|v| is added beside it.
 //!
 //! With these terms the classic models are special cases of ours: Coulomb +
-//! viscous (F_c, b), Stribeck with its static level above or below the
-//! Coulomb level (F_c, ΔF_s, v_s, b), and LuGre (the same on the pre-sliding
+//! viscous (F_cd, b), Stribeck with its static level above or below the
+//! Coulomb level (F_cd, ΔF_s, v_s, b), and LuGre (the same on the pre-sliding
 //! bristle, σ0 and σ1): a calibration can always reach the best classic's
 //! training error, and the data say where the film adds to it.
 
@@ -137,7 +137,7 @@ pub const KEYS: &[TermKey] = &[
 /// The drivetrain terms.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Drivetrain {
-    /// F_c, N.
+    /// F_cd, N.
     pub coulomb: f64,
     /// b, N·s/m.
     pub viscous: f64,
@@ -145,7 +145,7 @@ pub struct Drivetrain {
     pub load_coefficient: f64,
     /// c_q, N·s²/m².
     pub quadratic: f64,
-    /// ΔF_c, N.
+    /// ΔF_cd, N.
     pub coulomb_asymmetry: f64,
     /// ΔF_s, N.
     pub stribeck: f64,
@@ -182,7 +182,7 @@ impl Drivetrain {
             && self.stribeck == 0.0
     }
 
-    /// The Coulomb level at speed `v` and load `load` (N): F_c + c_N F +
+    /// The Coulomb level at speed `v` and load `load` (N): F_cd + c_N F +
     /// ΔF_s e^(−(v/v_s)²) (the Stribeck part only when it is on: off, the
     /// level is the one before it, bit for bit).
     #[inline(always)]
@@ -207,8 +207,8 @@ impl Drivetrain {
     }
 
     /// The terms that act at zero speed, at speed `v` with the sign `s` of
-    /// gross sliding (−1, 0 or 1): (F_c + c_N F + ΔF_s e^(−(v/v_s)²)) s +
-    /// ΔF_c |s|. With pre-sliding on they are part of the bristle's level:
+    /// gross sliding (−1, 0 or 1): (F_cd + c_N F + ΔF_s e^(−(v/v_s)²)) s +
+    /// ΔF_cd |s|. With pre-sliding on they are part of the bristle's level:
     /// the compliance at a reversal is the whole axis's, not the contact's
     /// alone.
     pub fn level_at_rest(&self, v: f64, s: f64, load: f64) -> f64 {
@@ -269,7 +269,7 @@ mod tests {
                 stribeck_speed: 0.01,
                 ..Default::default()
             };
-            // At rest (well past v_reg): F_c + ΔF_s; at v_s: e^-1 of the excess.
+            // At rest (well past v_reg): F_cd + ΔF_s; at v_s: e^-1 of the excess.
             approx::assert_relative_eq!(
                 d.force(1e-5, 0.0, 1e-9),
                 10.0 + excess,

@@ -25,7 +25,7 @@
 //! 2. contact   F_c = L_c
 //! 3. total     F_f = F_c + F_dt(v, F_ext)
 //! with pre-sliding (the compliance at a reversal is the whole axis's):
-//! 2. level     L   = L_c + (F_c,dt + c_N F_ext) sgn(v) + ΔF_c |sgn(v)|   (what acts at zero speed)
+//! 2. level     L   = L_c + (F_cd + c_N F_ext) sgn(v) + ΔF_cd |sgn(v)|   (what acts at zero speed)
 //!              F_b = σ0 z + σ1 ż on L                                  (the bristle)
 //!              F_c = F_b L_c / L   (the contact's share; F_b when L = 0)
 //! 3. total     F_f = F_b + b v + c_q v |v|

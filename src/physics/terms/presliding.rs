@@ -5,7 +5,7 @@
 //!
 //! ```text
 //! L  = F_visc + μ_bl F_asp sgn(v) + F_asp μ_r asinh(v/v_a)
-//!      + (F_c + c_N F_ext) sgn(v) + ΔF_c |sgn(v)|   the friction in gross sliding that acts at zero speed
+//!      + (F_cd + c_N F_ext) sgn(v) + ΔF_cd |sgn(v)|   the friction in gross sliding that acts at zero speed
 //! ż  = |v| sgn(L) − σ0 |v| z / |L|  = a (z_ss − z),   a = σ0 |v| / |L|,  z_ss = L / σ0
 //! F  = σ0 z + σ1 ż
 //! ```
