@@ -46,7 +46,7 @@ const fn data(factor: f64, speed_power: i32) -> FitScale {
 pub const KEYS: &[TermKey] = &[
     TermKey {
         key: "drivetrain.coulomb_n",
-        symbol: "F_c",
+        symbol: "F_cd",
         unit: "N",
         lo: End::Closed(0.0),
         hi: End::Closed(1e9),
@@ -119,7 +119,7 @@ pub const KEYS: &[TermKey] = &[
     },
     TermKey {
         key: "drivetrain.coulomb_asymmetry_n",
-        symbol: "ΔF_c",
+        symbol: "ΔF_cd",
         unit: "N",
         lo: End::Closed(-1e9),
         hi: End::Closed(1e9),
@@ -130,7 +130,7 @@ pub const KEYS: &[TermKey] = &[
             per_load: false,
             symmetric: true,
         },
-        meaning: "direction asymmetry: the level is F_c + ΔF_c forward, F_c − ΔF_c backward",
+        meaning: "direction asymmetry: the level is F_cd + ΔF_cd forward, F_cd − ΔF_cd backward",
     },
 ];
 
