@@ -226,15 +226,7 @@ impl Config {
             tolerance: s.tolerance,
             max_iterations: s.max_iterations,
             flux: s.flux.couette_flux(),
-            reference: ReferenceSettings {
-                fluid_relaxation: r.fluid_relaxation,
-                fluid_relaxation_min: r.fluid_relaxation_min,
-                max_fluid_iterations: r.max_fluid_iterations,
-                fluid_tolerance: r.fluid_tolerance,
-                motion_relaxation: r.motion_relaxation,
-                max_motion_iterations: r.max_motion_iterations,
-                motion_tolerance: r.motion_tolerance,
-            },
+            reference: ReferenceSettings::from(r),
         }
     }
 

@@ -68,8 +68,16 @@ pub const DEFAULT_LOAD_N: f64 = 20_762.0;
 
 impl Default for ContactConfig {
     fn default() -> Self {
-        let g = Geometry::default();
-        let c = Contact::default();
+        Self::of_core(&Geometry::default(), &Contact::default(), DEFAULT_LOAD_N)
+    }
+}
+
+impl ContactConfig {
+    /// The section as it writes a core geometry and contact at load
+    /// `load_n` (its defaults are the core's: one source of truth). The
+    /// other way is `Config::model`; the pair is tested (a round trip of
+    /// distinct values returns every key to its place).
+    pub fn of_core(g: &Geometry, c: &Contact, load_n: f64) -> Self {
         let (profile, depth) = match g.profile {
             Profile::Parabolic { depth } => (ProfileKind::Parabolic, depth),
             Profile::Linear { depth } => (ProfileKind::Linear, depth),
@@ -79,7 +87,7 @@ impl Default for ContactConfig {
             length_m: g.length,
             width_m: g.width,
             mass_kg: c.mass,
-            load_n: DEFAULT_LOAD_N,
+            load_n,
             profile,
             profile_depth_m: depth,
             boundary_friction: c.boundary_friction,
@@ -388,7 +396,13 @@ pub struct ReferenceConfig {
 
 impl Default for ReferenceConfig {
     fn default() -> Self {
-        let r = ReferenceSettings::default();
+        ReferenceSettings::default().into()
+    }
+}
+
+/// The core's settings as the configuration writes them (its defaults).
+impl From<ReferenceSettings> for ReferenceConfig {
+    fn from(r: ReferenceSettings) -> Self {
         Self {
             fluid_relaxation: r.fluid_relaxation,
             fluid_relaxation_min: r.fluid_relaxation_min,
@@ -398,5 +412,73 @@ impl Default for ReferenceConfig {
             max_motion_iterations: r.max_motion_iterations,
             motion_tolerance: r.motion_tolerance,
         }
+    }
+}
+
+/// The configuration's section as the core's settings (the pair is
+/// tested: a round trip of distinct values returns every field to its
+/// place).
+impl From<&ReferenceConfig> for ReferenceSettings {
+    fn from(r: &ReferenceConfig) -> Self {
+        Self {
+            fluid_relaxation: r.fluid_relaxation,
+            fluid_relaxation_min: r.fluid_relaxation_min,
+            max_fluid_iterations: r.max_fluid_iterations,
+            fluid_tolerance: r.fluid_tolerance,
+            motion_relaxation: r.motion_relaxation,
+            max_motion_iterations: r.max_motion_iterations,
+            motion_tolerance: r.motion_tolerance,
+        }
+    }
+}
+
+#[cfg(test)]
+mod mirror_tests {
+    use super::*;
+
+    #[test]
+    fn the_reference_section_and_the_cores_reference_settings_map_field_to_field() {
+        let c = ReferenceConfig {
+            fluid_relaxation: 0.1,
+            fluid_relaxation_min: 0.2,
+            max_fluid_iterations: 3,
+            fluid_tolerance: 0.4,
+            motion_relaxation: 0.5,
+            max_motion_iterations: 6,
+            motion_tolerance: 0.7,
+        };
+        let core = ReferenceSettings::from(&c);
+        assert_eq!(ReferenceConfig::from(core), c);
+        assert_eq!(
+            ReferenceSettings::from(&ReferenceConfig::default()),
+            ReferenceSettings::default()
+        );
+    }
+
+    #[test]
+    fn the_contact_section_and_the_cores_geometry_and_contact_map_key_to_key() {
+        let c = ContactConfig {
+            length_m: 0.011,
+            width_m: 0.012,
+            mass_kg: 0.013,
+            load_n: 14.0,
+            profile: ProfileKind::Linear,
+            profile_depth_m: 1.5e-5,
+            boundary_friction: 0.16,
+            boundary_friction_rate: 0.017,
+            boundary_activation_speed_m_s: 0.018,
+            sign_regularization_m_s: 1.9e-4,
+            min_film_m: 2.0e-9,
+            presliding_stiffness_n_m: 2.1e6,
+            presliding_damping_n_s_m: 22.0,
+            width_load_exponent: 0.23,
+            width_reference_load_n: 24.0,
+        };
+        let config = crate::config::Config {
+            contact: c.clone(),
+            ..Default::default()
+        };
+        let m = config.model();
+        assert_eq!(ContactConfig::of_core(&m.geometry, &m.contact, c.load_n), c);
     }
 }
