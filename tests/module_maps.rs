@@ -91,7 +91,8 @@ fn raw_rows(text: &str) -> BTreeSet<String> {
 }
 
 /// The modules named in the doc comment's table rows, by the first cell:
-/// a file (`` `x.rs` ``), a folder (`` `x/` ``) or a link (``[`x`]``).
+/// a file (`` `x.rs` ``), a folder (`` `x/` ``) or a link (``[`x`]``,
+/// ``[`mod@x`]``).
 fn listed(text: &str) -> BTreeSet<String> {
     let mut out = BTreeSet::new();
     for line in text.lines() {
@@ -106,6 +107,8 @@ fn listed(text: &str) -> BTreeSet<String> {
             .trim_start_matches('[')
             .trim_end_matches(']')
             .trim_matches('`');
+        // A link disambiguated for rustdoc (`mod@bench`: a module and a macro).
+        let name = name.strip_prefix("mod@").unwrap_or(name);
         let name = name
             .strip_suffix(".rs")
             .or_else(|| name.strip_suffix('/'))
@@ -236,4 +239,91 @@ fn the_calibration_reads_top_down_every_file_using_only_files_below_it() {
     }
     assert!(edges > 40, "{edges} uses found: the scan reads nothing");
     assert!(up.is_empty(), "{}", up.join("\n"));
+}
+
+/// The fields of `pub struct NAME { ... }` in `text`.
+fn struct_fields(text: &str, name: &str) -> Vec<String> {
+    let start = text
+        .find(&format!("pub struct {name} {{"))
+        .unwrap_or_else(|| panic!("no struct {name}"));
+    let body = &text[start..];
+    let body = &body[..body.find("\n}\n").expect("the struct ends")];
+    body.lines()
+        .skip(1)
+        .filter_map(|l| {
+            let l = l.strip_prefix("    ")?;
+            if l.starts_with(' ') || l.starts_with("//") || l.starts_with('#') {
+                return None;
+            }
+            let l = l
+                .trim_start_matches("pub(crate) ")
+                .trim_start_matches("pub ");
+            let (name, _) = l.split_once(':')?;
+            name.chars()
+                .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_')
+                .then(|| name.to_string())
+        })
+        .collect()
+}
+
+/// Whether `text` names `self.FIELD` (the field, not a longer name).
+fn uses_field(text: &str, field: &str) -> bool {
+    let pat = format!("self.{field}");
+    text.match_indices(&pat).any(|(i, _)| {
+        text[i + pat.len()..]
+            .chars()
+            .next()
+            .is_none_or(|c| !(c.is_ascii_alphanumeric() || c == '_'))
+    })
+}
+
+/// The files that hold part of `Solver`'s or `Loop`'s methods are headed by
+/// the fields they use, and the header stays true: it lists exactly the
+/// struct's fields the file's code names (`self.field`).
+#[test]
+fn each_file_of_the_solvers_and_the_loops_methods_is_headed_by_the_fields_it_uses() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    for (defn, name, dir) in [
+        ("src/physics/solver/mod.rs", "Solver", "src/physics/solver"),
+        ("src/node/mod.rs", "Loop", "src/node"),
+    ] {
+        let fields = struct_fields(&std::fs::read_to_string(root.join(defn)).unwrap(), name);
+        assert!(fields.len() > 10, "{name}: {fields:?}");
+        let mut headed = 0;
+        for e in std::fs::read_dir(root.join(dir)).unwrap() {
+            let p = e.unwrap().path();
+            if p.file_name().is_some_and(|n| n == "mod.rs")
+                || p.extension().is_none_or(|x| x != "rs")
+            {
+                continue;
+            }
+            let text = std::fs::read_to_string(&p).unwrap();
+            if !text.contains(&format!("impl {name} {{")) {
+                continue;
+            }
+            headed += 1;
+            let marker = format!("//! `{name}`'s fields this file uses: ");
+            let line = text
+                .lines()
+                .find_map(|l| l.strip_prefix(marker.as_str()))
+                .unwrap_or_else(|| panic!("{}: no line `{marker}…`", p.display()));
+            let listed: BTreeSet<String> = line
+                .trim_end_matches('.')
+                .split(", ")
+                .map(|f| f.trim_matches('`').to_string())
+                .collect();
+            let code: String = text
+                .lines()
+                .filter(|l| !l.trim_start().starts_with("//"))
+                .collect::<Vec<_>>()
+                .join("\n");
+            let used: BTreeSet<String> = fields
+                .iter()
+                .filter(|f| uses_field(&code, f))
+                .cloned()
+                .collect();
+            assert_eq!(listed, used, "{}: the header's fields", p.display());
+        }
+        assert!(headed >= 4, "{name}: {headed} files");
+    }
 }

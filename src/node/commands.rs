@@ -7,6 +7,8 @@
 //! Load and temperature commands apply to every contact (one load topic,
 //! one oil sump); each contact's viscosity follows the temperature by its
 //! own lubricant's law.
+//!
+//! `Loop`'s fields this file uses: `contacts`, `cmd`, `watches`, `settings`, `ports`, `live`, `temperature_c`, `viscosity`, `summary`.
 
 use super::Loop;
 use crate::config::TimeoutBehaviour;

@@ -1,6 +1,8 @@
 //! Lockstep mode: one step per velocity command, stamped with the
 //! command's stamp; and [`Loop::feed`], the same path driven directly
 //! (replay).
+//!
+//! `Loop`'s fields this file uses: `cmd`, `settings`, `ports`, `live`, `clock`, `last_stamp`, `summary`, `started_ns`.
 
 use super::Loop;
 use crate::msgs::{Command, CommandKind};

@@ -1,5 +1,7 @@
 //! One model step and its outputs: the estimate to every port and the
 //! recorder, the film profile, the loop statistics.
+//!
+//! `Loop`'s fields this file uses: `contacts`, `cmd`, `watches`, `flags`, `velocities`, `loads`, `efforts`, `by_joint`, `settings`, `ports`, `record`, `film_profile`, `live`, `clock`, `stamps`, `temperature_c`, `summary`, `window_compute`, `window_jitter`, `hist_compute`, `hist_jitter`.
 
 use super::Loop;
 use crate::config::StepMode;

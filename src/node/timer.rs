@@ -1,5 +1,7 @@
 //! Timer mode: one step per period against absolute deadlines, catching up
 //! the steps of a late wake-up so that model time stays wall time.
+//!
+//! `Loop`'s fields this file uses: `settings`, `live`, `clock`, `stamps`, `summary`, `started_ns`, `first_step`.
 
 use super::Loop;
 use std::sync::atomic::{AtomicBool, Ordering};

@@ -6,6 +6,8 @@
 //! nanoseconds from any monotonic source. Each part runs `reps` times back
 //! to back on the same inputs, so the figures are warm-cache costs; their
 //! sum is close to a one-iteration step.
+//!
+//! `Solver`'s fields this file uses: `d`, `settings`, `hist_len`.
 
 use super::assembly::{balance_row, face_pass, row_pass};
 use super::bordered::{direction_with_old_factors, factor_solve};

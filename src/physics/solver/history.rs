@@ -1,5 +1,7 @@
 //! Starting states and the stored time levels (BDF2 and the θ scheme use
 //! two past levels).
+//!
+//! `Solver`'s fields this file uses: `d`, `p`, `h0`, `velocity`, `hist`, `hist_len`, `w`, `predictor`, `last`.
 
 use super::Solver;
 use crate::physics::error::SetupError;

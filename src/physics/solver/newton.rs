@@ -57,6 +57,8 @@
 //! | β | steepness of the EOS transition | 1/Pa |
 //! | U, K | mapped variable, its vapour weight | Pa |
 //! | λ | step length of the line search | – |
+//!
+//! `Solver`'s fields this file uses: `d`, `settings`, `p`, `h0`, `velocity`, `hist`, `hist_save`, `last_load`, `w`, `predictor`, `contraction`.
 
 use super::assembly::assemble;
 use super::bordered::{direction_with_old_factors, factor_solve};

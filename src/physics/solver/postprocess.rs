@@ -1,5 +1,7 @@
 //! From a solved state to an [`Estimate`]: forces, friction, COF, inertia,
 //! diagnostics; and, when the step advances time, the new history level.
+//!
+//! `Solver`'s fields this file uses: `d`, `terms`, `settings`, `p`, `h0`, `time`, `hist`, `hist_len`, `w`, `bristle`, `width_scale`.
 
 use super::assembly::assemble;
 use super::lanes::{lane_max, lane_sum};

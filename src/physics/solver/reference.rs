@@ -22,6 +22,8 @@
 //! cells), as in the paper; the storage term uses the same θ/BDF2
 //! coefficients as the Newton solver. It is kept as a cross-check and as the
 //! benchmark baseline; it is slow by construction.
+//!
+//! `Solver`'s fields this file uses: `d`, `settings`, `p`, `h0`, `hist`, `w`.
 
 use super::{Ctx, H0Mode, Outcome, Solver};
 use crate::physics::estimate::Status;

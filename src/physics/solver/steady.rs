@@ -1,6 +1,8 @@
 //! Steady states (Stribeck points): the time derivatives dropped, warm
 //! starts from the current state and continuation in velocity and load from
 //! the last converged steady state when a direct solve fails.
+//!
+//! `Solver`'s fields this file uses: `d`, `p`, `h0`, `velocity`, `w`, `anchor`, `last`.
 
 use super::{Ctx, H0Mode, Outcome, Solver};
 use crate::physics::estimate::{Estimate, Status};

@@ -29,6 +29,8 @@
 //! | p_n | the cell's pressure at the last step | Pa |
 //! | p_s | saturation pressure (α = α_s) | Pa |
 //! | β | steepness of the EOS transition (`eos.rs`) | 1/Pa |
+//!
+//! `Solver`'s fields this file uses: `d`, `settings`, `p`, `h0`, `time`, `velocity`, `hist`, `last_load`, `hist_len`, `w`, `predictor`, `last`, `width_scale`, `isa`.
 
 use super::newton::MAX_SUBSTEPS;
 use super::{Ctx, H0Mode, Isa, Outcome, Solver};
