@@ -91,26 +91,25 @@ typedef struct FnModel FnModel;
 typedef struct FnEstimate {
   // Model time at the end of the step, s.
   double time_s;
-  // Sliding velocity of the step, m/s.
+  // sliding velocity of the step
   double velocity_m_s;
-  // Normal load of the step, N.
+  // normal load of the step
   double load_n;
-  // Total friction (contact and drivetrain), signed like the velocity:
-  // add it to the command, N.
+  // total friction: the contact plus the drivetrain terms, signed like the velocity
   double friction_force_n;
-  // The lubricated contact alone, N.
+  // the lubricated contact alone, signed like the velocity
   double contact_friction_force_n;
   // contact friction per unit load: rigid (|F_visc| + (mu_bl + mu_r asinh(|v|/v_a)) F_asp) / F_ext; with pre-sliding |F_c| / F_ext; drivetrain terms excluded
   double cof;
-  // Minimum nominal separation, m.
+  // minimum nominal separation
   double h0_m;
-  // Minimum film thickness, m.
+  // minimum film thickness
   double h_min_m;
-  // Fluid load, N.
+  // B * integral of (p - p_amb)
   double hydrodynamic_force_n;
-  // Greenwood–Williamson contact force, N.
+  // Greenwood-Williamson contact force
   double asperity_force_n;
-  // asperity_force_n / load_n.
+  // asperity_force_n / load_n
   double asperity_load_share;
   // Newton's last residual (scaled).
   double residual;

@@ -78,26 +78,25 @@ pub const FN_REGIME_HYDRODYNAMIC: u8 = 2;
 pub struct FnEstimate {
     /// Model time at the end of the step, s.
     pub time_s: f64,
-    /// Sliding velocity of the step, m/s.
+    /// sliding velocity of the step
     pub velocity_m_s: f64,
-    /// Normal load of the step, N.
+    /// normal load of the step
     pub load_n: f64,
-    /// Total friction (contact and drivetrain), signed like the velocity:
-    /// add it to the command, N.
+    /// total friction: the contact plus the drivetrain terms, signed like the velocity
     pub friction_force_n: f64,
-    /// The lubricated contact alone, N.
+    /// the lubricated contact alone, signed like the velocity
     pub contact_friction_force_n: f64,
     /// contact friction per unit load: rigid (|F_visc| + (mu_bl + mu_r asinh(|v|/v_a)) F_asp) / F_ext; with pre-sliding |F_c| / F_ext; drivetrain terms excluded
     pub cof: f64,
-    /// Minimum nominal separation, m.
+    /// minimum nominal separation
     pub h0_m: f64,
-    /// Minimum film thickness, m.
+    /// minimum film thickness
     pub h_min_m: f64,
-    /// Fluid load, N.
+    /// B * integral of (p - p_amb)
     pub hydrodynamic_force_n: f64,
-    /// Greenwood–Williamson contact force, N.
+    /// Greenwood-Williamson contact force
     pub asperity_force_n: f64,
-    /// asperity_force_n / load_n.
+    /// asperity_force_n / load_n
     pub asperity_load_share: f64,
     /// Newton's last residual (scaled).
     pub residual: f64,

@@ -195,42 +195,41 @@ pub mod estimate_constants {
 pub struct FrictionEstimate {
     /// Stamp: the step's deadline in wall time (timer mode) or the command's stamp (lockstep).
     pub header: Header,
-    /// Sliding velocity of the step (m/s).
+    /// sliding velocity of the step
     pub velocity_m_s: f64,
-    /// Normal load of the step (N).
+    /// normal load of the step
     pub load_n: f64,
-    /// Lubricant temperature of the step (the reference temperature when none is measured).
+    /// lubricant temperature of the step (the reference temperature when none is measured)
     pub temperature_c: f64,
-    /// Total friction: the contact plus the drivetrain terms, signed like the velocity (N).
+    /// total friction: the contact plus the drivetrain terms, signed like the velocity
     pub friction_force_n: f64,
-    /// The lubricated contact alone, signed like the velocity (N).
+    /// the lubricated contact alone, signed like the velocity
     pub contact_friction_force_n: f64,
     /// contact friction per unit load: rigid (|F_visc| + (mu_bl + mu_r asinh(|v|/v_a)) F_asp) / F_ext; with pre-sliding |F_c| / F_ext; drivetrain terms excluded
     pub cof: f64,
-    /// Minimum nominal separation (m).
+    /// minimum nominal separation
     pub h0_m: f64,
-    /// Minimum film thickness (m).
+    /// minimum film thickness
     pub h_min_m: f64,
-    /// B * integral of (p - p_amb), N.
+    /// B * integral of (p - p_amb)
     pub hydrodynamic_force_n: f64,
-    /// Greenwood-Williamson contact force (N).
+    /// Greenwood-Williamson contact force
     pub asperity_force_n: f64,
-    /// asperity_force_n / load_n.
+    /// asperity_force_n / load_n
     pub asperity_load_share: f64,
-    /// REGIME_*.
+    /// REGIME_*
     pub regime: u8,
-    /// STATUS_*: the solver's outcome.
+    /// STATUS_*: the solver's outcome
     pub status: u8,
-    /// COMMAND_*: the command's state.
+    /// COMMAND_*: the command's state
     pub command_status: u8,
-    /// RANGE_*: where the step's input lies against the calibrated range.
+    /// RANGE_*: where the step's input lies against the calibrated range
     pub calibrated_range: u8,
-    /// Newton iterations of the step.
+    /// Newton iterations of the step
     pub iterations: u32,
-    /// Wall time of the model step (ns).
+    /// wall time of the model step
     pub compute_time_ns: u64,
-    /// How long after its deadline the step started (timer mode; catch-up steps are late by
-    /// design).
+    /// how long after its deadline the step started (timer mode; catch-up steps are late by design)
     pub late_ns: u64,
 }
 

@@ -1,0 +1,158 @@
+//! One definition of the estimate: `msg/msg/FrictionEstimate.msg` (the wire
+//! layout's source of truth) names every field and says what it is, once.
+//! Every other shape is held to it, field by field and doc by doc:
+//!
+//! - the loop's record (`EstimateRecord`), the ROS 2 wire struct and the
+//!   iceoryx2 payload carry exactly the message's fields (the header as its
+//!   stamp, `stamp_ns`), each documented with the message's comment;
+//! - the offline shapes, the C API's `FnEstimate` and Python's `Estimate`,
+//!   document the physical fields they share with it (velocity, load,
+//!   forces, COF, film) with the message's comment; their own fields
+//!   (model time, residual, sub-steps) and their code lists (`FN_STATUS_*`,
+//!   strings in Python) are theirs.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+fn read(path: &str) -> String {
+    std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(path)).unwrap()
+}
+
+/// The message's fields in order, each with its trailing comment.
+fn message() -> Vec<(String, String)> {
+    read("msg/msg/FrictionEstimate.msg")
+        .lines()
+        .filter_map(|l| {
+            let (decl, comment) = l.split_once('#')?;
+            let mut words = decl.split_whitespace();
+            let (_, name) = (words.next()?, words.next()?);
+            (!name.contains('=')).then(|| (name.to_string(), comment.trim().to_string()))
+        })
+        .collect()
+}
+
+/// The fields of `pub struct NAME` in `path`, in order, each with its doc
+/// comment (the `///` lines above it, attributes skipped, joined by spaces).
+fn shape(path: &str, name: &str) -> Vec<(String, String)> {
+    let text = read(path);
+    let lines: Vec<&str> = text.lines().collect();
+    let start = lines
+        .iter()
+        .position(|l| {
+            l.strip_prefix("pub struct ").is_some_and(|r| {
+                r.starts_with(name)
+                    && !r[name.len()..].starts_with(|c: char| c.is_alphanumeric() || c == '_')
+            })
+        })
+        .unwrap_or_else(|| panic!("{path}: no struct {name}"));
+    let mut out = Vec::new();
+    for (i, l) in lines.iter().enumerate().skip(start + 1) {
+        if *l == "}" {
+            break;
+        }
+        let Some(field) = l.strip_prefix("    pub ").and_then(|r| r.split_once(':')) else {
+            continue;
+        };
+        let mut j = i;
+        while lines[j - 1].trim_start().starts_with("#[") {
+            j -= 1;
+        }
+        let mut doc = Vec::new();
+        while let Some(d) = lines[j - 1].trim_start().strip_prefix("///") {
+            doc.insert(0, d.trim().to_string());
+            j -= 1;
+        }
+        out.push((field.0.to_string(), doc.join(" ")));
+    }
+    out
+}
+
+#[test]
+fn the_record_the_wire_struct_and_the_payload_carry_exactly_the_messages_fields_with_its_docs() {
+    let msg = message();
+    assert!(msg.len() >= 19, "{msg:?}");
+    let expected: BTreeMap<String, String> = msg
+        .iter()
+        .map(|(n, d)| {
+            if n == "header" {
+                ("stamp_ns".to_string(), String::new())
+            } else {
+                (n.clone(), d.clone())
+            }
+        })
+        .collect();
+    for (path, name) in [
+        ("src/msgs/records.rs", "EstimateRecord"),
+        ("src/msgs/wire.rs", "FrictionEstimate"),
+        ("src/transport/iceoryx/payloads.rs", "EstimatePayload"),
+    ] {
+        let fields = shape(path, name);
+        let names: Vec<&str> = fields
+            .iter()
+            .map(|(n, _)| {
+                if n == "header" {
+                    "stamp_ns"
+                } else {
+                    n.as_str()
+                }
+            })
+            .collect();
+        let mut sorted = names.clone();
+        sorted.sort_unstable();
+        assert_eq!(
+            sorted,
+            expected.keys().map(String::as_str).collect::<Vec<_>>(),
+            "{path}: {name}'s fields are not the message's"
+        );
+        for (field, doc) in &fields {
+            if field == "header" || field == "stamp_ns" {
+                continue;
+            }
+            assert_eq!(
+                doc, &expected[field],
+                "{path}: {name}.{field}'s doc is not the message's comment"
+            );
+        }
+    }
+}
+
+#[test]
+fn the_c_api_and_python_document_the_physical_fields_they_share_with_the_message_as_it_does() {
+    let msg: BTreeMap<String, String> = message().into_iter().collect();
+    let physical = [
+        "velocity_m_s",
+        "load_n",
+        "friction_force_n",
+        "contact_friction_force_n",
+        "cof",
+        "h0_m",
+        "h_min_m",
+        "hydrodynamic_force_n",
+        "asperity_force_n",
+        "asperity_load_share",
+    ];
+    for (path, name) in [
+        ("capi/src/codes.rs", "FnEstimate"),
+        ("python/src/model.rs", "Estimate"),
+    ] {
+        let fields: BTreeMap<String, String> = shape(path, name).into_iter().collect();
+        for f in physical {
+            let doc = fields
+                .get(f)
+                .unwrap_or_else(|| panic!("{path}: {name} lacks {f}"));
+            assert_eq!(
+                doc, &msg[f],
+                "{path}: {name}.{f}'s doc is not the message's comment"
+            );
+        }
+    }
+    // The C header is generated from capi/src (tests/header.rs there): it
+    // carries the same words.
+    let header = read("capi/include/friction_node.h");
+    for f in physical {
+        assert!(
+            header.contains(&format!("// {}\n", msg[f])),
+            "friction_node.h: {f}'s comment is not the message's"
+        );
+    }
+}
