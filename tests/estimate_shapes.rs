@@ -156,3 +156,41 @@ fn the_c_api_and_python_document_the_physical_fields_they_share_with_the_message
         );
     }
 }
+
+/// The fields of a `.msg` file in order, each with its trailing comment
+/// (empty when it has none).
+fn message_of(path: &str) -> Vec<(String, String)> {
+    read(path)
+        .lines()
+        .filter(|l| !l.trim_start().starts_with('#') && !l.trim().is_empty())
+        .filter_map(|l| {
+            let (decl, comment) = l.split_once('#').unwrap_or((l, ""));
+            let mut words = decl.split_whitespace();
+            let (_, name) = (words.next()?, words.next()?);
+            (!name.contains('=')).then(|| (name.to_string(), comment.trim().to_string()))
+        })
+        .collect()
+}
+
+/// The loop's statistics on the wire mirror `LoopStatistics.msg`: its
+/// fields in its order, each commented field documented with its comment.
+/// (The record groups them and the iceoryx2 payload packs them in fixed
+/// arrays; both convert through the wire struct's tests.)
+#[test]
+fn the_wire_statistics_carry_the_messages_fields_in_order_with_its_docs() {
+    let msg = message_of("msg/msg/LoopStatistics.msg");
+    assert!(msg.len() >= 30, "{msg:?}");
+    let wire = shape("src/msgs/wire.rs", "LoopStatistics");
+    assert_eq!(
+        wire.iter().map(|(n, _)| n.as_str()).collect::<Vec<_>>(),
+        msg.iter().map(|(n, _)| n.as_str()).collect::<Vec<_>>()
+    );
+    for ((field, doc), (_, comment)) in wire.iter().zip(&msg) {
+        if !comment.is_empty() && field != "header" {
+            assert_eq!(
+                doc, comment,
+                "LoopStatistics.{field}'s doc is not the message's comment"
+            );
+        }
+    }
+}

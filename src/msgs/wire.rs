@@ -285,84 +285,81 @@ pub struct FilmProfile {
 pub struct LoopStatistics {
     /// Stamp: the step's deadline in wall time (timer mode) or the command's stamp (lockstep).
     pub header: Header,
-    /// Model steps taken.
+    /// model steps taken
     pub steps: u64,
-    /// Steps that finished after the next deadline (timer mode).
+    /// steps that finished after the next deadline (timer mode)
     pub deadline_misses: u64,
-    /// Steps taken late, after their deadline had passed, to keep model time = wall time.
+    /// steps taken late, after their deadline had passed, to keep model time = wall time
     pub catch_up_steps: u64,
-    /// Lost time beyond node.max_catch_up_s, advanced in one variable-length step.
+    /// lost time beyond node.max_catch_up_s, advanced in one variable-length step
     pub time_jumps: u64,
-    /// Steps of the wall clock (NTP) seen; stamps stay monotonic.
+    /// steps of the wall clock (NTP) seen; stamps stay monotonic
     pub clock_jumps: u64,
-    /// Commands the transports delivered.
+    /// commands the transports delivered
     pub commands_received: u64,
-    /// Accepted as the current set point.
+    /// accepted as the current set point
     pub commands_applied: u64,
-    /// Discarded by a full receive queue before the loop saw them.
+    /// discarded by a full receive queue before the loop saw them
     pub commands_overwritten: u64,
-    /// Non-finite, beyond limits, or out-of-order stamps (lockstep).
+    /// non-finite, beyond limits, or out-of-order stamps (lockstep)
     pub commands_rejected: u64,
-    /// Steps taken with a timed-out command.
+    /// steps taken with a timed-out command
     pub command_timeouts: u64,
-    /// Outputs the loop could not hand to a transport (queue full).
+    /// outputs the loop could not hand to a transport (queue full)
     pub publish_drops: u64,
-    /// Outputs a transport's I/O failed to send.
+    /// outputs a transport's I/O failed to send
     pub publish_failures: u64,
-    /// LoopStatistics that could not be handed over or sent.
+    /// LoopStatistics that could not be handed over or sent
     pub statistics_not_sent: u64,
-    /// Outputs dropped because the recorder queue was full.
+    /// outputs dropped because the recorder queue was full
     pub recorder_drops: u64,
-    /// Recording files started (split recordings: one per split).
+    /// recording files started (split recordings: one per split)
     pub recording_files: u64,
-    /// Split files deleted to keep to recording.budget_bytes.
+    /// split files deleted to keep to recording.budget_bytes
     pub recording_files_deleted: u64,
-    /// Messages not recorded because writing had failed (a full disk).
+    /// messages not recorded because writing had failed (a full disk)
     pub recording_lost: u64,
-    /// Snapshot files written.
+    /// snapshot files written
     pub snapshots: u64,
-    /// The latest snapshot file ("" before the first).
+    /// the latest snapshot file ("" before the first)
     pub last_snapshot: String,
-    /// The time span it holds (s).
+    /// the time span it holds
     pub last_snapshot_span_s: f64,
-    /// Model step wall time (ns).
+    /// model step wall time
     pub compute_time_p50_ns: u64,
     /// Model step wall time, p99 (ns).
     pub compute_time_p99_ns: u64,
     /// Model step wall time, max (ns).
     pub compute_time_max_ns: u64,
-    /// Lateness of the step start against its deadline (timer mode).
+    /// lateness of the step start against its deadline (timer mode)
     pub period_jitter_p50_ns: u64,
     /// Lateness of the step start, p99 (ns).
     pub period_jitter_p99_ns: u64,
     /// Lateness of the step start, max (ns).
     pub period_jitter_max_ns: u64,
-    /// Steps whose solver status was not converged (iteration bound, non-finite, rejected input).
+    /// steps whose solver status was not converged (iteration bound, non-finite, rejected input)
     pub steps_not_converged: u64,
-    /// Parameter changes applied while running (ros2 param set).
+    /// parameter changes applied while running (ros2 param set)
     pub parameter_updates: u64,
-    /// Contacts the loop steps (1 without `contacts`).
+    /// contacts the loop steps (1 without `contacts`)
     pub contacts: u32,
-    /// Index (configured order) of the contact whose step took longest since the previous
-    /// LoopStatistics.
+    /// index (configured order) of the contact whose step took longest since the previous LoopStatistics
     pub slowest_contact: u32,
-    /// That contact's longest step compute time since the previous LoopStatistics (ns).
+    /// that contact's longest step compute time since the previous LoopStatistics
     pub slowest_contact_compute_ns: u64,
-    /// Contact steps whose input lay outside the contact's calibrated range (FrictionEstimate
-    /// RANGE_OUTSIDE).
+    /// contact steps whose input lay outside the contact's calibrated range (FrictionEstimate RANGE_OUTSIDE)
     pub steps_outside_calibrated_range: u64,
-    /// The latest input outside a calibrated range since the previous LoopStatistics: speed
-    /// forward, speed backward, load or temperature ("" none).
+    /// the latest input outside a calibrated range since the previous LoopStatistics: speed forward, speed backward, load or temperature ("" none)
     pub outside_input: String,
-    /// Its contact (configured order).
+    /// its contact (configured order)
     pub outside_contact: u32,
-    /// Its value, in its range's units (a joint's speed: the joint's).
+    /// its value, in its range's units (a joint's speed: the joint's)
     pub outside_value: f64,
-    /// The calibrated range it left.
+    /// the calibrated range it left
     pub outside_min: f64,
     /// See `outside_min`.
     pub outside_max: f64,
-    /// Their unit: m/s, rad/s (a rotary joint's speed), N or degC.
+    /// their unit: m/s, rad/s (a rotary joint's speed: the joint's), N or °C
     pub outside_unit: String,
 }
 
