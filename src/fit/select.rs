@@ -132,6 +132,19 @@ fn pays(from: &Tried, to: &Tried) -> (bool, f64, f64, f64) {
     )
 }
 
+/// Keep the first of the sets with the same terms: a set come back to (by
+/// removal or a flag) is listed once.
+fn listed_once(tried: &mut Vec<Tried>) {
+    let mut seen: Vec<Vec<&'static str>> = Vec::new();
+    tried.retain(|t| {
+        let mut key = t.terms.clone();
+        key.sort_unstable();
+        let new = !seen.contains(&key);
+        seen.push(key);
+        new
+    });
+}
+
 /// Choose the terms (see the module's rule). `given` are the specs of the
 /// names after `auto`; `say` receives a line per set tried.
 pub fn select(
@@ -206,15 +219,7 @@ pub fn select(
     // A term that ends at zero or at a bound, or that the data cannot tell
     // from another, is dropped and the set fitted again.
     let current = ctx.drop_flagged(current, &mut tried, &mut removed, say)?;
-    // A set come back to (by removal or a flag) is listed once.
-    let mut seen: Vec<Vec<&'static str>> = Vec::new();
-    tried.retain(|t| {
-        let mut key = t.terms.clone();
-        key.sort_unstable();
-        let new = !seen.contains(&key);
-        seen.push(key);
-        new
-    });
+    listed_once(&mut tried);
     let keys = set_keys(&current.tried.terms)
         .into_iter()
         .map(String::from)
@@ -499,6 +504,20 @@ mod tests {
             simplest_that_predicts_as_well(step).tried.terms,
             ["drivetrain Stribeck"]
         );
+    }
+
+    #[test]
+    fn a_set_come_back_to_in_another_order_is_listed_once_as_first_tried() {
+        let mut tried = vec![
+            scored(&["a"], &[1.0]).tried,
+            scored(&["a", "b"], &[2.0]).tried,
+            scored(&["b", "a"], &[3.0]).tried,
+            scored(&["b"], &[4.0]).tried,
+        ];
+        listed_once(&mut tried);
+        let sets: Vec<Vec<&str>> = tried.iter().map(|t| t.terms.clone()).collect();
+        assert_eq!(sets, [vec!["a"], vec!["a", "b"], vec!["b"]]);
+        assert_eq!(tried[1].fold_mse, [2.0]);
     }
 
     #[test]
