@@ -78,20 +78,20 @@ fn steps_with_every_real_drive_term_on_allocate_nothing_through_reversals() {
     // Pre-sliding, a soft width, a rate-sensitive boundary film and the
     // drivetrain's losses, all on.
     let mut m = ModelParams::default();
-    m.contact.presliding = Presliding {
+    m.terms.presliding = Presliding {
         stiffness: 1e8,
         damping: 50.0,
     };
-    m.contact.width_law = WidthLaw {
+    m.terms.soft_width = WidthLaw {
         exponent: 0.5,
         reference_load: 20_762.0,
     };
-    m.contact.boundary_rate = BoundaryRate {
+    m.terms.boundary_rate = BoundaryRate {
         sensitivity: 0.01,
         activation_speed: 1e-3,
     };
-    m.drivetrain.quadratic = 300.0;
-    m.drivetrain.coulomb_asymmetry = 40.0;
+    m.terms.drivetrain.quadratic = 300.0;
+    m.terms.drivetrain.coulomb_asymmetry = 40.0;
     let mut s = Solver::new(
         &m,
         &SolverSettings {
@@ -243,7 +243,7 @@ fn a_prepared_model_swaps_in_between_two_steps_without_allocating() {
     // Boundary friction halved, rougher surfaces, a thicker oil: built here,
     // off the "loop".
     let mut changed = model.clone();
-    changed.contact.boundary_friction = 0.15;
+    changed.terms.boundary_film.friction = 0.15;
     changed.roughness.sigma = 6e-6;
     changed.lubricant.viscosity = 0.08;
     let mut prepared = Solver::prepare_model(&changed, &settings).unwrap();

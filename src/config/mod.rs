@@ -162,33 +162,49 @@ impl Config {
                 flow_factors: self.roughness.flow_factors,
                 lay_gamma: self.roughness.lay_gamma,
             },
-            drivetrain: crate::physics::Drivetrain {
-                coulomb: self.drivetrain.coulomb_n,
-                viscous: self.drivetrain.viscous_n_s_m,
-                load_coefficient: self.drivetrain.load_coefficient,
-                quadratic: self.drivetrain.quadratic_n_s2_m2,
-                coulomb_asymmetry: self.drivetrain.coulomb_asymmetry_n,
-                stribeck: self.drivetrain.stribeck_n,
-                stribeck_speed: self.drivetrain.stribeck_speed_m_s,
-            },
             contact: Contact {
                 mass: c.mass_kg,
-                boundary_friction: c.boundary_friction,
-                boundary_rate: crate::physics::BoundaryRate {
-                    sensitivity: c.boundary_friction_rate,
-                    activation_speed: c.boundary_activation_speed_m_s,
-                },
-                sign_regularization: c.sign_regularization_m_s,
                 min_film: c.min_film_m,
-                presliding: crate::physics::Presliding {
-                    stiffness: c.presliding_stiffness_n_m,
-                    damping: c.presliding_damping_n_s_m,
-                },
-                width_law: crate::physics::WidthLaw {
-                    exponent: c.width_load_exponent,
-                    reference_load: c.width_reference_load_n,
-                },
             },
+            terms: self.terms(),
+        }
+    }
+
+    /// The contact's friction terms (the `contact` and `drivetrain`
+    /// sections' term keys).
+    // A test build's list has a test term without YAML: it takes its default.
+    #[allow(clippy::needless_update)]
+    fn terms(&self) -> crate::physics::FrictionTerms {
+        use crate::physics::terms::boundary_film::BoundaryFilm;
+        let c = &self.contact;
+        let d = &self.drivetrain;
+        crate::physics::FrictionTerms {
+            boundary_film: BoundaryFilm {
+                friction: c.boundary_friction,
+                sign_regularization: c.sign_regularization_m_s,
+            },
+            boundary_rate: crate::physics::BoundaryRate {
+                sensitivity: c.boundary_friction_rate,
+                activation_speed: c.boundary_activation_speed_m_s,
+            },
+            presliding: crate::physics::Presliding {
+                stiffness: c.presliding_stiffness_n_m,
+                damping: c.presliding_damping_n_s_m,
+            },
+            soft_width: crate::physics::WidthLaw {
+                exponent: c.width_load_exponent,
+                reference_load: c.width_reference_load_n,
+            },
+            drivetrain: crate::physics::Drivetrain {
+                coulomb: d.coulomb_n,
+                viscous: d.viscous_n_s_m,
+                load_coefficient: d.load_coefficient,
+                quadratic: d.quadratic_n_s2_m2,
+                coulomb_asymmetry: d.coulomb_asymmetry_n,
+                stribeck: d.stribeck_n,
+                stribeck_speed: d.stribeck_speed_m_s,
+            },
+            ..Default::default()
         }
     }
 

@@ -3,7 +3,8 @@
 //! core's `Default` impls (one source of truth); units are in the key names.
 
 use crate::physics::{
-    Contact, Geometry, Lubricant, Profile, ReferenceSettings, Roughness, SolverSettings, TimeScheme,
+    Contact, FrictionTerms, Geometry, Lubricant, Profile, ReferenceSettings, Roughness,
+    SolverSettings, TimeScheme,
 };
 use serde::{Deserialize, Serialize};
 
@@ -68,16 +69,22 @@ pub const DEFAULT_LOAD_N: f64 = 20_762.0;
 
 impl Default for ContactConfig {
     fn default() -> Self {
-        Self::of_core(&Geometry::default(), &Contact::default(), DEFAULT_LOAD_N)
+        Self::of_core(
+            &Geometry::default(),
+            &Contact::default(),
+            &FrictionTerms::default(),
+            DEFAULT_LOAD_N,
+        )
     }
 }
 
 impl ContactConfig {
-    /// The section as it writes a core geometry and contact at load
-    /// `load_n` (its defaults are the core's: one source of truth). The
-    /// other way is `Config::model`; the pair is tested (a round trip of
-    /// distinct values returns every key to its place).
-    pub fn of_core(g: &Geometry, c: &Contact, load_n: f64) -> Self {
+    /// The section as it writes a core geometry, contact and the contact's
+    /// friction terms at load `load_n` (its defaults are the core's: one
+    /// source of truth). The other way is `Config::model`; the pair is
+    /// tested (a round trip of distinct values returns every key to its
+    /// place).
+    pub fn of_core(g: &Geometry, c: &Contact, t: &FrictionTerms, load_n: f64) -> Self {
         let (profile, depth) = match g.profile {
             Profile::Parabolic { depth } => (ProfileKind::Parabolic, depth),
             Profile::Linear { depth } => (ProfileKind::Linear, depth),
@@ -90,15 +97,15 @@ impl ContactConfig {
             load_n,
             profile,
             profile_depth_m: depth,
-            boundary_friction: c.boundary_friction,
-            boundary_friction_rate: c.boundary_rate.sensitivity,
-            boundary_activation_speed_m_s: c.boundary_rate.activation_speed,
-            sign_regularization_m_s: c.sign_regularization,
+            boundary_friction: t.boundary_film.friction,
+            boundary_friction_rate: t.boundary_rate.sensitivity,
+            boundary_activation_speed_m_s: t.boundary_rate.activation_speed,
+            sign_regularization_m_s: t.boundary_film.sign_regularization,
             min_film_m: c.min_film,
-            presliding_stiffness_n_m: c.presliding.stiffness,
-            presliding_damping_n_s_m: c.presliding.damping,
-            width_load_exponent: c.width_law.exponent,
-            width_reference_load_n: c.width_law.reference_load,
+            presliding_stiffness_n_m: t.presliding.stiffness,
+            presliding_damping_n_s_m: t.presliding.damping,
+            width_load_exponent: t.soft_width.exponent,
+            width_reference_load_n: t.soft_width.reference_load,
         }
     }
 }
@@ -479,6 +486,9 @@ mod mirror_tests {
             ..Default::default()
         };
         let m = config.model();
-        assert_eq!(ContactConfig::of_core(&m.geometry, &m.contact, c.load_n), c);
+        assert_eq!(
+            ContactConfig::of_core(&m.geometry, &m.contact, &m.terms, c.load_n),
+            c
+        );
     }
 }

@@ -21,7 +21,7 @@
 use super::IntervalText;
 use super::{key_ranges, Config, ConfigError, KeyRange};
 use crate::msgs::ros_interfaces::{parameter_type as ty, ParameterValue};
-use crate::physics::terms::{catalogue, Interval};
+use crate::physics::terms::{configured_catalogue as catalogue, Interval};
 use serde_norway::Value;
 
 /// Whether `key` may change while the node runs.

@@ -128,7 +128,7 @@ impl Config {
     /// Every friction term's key against the range its term declares
     /// (`physics::terms`: the catalogue is the one list of them).
     pub(super) fn validate_terms(&self) -> Result<(), ConfigError> {
-        use crate::physics::terms::catalogue;
+        use crate::physics::terms::configured_catalogue as catalogue;
         let tree = serde_norway::to_value(self).expect("a configuration serializes");
         for k in catalogue() {
             let v = k

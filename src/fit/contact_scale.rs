@@ -442,7 +442,7 @@ mod tests {
 
     #[test]
     fn every_friction_term_key_with_a_force_or_a_speed_has_its_joint_equivalent() {
-        for k in crate::physics::terms::catalogue() {
+        for k in crate::physics::terms::configured_catalogue() {
             let dimensional = k.unit.contains('N') || k.unit.contains("m/s");
             // A load is the contact's normal load, not a force on the joint.
             let load = k.key.ends_with("_load_n");

@@ -33,7 +33,7 @@ use super::series::{mix, Series};
 use super::unknowns::{ConfigKeys, DataScale, FittedParameter, ParamSpec};
 use super::{FitError, PredictError};
 use crate::config::{Config, ViscosityLaw};
-use crate::physics::terms::{acts_after_the_film, BristleMove, FrictionTerms};
+use crate::physics::terms::{acts_after_the_film, BristleMove, FrictionTerms, TermStates};
 use crate::physics::{Estimate, Solver, Status, ViscosityModel};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
@@ -94,12 +94,13 @@ const TRACES_KEPT: usize = 16;
 /// at.
 fn film_fingerprint(config: &Config) -> u64 {
     let mut m = config.model();
-    let terms_off = crate::physics::ModelParams::default();
-    m.contact.boundary_friction = terms_off.contact.boundary_friction;
-    m.contact.sign_regularization = terms_off.contact.sign_regularization;
-    m.contact.boundary_rate = terms_off.contact.boundary_rate;
-    m.contact.presliding = terms_off.contact.presliding;
-    m.drivetrain = terms_off.drivetrain;
+    let off = FrictionTerms::default();
+    for k in crate::physics::terms::catalogue() {
+        if acts_after_the_film(k.key) {
+            let default = off.get(k.key).expect("a listed term has its keys");
+            m.terms.set(k.key, default);
+        }
+    }
     let text = format!(
         "{m:?} {:?} {:?} {}",
         config.solver_settings(),
@@ -145,10 +146,10 @@ impl FilmTrace {
 
     /// The friction at the series' samples with `terms` on this film.
     fn compose(&self, terms: &FrictionTerms, s: &Series) -> Vec<f64> {
-        let mut bristle = 0.0;
+        let mut states = TermStates::default();
         let mut friction = |st: &[f64; 4], how: BristleMove| {
             terms
-                .friction((st[0], st[1]), (st[2], st[3]), &mut bristle, how)
+                .friction((st[0], st[1]), (st[2], st[3]), &mut states, how)
                 .1
         };
         if self.steady {
@@ -213,7 +214,7 @@ impl PhysicsModel {
         let base = FilmBase {
             fingerprint: film_fingerprint(base),
             film_params,
-            terms: FrictionTerms::of(&base.model()),
+            terms: base.model().terms,
         };
         Ok(Self {
             names: params.iter().map(|p| p.name.clone()).collect(),
@@ -724,19 +725,18 @@ mod tests {
     }
 
     #[test]
-    fn every_key_that_acts_after_the_film_can_be_set_on_the_terms_as_the_configuration_sets_it() {
+    fn every_term_key_can_be_set_on_the_terms_as_the_configuration_sets_it() {
         let base = Config::default();
         let keys = ConfigKeys::new(&base);
-        for k in crate::physics::terms::catalogue() {
-            let mut t = FrictionTerms::of(&base.model());
+        for k in crate::physics::terms::configured_catalogue() {
+            let mut t = base.model().terms;
             let v = keys.value(k.key).unwrap();
             let moved = if v == 0.0 { 0.25 } else { v * 0.75 };
-            assert_eq!(t.set(k.key, moved), acts_after_the_film(k.key), "{}", k.key);
-            if acts_after_the_film(k.key) {
-                let c = keys.with(&[k.key.to_string()], &[moved]).unwrap();
-                assert_eq!(t, FrictionTerms::of(&c.model()), "{}", k.key);
-            }
+            assert!(t.set(k.key, moved), "{}", k.key);
+            let c = keys.with(&[k.key.to_string()], &[moved]).unwrap();
+            assert_eq!(t, c.model().terms, "{}", k.key);
         }
+        assert!(!base.model().terms.set("lubricant.viscosity_pa_s", 0.1));
     }
 
     #[test]
@@ -745,7 +745,7 @@ mod tests {
         config.contact.width_load_exponent = 0.5;
         let base = film_fingerprint(&config);
         let keys = ConfigKeys::new(&config);
-        for k in crate::physics::terms::catalogue() {
+        for k in crate::physics::terms::configured_catalogue() {
             let v = keys.value(k.key).unwrap();
             let moved = if v == 0.0 { 0.5 } else { v * 0.9 };
             let c = keys.with(&[k.key.to_string()], &[moved]).unwrap();

@@ -53,5 +53,5 @@ pub use terms::boundary_film::BoundaryRate;
 pub use terms::drivetrain::Drivetrain;
 pub use terms::presliding::Presliding;
 pub use terms::soft_width::WidthLaw;
-pub use terms::{sgn, FrictionTerms};
+pub use terms::{sgn, FrictionTerm, FrictionTerms, TermStates};
 pub use viscosity::{ViscosityModel, VogelModel};

@@ -21,12 +21,11 @@
 //! | β_a | `asperity_radius` | asperity tip radius | m |
 //! | E* | `effective_modulus` | effective elastic modulus | Pa |
 //! | m | `Contact::mass` | equivalent slider mass | kg |
-//! | μ_bl | `boundary_friction` | boundary friction coefficient | – |
-//! | μ_r, v_a | `boundary_rate` | the boundary friction's rate sensitivity and activation speed (0 = constant μ_bl; see [`super::terms::boundary_film`]) | –, m/s |
-//! | v_reg | `sign_regularization` | velocity scale of tanh(v/v_reg) | m/s |
-//! | h_floor | `min_film` | optional floor on h0 (0 = off) | m |
-//! | σ0, σ1 | `presliding` | pre-sliding stiffness and damping (0 = rigid; see [`super::terms::presliding`]) | N/m, N·s/m |
-//! | κ, F_ref | `width_law` | soft contact: width B(F) = B (F/F_ref)^κ (κ = 0: rigid) | –, N |
+//! | h_floor | `Contact::min_film` | optional floor on h0 (0 = off) | m |
+//!
+//! The friction terms (μ_bl, v_reg, μ_r, v_a, σ0, σ1, κ, F_ref and the
+//! drivetrain's) are [`ModelParams::terms`], each documented in its file
+//! of [`super::terms`].
 
 use super::error::SetupError;
 
@@ -159,35 +158,21 @@ impl Default for Roughness {
     }
 }
 
-/// Rigid-body and boundary-friction parameters.
+/// The slider's rigid-body parameters and the film's floor (its friction
+/// terms are [`ModelParams::terms`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Contact {
     /// m, slider mass, kg.
     pub mass: f64,
-    /// μ_bl, the boundary (asperity) friction coefficient.
-    pub boundary_friction: f64,
-    /// The boundary friction's dependence on speed (off by default).
-    pub boundary_rate: super::terms::boundary_film::BoundaryRate,
-    /// v_reg of the sign's tanh regularisation, m/s.
-    pub sign_regularization: f64,
     /// Floor on h0; 0 disables it (the default: with GW it should not bind).
     pub min_film: f64,
-    /// Pre-sliding compliance (off by default).
-    pub presliding: super::terms::presliding::Presliding,
-    /// How the contact's width follows the load (constant by default).
-    pub width_law: super::terms::soft_width::WidthLaw,
 }
 
 impl Default for Contact {
     fn default() -> Self {
         Self {
             mass: 1.0,
-            boundary_friction: 0.3,
-            boundary_rate: super::terms::boundary_film::BoundaryRate::default(),
-            sign_regularization: 1e-4,
             min_film: 0.0,
-            presliding: super::terms::presliding::Presliding::default(),
-            width_law: super::terms::soft_width::WidthLaw::default(),
         }
     }
 }
@@ -201,10 +186,12 @@ pub struct ModelParams {
     pub lubricant: Lubricant,
     /// The surfaces' roughness.
     pub roughness: Roughness,
-    /// Mass, boundary friction and the contact's other terms.
+    /// The slider's mass and the film's floor.
     pub contact: Contact,
-    /// Losses beside the contact (zero by default).
-    pub drivetrain: super::terms::drivetrain::Drivetrain,
+    /// The friction terms beside the film's shear: the boundary film and
+    /// its rate, pre-sliding, the soft width, the drivetrain (all off by
+    /// default but the boundary film; see [`super::terms`]).
+    pub terms: super::terms::FrictionTerms,
 }
 
 pub(super) fn positive(field: &'static str, value: f64) -> Result<(), SetupError> {
@@ -231,7 +218,7 @@ impl ModelParams {
         check_lubricant(&self.lubricant)?;
         check_roughness(&self.roughness)?;
         check_contact(&self.contact)?;
-        check_drivetrain(&self.drivetrain)?;
+        self.terms.check()?;
         Ok(())
     }
 }
@@ -307,50 +294,9 @@ fn check_roughness(r: &Roughness) -> Result<(), SetupError> {
     Ok(())
 }
 
-/// The contact's mass, film floor and friction terms.
+/// The contact's mass and film floor (its terms check themselves).
 fn check_contact(c: &Contact) -> Result<(), SetupError> {
     non_negative("contact.mass", c.mass)?;
-    non_negative("contact.boundary_friction", c.boundary_friction)?;
-    non_negative(
-        "contact.boundary_rate.sensitivity",
-        c.boundary_rate.sensitivity,
-    )?;
-    positive(
-        "contact.boundary_rate.activation_speed",
-        c.boundary_rate.activation_speed,
-    )?;
-    positive("contact.sign_regularization", c.sign_regularization)?;
     non_negative("contact.min_film", c.min_film)?;
-    non_negative("contact.presliding.stiffness", c.presliding.stiffness)?;
-    non_negative("contact.presliding.damping", c.presliding.damping)?;
-    non_negative("contact.width_law.exponent", c.width_law.exponent)?;
-    positive(
-        "contact.width_law.reference_load",
-        c.width_law.reference_load,
-    )?;
-    Ok(())
-}
-
-/// The drivetrain's terms.
-fn check_drivetrain(d: &super::terms::drivetrain::Drivetrain) -> Result<(), SetupError> {
-    non_negative("drivetrain.coulomb", d.coulomb)?;
-    non_negative("drivetrain.viscous", d.viscous)?;
-    non_negative("drivetrain.load_coefficient", d.load_coefficient)?;
-    non_negative("drivetrain.quadratic", d.quadratic)?;
-    if !d.coulomb_asymmetry.is_finite() {
-        return Err(SetupError::invalid(
-            "drivetrain.coulomb_asymmetry",
-            d.coulomb_asymmetry,
-            "must be finite",
-        ));
-    }
-    if !d.stribeck.is_finite() {
-        return Err(SetupError::invalid(
-            "drivetrain.stribeck",
-            d.stribeck,
-            "must be finite",
-        ));
-    }
-    positive("drivetrain.stribeck_speed", d.stribeck_speed)?;
     Ok(())
 }

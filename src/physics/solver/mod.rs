@@ -92,7 +92,8 @@ use super::gw::{Greenwood, SummedContact};
 use super::params::ModelParams;
 use super::scheme::StepCoefficients;
 use super::settings::{Method, SolverSettings};
-use super::terms::FrictionTerms;
+use super::terms::soft_width::WidthScale;
+use super::terms::{FrictionTerms, TermStates};
 use newton::CONTRACTION_MAX;
 use predictor::Predictor;
 
@@ -271,12 +272,12 @@ pub struct Solver {
     contraction: f64,
     anchor: (f64, f64, f64),
     last: Option<Estimate>,
-    /// The contact's pre-sliding displacement z, m (see
-    /// [`crate::physics::terms::presliding`]; 0 while it is off).
-    pub(crate) bristle: f64,
-    /// B(F)/B of the solve in progress (see [`crate::physics::WidthLaw`]);
-    /// the solver works on the load per reference width, F/this.
-    pub(crate) width_scale: f64,
+    /// The friction terms' states, owned beside the terms: the pre-sliding
+    /// displacement z ([`crate::physics::terms::presliding`]) and the soft
+    /// width's B(F)/B of the solve in progress
+    /// ([`crate::physics::WidthLaw`]; the solver works on the load per
+    /// reference width, F/that).
+    pub(crate) states: TermStates,
     /// The instruction-set version of the step.
     isa: Isa,
 }
@@ -351,7 +352,7 @@ impl Solver {
     ) -> Result<PreparedModel, SetupError> {
         Ok(PreparedModel {
             d: Self::disc(model, settings)?,
-            terms: FrictionTerms::of(model),
+            terms: model.terms,
             cells: settings.cells,
             geometry: model.geometry.clone(),
         })
@@ -369,18 +370,12 @@ impl Solver {
         if !self.fits(m) {
             return Err(ModelMismatch);
         }
-        let was_rigid = !self.terms.presliding.is_on();
         std::mem::swap(&mut self.d, &mut m.d);
         std::mem::swap(&mut self.terms, &mut m.terms);
-        if was_rigid && self.terms.presliding.is_on() {
-            // Compliance switched on: as if it had always been, the
-            // displacement of the last state's level.
-            self.bristle = self.last.map_or(0.0, |e| {
-                self.terms
-                    .presliding
-                    .steady_displacement(e.contact_friction_force)
-            });
-        }
+        // Each term's state carries over, or starts as if it had always
+        // been on (pre-sliding switched on: the last state's level).
+        let last = self.last.map(|e| e.contact_friction_force);
+        self.states = self.terms.swapped(&m.terms, self.states, last);
         Ok(())
     }
 
@@ -393,7 +388,7 @@ impl Solver {
         let p_amb = d.p_amb;
         let mut s = Self {
             d,
-            terms: FrictionTerms::of(model),
+            terms: model.terms,
             geometry: model.geometry.clone(),
             settings: *settings,
             p: vec![p_amb; n],
@@ -411,8 +406,7 @@ impl Solver {
             contraction: CONTRACTION_MAX,
             anchor: (0.0, 0.0, 0.0),
             last: None,
-            bristle: 0.0,
-            width_scale: 1.0,
+            states: TermStates::default(),
             isa: Isa::Baseline,
         };
         s.set_isa(Isa::detect());
@@ -485,8 +479,9 @@ impl Solver {
     /// The load per reference width of a solve at `load` (N), after
     /// setting the width scale the solve's forces are reported with.
     pub(crate) fn per_reference_width(&mut self, load: f64) -> f64 {
-        self.width_scale = self.terms.width_law.scale(load);
-        load / self.width_scale
+        let scale = self.terms.soft_width.scale(load);
+        self.states.soft_width = WidthScale(scale);
+        load / scale
     }
 
     /// Restart the time count at `t`, s.

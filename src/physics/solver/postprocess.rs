@@ -1,7 +1,7 @@
 //! From a solved state to an [`Estimate`]: forces, friction, COF, inertia,
 //! diagnostics; and, when the step advances time, the new history level.
 //!
-//! `Solver`'s fields this file uses: `d`, `terms`, `settings`, `p`, `h0`, `time`, `hist`, `hist_len`, `w`, `bristle`, `width_scale`.
+//! `Solver`'s fields this file uses: `d`, `terms`, `settings`, `p`, `h0`, `time`, `hist`, `hist_len`, `w`, `states`.
 
 use super::assembly::assemble;
 use super::lanes::{lane_max, lane_sum};
@@ -155,7 +155,7 @@ impl Solver {
             _ => BristleMove::Hold,
         };
         self.terms
-            .friction((ctx.v, load), forces, &mut self.bristle, how)
+            .friction((ctx.v, load), forces, &mut self.states, how)
     }
 
     /// Make the solved state the newest history level (ρ h from `w.tmp`),
@@ -206,7 +206,7 @@ impl Solver {
         let (inertia, load_res) = self.inertia_and_residual(ctx, film.net);
         // A soft contact's forces on its width at this load (w = 1: rigid,
         // and every force below is the film's, bit for bit).
-        let w = self.width_scale;
+        let w = self.states.soft_width.0;
         let (f_hyd, f_asp, f_visc, inertia) = (
             w * film.hydrodynamic,
             w * film.asperity,

@@ -30,7 +30,7 @@
 //! | p_s | saturation pressure (α = α_s) | Pa |
 //! | β | steepness of the EOS transition (`eos.rs`) | 1/Pa |
 //!
-//! `Solver`'s fields this file uses: `d`, `settings`, `p`, `h0`, `time`, `velocity`, `hist`, `last_load`, `hist_len`, `w`, `predictor`, `last`, `width_scale`, `isa`.
+//! `Solver`'s fields this file uses: `d`, `settings`, `p`, `h0`, `time`, `velocity`, `hist`, `last_load`, `hist_len`, `w`, `predictor`, `last`, `states`, `isa`.
 
 use super::newton::MAX_SUBSTEPS;
 use super::{Ctx, H0Mode, Isa, Outcome, Solver};
@@ -201,7 +201,7 @@ impl Solver {
             // Never initialised: start from the steady state at this input.
             // (`load` is per reference width; the steady solve takes the
             // load itself.)
-            self.initialize_steady(v, load * self.width_scale);
+            self.initialize_steady(v, load * self.states.soft_width.0);
         }
         let coeffs = if self.hist_len >= 2 {
             StepCoefficients::for_scheme(self.settings.scheme)

@@ -30,11 +30,12 @@
 //! level below the Coulomb level) is this term's, not the film's; the film
 //! adds its viscous shear on top.
 
+use super::term::{At, BristleMove, FrictionTerm, Place};
 use super::{End, FitScale, TermKey};
 
-/// The boundary friction's keys: μ_bl and the rigid contact's sign
-/// regularisation, the rate sensitivity and its activation speed.
-pub const KEYS: &[TermKey] = &[
+/// The boundary film's keys: μ_bl and the rigid contact's sign
+/// regularisation.
+const FILM_KEYS: &[TermKey] = &[
     TermKey {
         key: "contact.boundary_friction",
         symbol: "μ_bl",
@@ -55,6 +56,10 @@ pub const KEYS: &[TermKey] = &[
         fit: FitScale::FromStart,
         meaning: "the rigid contact's (and the drivetrain's) sign tanh(v/v_reg); not used by the pre-sliding bristle",
     },
+];
+
+/// The rate dependence's keys: the sensitivity and its activation speed.
+const RATE_KEYS: &[TermKey] = &[
     TermKey {
         key: "contact.boundary_friction_rate",
         symbol: "μ_r",
@@ -83,6 +88,84 @@ pub const KEYS: &[TermKey] = &[
     },
 ];
 
+/// The boundary film's friction μ_bl F_asp s(v) (always in: the paper's
+/// term), and the sign's regularisation v_reg that the rigid contact and
+/// the drivetrain use.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BoundaryFilm {
+    /// μ_bl, the boundary friction coefficient.
+    pub friction: f64,
+    /// v_reg of the rigid contact's (and the drivetrain's) tanh sign, m/s.
+    pub sign_regularization: f64,
+}
+
+impl Default for BoundaryFilm {
+    /// The paper's μ_bl = 0.3, v_reg = 1e-4 m/s.
+    fn default() -> Self {
+        Self {
+            friction: 0.3,
+            sign_regularization: 1e-4,
+        }
+    }
+}
+
+impl FrictionTerm for BoundaryFilm {
+    const KEYS: &'static [TermKey] = FILM_KEYS;
+    const PLACE: Place = Place::Contact;
+    type State = ();
+
+    /// Always: μ_bl = 0 adds a zero, as the paper's model does.
+    fn is_on(&self) -> bool {
+        true
+    }
+
+    fn force(&self, at: &At) -> f64 {
+        self.friction * at.f_asp * at.s
+    }
+
+    fn carried(&self, at: &At) -> f64 {
+        self.friction * at.f_asp * at.s
+    }
+
+    fn beside(&self, _: &At) -> f64 {
+        0.0
+    }
+
+    fn cof(&self, _: &At) -> f64 {
+        self.friction
+    }
+
+    fn carry(&self, level: f64, _: f64, _: &mut Self::State, _: BristleMove) -> f64 {
+        level
+    }
+
+    fn steady_state(&self, _: f64, state: Self::State) -> Self::State {
+        state
+    }
+
+    fn swapped(&self, _: &Self, state: Self::State, _: Option<f64>) -> Self::State {
+        state
+    }
+
+    fn get(&self, key: &str) -> Option<f64> {
+        match key {
+            "contact.boundary_friction" => Some(self.friction),
+            "contact.sign_regularization_m_s" => Some(self.sign_regularization),
+            _ => None,
+        }
+    }
+
+    fn set(&mut self, key: &str, value: f64) -> bool {
+        let slot = match key {
+            "contact.boundary_friction" => &mut self.friction,
+            "contact.sign_regularization_m_s" => &mut self.sign_regularization,
+            _ => return false,
+        };
+        *slot = value;
+        true
+    }
+}
+
 /// The rate dependence of the boundary friction (off by default).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BoundaryRate {
@@ -102,15 +185,67 @@ impl Default for BoundaryRate {
 }
 
 impl BoundaryRate {
-    /// Whether the coefficient depends on speed.
-    pub fn is_on(&self) -> bool {
-        self.sensitivity > 0.0
-    }
-
     /// μ_r asinh(v/v_a): the signed, rate-dependent part of the coefficient
     /// at velocity `v` (m/s).
     pub fn signed_term(&self, v: f64) -> f64 {
         self.sensitivity * (v / self.activation_speed).asinh()
+    }
+}
+
+impl FrictionTerm for BoundaryRate {
+    const KEYS: &'static [TermKey] = RATE_KEYS;
+    const PLACE: Place = Place::Contact;
+    type State = ();
+
+    fn is_on(&self) -> bool {
+        self.sensitivity > 0.0
+    }
+
+    /// F_asp μ_r asinh(v/v_a): odd in v, no sign needed.
+    fn force(&self, at: &At) -> f64 {
+        at.f_asp * self.signed_term(at.v)
+    }
+
+    fn carried(&self, at: &At) -> f64 {
+        at.f_asp * self.signed_term(at.v)
+    }
+
+    fn beside(&self, _: &At) -> f64 {
+        0.0
+    }
+
+    fn cof(&self, at: &At) -> f64 {
+        self.signed_term(at.v)
+    }
+
+    fn carry(&self, level: f64, _: f64, _: &mut Self::State, _: BristleMove) -> f64 {
+        level
+    }
+
+    fn steady_state(&self, _: f64, state: Self::State) -> Self::State {
+        state
+    }
+
+    fn swapped(&self, _: &Self, state: Self::State, _: Option<f64>) -> Self::State {
+        state
+    }
+
+    fn get(&self, key: &str) -> Option<f64> {
+        match key {
+            "contact.boundary_friction_rate" => Some(self.sensitivity),
+            "contact.boundary_activation_speed_m_s" => Some(self.activation_speed),
+            _ => None,
+        }
+    }
+
+    fn set(&mut self, key: &str, value: f64) -> bool {
+        let slot = match key {
+            "contact.boundary_friction_rate" => &mut self.sensitivity,
+            "contact.boundary_activation_speed_m_s" => &mut self.activation_speed,
+            _ => return false,
+        };
+        *slot = value;
+        true
     }
 }
 

@@ -30,6 +30,7 @@
 //! bristle, σ0 and σ1): a calibration can always reach the best classic's
 //! training error, and the data say where the film adds to it.
 
+use super::term::{At, BristleMove, FrictionTerm, Place};
 use super::{End, FitScale, TermKey};
 
 /// Bounds up to `factor` times the data's friction over speed^`power`.
@@ -43,7 +44,7 @@ const fn data(factor: f64, speed_power: i32) -> FitScale {
 }
 
 /// The drivetrain's keys.
-pub const KEYS: &[TermKey] = &[
+const KEYS: &[TermKey] = &[
     TermKey {
         key: "drivetrain.coulomb_n",
         symbol: "F_cd",
@@ -171,6 +172,81 @@ impl Default for Drivetrain {
     }
 }
 
+impl FrictionTerm for Drivetrain {
+    const KEYS: &'static [TermKey] = KEYS;
+    const PLACE: Place = Place::Axis;
+    type State = ();
+
+    /// Whether any of its terms is not zero (all zero: the estimate is the
+    /// contact's alone).
+    fn is_on(&self) -> bool {
+        !self.is_zero()
+    }
+
+    /// F_dt with the rigid contact's s = tanh(v/v_reg).
+    #[inline(always)]
+    fn force(&self, at: &At) -> f64 {
+        self.force_at(at.v, at.load, at.s)
+    }
+
+    /// (F_cd + c_N F + ΔF_s e^(−(v/v_s)²)) s + ΔF_cd |s| with s = sgn v.
+    #[inline(always)]
+    fn carried(&self, at: &At) -> f64 {
+        self.level_at_rest(at.v, at.s, at.load)
+    }
+
+    /// b v + c_q v |v|.
+    #[inline(always)]
+    fn beside(&self, at: &At) -> f64 {
+        self.rate_terms(at.v)
+    }
+
+    /// None: the COF is the contact's.
+    fn cof(&self, _: &At) -> f64 {
+        0.0
+    }
+
+    fn carry(&self, level: f64, _: f64, _: &mut (), _: BristleMove) -> f64 {
+        level
+    }
+
+    fn steady_state(&self, _: f64, state: Self::State) -> Self::State {
+        state
+    }
+
+    fn swapped(&self, _: &Self, state: Self::State, _: Option<f64>) -> Self::State {
+        state
+    }
+
+    fn get(&self, key: &str) -> Option<f64> {
+        Some(match key {
+            "drivetrain.coulomb_n" => self.coulomb,
+            "drivetrain.viscous_n_s_m" => self.viscous,
+            "drivetrain.load_coefficient" => self.load_coefficient,
+            "drivetrain.quadratic_n_s2_m2" => self.quadratic,
+            "drivetrain.stribeck_n" => self.stribeck,
+            "drivetrain.stribeck_speed_m_s" => self.stribeck_speed,
+            "drivetrain.coulomb_asymmetry_n" => self.coulomb_asymmetry,
+            _ => return None,
+        })
+    }
+
+    fn set(&mut self, key: &str, value: f64) -> bool {
+        let slot = match key {
+            "drivetrain.coulomb_n" => &mut self.coulomb,
+            "drivetrain.viscous_n_s_m" => &mut self.viscous,
+            "drivetrain.load_coefficient" => &mut self.load_coefficient,
+            "drivetrain.quadratic_n_s2_m2" => &mut self.quadratic,
+            "drivetrain.stribeck_n" => &mut self.stribeck,
+            "drivetrain.stribeck_speed_m_s" => &mut self.stribeck_speed,
+            "drivetrain.coulomb_asymmetry_n" => &mut self.coulomb_asymmetry,
+            _ => return false,
+        };
+        *slot = value;
+        true
+    }
+}
+
 impl Drivetrain {
     /// Whether every term is zero (the estimate is then the contact's alone).
     pub fn is_zero(&self) -> bool {
@@ -196,10 +272,10 @@ impl Drivetrain {
         }
     }
 
-    /// F_dt at velocity `v` (m/s) and load `load` (N), with the contact's
-    /// sign regularisation `v_reg` (m/s).
-    pub fn force(&self, v: f64, load: f64, v_reg: f64) -> f64 {
-        let s = (v / v_reg).tanh();
+    /// F_dt at velocity `v` (m/s) and load `load` (N), with the sign `s`
+    /// (the rigid contact's tanh(v/v_reg)).
+    #[inline(always)]
+    pub fn force_at(&self, v: f64, load: f64, s: f64) -> f64 {
         self.level(v, load) * s
             + self.coulomb_asymmetry * s.abs()
             + self.viscous * v
@@ -227,6 +303,11 @@ impl Drivetrain {
 mod tests {
     use super::*;
 
+    /// F_dt with the contact's regularisation `v_reg`.
+    fn force(d: &Drivetrain, v: f64, load: f64, v_reg: f64) -> f64 {
+        d.force_at(v, load, (v / v_reg).tanh())
+    }
+
     #[test]
     fn the_drivetrain_force_is_odd_in_velocity_and_linear_in_each_term() {
         let d = Drivetrain {
@@ -235,10 +316,10 @@ mod tests {
             load_coefficient: 0.002,
             ..Default::default()
         };
-        let f = d.force(0.2, 1000.0, 1e-4);
+        let f = force(&d, 0.2, 1000.0, 1e-4);
         approx::assert_relative_eq!(f, 10.0 + 2.0 + 10.0, max_relative = 1e-12);
-        approx::assert_relative_eq!(d.force(-0.2, 1000.0, 1e-4), -f, max_relative = 1e-12);
-        assert_eq!(d.force(0.0, 1000.0, 1e-4), 0.0);
+        approx::assert_relative_eq!(force(&d, -0.2, 1000.0, 1e-4), -f, max_relative = 1e-12);
+        assert_eq!(force(&d, 0.0, 1000.0, 1e-4), 0.0);
         assert!(Drivetrain::default().is_zero());
     }
 
@@ -250,13 +331,17 @@ mod tests {
             coulomb_asymmetry: 1.0,
             ..Default::default()
         };
-        let (a, b) = (d.force(0.1, 0.0, 1e-6), d.force(0.2, 0.0, 1e-6));
+        let (a, b) = (force(&d, 0.1, 0.0, 1e-6), force(&d, 0.2, 0.0, 1e-6));
         // Above the constant level the loss quadruples when speed doubles.
         approx::assert_relative_eq!(b - 5.0, 4.0 * (a - 5.0), max_relative = 1e-12);
         // Forward 4 + 1, backward 4 − 1 (in magnitude).
-        approx::assert_relative_eq!(d.force(1e-3, 0.0, 1e-6), 5.0 + 1e-4, max_relative = 1e-12);
-        approx::assert_relative_eq!(d.force(-1e-3, 0.0, 1e-6), -3.0 - 1e-4, max_relative = 1e-12);
-        assert_eq!(d.force(0.0, 0.0, 1e-6), 0.0);
+        approx::assert_relative_eq!(force(&d, 1e-3, 0.0, 1e-6), 5.0 + 1e-4, max_relative = 1e-12);
+        approx::assert_relative_eq!(
+            force(&d, -1e-3, 0.0, 1e-6),
+            -3.0 - 1e-4,
+            max_relative = 1e-12
+        );
+        assert_eq!(force(&d, 0.0, 0.0, 1e-6), 0.0);
         assert!(!d.is_zero());
     }
 
@@ -271,17 +356,17 @@ mod tests {
             };
             // At rest (well past v_reg): F_cd + ΔF_s; at v_s: e^-1 of the excess.
             approx::assert_relative_eq!(
-                d.force(1e-5, 0.0, 1e-9),
+                force(&d, 1e-5, 0.0, 1e-9),
                 10.0 + excess,
                 max_relative = 1e-5
             );
             approx::assert_relative_eq!(
-                d.force(0.01, 0.0, 1e-9),
+                force(&d, 0.01, 0.0, 1e-9),
                 10.0 + excess / std::f64::consts::E,
                 max_relative = 1e-12
             );
-            approx::assert_relative_eq!(d.force(0.1, 0.0, 1e-9), 10.0, max_relative = 1e-12);
-            approx::assert_relative_eq!(d.force(-0.01, 0.0, 1e-9), -d.force(0.01, 0.0, 1e-9));
+            approx::assert_relative_eq!(force(&d, 0.1, 0.0, 1e-9), 10.0, max_relative = 1e-12);
+            approx::assert_relative_eq!(force(&d, -0.01, 0.0, 1e-9), -force(&d, 0.01, 0.0, 1e-9));
             approx::assert_relative_eq!(d.level_at_rest(0.0, 1.0, 0.0), 10.0 + excess);
         }
         // Off, the level is the one before the term, bit for bit.
@@ -289,6 +374,9 @@ mod tests {
             coulomb: 10.0,
             ..Default::default()
         };
-        assert_eq!(off.force(0.003, 0.0, 1e-4), 10.0 * (0.003f64 / 1e-4).tanh());
+        assert_eq!(
+            force(&off, 0.003, 0.0, 1e-4),
+            10.0 * (0.003f64 / 1e-4).tanh()
+        );
     }
 }

@@ -9,11 +9,15 @@
 //!
 //! | file | term |
 //! |---|---|
-//! | `mod.rs` | the catalogue, the sign functions, the composition |
+//! | `mod.rs` | the list of terms, the catalogue, the sign function, the COF's definition |
+//! | `term.rs` | the interface every term implements ([`FrictionTerm`]): its force, its level under pre-sliding, what acts beside the bristle, its COF part, its state, its keys and their check |
+//! | `keys.rs` | a key's catalogue entry: its range, unit and fit scale |
+//! | `compose.rs` | the composition: one loop over the terms per part, in the order below |
 //! | `boundary_film.rs` | the boundary film: friction μ_bl on the asperity load, the rigid contact's sign regularisation, and the boundary film's rise with the logarithm of speed (Eyring) |
 //! | `presliding.rs` | the contact's elastic displacement before gross sliding (a bristle on the model's own level) |
 //! | `soft_width.rs` | a soft contact whose width follows the load |
 //! | `drivetrain.rs` | losses beside the contact (bearings, seals, gears, a motor) |
+//! | `test_term.rs` | (tests only) a term added as a new one is: its file and one line of the list |
 //!
 //! Composition, every step, once the film is solved (F_visc, F_asp are the
 //! film's forces on the width B(F) of `soft_width.rs`):
@@ -46,21 +50,44 @@
 //! Every term is off by default (0) and then leaves every number of the
 //! paper's model unchanged, bit for bit (a term is applied only when on).
 //!
-//! Adding a term: its file (struct, equation, symbol table, `KEYS`), a field
-//! of [`FrictionTerms`] and its place in the composition above, its slice in
-//! [`catalogue`], its configuration fields (`config/model.rs`, `config/mod.rs`)
-//! and its tests. Validation, live-ness, the fit's bounds and the docs'
-//! table follow from `KEYS`.
+//! Adding a term: its file (a type implementing [`FrictionTerm`], with its
+//! equation, symbol table and `KEYS`), one line in the list below, and its
+//! keys in the configuration (`config/model.rs`, `config/mod.rs`) with its
+//! tests. The composition, the states, `get`/`set`/`check`, validation,
+//! live-ness, the fit's bounds and the docs' table follow from the list
+//! and `KEYS`; `test_term.rs` is such a term, seen by the model, the
+//! catalogue and the fit.
 
 pub mod boundary_film;
+mod compose;
 pub mod drivetrain;
+pub mod keys;
 pub mod presliding;
 pub mod soft_width;
+pub mod term;
+#[cfg(test)]
+mod test_term;
 
-use boundary_film::BoundaryRate;
+use boundary_film::{BoundaryFilm, BoundaryRate};
+use compose::friction_terms;
 use drivetrain::Drivetrain;
+pub use keys::{End, FitScale, Interval, TermKey};
 use presliding::Presliding;
 use soft_width::WidthLaw;
+pub use term::{At, BristleMove, FrictionTerm, Place};
+
+// The list of terms, in the composition's order: adding a term is its file
+// (its type implementing `FrictionTerm`, its equation, symbol table and
+// `KEYS`), one line here, and its keys' YAML (`config/model.rs`).
+friction_terms! {
+    boundary_film: BoundaryFilm,
+    boundary_rate: BoundaryRate,
+    presliding: Presliding,
+    soft_width: WidthLaw,
+    drivetrain: Drivetrain,
+    #[cfg(test)]
+    probe: test_term::Probe,
+}
 
 /// The coefficient of friction as users read it, in one line of ASCII:
 /// the text every shape of the estimate carries beside its `cof` field
@@ -83,119 +110,27 @@ pub fn sgn(v: f64) -> f64 {
     }
 }
 
-/// One end of a key's valid range.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum End {
-    /// The value itself is allowed.
-    Closed(f64),
-    /// The value itself is not allowed.
-    Open(f64),
-}
-
-impl End {
-    /// The number at this end.
-    pub fn value(self) -> f64 {
-        match self {
-            End::Closed(v) | End::Open(v) => v,
-        }
-    }
-}
-
-/// An interval of allowed values: a key's valid range (the one interval
-/// type: the catalogue, validation and the parameter descriptors use it;
-/// `config::validate` writes it as `[lo, hi)`).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Interval {
-    /// The lower end.
-    pub lo: End,
-    /// The upper end.
-    pub hi: End,
-}
-
-impl Interval {
-    /// Whether `v` is finite and lies in the interval.
-    pub fn contains(self, v: f64) -> bool {
-        let above = match self.lo {
-            End::Closed(l) => v >= l,
-            End::Open(l) => v > l,
-        };
-        let below = match self.hi {
-            End::Closed(h) => v <= h,
-            End::Open(h) => v < h,
-        };
-        v.is_finite() && above && below
-    }
-}
-
-/// The scale of a key's default fit bounds when its start gives none (a
-/// term that is off starts at 0).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum FitScale {
-    /// Only from its start: a decade either side of a positive start;
-    /// `--bounds` is needed for a start of 0.
-    FromStart,
-    /// [0, factor · F / (v^speed_power · (F_N if per_load))], capped at the
-    /// key's upper bound; `symmetric`: [−hi, hi]. F is the data's largest
-    /// friction, v its largest speed, F_N its smallest load.
-    Data {
-        /// The multiple of the data's friction scale.
-        factor: f64,
-        /// The power of the data's speed the friction is divided by.
-        speed_power: i32,
-        /// Divided by the data's smallest load (a coefficient).
-        per_load: bool,
-        /// Bounds either side of zero (a signed term).
-        symmetric: bool,
-    },
-    /// A speed: [lo · v, hi · v], v the data's largest speed (log scale).
-    Speed {
-        /// The lower bound as a fraction of the data's largest speed.
-        lo: f64,
-        /// The upper bound as a multiple of it.
-        hi: f64,
-    },
-    /// A stiffness: [F / x_hi, F / x_lo], F the data's largest friction:
-    /// the displacement |F|/k at which the force builds lies within
-    /// [x_lo, x_hi] (m).
-    Stiffness {
-        /// The smallest displacement, m.
-        x_lo: f64,
-        /// The largest displacement, m.
-        x_hi: f64,
-    },
-}
-
-/// One configuration key of a friction term.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct TermKey {
-    /// The dotted configuration key.
-    pub key: &'static str,
-    /// Its symbol in the equations.
-    pub symbol: &'static str,
-    /// Its unit ("–" when dimensionless).
-    pub unit: &'static str,
-    /// The lower end of its valid range.
-    pub lo: End,
-    /// The upper end of its valid range.
-    pub hi: End,
-    /// Whether it may change while the node runs.
-    pub live: bool,
-    /// The scale of its default fit bounds.
-    pub fit: FitScale,
-    /// What it is, in a few words.
-    pub meaning: &'static str,
-}
-
 /// Every friction term's keys, term by term, in the composition's order.
 pub fn catalogue() -> impl Iterator<Item = &'static TermKey> {
-    [
-        boundary_film::KEYS,
-        presliding::KEYS,
-        soft_width::KEYS,
-        drivetrain::KEYS,
-    ]
-    .into_iter()
-    .flatten()
+    TERM_KEYS.iter().copied().flatten()
+}
+
+/// The catalogue's keys that the configuration holds: all of them but a
+/// test build's test term's (`test_term.rs`, which has no YAML).
+pub fn configured_catalogue() -> impl Iterator<Item = &'static TermKey> {
+    catalogue().filter(|k| !of_the_test_term(k))
+}
+
+/// Whether `k` is the test term's (never in a build that is not a test).
+#[cfg(test)]
+fn of_the_test_term(k: &TermKey) -> bool {
+    test_term::KEYS.contains(k)
+}
+
+/// Whether `k` is the test term's (never in a build that is not a test).
+#[cfg(not(test))]
+fn of_the_test_term(_: &TermKey) -> bool {
+    false
 }
 
 /// The catalogue's entry for `key`.
@@ -205,217 +140,22 @@ pub fn term_key(key: &str) -> Option<&'static TermKey> {
 
 /// Whether configuration key `key` acts after the film: a friction term's
 /// key that the film's solution (pressure, gap, the film's forces) does not
-/// depend on. Every term's keys are, but the soft width's, which scale the
-/// film's forces. A change of such keys alone leaves the film as it was,
-/// and the friction follows from the film's forces step by step through
+/// depend on: every term's keys but those of a term on the film
+/// ([`Place::Film`], the soft width, which scales the film's forces). A
+/// change of such keys alone leaves the film as it was, and the friction
+/// follows from the film's forces step by step through
 /// [`FrictionTerms::friction`] (what a calibration uses to evaluate them
 /// without solving the film again).
 pub fn acts_after_the_film(key: &str) -> bool {
-    [boundary_film::KEYS, presliding::KEYS, drivetrain::KEYS]
-        .into_iter()
-        .flatten()
-        .any(|k| k.key == key)
-}
-
-/// The friction terms of one contact, composed in the order of the module
-/// documentation. All off by default.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct FrictionTerms {
-    /// μ_bl, the boundary friction coefficient.
-    pub boundary_friction: f64,
-    /// v_reg of the rigid contact's (and the drivetrain's) tanh sign, m/s.
-    pub sign_regularization: f64,
-    /// The boundary film's rise with speed.
-    pub boundary_rate: BoundaryRate,
-    /// The pre-sliding bristle.
-    pub presliding: Presliding,
-    /// The soft contact's width against the load.
-    pub width_law: WidthLaw,
-    /// The drivetrain's terms.
-    pub drivetrain: Drivetrain,
-}
-
-impl FrictionTerms {
-    /// The terms of `model` (its contact's and its drivetrain's keys).
-    pub fn of(model: &crate::physics::ModelParams) -> Self {
-        let c = &model.contact;
-        Self {
-            boundary_friction: c.boundary_friction,
-            sign_regularization: c.sign_regularization,
-            boundary_rate: c.boundary_rate,
-            presliding: c.presliding,
-            width_law: c.width_law,
-            drivetrain: model.drivetrain,
-        }
-    }
-}
-
-impl FrictionTerms {
-    /// Set the term key `key` (one that acts after the film, see
-    /// [`acts_after_the_film`]) to `value`; false for any other key. The
-    /// value is taken as it is (the caller keeps it in the key's valid
-    /// range).
-    pub fn set(&mut self, key: &str, value: f64) -> bool {
-        let d = &mut self.drivetrain;
-        let slot = match key {
-            "contact.boundary_friction" => &mut self.boundary_friction,
-            "contact.sign_regularization_m_s" => &mut self.sign_regularization,
-            "contact.boundary_friction_rate" => &mut self.boundary_rate.sensitivity,
-            "contact.boundary_activation_speed_m_s" => &mut self.boundary_rate.activation_speed,
-            "contact.presliding_stiffness_n_m" => &mut self.presliding.stiffness,
-            "contact.presliding_damping_n_s_m" => &mut self.presliding.damping,
-            "drivetrain.coulomb_n" => &mut d.coulomb,
-            "drivetrain.viscous_n_s_m" => &mut d.viscous,
-            "drivetrain.load_coefficient" => &mut d.load_coefficient,
-            "drivetrain.quadratic_n_s2_m2" => &mut d.quadratic,
-            "drivetrain.stribeck_n" => &mut d.stribeck,
-            "drivetrain.stribeck_speed_m_s" => &mut d.stribeck_speed,
-            "drivetrain.coulomb_asymmetry_n" => &mut d.coulomb_asymmetry,
-            _ => return false,
-        };
-        *slot = value;
-        true
-    }
-}
-
-/// What the composition produced at one state.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Composed {
-    /// F_c, the friction the contact transmits, N.
-    pub contact: f64,
-    /// F_f, with the drivetrain's terms, N.
-    pub total: f64,
-    /// The COF.
-    pub cof: f64,
-    /// The boundary rate's part of the COF (0 with pre-sliding).
-    pub boundary_rate_cof: f64,
-}
-
-/// How the bristle moves in this evaluation.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum BristleMove {
-    /// A step of this length, s: the bristle advances.
-    Step(f64),
-    /// A steady state: the bristle takes its steady displacement.
-    Steady,
-    /// Neither (a solve that does not advance time): the bristle is held.
-    Hold,
-}
-
-impl FrictionTerms {
-    /// L with the boundary rate's term added when it is on (off: the
-    /// paper's constant μ_bl, bit for bit, signed zeros included).
-    #[inline(always)]
-    fn with_rate(&self, f: f64, v: f64, f_asp: f64) -> f64 {
-        if self.boundary_rate.is_on() {
-            f + f_asp * self.boundary_rate.signed_term(v)
-        } else {
-            f
-        }
-    }
-
-    /// (F_c, F_f): the contact's friction and the total at load `load`,
-    /// from the film's forces (steps 1–3); `bristle` is the pre-sliding
-    /// displacement z, moved as `how` says. Zero drivetrain terms leave
-    /// F_f = F_c, bit for bit.
-    #[inline(always)]
-    pub fn friction(
-        &self,
-        (v, load): (f64, f64),
-        (f_visc, f_asp): (f64, f64),
-        bristle: &mut f64,
-        how: BristleMove,
-    ) -> (f64, f64) {
-        let mu_bl = self.boundary_friction;
-        let dt = self.drivetrain;
-        if !self.presliding.is_on() {
-            let s = (v / self.sign_regularization).tanh();
-            let contact = self.with_rate(f_visc + mu_bl * f_asp * s, v, f_asp);
-            if dt.is_zero() {
-                return (contact, contact);
-            }
-            let total = contact + dt.force(v, load, self.sign_regularization);
-            return (contact, total);
-        }
-        let level_c = self.with_rate(f_visc + mu_bl * f_asp * sgn(v), v, f_asp);
-        if dt.is_zero() {
-            let f = self.bristle(level_c, v, bristle, how);
-            return (f, f);
-        }
-        // What acts at zero speed rides on the bristle; the contact's share
-        // of its force is its share of the level.
-        let level = level_c + dt.level_at_rest(v, sgn(v), load);
-        let f = self.bristle(level, v, bristle, how);
-        let contact = if level == 0.0 {
-            f
-        } else {
-            f * (level_c / level)
-        };
-        (contact, f + dt.rate_terms(v))
-    }
-
-    /// The bristle's force on `level`, z moved as `how` says.
-    #[inline(always)]
-    fn bristle(&self, level: f64, v: f64, bristle: &mut f64, how: BristleMove) -> f64 {
-        let p = self.presliding;
-        match how {
-            BristleMove::Step(dt) => {
-                let (z, f) = p.advance(*bristle, level, v, dt);
-                *bristle = z;
-                f
-            }
-            BristleMove::Steady => {
-                *bristle = p.steady_displacement(level);
-                level
-            }
-            BristleMove::Hold => level,
-        }
-    }
-
-    /// The COF and the boundary rate's part of it (step 4): the magnitude
-    /// of the friction the contact transmits per unit load. Rigid contact:
-    /// it always slides, so (|F_visc| + μ(v) F_asp) / F_ext, the sign's
-    /// regularisation not applied; with pre-sliding, |F_c| / F_ext. The
-    /// rate's part μ_r asinh(|v|/v_a) F_asp / F_ext is 0 at v = 0 and steep
-    /// near it: the one-sided limits at v = 0 are taken without it.
-    #[inline(always)]
-    pub fn cof(&self, v: f64, f_visc: f64, f_asp: f64, contact: f64, load: f64) -> (f64, f64) {
-        if self.presliding.is_on() {
-            return (contact.abs() / load, 0.0);
-        }
-        let mu_bl = self.boundary_friction;
-        if self.boundary_rate.is_on() {
-            let rate = self.boundary_rate.signed_term(v.abs()) * f_asp / load;
-            let mu = mu_bl + self.boundary_rate.signed_term(v.abs());
-            ((f_visc.abs() + mu * f_asp) / load, rate)
-        } else {
-            ((f_visc.abs() + mu_bl * f_asp) / load, 0.0)
-        }
-    }
+    TERM_PLACES
+        .iter()
+        .any(|(keys, place)| *place != Place::Film && keys.iter().any(|k| k.key == key))
 }
 
 #[cfg(test)]
 #[allow(clippy::float_cmp)] // the values compared exactly are exact claims
 mod tests {
     use super::*;
-
-    #[test]
-    fn an_interval_holds_its_closed_ends_but_not_its_open_ones_nor_a_non_finite_value() {
-        let r = Interval {
-            lo: End::Open(0.0),
-            hi: End::Closed(1.0),
-        };
-        assert!(!r.contains(0.0));
-        assert!(r.contains(1e-300));
-        assert!(r.contains(1.0));
-        assert!(!r.contains(1.0 + f64::EPSILON));
-        assert!(!r.contains(f64::NAN));
-        let all = Interval {
-            lo: End::Closed(f64::NEG_INFINITY),
-            hi: End::Closed(f64::INFINITY),
-        };
-        assert!(!all.contains(f64::INFINITY));
-    }
 
     #[test]
     fn every_key_of_the_catalogue_is_named_once_with_a_unit_and_an_ordered_range() {
@@ -437,8 +177,8 @@ mod tests {
 
     #[test]
     fn off_terms_leave_the_rigid_contact_as_the_paper_has_it() {
-        let t = FrictionTerms::of(&crate::physics::ModelParams::default());
-        let mut z = 0.0;
+        let t = crate::physics::ModelParams::default().terms;
+        let mut z = TermStates::default();
         let (v, f_visc, f_asp, load) = (0.01, 12.0, 5000.0, 20_000.0);
         let (c, total) = t.friction((v, load), (f_visc, f_asp), &mut z, BristleMove::Step(1e-3));
         assert_eq!(c, f_visc + 0.3 * f_asp * (v / 1e-4).tanh());
@@ -447,8 +187,65 @@ mod tests {
             t.cof(v, f_visc, f_asp, c, load),
             ((12.0 + 0.3 * 5000.0) / load, 0.0)
         );
-        assert_eq!(z, 0.0);
+        assert_eq!(z, TermStates::default());
         assert_eq!(sgn(-0.0), 0.0);
         assert_eq!(sgn(-2.0), -1.0);
+    }
+
+    #[test]
+    fn every_listed_terms_keys_read_and_write_their_own_field_and_its_defaults_pass_its_check() {
+        let base = FrictionTerms::default();
+        assert!(base.check().is_ok());
+        for k in catalogue() {
+            let v = base
+                .get(k.key)
+                .unwrap_or_else(|| panic!("{} cannot be read", k.key));
+            let mut t = base;
+            let moved = if v == 0.0 { 0.5 } else { v * 0.5 };
+            assert!(t.set(k.key, moved), "{} cannot be written", k.key);
+            assert_eq!(t.get(k.key), Some(moved), "{}", k.key);
+            // Every other key is where it was: each key has a field of its own.
+            for other in catalogue().filter(|o| o.key != k.key) {
+                assert_eq!(
+                    t.get(other.key),
+                    base.get(other.key),
+                    "{} moved {}",
+                    k.key,
+                    other.key
+                );
+            }
+        }
+        assert!(base.get("contact.load_n").is_none());
+    }
+
+    #[test]
+    fn a_term_outside_its_keys_range_is_refused_by_the_model_naming_the_catalogue_key() {
+        let mut m = crate::physics::ModelParams::default();
+        m.terms.boundary_rate.sensitivity = -0.1;
+        match m.check() {
+            Err(crate::physics::SetupError::InvalidParameter { field, value, .. }) => {
+                assert_eq!(field, "contact.boundary_friction_rate");
+                assert_eq!(value, -0.1);
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn switching_pre_sliding_on_while_running_starts_the_bristle_at_the_last_level() {
+        let off = FrictionTerms::default();
+        let mut on = off;
+        on.presliding.stiffness = 1e6;
+        let states = TermStates::default();
+        let swapped = on.swapped(&off, states, Some(25.0));
+        assert_eq!(swapped.presliding, 25.0 / 1e6);
+        // Already on: the displacement is kept; off again: kept (unused).
+        let kept = TermStates {
+            presliding: 3e-6,
+            ..states
+        };
+        assert_eq!(on.swapped(&on, kept, Some(25.0)).presliding, 3e-6);
+        assert_eq!(off.swapped(&on, kept, Some(25.0)).presliding, 3e-6);
+        assert_eq!(on.swapped(&off, states, None).presliding, 0.0);
     }
 }

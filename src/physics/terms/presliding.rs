@@ -48,10 +48,11 @@
 //! resolve (a Δt ≫ 1) relaxes within the step, and the rigid model
 //! results. At rest (v = 0) z is held.
 
+use super::term::{At, BristleMove, FrictionTerm, Place};
 use super::{End, FitScale, TermKey};
 
 /// The bristle's keys: stiffness and damping.
-pub const KEYS: &[TermKey] = &[
+const KEYS: &[TermKey] = &[
     TermKey {
         key: "contact.presliding_stiffness_n_m",
         symbol: "σ0",
@@ -96,12 +97,84 @@ pub struct Presliding {
     pub damping: f64,
 }
 
-impl Presliding {
+impl FrictionTerm for Presliding {
+    const KEYS: &'static [TermKey] = KEYS;
+    const PLACE: Place = Place::Carrier;
+    /// z, the displacement, m (0 while off).
+    type State = f64;
+
     /// Whether the bristle is in (a stiffness above zero).
-    pub fn is_on(&self) -> bool {
+    fn is_on(&self) -> bool {
         self.stiffness > 0.0
     }
 
+    fn force(&self, _: &At) -> f64 {
+        0.0
+    }
+
+    fn carried(&self, _: &At) -> f64 {
+        0.0
+    }
+
+    fn beside(&self, _: &At) -> f64 {
+        0.0
+    }
+
+    fn cof(&self, _: &At) -> f64 {
+        0.0
+    }
+
+    /// The bristle's force on `level`, z moved as `how` says.
+    #[inline(always)]
+    fn carry(&self, level: f64, v: f64, z: &mut f64, how: BristleMove) -> f64 {
+        match how {
+            BristleMove::Step(dt) => {
+                let (z_new, f) = self.advance(*z, level, v, dt);
+                *z = z_new;
+                f
+            }
+            BristleMove::Steady => {
+                *z = self.steady_displacement(level);
+                level
+            }
+            BristleMove::Hold => level,
+        }
+    }
+
+    fn steady_state(&self, level: f64, _: f64) -> f64 {
+        self.steady_displacement(level)
+    }
+
+    /// Switched on while running: as if it had always been, the displacement
+    /// of the last state's level (0 before the first step).
+    fn swapped(&self, old: &Self, z: f64, last_level: Option<f64>) -> f64 {
+        if !old.is_on() && self.is_on() {
+            last_level.map_or(0.0, |l| self.steady_displacement(l))
+        } else {
+            z
+        }
+    }
+
+    fn get(&self, key: &str) -> Option<f64> {
+        match key {
+            "contact.presliding_stiffness_n_m" => Some(self.stiffness),
+            "contact.presliding_damping_n_s_m" => Some(self.damping),
+            _ => None,
+        }
+    }
+
+    fn set(&mut self, key: &str, value: f64) -> bool {
+        let slot = match key {
+            "contact.presliding_stiffness_n_m" => &mut self.stiffness,
+            "contact.presliding_damping_n_s_m" => &mut self.damping,
+            _ => return false,
+        };
+        *slot = value;
+        true
+    }
+}
+
+impl Presliding {
     /// The displacement in steady sliding at level `level` (N), m.
     pub fn steady_displacement(&self, level: f64) -> f64 {
         level / self.stiffness

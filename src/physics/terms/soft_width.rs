@@ -20,10 +20,11 @@
 //! The slider's mass is taken per the reference width (its inertia is a
 //! millionth of the load at the paper's conditions).
 
+use super::term::{At, BristleMove, FrictionTerm, Place};
 use super::{End, FitScale, TermKey};
 
 /// The soft contact's keys: the exponent and the reference load.
-pub const KEYS: &[TermKey] = &[
+const KEYS: &[TermKey] = &[
     TermKey {
         key: "contact.width_load_exponent",
         symbol: "κ",
@@ -62,6 +63,74 @@ impl Default for WidthLaw {
             exponent: 0.0,
             reference_load: 20_762.0,
         }
+    }
+}
+
+/// B(F)/B of the solve in progress (1: the reference width).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WidthScale(pub f64);
+
+impl Default for WidthScale {
+    fn default() -> Self {
+        Self(1.0)
+    }
+}
+
+impl FrictionTerm for WidthLaw {
+    const KEYS: &'static [TermKey] = KEYS;
+    const PLACE: Place = Place::Film;
+    /// The scale the solve in progress reports the film's forces with,
+    /// set by the solver from the load ([`WidthLaw::scale`]).
+    type State = WidthScale;
+
+    fn is_on(&self) -> bool {
+        self.exponent != 0.0
+    }
+
+    fn force(&self, _: &At) -> f64 {
+        0.0
+    }
+
+    fn carried(&self, _: &At) -> f64 {
+        0.0
+    }
+
+    fn beside(&self, _: &At) -> f64 {
+        0.0
+    }
+
+    fn cof(&self, _: &At) -> f64 {
+        0.0
+    }
+
+    fn carry(&self, level: f64, _: f64, _: &mut WidthScale, _: BristleMove) -> f64 {
+        level
+    }
+
+    fn steady_state(&self, _: f64, state: WidthScale) -> WidthScale {
+        state
+    }
+
+    fn swapped(&self, _: &Self, state: WidthScale, _: Option<f64>) -> WidthScale {
+        state
+    }
+
+    fn get(&self, key: &str) -> Option<f64> {
+        match key {
+            "contact.width_load_exponent" => Some(self.exponent),
+            "contact.width_reference_load_n" => Some(self.reference_load),
+            _ => None,
+        }
+    }
+
+    fn set(&mut self, key: &str, value: f64) -> bool {
+        let slot = match key {
+            "contact.width_load_exponent" => &mut self.exponent,
+            "contact.width_reference_load_n" => &mut self.reference_load,
+            _ => return false,
+        };
+        *slot = value;
+        true
     }
 }
 
