@@ -175,7 +175,7 @@ fn message_of(path: &str) -> Vec<(String, String)> {
 /// The loop's statistics on the wire mirror `LoopStatistics.msg`: its
 /// fields in its order, each commented field documented with its comment.
 /// (The record groups them and the iceoryx2 payload packs them in fixed
-/// arrays; both convert through the wire struct's tests.)
+/// arrays: see the next test.)
 #[test]
 fn the_wire_statistics_carry_the_messages_fields_in_order_with_its_docs() {
     let msg = message_of("msg/msg/LoopStatistics.msg");
@@ -193,4 +193,93 @@ fn the_wire_statistics_carry_the_messages_fields_in_order_with_its_docs() {
             );
         }
     }
+}
+
+/// A message comment as a doc sentence starts: capitalised, no final stop.
+fn sentence(comment: &str) -> String {
+    let mut c = comment.chars();
+    let first = c.next().map(|f| f.to_uppercase().collect::<String>());
+    format!("{}{}", first.unwrap_or_default(), c.as_str())
+        .trim_end_matches('.')
+        .to_string()
+}
+
+/// The loop's record of its statistics and the iceoryx2 payload carry every
+/// field of `LoopStatistics.msg`, by its name or in a group the test names
+/// (the stamp, the recorder's counters, the p50/p99/max arrays, the latest
+/// input outside the calibrated range), and each field named as the
+/// message's is documented with the message's comment (what a shape adds,
+/// a code list or a unit, follows it).
+#[test]
+fn the_statistics_record_and_payload_carry_the_messages_fields_with_its_docs() {
+    let msg = message_of("msg/msg/LoopStatistics.msg");
+    let record = shape("src/msgs/records.rs", "StatisticsRecord");
+    let recording = shape("src/msgs/records.rs", "RecordingStatus");
+    let payload = shape("src/transport/iceoryx/payloads.rs", "StatisticsPayload");
+    // Where a message field lives in a shape that groups it.
+    let grouped = |shape: &str, field: &str| -> Option<&'static str> {
+        let arrays = [
+            ("compute_time_p", "compute_time_ns"),
+            ("compute_time_max_ns", "compute_time_ns"),
+            ("period_jitter_", "period_jitter_ns"),
+        ];
+        if field == "header" {
+            return Some("stamp_ns");
+        }
+        if let Some((_, a)) = arrays.iter().find(|(p, _)| field.starts_with(p)) {
+            return Some(a);
+        }
+        match shape {
+            "record" if field.starts_with("recording_") || field.contains("snapshot") => {
+                Some("recording")
+            }
+            "record" if field.starts_with("outside_") => Some("last_outside"),
+            _ => None,
+        }
+    };
+    let comment = |f: &str| msg.iter().find(|(n, _)| n == f).map(|(_, c)| c.clone());
+    let mut checked = 0;
+    for (name, fields) in [("record", &record), ("payload", &payload)] {
+        let names: Vec<&str> = fields.iter().map(|(n, _)| n.as_str()).collect();
+        for (field, _) in &msg {
+            let there = names.contains(&field.as_str())
+                || grouped(name, field).is_some_and(|g| names.contains(&g));
+            assert!(there, "the statistics {name} lacks LoopStatistics.{field}");
+        }
+        for (field, doc) in fields {
+            let own = ["stamp_ns", "last_snapshot_len"].contains(&field.as_str())
+                || msg
+                    .iter()
+                    .any(|(m, _)| grouped(name, m) == Some(field.as_str()));
+            let Some(c) = comment(field) else {
+                assert!(
+                    own,
+                    "the statistics {name}'s `{field}` is not in LoopStatistics.msg"
+                );
+                continue;
+            };
+            let c = if c.is_empty() && field == "outside_max" {
+                comment("outside_min").unwrap()
+            } else {
+                c
+            };
+            assert!(
+                doc.starts_with(&sentence(&c)),
+                "the statistics {name}'s `{field}` doc `{doc}` is not the message's `{c}`"
+            );
+            checked += 1;
+        }
+    }
+    // The recorder's counters, under the record's `recording`.
+    for (field, doc) in &recording {
+        let c = comment(&format!("recording_{field}"))
+            .or_else(|| comment(field))
+            .unwrap_or_else(|| panic!("RecordingStatus.{field} is not in LoopStatistics.msg"));
+        assert!(
+            doc.starts_with(&sentence(&c)),
+            "RecordingStatus.{field}: `{doc}`, not `{c}`"
+        );
+        checked += 1;
+    }
+    assert!(checked > 50, "{checked} docs checked");
 }

@@ -323,17 +323,17 @@ impl Note {
 /// What the recorder reports into the loop statistics.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct RecordingStatus {
-    /// Recording files started.
+    /// Recording files started (split recordings: one per split).
     pub files: u64,
-    /// Split files deleted for the budget.
+    /// Split files deleted to keep to recording.budget_bytes.
     pub files_deleted: u64,
-    /// Messages not recorded after a write error.
+    /// Messages not recorded because writing had failed (a full disk).
     pub lost: u64,
     /// Snapshot files written.
     pub snapshots: u64,
-    /// The latest snapshot file.
+    /// The latest snapshot file ("" before the first).
     pub last_snapshot: Note,
-    /// The time span it holds, s.
+    /// The time span it holds. In s.
     pub last_snapshot_span_s: f64,
 }
 
@@ -376,18 +376,17 @@ pub struct StatisticsRecord {
     pub compute_time_ns: [u64; 3],
     /// Lateness of the step start against its deadline: p50, p99, max, ns.
     pub period_jitter_ns: [u64; 3],
-    /// Steps whose solver status was not converged.
+    /// Steps whose solver status was not converged (iteration bound, non-finite, rejected input).
     pub steps_not_converged: u64,
-    /// Parameter changes applied while running.
+    /// Parameter changes applied while running (ros2 param set).
     pub parameter_updates: u64,
-    /// Contacts the loop steps.
+    /// Contacts the loop steps (1 without `contacts`).
     pub contacts: u32,
-    /// The contact whose step took longest since the previous statistics,
-    /// and that step's compute time, ns.
+    /// Index (configured order) of the contact whose step took longest since the previous LoopStatistics.
     pub slowest_contact: u32,
-    /// That contact's longest step compute time since the previous LoopStatistics (ns).
+    /// That contact's longest step compute time since the previous LoopStatistics. In ns.
     pub slowest_contact_compute_ns: u64,
-    /// Contact steps whose input lay outside the contact's calibrated range.
+    /// Contact steps whose input lay outside the contact's calibrated range (FrictionEstimate RANGE_OUTSIDE).
     pub steps_outside_calibrated_range: u64,
     /// The latest step outside a calibrated range since the previous
     /// statistics (`/diagnostics` names it).

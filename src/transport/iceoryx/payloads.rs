@@ -106,9 +106,9 @@ pub struct StatisticsPayload {
     pub recording_lost: u64,
     /// Snapshot files written.
     pub snapshots: u64,
-    /// The time span it holds.
+    /// The time span it holds. In s.
     pub last_snapshot_span_s: f64,
-    /// UTF-8, `last_snapshot_len` bytes used.
+    /// The latest snapshot file ("" before the first). UTF-8, `last_snapshot_len` bytes used.
     pub last_snapshot: [u8; 255],
     /// Bytes of `last_snapshot` used.
     pub last_snapshot_len: u8,
@@ -122,26 +122,24 @@ pub struct StatisticsPayload {
     pub parameter_updates: u64,
     /// Contacts the loop steps (1 without `contacts`).
     pub contacts: u32,
-    /// Index (configured order) of the contact whose step took longest since the previous
-    /// LoopStatistics.
+    /// Index (configured order) of the contact whose step took longest since the previous LoopStatistics.
     pub slowest_contact: u32,
-    /// That contact's longest step compute time since the previous LoopStatistics.
+    /// That contact's longest step compute time since the previous LoopStatistics. In ns.
     pub slowest_contact_compute_ns: u64,
-    /// Contact steps whose input lay outside the contact's calibrated range.
+    /// Contact steps whose input lay outside the contact's calibrated range (FrictionEstimate RANGE_OUTSIDE).
     pub steps_outside_calibrated_range: u64,
-    /// The latest step outside since the previous statistics: its input
-    /// (0 none, 1 speed forward, 2 speed backward, 3 load, 4 temperature) …
+    /// The latest input outside a calibrated range since the previous LoopStatistics: speed forward, speed backward, load or temperature ("" none). Coded: 0 none, 1 speed forward, 2 speed backward, 3 load, 4 temperature.
     pub outside_input: u8,
-    /// … its contact …
+    /// Its contact (configured order).
     pub outside_contact: u32,
-    /// … the unit of its value and range (0 m/s, 1 rad/s, 2 N, 3 °C) …
+    /// Their unit: m/s, rad/s (a rotary joint's speed: the joint's), N or °C. Coded: 0 m/s, 1 rad/s, 2 N, 3 °C.
     pub outside_unit: u8,
-    /// … its value (its range's units) …
+    /// Its value, in its range's units (a joint's speed: the joint's).
     pub outside_value: f64,
-    /// … and the range it left.
-    pub outside_lo: f64,
-    /// See `outside_lo`.
-    pub outside_hi: f64,
+    /// The calibrated range it left. Its lower end.
+    pub outside_min: f64,
+    /// The calibrated range it left. Its upper end.
+    pub outside_max: f64,
 }
 
 impl From<&StatisticsRecord> for StatisticsPayload {
@@ -187,8 +185,8 @@ impl From<&StatisticsRecord> for StatisticsPayload {
                 .map_or(0, |o| crate::msgs::OutsideEvent::input_code(o.input)),
             outside_contact: s.last_outside.map_or(0, |o| o.contact),
             outside_value: s.last_outside.map_or(0.0, |o| o.value),
-            outside_lo: s.last_outside.map_or(0.0, |o| o.lo),
-            outside_hi: s.last_outside.map_or(0.0, |o| o.hi),
+            outside_min: s.last_outside.map_or(0.0, |o| o.lo),
+            outside_max: s.last_outside.map_or(0.0, |o| o.hi),
             outside_unit: s
                 .last_outside
                 .map_or(0, |o| crate::msgs::OutsideEvent::unit_code(o.unit)),
@@ -238,8 +236,8 @@ impl From<&StatisticsPayload> for StatisticsRecord {
                     contact: s.outside_contact,
                     input,
                     value: s.outside_value,
-                    lo: s.outside_lo,
-                    hi: s.outside_hi,
+                    lo: s.outside_min,
+                    hi: s.outside_max,
                     unit: crate::msgs::OutsideEvent::unit_of_code(s.outside_unit),
                 }
             }),
