@@ -1,8 +1,11 @@
 //! friction-node: a physics-based, real-time estimate of sliding friction.
 //!
 //! The [`physics`] module is the model core (no I/O, no clock, no logging);
-//! everything else carries it to and from the world. Layers, lowest first:
-//! the core; configuration, inputs and tables; messages and transports;
+//! everything else carries it to and from the world. Layers, lowest first,
+//! each importing only from the layers below it (no file imports upward,
+//! and no two files import each other but a `mod.rs` and its children):
+//! the core; the messages (wire structs mirroring `msg/*.msg`, the wire
+//! choices); configuration, inputs and tables; the links and transports;
 //! the loop (node, contacts) and recording; offline work (simulate, replay,
 //! fit, studies, benches) on top.
 //!
