@@ -621,6 +621,37 @@ mod tests {
     }
 
     #[test]
+    fn the_fit_recomposes_a_term_added_to_the_list_as_the_solver_computes_it() {
+        // physics/terms/test_term.rs: a term added in its file and one line
+        // of the list. The fit sets its key on the terms and recomposes the
+        // friction along the kept film, with the bristle carrying it.
+        let mut config = Config::default();
+        config.solver.cells = 32;
+        config.contact.presliding_stiffness_n_m = 5e7;
+        let t: Vec<f64> = (0..=150).map(|k| k as f64 * 1e-3).collect();
+        let v: Vec<f64> = t.iter().map(|t| 0.02 * (20.0 * t).sin()).collect();
+        let s = series(t.clone(), v.clone(), false);
+        let (_, trace) = transient(&config, &s).unwrap();
+        let mut terms = config.model().terms;
+        assert!(terms.set("probe.drag_n", 40.0));
+        let got = trace.compose(&terms, &s);
+        let mut model = config.model();
+        model.terms.probe.drag = 40.0;
+        let mut solver = Solver::new(&model, &config.solver_settings()).unwrap();
+        let first = solver.initialize_steady(v[0], config.contact.load_n);
+        assert_relative_eq!(got[0], first.friction_force, max_relative = 1e-9);
+        for k in 1..t.len() {
+            let e = solver.step(v[k], config.contact.load_n);
+            assert_relative_eq!(
+                got[k],
+                e.friction_force,
+                max_relative = 1e-9,
+                epsilon = 1e-9
+            );
+        }
+    }
+
+    #[test]
     fn a_series_that_starts_at_rest_is_predicted_as_simulate_ran_it() {
         // simulate starts at rest at t = 0 and writes its first row at t = dt:
         // with the bristle on, a start in steady sliding would begin it fully
