@@ -11,9 +11,9 @@
 
 use crate::config::Config;
 use crate::fit::driver::{fit, FitOutcome};
+use crate::fit::models_table::{models_table, ModelRow};
 use crate::fit::options::Options;
 use crate::fit::prepare::data_scale;
-use crate::fit::report::{models_table, ModelRow};
 use crate::fit::synthetic::{
     model_friction, motion, noisy_csv, two_amplitudes_two_loads, Sample, Segment,
 };

@@ -29,7 +29,9 @@
 //! | `trial.rs` | one set of terms tried: fitted on the training data, scored by cross-validation |
 //! | `candidates.rs` | the candidate terms, the keys of a set, which candidates the data allow, the keys `--fit auto` starts from |
 //! | `compare.rs` | ours and the classic models fitted on the same data with the same optimiser |
-//! | `report.rs` | the summary, the tables, plots, the fitted YAML |
+//! | `report.rs` | the summary, the parameter tables, the report folder, the fitted YAML |
+//! | `models_table.rs` | the models table: ours and each classic on the same yardstick; the verdict |
+//! | `report_plots.rs` | a report's plots: fit and residuals per series, every model's residual against velocity |
 //! | `by_direction.rs` | the residual by direction of motion: level and offset errors |
 //! | `calibrated_range.rs` | the calibrated range from the training samples (into the fitted file); where held-out data lie against it, the error inside and outside |
 //! | `cross_validate.rs` | cross-validation by what a calibration is used for: the folds (files, time blocks, speed ranges) and each fold's refit |
@@ -67,6 +69,7 @@ pub mod error;
 mod expr;
 pub mod inputs;
 pub mod local_run;
+pub mod models_table;
 pub mod multistart;
 pub mod options;
 pub mod physics_model;
@@ -74,6 +77,8 @@ pub mod prepare;
 pub mod prepared;
 pub mod problem;
 pub mod report;
+#[cfg(feature = "plots")]
+pub mod report_plots;
 pub mod request;
 pub mod reversals;
 pub mod select;

@@ -166,8 +166,11 @@ impl FitRequest {
             say(s);
         }
         let verdict = if self.baselines {
-            extra_md.push_str(&super::report::models_section(&ours.outcome, &classic));
-            super::report::verdict(&ours.outcome, &classic)
+            extra_md.push_str(&super::models_table::models_section(
+                &ours.outcome,
+                &classic,
+            ));
+            super::models_table::verdict(&ours.outcome, &classic)
         } else {
             String::new()
         };

@@ -6,8 +6,8 @@ use crate::model::load_config;
 use friction_node::fit::compare::OursFitted;
 use friction_node::fit::inputs::{DataRequest, TopicChoice};
 use friction_node::fit::options::{LabelledProgress, SearchSettings};
-use friction_node::fit::report;
 use friction_node::fit::request::{param_specs, FitOutputs, FitRequest};
+use friction_node::fit::{models_table, report};
 use friction_node::fit::{Delimiter, FitOutcome, Mapping};
 use numpy::PyArray1;
 use pyo3::prelude::*;
@@ -278,7 +278,7 @@ fn fit_dict<'py>(
     if let Some(classic) = classic {
         d.set_item(
             "models_table",
-            report::models_table_of(&ours.outcome, classic),
+            models_table::models_table_of(&ours.outcome, classic),
         )?;
         let all: Vec<&FitOutcome> = std::iter::once(&ours.outcome).chain(classic).collect();
         d.set_item(

@@ -1,0 +1,215 @@
+//! The models table: ours and each classic model on the same yardstick
+//! (training, cross-validated and held-out error), and the plain verdict
+//! that leads a report's summary.
+
+use super::driver::FitOutcome;
+use crate::text::Num;
+use std::fmt::Write as _;
+
+/// A parameter's value as it acts on the data's axis (our model behind a
+/// gain), e.g. `2.1e-4 N·m` on a joint; empty for a property of the
+/// contact itself or without a gain.
+pub(super) fn on_joint(o: &FitOutcome, name: &str, value: f64) -> String {
+    o.contact_scale
+        .as_ref()
+        .and_then(|j| super::contact_scale::joint_equivalent(name, value, j.gain, o.units))
+        .map_or(String::new(), |(v, unit)| {
+            format!("{} {unit}", Num::sig(v, 5))
+        })
+}
+
+/// One row of the baselines table.
+#[derive(Debug, Clone)]
+pub struct ModelRow {
+    /// The model's name.
+    pub label: String,
+    /// Its fitted parameters: name, value, and the value as it acts on a
+    /// rotary joint when it differs (else empty).
+    pub parameters: Vec<(String, f64, String)>,
+    /// The data's units.
+    pub units: super::Units,
+    /// RMS residual on the training samples, N.
+    pub train_rms: f64,
+    /// Cross-validated RMS on the training data's folds, N.
+    pub cv_rms: Option<f64>,
+    /// RMS residual on the held-out samples, N.
+    pub held_out_rms: Option<f64>,
+    /// Why there is no held-out prediction, when there is none.
+    pub held_out_failure: Option<String>,
+    /// Whether its fit converged.
+    pub converged: bool,
+    /// How the best local run ended.
+    pub termination: String,
+    /// ½ Σ r² on the fitted samples, N².
+    pub cost: f64,
+}
+
+impl From<&FitOutcome> for ModelRow {
+    fn from(o: &FitOutcome) -> Self {
+        Self {
+            label: o.label.clone(),
+            units: o.units,
+            // Ours on a joint: a term's contact value with what it is on
+            // the joint; a classic model: its names in the data's units.
+            parameters: o
+                .params
+                .iter()
+                .zip(&o.best)
+                .map(|(p, v)| {
+                    let joint = match on_joint(o, &p.name, *v) {
+                        j if j.is_empty() => j,
+                        j if o.units == super::Units::Rotary => format!("{j} on the joint"),
+                        j => format!("{j} on the axis"),
+                    };
+                    let name = if o.contact_scale.is_some() {
+                        p.name.clone()
+                    } else {
+                        super::baselines::parameter_name(&p.name, o.units)
+                    };
+                    (name, *v, joint)
+                })
+                .collect(),
+            train_rms: o.train_rms,
+            cv_rms: o.fold_mse.as_deref().map(super::cross_validate::cv_rms),
+            held_out_rms: o.held_out_rms(),
+            held_out_failure: o.validate_failure.clone(),
+            converged: o.converged,
+            termination: o
+                .optima
+                .first()
+                .map_or(String::new(), |r| r.termination.clone()),
+            cost: o.optima.first().map_or(f64::NAN, |r| r.cost),
+        }
+    }
+}
+
+/// Model | parameters | training RMS | held-out RMS (relative to `floor_n`
+/// when given).
+pub fn models_table(rows: &[ModelRow], scale_n: f64) -> String {
+    let u = rows.first().map_or("N", |r| r.units.force());
+    let mut s = format!(
+        "| model | n | parameters | fit | training RMS ({u}) | CV RMS ({u}) | held-out RMS ({u}) | held-out / friction scale |\n|---|---|---|---|---|---|---|---|\n",
+    );
+    for r in rows {
+        let params: Vec<String> = r
+            .parameters
+            .iter()
+            .map(|(n, v, joint)| {
+                if joint.is_empty() {
+                    format!("{n}={}", Num::sig(*v, 4))
+                } else {
+                    format!("{n}={} ({joint})", Num::sig(*v, 4))
+                }
+            })
+            .collect();
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {} | {} | {} | {} |",
+            r.label,
+            r.parameters.len(),
+            params.join(", "),
+            if r.converged {
+                "converged".to_string()
+            } else {
+                format!(
+                    "NOT converged: {}",
+                    r.termination
+                        .trim_start_matches("not converged: ")
+                        .replace('|', "/")
+                )
+            },
+            Num::sig(r.train_rms, 5),
+            r.cv_rms
+                .map_or("–".to_string(), |c| Num::sig(c, 5).to_string()),
+            match (&r.held_out_rms, &r.held_out_failure) {
+                (Some(h), _) => Num::sig(*h, 5).to_string(),
+                (None, Some(why)) => format!("none: {}", why.replace('|', "/")),
+                (None, None) => "–".into(),
+            },
+            r.held_out_rms
+                .map_or("–".into(), |h| format!("{:.1} %", 100.0 * h / scale_n)),
+        );
+    }
+    let _ = writeln!(
+        s,
+        "\nCV RMS: the training data's folds, each predicted by the model refitted without it (the same folds for every model). held-out / friction scale: the held-out RMS divided by the RMS of the measured friction on the held-out samples ({} {u}), the same for every model.",
+        Num::sig(scale_n, 5)
+    );
+    s
+}
+
+/// RMS of the measured friction on held-out samples (validation data, else
+/// the held-out parts), N: the scale of the held-out error.
+pub fn held_out_scale(o: &FitOutcome) -> f64 {
+    let fits = if o.validate.is_empty() {
+        &o.held_out
+    } else {
+        &o.validate
+    };
+    let (ss, n) = fits
+        .iter()
+        .flat_map(|sf| sf.series.friction.iter())
+        .fold((0.0, 0usize), |(ss, n), f| (ss + f * f, n + 1));
+    (ss / n.max(1) as f64).sqrt()
+}
+
+/// Which model predicts best, in one sentence for the summary's first
+/// lines: on the held-out data when there are any, else cross-validated
+/// on the training data's folds; said plainly when ours is not the best.
+pub fn verdict(ours: &FitOutcome, classic: &[FitOutcome]) -> String {
+    let held = ours.held_out_rms().is_some();
+    let score = |o: &FitOutcome| -> Option<f64> {
+        if held {
+            o.held_out_rms()
+        } else {
+            o.fold_mse.as_deref().map(super::cross_validate::cv_rms)
+        }
+    };
+    let what = if held { "held-out" } else { "cross-validated" };
+    let u = ours.units.force();
+    let Some(mine) = score(ours) else {
+        return String::new();
+    };
+    let best = classic
+        .iter()
+        .filter_map(|o| score(o).map(|s| (o, s)))
+        .min_by(|a, b| a.1.total_cmp(&b.1));
+    let Some((b, theirs)) = best else {
+        return String::new();
+    };
+    if mine <= theirs {
+        format!(
+            "**Verdict:** ours predicts best: {what} RMS {} {u}, the best classic model ({}) {} {u} ({:.1} % lower).",
+            Num::sig(mine, 5),
+            b.label,
+            Num::sig(theirs, 5),
+            100.0 * (1.0 - mine / theirs)
+        )
+    } else {
+        format!(
+            "**Verdict: ours is not the best here.** {} predicts better: {what} RMS {} {u} against ours {} {u} ({:.1} % higher). Use it, or the terms it points at (see the models table).",
+            b.label,
+            Num::sig(theirs, 5),
+            Num::sig(mine, 5),
+            100.0 * (mine / theirs - 1.0)
+        )
+    }
+}
+
+/// The models table of ours and the classic models fitted beside it.
+pub fn models_table_of(ours: &FitOutcome, classic: &[FitOutcome]) -> String {
+    let mut rows = vec![ModelRow::from(ours)];
+    rows.extend(classic.iter().map(ModelRow::from));
+    models_table(&rows, held_out_scale(ours))
+}
+
+/// The comparison section of a fit with classic models (markdown): the
+/// models table, then every model's level and offset error by source.
+pub fn models_section(ours: &FitOutcome, classic: &[FitOutcome]) -> String {
+    let all: Vec<&FitOutcome> = std::iter::once(ours).chain(classic).collect();
+    format!(
+        "## Models on the same data, same optimiser\n\n{}\n## Error by direction of motion, every model\n\n{}",
+        models_table_of(ours, classic),
+        super::by_direction::models_direction_table(&all)
+    )
+}
