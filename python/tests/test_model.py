@@ -142,6 +142,30 @@ def test_fit_recovers_boundary_friction_and_equals_the_cli(cli, tmp_path):
     assert r.fitted_yaml == out.read_text()
 
 
+def test_a_fit_from_python_writes_the_report_the_cli_writes_section_for_section(cli, tmp_path):
+    # One flow (fit/request.rs) for both: the same sections, --fit auto's
+    # "Terms chosen by the data" and the models table included.
+    truth = fn.Model(**{"solver.cells": 16, "contact.boundary_friction": 0.22,
+                        "drivetrain.viscous_n_s_m": 400.0})
+    t = np.arange(1001) * truth.dt
+    v = 0.5 * np.sin(2 * np.pi * t)
+    run = truth.run(t, v)
+    data = tmp_path / "data.csv"
+    np.savetxt(data, np.column_stack([t, v, run["friction_n"]]), delimiter=",",
+               header="t_s,velocity_m_s,friction_n", comments="")
+    fn.fit(data, ["auto"], overrides={"solver.cells": 16}, baselines=True, starts=1,
+           global_points=0, max_evaluations=40, report=tmp_path / "py")
+    cli("--set", "solver.cells=16", "fit", data, "--fit", "auto", "--baselines", "--starts", "1",
+        "--global-points", "0", "--max-evaluations", "40", "--report", tmp_path / "cli")
+
+    def sections(d):
+        return [l for l in (d / "summary.md").read_text().splitlines() if l.startswith("#")]
+
+    assert sections(tmp_path / "py") == sections(tmp_path / "cli")
+    assert any("Terms chosen" in s for s in sections(tmp_path / "py")), sections(tmp_path / "py")
+    assert any("Models" in s for s in sections(tmp_path / "py")), sections(tmp_path / "py")
+
+
 def test_a_rotary_fit_takes_rad_s_and_newton_metres_and_equals_the_cli(cli, tmp_path):
     truth = fn.Model(**{"solver.cells": 32})
     t = np.arange(2001) * truth.dt
