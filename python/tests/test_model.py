@@ -156,7 +156,8 @@ def test_a_fit_from_python_writes_the_report_the_cli_writes_section_for_section(
     fn.fit(data, ["auto"], overrides={"solver.cells": 16}, baselines=True, starts=1,
            global_points=0, max_evaluations=40, report=tmp_path / "py")
     cli("--set", "solver.cells=16", "fit", data, "--fit", "auto", "--baselines", "--starts", "1",
-        "--global-points", "0", "--max-evaluations", "40", "--report", tmp_path / "cli")
+        "--global-points", "0", "--max-evaluations", "40", "--report", tmp_path / "cli",
+        "--out", tmp_path / "cli.yaml")
 
     def sections(d):
         return [l for l in (d / "summary.md").read_text().splitlines() if l.startswith("#")]
