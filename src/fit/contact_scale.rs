@@ -126,6 +126,45 @@ fn transition_speed(config: &Config, load: f64) -> Result<f64, FitError> {
     Ok(SPEEDS_M_S.1)
 }
 
+/// The root of `g`, increasing, in `bracket` (ln F, its end when `g` has
+/// no sign change there): secant steps from `start`, kept inside the
+/// bracket; a step that leaves it bisects.
+fn root_in(
+    g: impl Fn(f64) -> Result<f64, FitError>,
+    (mut a, mut b): (f64, f64),
+    start: f64,
+) -> Result<f64, FitError> {
+    if g(a)? >= 0.0 {
+        return Ok(a);
+    }
+    if g(b)? <= 0.0 {
+        return Ok(b);
+    }
+    let mut x = start.clamp(a, b);
+    let mut gx = g(x)?;
+    let mut x_prev = if x + 1.0 <= b { x + 1.0 } else { x - 1.0 };
+    let mut g_prev = g(x_prev)?;
+    for _ in 0..40 {
+        if gx.abs() < 1e-3 {
+            break;
+        }
+        if gx < 0.0 {
+            a = x;
+        } else {
+            b = x;
+        }
+        let slope = (gx - g_prev) / (x - x_prev);
+        let mut next = x - gx / slope;
+        if !(slope > 0.0 && next > a && next < b) {
+            next = 0.5 * (a + b);
+        }
+        (x_prev, g_prev) = (x, gx);
+        x = next;
+        gx = g(x)?;
+    }
+    Ok(x)
+}
+
 /// Choose g and F_N for data whose top speed is `top` (m/s or rad/s) and
 /// sliding level `level` (N or N·m), on `config`'s contact, within the
 /// node's limits.
@@ -158,38 +197,8 @@ pub fn choose(
         let f = ln_f.exp();
         Ok((f * transition_speed(config, f)?).ln() - target)
     };
-    let (mut a, mut b) = (limits.load.0.ln(), limits.load.1.ln());
-    let ln_f = if g(a)? >= 0.0 {
-        a
-    } else if g(b)? <= 0.0 {
-        b
-    } else {
-        // Secant steps from the configured load, kept inside the bracket
-        // [a, b] (g(a) < 0 < g(b)); a step that leaves it bisects.
-        let mut x = config.contact.load_n.ln().clamp(a, b);
-        let mut gx = g(x)?;
-        let mut x_prev = if x + 1.0 <= b { x + 1.0 } else { x - 1.0 };
-        let mut g_prev = g(x_prev)?;
-        for _ in 0..40 {
-            if gx.abs() < 1e-3 {
-                break;
-            }
-            if gx < 0.0 {
-                a = x;
-            } else {
-                b = x;
-            }
-            let slope = (gx - g_prev) / (x - x_prev);
-            let mut next = x - gx / slope;
-            if !(slope > 0.0 && next > a && next < b) {
-                next = 0.5 * (a + b);
-            }
-            (x_prev, g_prev) = (x, gx);
-            x = next;
-            gx = g(x)?;
-        }
-        x
-    };
+    let bracket = (limits.load.0.ln(), limits.load.1.ln());
+    let ln_f = root_in(g, bracket, config.contact.load_n.ln())?;
     let mut load_n = ln_f.exp();
     let mut gain = level / (mu * load_n);
     // The node's limits on the gain and the contact's speed bound the gain

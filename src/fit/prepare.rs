@@ -172,16 +172,14 @@ fn rotary_columns(mapping: &super::Mapping, table: &super::Table) -> super::Mapp
 /// whether its velocity is in deg/s.
 const FAST_JOINT_RAD_S: f64 = 20.0;
 
-/// Read the data and set up the parameters (everything checked before any
-/// simulation).
-pub fn prepare(
-    config: &Config,
-    req: &DataRequest,
-    params: &[ParamSpec],
-    auto: bool,
-) -> Result<Prepared, FitError> {
-    req.check()?;
-    let mut notes = Vec::new();
+/// Training, held-out and validation sources.
+type Sources = (Vec<Source>, Vec<Source>, Vec<Source>);
+
+/// The training, held-out and validation sources of `req`, each file read
+/// (its notes into `notes`). `--holdout` cuts each training file in two
+/// here, before anything reads it: from then on every choice sees the
+/// training part alone.
+fn read_sources(req: &DataRequest, notes: &mut Vec<String>) -> Result<Sources, FitError> {
     let mut source = |p: &PathBuf| -> Result<Source, FitError> {
         let (table, note) = req.table(p)?;
         notes.extend(note);
@@ -202,29 +200,23 @@ pub fn prepare(
         .iter()
         .map(&mut source)
         .collect::<Result<Vec<_>, _>>()?;
-    // --holdout cuts each training file in two here, before anything reads
-    // it: from now on every choice sees the training part alone.
-    let (train, held_out) = if req.holdout > 0.0 {
+    if req.holdout > 0.0 {
         let parts = given
             .iter()
             .map(|s| s.split_held_out(req.holdout, &req.mapping))
             .collect::<Result<Vec<_>, _>>()?;
-        parts.into_iter().unzip()
+        let (train, held_out) = parts.into_iter().unzip();
+        Ok((train, held_out, validate))
     } else {
-        (given, Vec::new())
-    };
-    let mapping = &req.mapping;
-    let map_names: Vec<String> = mapping.coefficients.iter().map(|c| c.0.clone()).collect();
-    let map_values: Vec<f64> = mapping.coefficients.iter().map(|c| c.1).collect();
-    let load_n = config.contact.load_n;
-    let (scale, mean_abs_n, loads_vary) = data_scale(&train, &map_values, load_n)?;
-    let load_given = train
-        .iter()
-        .map(|s| s.series(&map_values).map(|se| se.load.is_some()))
-        .collect::<Result<Vec<_>, _>>()?
-        .into_iter()
-        .any(|g| g);
-    let (key_specs, map_fit) = split_specs(params, &map_names, &map_values)?;
+        Ok((given, Vec::new(), validate))
+    }
+}
+
+/// What the data cannot tell or may have wrong, said before the fit: a
+/// pre-sliding key without a reversal to identify it, a joint too fast
+/// for rad/s.
+fn data_warnings(req: &DataRequest, scale: &DataScale, key_specs: &[ParamSpec]) -> Vec<String> {
+    let mut notes = Vec::new();
     if scale.reversal_stiffness_n_m.is_none() {
         for s in key_specs.iter().filter(|s| s.name.contains("presliding_")) {
             notes.push(format!(
@@ -240,6 +232,33 @@ pub fn prepare(
             crate::text::Num(scale.velocity_m_s.to_degrees().round())
         ));
     }
+    notes
+}
+
+/// Read the data and set up the parameters (everything checked before any
+/// simulation).
+pub fn prepare(
+    config: &Config,
+    req: &DataRequest,
+    params: &[ParamSpec],
+    auto: bool,
+) -> Result<Prepared, FitError> {
+    req.check()?;
+    let mut notes = Vec::new();
+    let (train, held_out, validate) = read_sources(req, &mut notes)?;
+    let mapping = &req.mapping;
+    let map_names: Vec<String> = mapping.coefficients.iter().map(|c| c.0.clone()).collect();
+    let map_values: Vec<f64> = mapping.coefficients.iter().map(|c| c.1).collect();
+    let load_n = config.contact.load_n;
+    let (scale, mean_abs_n, loads_vary) = data_scale(&train, &map_values, load_n)?;
+    let load_given = train
+        .iter()
+        .map(|s| s.series(&map_values).map(|se| se.load.is_some()))
+        .collect::<Result<Vec<_>, _>>()?
+        .into_iter()
+        .any(|g| g);
+    let (key_specs, map_fit) = split_specs(params, &map_names, &map_values)?;
+    notes.extend(data_warnings(req, &scale, &key_specs));
     // The scale is chosen for a joint's data, and under --fit auto for
     // data that do not give the load when the configuration does not
     // either: a `contact.load_n` other than the default is the user's

@@ -157,8 +157,54 @@ impl FitRequest {
             // Said at once: a stop during the classic models keeps it.
             say(&format!("wrote {} (complete)", o.display()));
         }
+        let Classics {
+            classic,
+            skipped,
+            verdict,
+            report_files,
+        } = self.classics_and_report(&p, &ours, &mut extra_md, outputs, progress, stop, &say)?;
+        if let Some(d) = report_dir {
+            d.keep();
+        }
+        Ok(Calibration {
+            prepared: p,
+            selection,
+            ours,
+            classic,
+            skipped,
+            yaml,
+            verdict,
+            extra_md,
+            report_files,
+        })
+    }
+}
+
+/// What follows our fit: the classic models, the verdict, the report's files.
+struct Classics {
+    classic: Vec<FitOutcome>,
+    skipped: Vec<String>,
+    verdict: String,
+    report_files: Vec<PathBuf>,
+}
+
+impl FitRequest {
+    /// The classic models on the same data (when asked), the models
+    /// section and verdict appended to `extra_md`, and the report folder
+    /// written (when asked).
+    #[allow(clippy::too_many_arguments)] // the flow's state, handed on once
+    fn classics_and_report(
+        &self,
+        p: &Prepared,
+        ours: &OursFitted,
+        extra_md: &mut String,
+        outputs: &FitOutputs,
+        progress: Option<&LabelledProgress>,
+        stop: &Stop,
+        say: &dyn Fn(&str),
+    ) -> Result<Classics, FitError> {
         let (classic, skipped) = if self.baselines {
-            fit_baselines(&p, &self.search, progress, stop)?
+            fit_baselines(p, &self.search, progress, stop)?
         } else {
             (Vec::new(), Vec::new())
         };
@@ -176,31 +222,18 @@ impl FitRequest {
         };
         let mut report_files = Vec::new();
         if let Some(r) = &outputs.report {
-            report_files = super::report::write_models_report(
-                r,
-                &ours.outcome,
-                &classic,
-                &verdict,
-                &extra_md,
-            )?;
+            report_files =
+                super::report::write_models_report(r, &ours.outcome, &classic, &verdict, extra_md)?;
             say(&format!(
                 "report in {} ({} files)",
                 r.display(),
                 report_files.len()
             ));
         }
-        if let Some(d) = report_dir {
-            d.keep();
-        }
-        Ok(Calibration {
-            prepared: p,
-            selection,
-            ours,
+        Ok(Classics {
             classic,
             skipped,
-            yaml,
             verdict,
-            extra_md,
             report_files,
         })
     }

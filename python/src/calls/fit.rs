@@ -6,7 +6,7 @@ use crate::model::load_config;
 use friction_node::fit::compare::OursFitted;
 use friction_node::fit::inputs::{DataRequest, TopicChoice};
 use friction_node::fit::options::{LabelledProgress, SearchSettings};
-use friction_node::fit::request::{param_specs, FitOutputs, FitRequest};
+use friction_node::fit::request::{param_specs, Calibration, FitOutputs, FitRequest};
 use friction_node::fit::{models_table, report};
 use friction_node::fit::{Delimiter, FitOutcome, Mapping};
 use numpy::PyArray1;
@@ -194,6 +194,17 @@ pub fn fit<'py>(
         req.run(&config, &outputs, progress.as_ref(), stop)
     })?
     .map_err(errors::fit)?;
+    calibration_dict(py, &c, baselines)
+}
+
+/// What `fit` returns of a calibration: ours (and the classic models when
+/// `baselines`), the fitted file, the notes, the summary and the
+/// calibrated range.
+fn calibration_dict<'py>(
+    py: Python<'py>,
+    c: &Calibration,
+    baselines: bool,
+) -> PyResult<Bound<'py, PyDict>> {
     let d = fit_dict(py, &c.ours, baselines.then_some(&c.classic[..]), &c.yaml)?;
     let mut notes = c.prepared.notes.clone();
     notes.extend(c.skipped.iter().cloned());
