@@ -183,6 +183,26 @@ pub(super) fn set_keys(terms: &[&'static str]) -> Vec<&'static str> {
     keys
 }
 
+/// The lighter forms of candidate `t` that `set` does not hold: the
+/// candidates whose keys are a strict part of `t`'s (the Stribeck curve's
+/// viscous rise), `t`'s place taken by one of them when its other keys do
+/// not pay.
+pub(super) fn lighter_forms(t: &str, set: &[&'static str]) -> Vec<&'static str> {
+    let Some(big) = CANDIDATES.iter().find(|c| c.name == t) else {
+        return Vec::new();
+    };
+    CANDIDATES
+        .iter()
+        .filter(|c| {
+            c.name != t
+                && c.keys.len() < big.keys.len()
+                && c.keys.iter().all(|k| big.keys.contains(k))
+                && !set.contains(&c.name)
+        })
+        .map(|c| c.name)
+        .collect()
+}
+
 /// The candidates on `p`'s data: those whose keys can be set up (a
 /// candidate without bounds to derive, pre-sliding without a reversal, is
 /// not one here, and is returned with why), that the loads allow and that
@@ -278,5 +298,16 @@ mod tests {
         assert!(auto);
         assert_eq!(rest, vec!["a_eff".to_string(), "f0".to_string()]);
         assert!(!split(&["contact.boundary_friction".into()]).0);
+    }
+
+    #[test]
+    fn the_stribeck_curve_has_its_viscous_rise_as_its_lighter_form() {
+        assert_eq!(
+            lighter_forms("drivetrain Stribeck", &["pre-sliding"]),
+            vec!["drivetrain viscous"]
+        );
+        assert!(lighter_forms("drivetrain Stribeck", &["drivetrain viscous"]).is_empty());
+        assert!(lighter_forms("drivetrain viscous", &[]).is_empty());
+        assert!(lighter_forms("pre-sliding", &[]).is_empty());
     }
 }

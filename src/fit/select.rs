@@ -22,15 +22,19 @@
 //!    lowest cross-validated error — unless a candidate with fewer keys
 //!    predicts as well (the best does not pay for its extra keys over it,
 //!    by rule 3), then the smallest such; then a term chosen earlier that no
-//!    longer pays beside the new one is removed (so a first choice does not
-//!    block a better pair).
+//!    longer pays beside the new one is removed, or gives way to its
+//!    lighter form (a candidate whose keys are part of its own: the
+//!    Stribeck curve to its viscous rise), so that a first choice does not
+//!    block a better pair, nor a curve stand in for a term added later.
 //! 3. The cost of a term: it pays only if it lowers the folds' mean squared
 //!    error by more than [`TERM_COST`] (1 %) of it **and** by more than the
 //!    standard error of that lowering over the folds (the one-standard-error
 //!    rule, on the folds' paired differences); otherwise the selection
 //!    stops.
 //! 4. A term whose key ends at zero or at a bound, or correlates above 0.95
-//!    with another parameter, is dropped and the set fitted again.
+//!    with another parameter, is dropped (or reduced to a lighter form
+//!    without that key) and the set fitted again, unless that predicts
+//!    worse.
 //! 5. The film: when the contact's scale was chosen from the data (its
 //!    transition far above them, `contact_scale.rs`), the film candidate is
 //!    also started with viscosities that place the transition inside the
@@ -42,7 +46,9 @@
 //! The report lists every set tried with its CV error per fold, the set
 //! chosen and why the selection stopped.
 
-use super::candidates::{candidates_here, set_keys, set_specs, Candidate, CANDIDATES};
+use super::candidates::{
+    candidates_here, lighter_forms, set_keys, set_specs, Candidate, CANDIDATES,
+};
 use super::options::SearchSettings;
 use super::prepared::{model_for, Prepared};
 use super::trial::{Ctx, Scored, Tried};
@@ -278,33 +284,32 @@ impl Ctx<'_> {
             if older.is_empty() {
                 return Ok(current);
             }
-            let without: Vec<(&'static str, Scored)> = older
+            let alternatives: Vec<(&'static str, Option<&'static str>, Vec<&'static str>)> = older
+                .iter()
+                .flat_map(|t| lighter(&current.tried.terms, t, None))
+                .collect();
+            let scored: Vec<(&'static str, Option<&'static str>, Scored)> = alternatives
                 .par_iter()
-                .map(|t| {
-                    let terms: Vec<&'static str> = current
-                        .tried
-                        .terms
-                        .iter()
-                        .copied()
-                        .filter(|x| x != t)
-                        .collect();
-                    Ok((*t, self.try_set(&terms, &current.optimum)?))
-                })
+                .map(|(t, form, terms)| Ok((*t, *form, self.try_set(terms, &current.optimum)?)))
                 .collect::<Result<_, FitError>>()?;
-            tried.extend(without.iter().map(|(_, s)| s.tried.clone()));
-            // The one whose removal costs least, if it does not pay.
-            let Some((t, lighter)) = without
+            tried.extend(scored.iter().map(|(_, _, s)| s.tried.clone()));
+            // The one whose removal (or reduction) costs least, if the term
+            // does not pay over it.
+            let Some((t, form, lighter)) = scored
                 .into_iter()
-                .filter(|(_, s)| !pays(&s.tried, &current.tried).0)
-                .min_by(|a, b| a.1.tried.cv_rms.total_cmp(&b.1.tried.cv_rms))
+                .filter(|(_, _, s)| !pays(&s.tried, &current.tried).0)
+                .min_by(|a, b| a.2.tried.cv_rms.total_cmp(&b.2.tried.cv_rms))
             else {
                 return Ok(current);
             };
+            let change = change_text(t, form);
             say(&format!(
-                "auto: − {t}: no longer pays beside {newest} (CV RMS {})",
+                "auto: {change}: no longer pays beside {newest} (CV RMS {})",
                 cv(&lighter.tried, self.p)
             ));
-            removed.push(format!("{t}: no longer paid for itself beside {newest}"));
+            removed.push(format!(
+                "{change}: no longer paid for itself beside {newest}"
+            ));
             current = lighter;
         }
     }
@@ -328,55 +333,100 @@ impl Ctx<'_> {
                     return None;
                 }
                 let c = CANDIDATES.iter().find(|c| c.name == *t)?;
-                let why = c.keys.iter().find_map(|k| {
+                let (key, why) = c.keys.iter().find_map(|k| {
                     let (_, edge, rho) = current.flags.iter().find(|(n, _, _)| n == k)?;
                     if *edge {
-                        Some(format!("{k} ended at zero or at a bound"))
+                        Some((*k, format!("{k} ended at zero or at a bound")))
                     } else if *rho > super::stats::CORRELATION_FLAG {
-                        Some(format!(
-                            "{k} correlates {} with another parameter",
-                            crate::text::Num::sig(*rho, 3)
+                        Some((
+                            *k,
+                            format!(
+                                "{k} correlates {} with another parameter",
+                                crate::text::Num::sig(*rho, 3)
+                            ),
                         ))
                     } else {
                         None
                     }
                 })?;
-                Some((*t, why))
+                Some((*t, key, why))
             });
-            let Some((t, why)) = flagged else {
+            let Some((t, key, why)) = flagged else {
                 return Ok(current);
             };
-            let terms: Vec<&'static str> = current
-                .tried
-                .terms
-                .iter()
-                .copied()
-                .filter(|x| {
-                    *x != t
-                        && CANDIDATES
-                            .iter()
-                            .all(|c| c.name != *x || c.requires != Some(t))
-                })
-                .collect();
-            let next = self.try_set(&terms, &current.optimum)?;
-            tried.push(next.tried.clone());
-            if pays(&next.tried, &current.tried).0 {
+            // Its lighter forms without the flagged key, then the set
+            // without it: the best that the term does not pay over.
+            let scored: Vec<(Option<&'static str>, Scored)> =
+                lighter(&current.tried.terms, t, Some(key))
+                    .par_iter()
+                    .map(|(_, form, terms)| Ok((*form, self.try_set(terms, &current.optimum)?)))
+                    .collect::<Result<_, FitError>>()?;
+            tried.extend(scored.iter().map(|(_, s)| s.tried.clone()));
+            let best = scored
+                .into_iter()
+                .filter(|(_, s)| !pays(&s.tried, &current.tried).0)
+                .min_by(|a, b| a.1.tried.cv_rms.total_cmp(&b.1.tried.cv_rms));
+            let Some((form, next)) = best else {
                 say(&format!(
-                    "auto: {t} kept: {why}, but the set without it cross-validates worse (CV RMS {})",
-                    cv(&next.tried, self.p)
+                    "auto: {t} kept: {why}, but the set without it cross-validates worse"
                 ));
                 kept.push(t);
                 continue;
-            }
+            };
+            let change = change_text(t, form);
             say(&format!(
-                "auto: − {t}: {why}, and the set without it predicts as well (CV RMS {})",
+                "auto: {change}: {why}, and that set predicts as well (CV RMS {})",
                 cv(&next.tried, self.p)
             ));
-            removed.push(format!(
-                "{t}: {why}, and the set without it predicts as well"
-            ));
+            removed.push(format!("{change}: {why}, and that set predicts as well"));
             current = next;
         }
+    }
+}
+
+/// The sets lighter than `set` by its term `t`: `t` replaced by each of
+/// its lighter forms (those without `flagged_key`), then `t` removed with
+/// the terms that require it. Each as (t, the form taking its place, the
+/// set).
+fn lighter(
+    set: &[&'static str],
+    t: &'static str,
+    flagged_key: Option<&str>,
+) -> Vec<(&'static str, Option<&'static str>, Vec<&'static str>)> {
+    let mut out: Vec<(&'static str, Option<&'static str>, Vec<&'static str>)> =
+        lighter_forms(t, set)
+            .into_iter()
+            .filter(|form| {
+                let keys = CANDIDATES.iter().find(|c| c.name == *form).map(|c| c.keys);
+                !keys.is_some_and(|k| flagged_key.is_some_and(|f| k.contains(&f)))
+            })
+            .map(|form| {
+                let terms = set
+                    .iter()
+                    .map(|x| if *x == t { form } else { *x })
+                    .collect();
+                (t, Some(form), terms)
+            })
+            .collect();
+    let without = set
+        .iter()
+        .copied()
+        .filter(|x| {
+            *x != t
+                && CANDIDATES
+                    .iter()
+                    .all(|c| c.name != *x || c.requires != Some(t))
+        })
+        .collect();
+    out.push((t, None, without));
+    out
+}
+
+/// "− t", or "t → form" when a lighter form takes its place.
+fn change_text(t: &str, form: Option<&str>) -> String {
+    match form {
+        Some(f) => format!("{t} → {f}"),
+        None => format!("− {t}"),
     }
 }
 
@@ -392,7 +442,7 @@ fn cv(t: &Tried, p: &Prepared) -> String {
 pub fn report(s: &Selection, units: super::Units) -> String {
     let u = units.force();
     let mut md = format!(
-        "## Terms chosen by the data (`--fit auto`)\n\nRule: stepwise selection on cross-validation of the training data ({}; each fold predicted by the set refitted without it); each step takes the candidate with the lowest CV error, unless one with fewer keys predicts as well (the best does not pay for its extra keys over it); a term is added only if it lowers the folds' mean squared error by more than the standard error of that lowering and by more than {:.0} % of it (the cost of a term), and a term chosen earlier goes when it no longer pays beside a later one; a term that ends at zero or at a bound, or that the data cannot tell from another (|ρ| > 0.95), is dropped and the set fitted again unless that predicts worse. Neither --validate nor --holdout data are used.\n\n| set (boundary friction +) | CV RMS ({u}) | RMS per fold ({u}) | film solves |\n|---|---|---|---|\n",
+        "## Terms chosen by the data (`--fit auto`)\n\nRule: stepwise selection on cross-validation of the training data ({}; each fold predicted by the set refitted without it); each step takes the candidate with the lowest CV error, unless one with fewer keys predicts as well (the best does not pay for its extra keys over it); a term is added only if it lowers the folds' mean squared error by more than the standard error of that lowering and by more than {:.0} % of it (the cost of a term), and a term chosen earlier goes, or gives way to a lighter form of it (the Stribeck curve to its viscous rise), when it no longer pays beside a later one; a term that ends at zero or at a bound, or that the data cannot tell from another (|ρ| > 0.95), is dropped or reduced and the set fitted again unless that predicts worse. Neither --validate nor --holdout data are used.\n\n| set (boundary friction +) | CV RMS ({u}) | RMS per fold ({u}) | film solves |\n|---|---|---|---|\n",
         s.folds,
         100.0 * TERM_COST
     );
@@ -528,5 +578,40 @@ mod tests {
         // Lower on average, but not beyond the spread: does not pay.
         let (g, se) = paired(&[10.0, 11.0, 12.0, 13.0], &[8.0, 12.0, 10.0, 14.5]);
         assert!(g <= se, "{g} vs {se}");
+    }
+
+    #[test]
+    fn a_stribeck_curve_gives_way_to_its_viscous_rise_before_it_is_removed() {
+        let set = ["pre-sliding", "drivetrain Stribeck", "drivetrain quadratic"];
+        let alternatives = lighter(&set, "drivetrain Stribeck", None);
+        assert_eq!(
+            alternatives,
+            vec![
+                (
+                    "drivetrain Stribeck",
+                    Some("drivetrain viscous"),
+                    vec!["pre-sliding", "drivetrain viscous", "drivetrain quadratic"]
+                ),
+                (
+                    "drivetrain Stribeck",
+                    None,
+                    vec!["pre-sliding", "drivetrain quadratic"]
+                ),
+            ]
+        );
+        // A flag on the viscous key itself: its form would keep the flag.
+        let flagged = lighter(
+            &set,
+            "drivetrain Stribeck",
+            Some("drivetrain.viscous_n_s_m"),
+        );
+        assert_eq!(flagged.len(), 1);
+        assert_eq!(flagged[0].1, None);
+        // A term without a lighter form is only removed.
+        assert_eq!(lighter(&set, "pre-sliding", None).len(), 1);
+        assert_eq!(
+            change_text("drivetrain Stribeck", Some("drivetrain viscous")),
+            "drivetrain Stribeck → drivetrain viscous"
+        );
     }
 }
