@@ -147,22 +147,12 @@ impl FrictionTerm for BoundaryFilm {
         state
     }
 
-    fn get(&self, key: &str) -> Option<f64> {
+    fn slot(&mut self, key: &str) -> Option<&mut f64> {
         match key {
-            "contact.boundary_friction" => Some(self.friction),
-            "contact.sign_regularization_m_s" => Some(self.sign_regularization),
+            "contact.boundary_friction" => Some(&mut self.friction),
+            "contact.sign_regularization_m_s" => Some(&mut self.sign_regularization),
             _ => None,
         }
-    }
-
-    fn set(&mut self, key: &str, value: f64) -> bool {
-        let slot = match key {
-            "contact.boundary_friction" => &mut self.friction,
-            "contact.sign_regularization_m_s" => &mut self.sign_regularization,
-            _ => return false,
-        };
-        *slot = value;
-        true
     }
 }
 
@@ -230,22 +220,12 @@ impl FrictionTerm for BoundaryRate {
         state
     }
 
-    fn get(&self, key: &str) -> Option<f64> {
+    fn slot(&mut self, key: &str) -> Option<&mut f64> {
         match key {
-            "contact.boundary_friction_rate" => Some(self.sensitivity),
-            "contact.boundary_activation_speed_m_s" => Some(self.activation_speed),
+            "contact.boundary_friction_rate" => Some(&mut self.sensitivity),
+            "contact.boundary_activation_speed_m_s" => Some(&mut self.activation_speed),
             _ => None,
         }
-    }
-
-    fn set(&mut self, key: &str, value: f64) -> bool {
-        let slot = match key {
-            "contact.boundary_friction_rate" => &mut self.sensitivity,
-            "contact.boundary_activation_speed_m_s" => &mut self.activation_speed,
-            _ => return false,
-        };
-        *slot = value;
-        true
     }
 }
 

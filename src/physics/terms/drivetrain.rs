@@ -218,32 +218,17 @@ impl FrictionTerm for Drivetrain {
         state
     }
 
-    fn get(&self, key: &str) -> Option<f64> {
-        Some(match key {
-            "drivetrain.coulomb_n" => self.coulomb,
-            "drivetrain.viscous_n_s_m" => self.viscous,
-            "drivetrain.load_coefficient" => self.load_coefficient,
-            "drivetrain.quadratic_n_s2_m2" => self.quadratic,
-            "drivetrain.stribeck_n" => self.stribeck,
-            "drivetrain.stribeck_speed_m_s" => self.stribeck_speed,
-            "drivetrain.coulomb_asymmetry_n" => self.coulomb_asymmetry,
-            _ => return None,
-        })
-    }
-
-    fn set(&mut self, key: &str, value: f64) -> bool {
-        let slot = match key {
-            "drivetrain.coulomb_n" => &mut self.coulomb,
-            "drivetrain.viscous_n_s_m" => &mut self.viscous,
-            "drivetrain.load_coefficient" => &mut self.load_coefficient,
-            "drivetrain.quadratic_n_s2_m2" => &mut self.quadratic,
-            "drivetrain.stribeck_n" => &mut self.stribeck,
-            "drivetrain.stribeck_speed_m_s" => &mut self.stribeck_speed,
-            "drivetrain.coulomb_asymmetry_n" => &mut self.coulomb_asymmetry,
-            _ => return false,
-        };
-        *slot = value;
-        true
+    fn slot(&mut self, key: &str) -> Option<&mut f64> {
+        match key {
+            "drivetrain.coulomb_n" => Some(&mut self.coulomb),
+            "drivetrain.viscous_n_s_m" => Some(&mut self.viscous),
+            "drivetrain.load_coefficient" => Some(&mut self.load_coefficient),
+            "drivetrain.quadratic_n_s2_m2" => Some(&mut self.quadratic),
+            "drivetrain.stribeck_n" => Some(&mut self.stribeck),
+            "drivetrain.stribeck_speed_m_s" => Some(&mut self.stribeck_speed),
+            "drivetrain.coulomb_asymmetry_n" => Some(&mut self.coulomb_asymmetry),
+            _ => None,
+        }
     }
 }
 

@@ -155,22 +155,12 @@ impl FrictionTerm for Presliding {
         }
     }
 
-    fn get(&self, key: &str) -> Option<f64> {
+    fn slot(&mut self, key: &str) -> Option<&mut f64> {
         match key {
-            "contact.presliding_stiffness_n_m" => Some(self.stiffness),
-            "contact.presliding_damping_n_s_m" => Some(self.damping),
+            "contact.presliding_stiffness_n_m" => Some(&mut self.stiffness),
+            "contact.presliding_damping_n_s_m" => Some(&mut self.damping),
             _ => None,
         }
-    }
-
-    fn set(&mut self, key: &str, value: f64) -> bool {
-        let slot = match key {
-            "contact.presliding_stiffness_n_m" => &mut self.stiffness,
-            "contact.presliding_damping_n_s_m" => &mut self.damping,
-            _ => return false,
-        };
-        *slot = value;
-        true
     }
 }
 

@@ -115,22 +115,12 @@ impl FrictionTerm for WidthLaw {
         state
     }
 
-    fn get(&self, key: &str) -> Option<f64> {
+    fn slot(&mut self, key: &str) -> Option<&mut f64> {
         match key {
-            "contact.width_load_exponent" => Some(self.exponent),
-            "contact.width_reference_load_n" => Some(self.reference_load),
+            "contact.width_load_exponent" => Some(&mut self.exponent),
+            "contact.width_reference_load_n" => Some(&mut self.reference_load),
             _ => None,
         }
-    }
-
-    fn set(&mut self, key: &str, value: f64) -> bool {
-        let slot = match key {
-            "contact.width_load_exponent" => &mut self.exponent,
-            "contact.width_reference_load_n" => &mut self.reference_load,
-            _ => return false,
-        };
-        *slot = value;
-        true
     }
 }
 

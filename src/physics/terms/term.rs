@@ -107,12 +107,28 @@ pub trait FrictionTerm: Copy + PartialEq + Default + std::fmt::Debug {
     /// first step).
     fn swapped(&self, old: &Self, state: Self::State, last_level: Option<f64>) -> Self::State;
 
+    /// The field of its key `key` (None: not its key): the one place a
+    /// term maps its keys onto its fields ([`FrictionTerm::get`] and
+    /// [`FrictionTerm::set`] follow from it).
+    fn slot(&mut self, key: &str) -> Option<&mut f64>;
+
     /// The value of its key `key` (None: not its key).
-    fn get(&self, key: &str) -> Option<f64>;
+    fn get(&self, key: &str) -> Option<f64> {
+        let mut copy = *self;
+        copy.slot(key).map(|v| *v)
+    }
 
     /// Set its key `key` to `value` (false: not its key; the value is taken
     /// as it is).
-    fn set(&mut self, key: &str, value: f64) -> bool;
+    fn set(&mut self, key: &str, value: f64) -> bool {
+        match self.slot(key) {
+            Some(v) => {
+                *v = value;
+                true
+            }
+            None => false,
+        }
+    }
 
     /// Its values against the ranges its keys declare, the offending key
     /// named as the catalogue (and the configuration) spells it.

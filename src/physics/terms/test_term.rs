@@ -79,17 +79,8 @@ impl FrictionTerm for Probe {
         state
     }
 
-    fn get(&self, key: &str) -> Option<f64> {
-        (key == "probe.drag_n").then_some(self.drag)
-    }
-
-    fn set(&mut self, key: &str, value: f64) -> bool {
-        if key == "probe.drag_n" {
-            self.drag = value;
-            true
-        } else {
-            false
-        }
+    fn slot(&mut self, key: &str) -> Option<&mut f64> {
+        (key == "probe.drag_n").then_some(&mut self.drag)
     }
 }
 
