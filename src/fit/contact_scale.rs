@@ -67,13 +67,26 @@ pub struct ContactScale {
 }
 
 /// How far above the data's top speed the chosen scale puts the film's
-/// transition: far enough that the film's lift is negligible on the data
-/// (two decades; the transition's width is about one).
-pub const TRANSITION_FAR: f64 = 100.0;
+/// transition: far enough that the film shapes nothing the data show.
+/// Three decades: at two the transition's tail still bent the curve by a
+/// few tenths of a percent (a classic model's own record was predicted
+/// 0.04–0.13 % worse by ours with the same terms; at three, equal).
+pub const TRANSITION_FAR: f64 = 1000.0;
 
 /// The sign's regularisation speed on a chosen scale, as a fraction of the
-/// contact's top speed (when the configured one is larger).
-pub const SIGN_REGULARIZATION_FRACTION: f64 = 1e-3;
+/// contact's top speed (when the configured one is larger): the classic
+/// models switch with sgn v, and a time series' first sample after a
+/// reversal can lie at a thousandth of the top speed (1 kHz, moves of
+/// 0.2 m/s), where a wider tanh would still round the switch.
+pub const SIGN_REGULARIZATION_FRACTION: f64 = 1e-5;
+
+/// The smallest sign regularisation a chosen scale sets, m/s (the key's
+/// valid range is open at 1e-9).
+pub const MIN_SIGN_REGULARIZATION_M_S: f64 = 1e-8;
+
+/// The largest viscosity the film candidate's starts may ask for (the
+/// key's valid range ends at 100 Pa·s).
+pub const MAX_PLACED_VISCOSITY_PA_S: f64 = 99.0;
 
 /// The largest gain the node accepts (`contacts.NAME.gain`).
 pub const MAX_GAIN: f64 = 1e3;
@@ -228,7 +241,7 @@ pub fn choose(
     }
     let v_t = transition_speed(config, load_n)?;
     let how = format!(
-        "chosen from the data: the boundary friction {} gives the sliding level {} {fu}, and the film's transition ({} m/s at this load and the configured viscosity) lies {}× above the contact's top speed {} m/s{}",
+        "chosen from the data: the boundary friction {} gives the sliding level {} {fu}, and the film's transition ({} m/s at this load and viscosity) lies {}× above the contact's top speed {} m/s{}",
         crate::text::Num(mu),
         crate::text::Num(level),
         crate::text::Num(v_t),
@@ -283,6 +296,50 @@ impl Limits {
             ),
         }
     }
+}
+
+/// The slowest sliding speed of the training data (the tenth percentile of
+/// |v| over the samples faster than a hundredth of the top speed), in the
+/// data's units.
+pub fn slow_speed(train: &[Source], map: &[f64]) -> Option<f64> {
+    let mut v: Vec<f64> = train
+        .iter()
+        .filter_map(|s| s.series(map).ok())
+        .flat_map(|s| s.velocity.into_iter().map(f64::abs))
+        .collect();
+    let top = v.iter().copied().fold(0.0f64, f64::max);
+    v.retain(|x| *x > 0.01 * top);
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 10).copied()
+}
+
+/// The transition speed goes as 1/μ_l at a given load (the Hersey number),
+/// so the film candidate moves it from [`TRANSITION_FAR`] × the top speed
+/// down to the slowest sliding speed by raising the viscosity
+/// [`TRANSITION_FAR`] × top / slow times. When that would pass
+/// [`MAX_PLACED_VISCOSITY_PA_S`], the scale starts from a viscosity low
+/// enough (the load is then chosen for it, so the data see the same
+/// boundary level and no film). Returns (configured, lowered) when it did.
+fn lower_viscosity_for_placements(
+    c: &mut Config,
+    top: f64,
+    slow: Option<f64>,
+) -> Option<(f64, f64)> {
+    let slow = slow.unwrap_or(0.1 * top).min(top);
+    if slow.is_nan() || slow <= 0.0 {
+        return None;
+    }
+    let reach = TRANSITION_FAR * top / slow;
+    let highest = MAX_PLACED_VISCOSITY_PA_S / reach;
+    let from = c.lubricant.viscosity_pa_s;
+    if from <= highest {
+        return None;
+    }
+    // Two significant digits, rounded down: a number a reader can carry.
+    let e = highest.log10().floor() - 1.0;
+    let to = (highest / 10f64.powf(e)).floor() * 10f64.powf(e);
+    c.lubricant.viscosity_pa_s = to;
+    Some((from, to))
 }
 
 /// The training data's top speed and sliding level (the mean |F| of the
@@ -346,8 +403,16 @@ pub fn setup(
         return Ok((one.config.clone(), None));
     }
     let (top, level) = top_and_level(train, map)?;
-    let scale = choose(&one.config, top, level, units)?;
     let mut c = one.config.clone();
+    let lowered = lower_viscosity_for_placements(&mut c, top, slow_speed(train, map));
+    let mut scale = choose(&c, top, level, units)?;
+    if let Some((from, to)) = lowered {
+        scale.how.push_str(&format!(
+            "; the viscosity is {} Pa·s, not the configured {} Pa·s: a part of the scale, low enough that the film candidate can place its transition inside the data within the viscosity's range",
+            crate::text::Num::sig(to, 2),
+            crate::text::Num(from)
+        ));
+    }
     let all_without_load = train
         .iter()
         .map(|s| s.series(map).map(|se| se.load.is_none()))
@@ -359,9 +424,9 @@ pub fn setup(
     }
     // The sign's regularisation is a numerical device on the contact's
     // speed: at the scale's contact speeds it must not shape the data's
-    // friction (a tenth of a percent of the top speed switches the sign
-    // well before the slowest sliding sample).
-    let v_reg = SIGN_REGULARIZATION_FRACTION * scale.gain * top;
+    // friction (1e-5 of the top speed switches the sign before the first
+    // sample after a reversal).
+    let v_reg = (SIGN_REGULARIZATION_FRACTION * scale.gain * top).max(MIN_SIGN_REGULARIZATION_M_S);
     if v_reg < c.contact.sign_regularization_m_s {
         c.contact.sign_regularization_m_s = v_reg;
     }
@@ -527,5 +592,24 @@ mod tests {
         );
         let fitted = on_joint(config.clone(), "axis", l.gain);
         assert!(fitted.validate().is_ok());
+    }
+
+    #[test]
+    fn a_scale_lowers_the_viscosity_so_the_film_candidate_can_reach_the_slowest_sliding_speed() {
+        let mut c = Config::default();
+        let configured = c.lubricant.viscosity_pa_s;
+        // Data from 0.005 to 0.2 m/s: the candidate must raise the viscosity
+        // TRANSITION_FAR × 40 times to bring the transition to 0.005 m/s.
+        let (from, to) = lower_viscosity_for_placements(&mut c, 0.2, Some(0.005)).unwrap();
+        assert_eq!(from, configured);
+        assert_eq!(c.lubricant.viscosity_pa_s, to);
+        assert!(to * TRANSITION_FAR * 0.2 / 0.005 <= MAX_PLACED_VISCOSITY_PA_S);
+        // Rounded down to two digits, not far below what is needed.
+        assert!(to * TRANSITION_FAR * 0.2 / 0.005 > 0.9 * MAX_PLACED_VISCOSITY_PA_S);
+        assert!(c.validate().is_ok());
+        // Data a narrow range that the configured viscosity already reaches: kept.
+        let mut k = Config::default();
+        assert!(lower_viscosity_for_placements(&mut k, 0.2, Some(0.15)).is_none());
+        assert_eq!(k.lubricant.viscosity_pa_s, configured);
     }
 }

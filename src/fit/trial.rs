@@ -5,6 +5,7 @@
 //! without it.
 
 use super::candidates::{set_keys, set_specs, CANDIDATES, FILM, FILM_KEY};
+use super::contact_scale::slow_speed;
 use super::cross_validate::cross_validate;
 use super::driver::fit;
 use super::options::{Options, SearchSettings};
@@ -63,12 +64,12 @@ fn film_placements(p: &Prepared) -> Vec<f64> {
         return Vec::new();
     };
     let top = p.model_scale.velocity_m_s;
-    let slow = slow_speed(p).unwrap_or(0.1 * top) * scale.gain;
+    let slow = slow_speed(&p.data.train, &p.data.map_values).unwrap_or(0.1 * top) * scale.gain;
     let mu0 = p.model_config.lubricant.viscosity_pa_s;
     let v_t = super::contact_scale::TRANSITION_FAR * top;
     [top, (slow * top).sqrt(), slow]
         .iter()
-        .map(|target| (mu0 * v_t / target).min(MAX_PLACED_VISCOSITY_PA_S))
+        .map(|target| (mu0 * v_t / target).min(super::contact_scale::MAX_PLACED_VISCOSITY_PA_S))
         .collect()
 }
 
@@ -84,32 +85,12 @@ fn placements(p: &Prepared, key: &str) -> Vec<f64> {
         "drivetrain.stribeck_speed_m_s" | "contact.boundary_activation_speed_m_s" => {
             let gain = p.contact_scale.as_ref().map_or(1.0, |s| s.gain);
             let top = p.model_scale.velocity_m_s;
-            let slow = slow_speed(p).map_or(0.1 * top, |v| v * gain);
+            let slow =
+                slow_speed(&p.data.train, &p.data.map_values).map_or(0.1 * top, |v| v * gain);
             vec![slow, (slow * top).sqrt(), top]
         }
         _ => Vec::new(),
     }
-}
-
-/// The largest viscosity a placement asks for (the key's valid range ends
-/// at 100 Pa·s).
-const MAX_PLACED_VISCOSITY_PA_S: f64 = 99.0;
-
-/// The slowest sliding speed of the training data (the tenth percentile of
-/// |v| over the samples faster than a hundredth of the top speed), in the
-/// data's units.
-fn slow_speed(p: &Prepared) -> Option<f64> {
-    let mut v: Vec<f64> = p
-        .data
-        .train
-        .iter()
-        .filter_map(|s| s.series(&p.data.map_values).ok())
-        .flat_map(|s| s.velocity.into_iter().map(f64::abs))
-        .collect();
-    let top = v.iter().copied().fold(0.0f64, f64::max);
-    v.retain(|x| *x > 0.01 * top);
-    v.sort_by(f64::total_cmp);
-    v.get(v.len() / 10).copied()
 }
 
 impl Ctx<'_> {
