@@ -153,9 +153,68 @@ pub fn held_out_scale(o: &FitOutcome) -> f64 {
     (ss / n.max(1) as f64).sqrt()
 }
 
+/// How ours stands against the best classic model on the verdict's
+/// yardstick.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Standing {
+    /// Ours predicts better, by more than the comparison can resolve.
+    Ahead,
+    /// The two differ by less than the standard error of their paired
+    /// difference: the data cannot tell them apart.
+    Level,
+    /// The classic predicts better, by more than that.
+    Behind,
+}
+
+/// The standing of `mine` against `theirs`, two models' squared errors on
+/// the same samples (or mean squared errors on the same folds), paired: a
+/// mean difference within one standard error of itself is `Level`.
+pub fn standing(mine: &[f64], theirs: &[f64]) -> Standing {
+    let d: Vec<f64> = mine
+        .iter()
+        .zip(theirs)
+        .map(|(a, b)| a - b)
+        .filter(|x| x.is_finite())
+        .collect();
+    let n = d.len() as f64;
+    let mean = d.iter().sum::<f64>() / n.max(1.0);
+    let se = if d.len() > 1 {
+        (d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt()
+    } else {
+        0.0
+    };
+    if mean.abs() <= se || mean == 0.0 {
+        Standing::Level
+    } else if mean < 0.0 {
+        Standing::Ahead
+    } else {
+        Standing::Behind
+    }
+}
+
+/// Each held-out sample's squared error (the validation data's, else the
+/// held-out parts'), in the order of the sources: the same samples for
+/// every model fitted to the same data.
+fn held_out_squared_errors(o: &FitOutcome) -> Vec<f64> {
+    let fits = if o.validate.is_empty() {
+        &o.held_out
+    } else {
+        &o.validate
+    };
+    fits.iter()
+        .flat_map(|f| {
+            f.predicted
+                .iter()
+                .zip(f.series.friction.iter())
+                .map(|(p, m)| (p - m).powi(2))
+        })
+        .collect()
+}
+
 /// Which model predicts best, in one sentence for the summary's first
 /// lines: on the held-out data when there are any, else cross-validated
-/// on the training data's folds; said plainly when ours is not the best.
+/// on the training data's folds; said plainly when ours is not the best,
+/// and called level when the difference is within its standard error.
 pub fn verdict(ours: &FitOutcome, classic: &[FitOutcome]) -> String {
     let held = ours.held_out_rms().is_some();
     let score = |o: &FitOutcome| -> Option<f64> {
@@ -163,6 +222,13 @@ pub fn verdict(ours: &FitOutcome, classic: &[FitOutcome]) -> String {
             o.held_out_rms()
         } else {
             o.fold_mse.as_deref().map(super::cross_validate::cv_rms)
+        }
+    };
+    let paired = |o: &FitOutcome| -> Vec<f64> {
+        if held {
+            held_out_squared_errors(o)
+        } else {
+            o.fold_mse.clone().unwrap_or_default()
         }
     };
     let what = if held { "held-out" } else { "cross-validated" };
@@ -177,22 +243,22 @@ pub fn verdict(ours: &FitOutcome, classic: &[FitOutcome]) -> String {
     let Some((b, theirs)) = best else {
         return String::new();
     };
-    if mine <= theirs {
-        format!(
-            "**Verdict:** ours predicts best: {what} RMS {} {u}, the best classic model ({}) {} {u} ({:.1} % lower).",
-            Num::sig(mine, 5),
+    let (m, t) = (Num::sig(mine, 5), Num::sig(theirs, 5));
+    let apart = 100.0 * (mine / theirs - 1.0);
+    match standing(&paired(ours), &paired(b)) {
+        Standing::Level => format!(
+            "**Verdict: ours and {} predict alike here** ({what} RMS {m} {u} against {t} {u}, {apart:+.2} %: within the standard error of their paired difference). The data cannot tell them apart; the terms ours chose say which physics the data show.",
+            b.label
+        ),
+        Standing::Ahead | Standing::Behind if mine <= theirs => format!(
+            "**Verdict:** ours predicts best: {what} RMS {m} {u}, the best classic model ({}) {t} {u} ({:.1} % lower).",
             b.label,
-            Num::sig(theirs, 5),
-            100.0 * (1.0 - mine / theirs)
-        )
-    } else {
-        format!(
-            "**Verdict: ours is not the best here.** {} predicts better: {what} RMS {} {u} against ours {} {u} ({:.1} % higher). Use it, or the terms it points at (see the models table).",
-            b.label,
-            Num::sig(theirs, 5),
-            Num::sig(mine, 5),
-            100.0 * (mine / theirs - 1.0)
-        )
+            -apart
+        ),
+        _ => format!(
+            "**Verdict: ours is not the best here.** {} predicts better: {what} RMS {t} {u} against ours {m} {u} ({apart:.1} % higher). Use it, or the terms it points at (see the models table).",
+            b.label
+        ),
     }
 }
 
@@ -212,4 +278,39 @@ pub fn models_section(ours: &FitOutcome, classic: &[FitOutcome]) -> String {
         models_table_of(ours, classic),
         super::by_direction::models_direction_table(&all)
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn two_models_whose_errors_differ_by_less_than_their_standard_error_are_level() {
+        // Paired squared errors that differ by ±1 around a mean of 0.01.
+        let theirs: Vec<f64> = (0..100).map(|k| 10.0 + (k % 7) as f64).collect();
+        let mine: Vec<f64> = theirs
+            .iter()
+            .enumerate()
+            .map(|(k, t)| t + if k % 2 == 0 { 1.01 } else { -0.99 })
+            .collect();
+        assert_eq!(standing(&mine, &theirs), Standing::Level);
+    }
+
+    #[test]
+    fn a_model_whose_errors_are_lower_beyond_their_standard_error_is_ahead_and_the_other_behind() {
+        let theirs: Vec<f64> = (0..100).map(|k| 10.0 + (k % 7) as f64).collect();
+        let mine: Vec<f64> = theirs
+            .iter()
+            .enumerate()
+            .map(|(k, t)| t - 0.5 + if k % 2 == 0 { 0.1 } else { -0.1 })
+            .collect();
+        assert_eq!(standing(&mine, &theirs), Standing::Ahead);
+        assert_eq!(standing(&theirs, &mine), Standing::Behind);
+    }
+
+    #[test]
+    fn identical_errors_are_level() {
+        let e = [1.0, 2.0, 3.0];
+        assert_eq!(standing(&e, &e), Standing::Level);
+    }
 }
