@@ -125,10 +125,13 @@ fn assert_ours_contains(md: &str, classic: &str) {
         ours_train <= 1.001 * their_train,
         "training RMS: ours {ours_train}, {classic} {their_train}\n{md}"
     );
+    // The same curve, fitted by two optimisers: equal to 1e-4 (the scale
+    // of 100× and a rounded sign left ours 4e-4 to 3e-3 behind).
     assert!(
-        !md.contains("ours is not the best"),
+        ours_held <= (1.0 + 1e-4) * their_held,
         "held-out RMS: ours {ours_held}, {classic} {their_held}\n{md}"
     );
+    assert!(!md.contains("ours is not the best"), "{md}");
 }
 
 #[test]

@@ -159,31 +159,32 @@ pub fn held_out_scale(o: &FitOutcome) -> f64 {
 pub enum Standing {
     /// Ours predicts better, by more than the comparison can resolve.
     Ahead,
-    /// The two differ by less than the standard error of their paired
-    /// difference: the data cannot tell them apart.
+    /// The two differ by no more than the standard error of their paired
+    /// difference, or by no more than a term must pay for itself
+    /// ([`super::select::TERM_COST`] of the mean squared error): the data
+    /// cannot tell them apart, or the difference is one no controller
+    /// would notice.
     Level,
     /// The classic predicts better, by more than that.
     Behind,
 }
 
 /// The standing of `mine` against `theirs`, two models' squared errors on
-/// the same samples (or mean squared errors on the same folds), paired: a
-/// mean difference within one standard error of itself is `Level`.
+/// the same samples (or mean squared errors on the same folds), paired:
+/// the yardstick by which `--fit auto` lets a term pay for itself.
 pub fn standing(mine: &[f64], theirs: &[f64]) -> Standing {
-    let d: Vec<f64> = mine
+    let (a, b): (Vec<f64>, Vec<f64>) = mine
         .iter()
         .zip(theirs)
-        .map(|(a, b)| a - b)
-        .filter(|x| x.is_finite())
-        .collect();
-    let n = d.len() as f64;
-    let mean = d.iter().sum::<f64>() / n.max(1.0);
-    let se = if d.len() > 1 {
-        (d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt()
-    } else {
-        0.0
-    };
-    if mean.abs() <= se || mean == 0.0 {
+        .filter(|(x, y)| x.is_finite() && y.is_finite())
+        .map(|(x, y)| (*x, *y))
+        .unzip();
+    if a.is_empty() {
+        return Standing::Level;
+    }
+    let (mean, se) = super::select::paired(&a, &b);
+    let mse = b.iter().sum::<f64>() / b.len() as f64;
+    if mean.abs() <= se || mean.abs() <= super::select::TERM_COST * mse {
         Standing::Level
     } else if mean < 0.0 {
         Standing::Ahead
@@ -247,15 +248,16 @@ pub fn verdict(ours: &FitOutcome, classic: &[FitOutcome]) -> String {
     let apart = 100.0 * (mine / theirs - 1.0);
     match standing(&paired(ours), &paired(b)) {
         Standing::Level => format!(
-            "**Verdict: ours and {} predict alike here** ({what} RMS {m} {u} against {t} {u}, {apart:+.2} %: within the standard error of their paired difference). The data cannot tell them apart; the terms ours chose say which physics the data show.",
-            b.label
+            "**Verdict: ours and {} predict alike here** ({what} RMS {m} {u} against {t} {u}, {apart:+.2} %: their mean squared errors differ by less than the standard error of that difference or by less than {:.0} % of it, what a term must gain to be chosen). The terms ours chose say which physics the data show.",
+            b.label,
+            100.0 * super::select::TERM_COST
         ),
-        Standing::Ahead | Standing::Behind if mine <= theirs => format!(
+        Standing::Ahead => format!(
             "**Verdict:** ours predicts best: {what} RMS {m} {u}, the best classic model ({}) {t} {u} ({:.1} % lower).",
             b.label,
             -apart
         ),
-        _ => format!(
+        Standing::Behind => format!(
             "**Verdict: ours is not the best here.** {} predicts better: {what} RMS {t} {u} against ours {m} {u} ({apart:.1} % higher). Use it, or the terms it points at (see the models table).",
             b.label
         ),
@@ -286,14 +288,25 @@ mod tests {
 
     #[test]
     fn two_models_whose_errors_differ_by_less_than_their_standard_error_are_level() {
-        // Paired squared errors that differ by ±1 around a mean of 0.01.
+        // Paired squared errors that differ by ±3 around a mean of 0.2
+        // (1.5 % of the mean squared error 13, beyond the term's cost).
         let theirs: Vec<f64> = (0..100).map(|k| 10.0 + (k % 7) as f64).collect();
         let mine: Vec<f64> = theirs
             .iter()
             .enumerate()
-            .map(|(k, t)| t + if k % 2 == 0 { 1.01 } else { -0.99 })
+            .map(|(k, t)| t + if k % 2 == 0 { 3.2 } else { -2.8 })
             .collect();
         assert_eq!(standing(&mine, &theirs), Standing::Level);
+    }
+
+    #[test]
+    fn a_consistent_difference_smaller_than_a_terms_cost_is_level() {
+        // Every sample 0.5 % worse: resolved, but less than 1 % of the MSE.
+        let theirs: Vec<f64> = (0..100).map(|k| 10.0 + (k % 7) as f64).collect();
+        let mine: Vec<f64> = theirs.iter().map(|t| t * 1.005).collect();
+        assert_eq!(standing(&mine, &theirs), Standing::Level);
+        let worse: Vec<f64> = theirs.iter().map(|t| t * 1.02).collect();
+        assert_eq!(standing(&worse, &theirs), Standing::Behind);
     }
 
     #[test]

@@ -115,7 +115,7 @@ fn simplest_that_predicts_as_well(step: Vec<Scored>) -> Scored {
 }
 
 /// Mean and standard error of the folds' paired differences a − b.
-fn paired(a: &[f64], b: &[f64]) -> (f64, f64) {
+pub(super) fn paired(a: &[f64], b: &[f64]) -> (f64, f64) {
     let d: Vec<f64> = a.iter().zip(b).map(|(x, y)| x - y).collect();
     let n = d.len() as f64;
     let mean = d.iter().sum::<f64>() / n;
