@@ -430,7 +430,19 @@ pub fn setup(
     if v_reg < c.contact.sign_regularization_m_s {
         c.contact.sign_regularization_m_s = v_reg;
     }
-    let mu = c.contact.boundary_friction;
+    level_within_bounds(specs, c.contact.boundary_friction, &scale, level)?;
+    Ok((c, Some(scale)))
+}
+
+/// A bound on the boundary friction that excludes `mu`, the value the
+/// chosen scale rests on, is an error naming both.
+fn level_within_bounds(
+    specs: &[ParamSpec],
+    mu: f64,
+    scale: &ContactScale,
+    level: f64,
+) -> Result<(), FitError> {
+    let units = scale.units;
     for s in specs
         .iter()
         .filter(|s| s.name == "contact.boundary_friction")
@@ -450,7 +462,7 @@ pub fn setup(
             }
         }
     }
-    Ok((c, Some(scale)))
+    Ok(())
 }
 
 /// `config` as the one contact of joint `joint` with gain `gain`: the

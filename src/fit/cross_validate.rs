@@ -22,6 +22,23 @@ use super::problem::{Data, Folds, HoldOut, Model};
 use super::{FitError, FittedParameter};
 use rayon::prelude::*;
 
+/// The cost of a term: the smallest fraction of the cross-validated mean
+/// squared error it must remove to be kept (1 %: about half a percent of
+/// the RMS). Below it, a term fits the data's fine structure — a noise
+/// floor's texture, a systematic residue of another effect — consistently
+/// enough to beat the blocks' spread while predicting no better in any
+/// sense a controller would notice.
+pub const TERM_COST: f64 = 0.01;
+
+/// Mean and standard error of the paired differences (of folds or samples) a − b.
+pub fn paired(a: &[f64], b: &[f64]) -> (f64, f64) {
+    let d: Vec<f64> = a.iter().zip(b).map(|(x, y)| x - y).collect();
+    let n = d.len() as f64;
+    let mean = d.iter().sum::<f64>() / n;
+    let var = d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
+    (mean, (var / n).sqrt())
+}
+
 /// Folds of one training record (time blocks or speed ranges).
 pub const FOLDS: usize = 4;
 

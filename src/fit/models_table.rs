@@ -161,7 +161,7 @@ pub enum Standing {
     Ahead,
     /// The two differ by no more than the standard error of their paired
     /// difference, or by no more than a term must pay for itself
-    /// ([`super::select::TERM_COST`] of the mean squared error): the data
+    /// ([`super::cross_validate::TERM_COST`] of the mean squared error): the data
     /// cannot tell them apart, or the difference is one no controller
     /// would notice.
     Level,
@@ -182,9 +182,9 @@ pub fn standing(mine: &[f64], theirs: &[f64]) -> Standing {
     if a.is_empty() {
         return Standing::Level;
     }
-    let (mean, se) = super::select::paired(&a, &b);
+    let (mean, se) = super::cross_validate::paired(&a, &b);
     let mse = b.iter().sum::<f64>() / b.len() as f64;
-    if mean.abs() <= se || mean.abs() <= super::select::TERM_COST * mse {
+    if mean.abs() <= se || mean.abs() <= super::cross_validate::TERM_COST * mse {
         Standing::Level
     } else if mean < 0.0 {
         Standing::Ahead
@@ -250,7 +250,7 @@ pub fn verdict(ours: &FitOutcome, classic: &[FitOutcome]) -> String {
         Standing::Level => format!(
             "**Verdict: ours and {} predict alike here** ({what} RMS {m} {u} against {t} {u}, {apart:+.2} %: their mean squared errors differ by less than the standard error of that difference or by less than {:.0} % of it, what a term must gain to be chosen). The terms ours chose say which physics the data show.",
             b.label,
-            100.0 * super::select::TERM_COST
+            100.0 * super::cross_validate::TERM_COST
         ),
         Standing::Ahead => format!(
             "**Verdict:** ours predicts best: {what} RMS {m} {u}, the best classic model ({}) {t} {u} ({:.1} % lower).",

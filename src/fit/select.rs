@@ -57,13 +57,8 @@ use super::FitError;
 use rayon::prelude::*;
 use std::fmt::Write as _;
 
-/// The cost of a term: the smallest fraction of the cross-validated mean
-/// squared error it must remove to be kept (1 %: about half a percent of
-/// the RMS). Below it, a term fits the data's fine structure — a noise
-/// floor's texture, a systematic residue of another effect — consistently
-/// enough to beat the blocks' spread while predicting no better in any
-/// sense a controller would notice.
-pub const TERM_COST: f64 = 0.01;
+use super::cross_validate::paired;
+pub use super::cross_validate::TERM_COST;
 
 /// The outcome of the selection.
 #[derive(Debug, Clone, PartialEq)]
@@ -112,15 +107,6 @@ fn simplest_that_predicts_as_well(step: Vec<Scored>) -> Scored {
                 .then(a.tried.cv_rms.total_cmp(&b.tried.cv_rms))
         })
         .expect("the lowest predicts as well as itself")
-}
-
-/// Mean and standard error of the folds' paired differences a − b.
-pub(super) fn paired(a: &[f64], b: &[f64]) -> (f64, f64) {
-    let d: Vec<f64> = a.iter().zip(b).map(|(x, y)| x - y).collect();
-    let n = d.len() as f64;
-    let mean = d.iter().sum::<f64>() / n;
-    let var = d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
-    (mean, (var / n).sqrt())
 }
 
 /// Whether going from `from` to `to` pays: it lowers the folds' mean
@@ -193,29 +179,13 @@ pub fn select(
         if open.is_empty() {
             break "every candidate was chosen".to_string();
         }
-        // The candidates of a step side by side.
-        let step: Vec<Scored> = open
-            .par_iter()
-            .map(|c| {
-                let mut terms = current.tried.terms.clone();
-                terms.push(c.name);
-                let t = ctx.try_set(&terms, &current.optimum)?;
-                say(&format!("auto: + {}: CV RMS {}", c.name, cv(&t.tried, p)));
-                Ok(t)
-            })
-            .collect::<Result<_, FitError>>()?;
+        let step = ctx.step(&current, &open, say)?;
         tried.extend(step.iter().map(|t| t.tried.clone()));
         let best = simplest_that_predicts_as_well(step);
         let (ok, gain, se, share) = pays(&current.tried, &best.tried);
         let name = best.tried.terms.last().copied().unwrap_or_default();
         if !ok {
-            break format!(
-                "the best next term, {name}, lowers the folds' mean squared error by {} ± {} (standard error), {:.2} % of it: a term must lower it by more than its standard error and by more than {:.0} % (the cost of a term), so it does not pay for itself",
-                crate::text::Num::sig(gain, 5),
-                crate::text::Num::sig(se, 5),
-                100.0 * share,
-                100.0 * TERM_COST
-            );
+            break does_not_pay(name, gain, se, share);
         }
         current = best;
         // Removal: a term chosen earlier that no longer pays beside the
@@ -226,21 +196,7 @@ pub fn select(
     // from another, is dropped and the set fitted again.
     let current = ctx.drop_flagged(current, &mut tried, &mut removed, say)?;
     listed_once(&mut tried);
-    let keys = set_keys(&current.tried.terms)
-        .into_iter()
-        .map(String::from)
-        .chain(
-            given
-                .iter()
-                .filter(|g| !g.if_chosen)
-                .map(|g| g.name.clone()),
-        )
-        .fold(Vec::<String>::new(), |mut v, k| {
-            if !v.contains(&k) {
-                v.push(k);
-            }
-            v
-        });
+    let keys = fitted_keys(&current.tried.terms, given);
     Ok(Selection {
         tried,
         excluded,
@@ -254,7 +210,61 @@ pub fn select(
     })
 }
 
+/// Why the selection stopped: the best next term does not pay.
+fn does_not_pay(name: &str, gain: f64, se: f64, share: f64) -> String {
+    format!(
+        "the best next term, {name}, lowers the folds' mean squared error by {} ± {} (standard error), {:.2} % of it: a term must lower it by more than its standard error and by more than {:.0} % (the cost of a term), so it does not pay for itself",
+        crate::text::Num::sig(gain, 5),
+        crate::text::Num::sig(se, 5),
+        100.0 * share,
+        100.0 * TERM_COST
+    )
+}
+
+/// The keys the chosen set fits: its terms' keys, then the names given
+/// after `auto` that are not tied to a term's choice, each once.
+fn fitted_keys(terms: &[&'static str], given: &[ParamSpec]) -> Vec<String> {
+    set_keys(terms)
+        .into_iter()
+        .map(String::from)
+        .chain(
+            given
+                .iter()
+                .filter(|g| !g.if_chosen)
+                .map(|g| g.name.clone()),
+        )
+        .fold(Vec::<String>::new(), |mut v, k| {
+            if !v.contains(&k) {
+                v.push(k);
+            }
+            v
+        })
+}
+
 impl Ctx<'_> {
+    /// One step: each open candidate added to `current`, fitted and
+    /// scored side by side.
+    fn step(
+        &self,
+        current: &Scored,
+        open: &[&&Candidate],
+        say: &(dyn Fn(&str) + Sync),
+    ) -> Result<Vec<Scored>, FitError> {
+        open.par_iter()
+            .map(|c| {
+                let mut terms = current.tried.terms.clone();
+                terms.push(c.name);
+                let t = self.try_set(&terms, &current.optimum)?;
+                say(&format!(
+                    "auto: + {}: CV RMS {}",
+                    c.name,
+                    cv(&t.tried, self.p)
+                ));
+                Ok(t)
+            })
+            .collect()
+    }
+
     /// Remove, one at a time, each chosen term (but `newest`) that does not
     /// pay beside the others any more: the one whose removal costs least.
     fn prune(

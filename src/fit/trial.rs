@@ -116,8 +116,9 @@ impl Ctx<'_> {
         Ok(scored)
     }
 
-    /// [`Ctx::try_set`]'s fit and score of a set not scored before.
-    fn score_set(&self, terms: &[&'static str], warm: &Optimum) -> Result<Scored, FitError> {
+    /// The set's parameter specs and the film's placements (the viscosity
+    /// key's bounds wide enough for every placement, unless given).
+    fn specs_and_placements(&self, terms: &[&'static str]) -> (Vec<ParamSpec>, Vec<f64>) {
         let mut specs = set_specs(self.given, &set_keys(terms));
         let placements = if terms.contains(&FILM) {
             film_placements(self.p)
@@ -125,7 +126,6 @@ impl Ctx<'_> {
             Vec::new()
         };
         if !placements.is_empty() {
-            // Bounds wide enough for every placement, unless given.
             if let Some(s) = specs
                 .iter_mut()
                 .find(|s| s.name == FILM_KEY && s.bounds.is_none())
@@ -134,13 +134,68 @@ impl Ctx<'_> {
                 s.bounds = Some((mu0 / 10.0, 100.0));
             }
         }
-        let (model, map_fit) = model_for(self.p, &specs, warm)?;
+        (specs, placements)
+    }
+
+    /// The starts besides the warm one: each key new to the set (not in
+    /// `warm`) at each of its placements, the others at the warm start.
+    fn extra_starts(
+        &self,
+        model: &super::physics_model::PhysicsModel,
+        map_fit: &super::prepared::MapFit,
+        terms: &[&'static str],
+        warm: &Optimum,
+        film: &[f64],
+    ) -> Vec<Vec<f64>> {
         let new_keys: Vec<&str> = terms
             .iter()
             .filter_map(|t| CANDIDATES.iter().find(|c| c.name == *t))
             .flat_map(|c| c.keys.iter().copied())
             .filter(|k| warm.iter().all(|(n, _)| n != k))
             .collect();
+        let start: Vec<f64> = model
+            .parameters()
+            .iter()
+            .map(|q| q.start)
+            .chain(map_fit.iter().map(|(_, q)| q.start))
+            .collect();
+        let mut out = Vec::new();
+        for (i, q) in model.parameters().iter().enumerate() {
+            if !new_keys.contains(&q.name.as_str()) {
+                continue;
+            }
+            let values = if q.name == FILM_KEY {
+                film.to_vec()
+            } else {
+                placements(self.p, &q.name)
+            };
+            for v in values {
+                let mut x = start.clone();
+                x[i] = v.clamp(q.lo, q.hi);
+                out.push(x);
+            }
+        }
+        out
+    }
+
+    /// A set the fit could not fit: scored as predicting nothing.
+    fn unfitted(&self, terms: &[&'static str]) -> Scored {
+        Scored {
+            tried: Tried {
+                terms: terms.to_vec(),
+                fold_mse: vec![f64::INFINITY; self.folds.count()],
+                cv_rms: f64::INFINITY,
+                simulations: 0,
+            },
+            optimum: Vec::new(),
+            flags: Vec::new(),
+        }
+    }
+
+    /// [`Ctx::try_set`]'s fit and score of a set not scored before.
+    fn score_set(&self, terms: &[&'static str], warm: &Optimum) -> Result<Scored, FitError> {
+        let (specs, placements) = self.specs_and_placements(terms);
+        let (model, map_fit) = model_for(self.p, &specs, warm)?;
         let mut options = Options {
             starts: 1,
             global_points: 0,
@@ -153,42 +208,11 @@ impl Ctx<'_> {
             xtol: 1e-5,
             ..Default::default()
         };
-        let start: Vec<f64> = model
-            .parameters()
-            .iter()
-            .map(|q| q.start)
-            .chain(map_fit.iter().map(|(_, q)| q.start))
-            .collect();
-        for (i, q) in model.parameters().iter().enumerate() {
-            if !new_keys.contains(&q.name.as_str()) {
-                continue;
-            }
-            let values = if q.name == FILM_KEY {
-                placements.clone()
-            } else {
-                self::placements(self.p, &q.name)
-            };
-            for v in values {
-                let mut x = start.clone();
-                x[i] = v.clamp(q.lo, q.hi);
-                options.extra_starts.push(x);
-            }
-        }
+        options.extra_starts = self.extra_starts(&model, &map_fit, terms, warm, &placements);
         let fitted = match fit(&model, &self.data, map_fit.clone(), &options) {
             Ok(o) => o,
             Err(FitError::Interrupted(i)) => return Err(FitError::Interrupted(i)),
-            Err(_) => {
-                return Ok(Scored {
-                    tried: Tried {
-                        terms: terms.to_vec(),
-                        fold_mse: vec![f64::INFINITY; self.folds.count()],
-                        cv_rms: f64::INFINITY,
-                        simulations: 0,
-                    },
-                    optimum: Vec::new(),
-                    flags: Vec::new(),
-                })
-            }
+            Err(_) => return Ok(self.unfitted(terms)),
         };
         let fold_mse = cross_validate(
             &model,
