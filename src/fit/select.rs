@@ -17,7 +17,9 @@
 //!    rises without end, or a regime the data do not reach, pays for it
 //!    there). Each fold is predicted by the set refitted without it.
 //! 2. Stepwise selection: each step fits every candidate not yet chosen
-//!    (whose prerequisite is chosen), warm-started from the current set's
+//!    (whose prerequisite is chosen, and that adds a key the set does not
+//!    fit already: beside the Stribeck curve the viscous rise is not tried
+//!    again), warm-started from the current set's
 //!    optimum with the new keys at their starts, and adds the one with the
 //!    lowest cross-validated error — unless a candidate with fewer keys
 //!    predicts as well (the best does not pay for its extra keys over it,
@@ -171,11 +173,7 @@ pub fn select(
     let mut removed: Vec<String> = Vec::new();
     let mut current = base;
     let why = loop {
-        let open: Vec<&&Candidate> = candidates
-            .iter()
-            .filter(|c| !current.tried.terms.contains(&c.name))
-            .filter(|c| c.requires.is_none_or(|r| current.tried.terms.contains(&r)))
-            .collect();
+        let open = open_candidates(&candidates, &current.tried.terms);
         if open.is_empty() {
             break "every candidate was chosen".to_string();
         }
@@ -208,6 +206,23 @@ pub fn select(
         why,
         wall_s: wall.elapsed().as_secs_f64(),
     })
+}
+
+/// The candidates a step tries beside `terms`: not chosen yet, their
+/// requirement chosen, and adding a key the set does not fit already (the
+/// viscous rise beside the Stribeck curve, which holds it, would be the
+/// same set fitted again).
+fn open_candidates<'c>(
+    candidates: &'c [&'static Candidate],
+    terms: &[&'static str],
+) -> Vec<&'c &'static Candidate> {
+    let fitted = set_keys(terms);
+    candidates
+        .iter()
+        .filter(|c| !terms.contains(&c.name))
+        .filter(|c| c.requires.is_none_or(|r| terms.contains(&r)))
+        .filter(|c| c.keys.iter().any(|k| !fitted.contains(k)))
+        .collect()
 }
 
 /// Why the selection stopped: the best next term does not pay.
@@ -530,6 +545,28 @@ mod tests {
             optimum: Vec::new(),
             flags: Vec::new(),
         }
+    }
+
+    #[test]
+    fn a_candidate_whose_keys_the_set_already_fits_is_not_tried_again() {
+        let all: Vec<&'static Candidate> = CANDIDATES.iter().collect();
+        let names = |open: Vec<&&Candidate>| open.iter().map(|c| c.name).collect::<Vec<_>>();
+        let beside_stribeck = names(open_candidates(&all, &["drivetrain Stribeck"]));
+        assert!(
+            !beside_stribeck.contains(&"drivetrain viscous"),
+            "{beside_stribeck:?}"
+        );
+        assert!(
+            beside_stribeck.contains(&"drivetrain quadratic"),
+            "{beside_stribeck:?}"
+        );
+        // The other way round the Stribeck curve adds its static excess and
+        // speed: still a candidate.
+        let beside_viscous = names(open_candidates(&all, &["drivetrain viscous"]));
+        assert!(
+            beside_viscous.contains(&"drivetrain Stribeck"),
+            "{beside_viscous:?}"
+        );
     }
 
     #[test]
