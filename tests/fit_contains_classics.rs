@@ -156,3 +156,61 @@ fn on_a_stribeck_record_that_rises_and_saturates_ours_reaches_the_classic_and_pr
     let md = fit_auto(&data);
     assert_ours_contains(&md, "Stribeck");
 }
+
+/// A joint's steady curve τ(ω) = sgn ω (f_c + (f_s − f_c) e^(−(ω/ω_s)²)) +
+/// b ω, each speed (deg/s) taken both ways with 0.5 % noise, as a CSV
+/// `velocity_rad_s,friction_nm`.
+fn joint_curve(path: &Path, speeds_deg_s: &[f64], (fc, fs, ws, b): (f64, f64, f64, f64)) {
+    let mut rng = StdRng::seed_from_u64(4);
+    let mut s = String::from("velocity_rad_s,friction_nm\n");
+    for deg in speeds_deg_s {
+        for sign in [1.0, -1.0] {
+            let w = sign * deg.to_radians();
+            let tau = sign * (fc + (fs - fc) * (-(w / ws).powi(2)).exp()) + b * w;
+            writeln!(s, "{w},{}", tau * (1.0 + gaussian(&mut rng, 0.005))).unwrap();
+        }
+    }
+    std::fs::write(path, s).unwrap();
+}
+
+#[test]
+fn a_joint_fitted_on_0_5_to_20_deg_s_predicts_25_to_90_deg_s_within_5_percent_of_the_classic() {
+    // The held-back direct-drive arm's split, on Stribeck curves: one
+    // whose static level is above the Coulomb level, one below it. A
+    // guard of the held-back target (within 1.05 × the best classic), not
+    // a reproduction of a past failure: on this noise draw the earlier
+    // scale passes too (on another, the peak curve's film collapsed past
+    // the data, 5.6 × Stribeck's held-out error).
+    let d = dir("joint-past-the-data");
+    let train = [0.5, 1.0, 2.0, 3.0, 5.0, 7.0, 10.0, 13.0, 16.0, 20.0];
+    let validate = [25.0, 35.0, 45.0, 60.0, 75.0, 90.0];
+    for (name, curve) in [
+        ("peak", (1.2, 1.8, 0.05, 2.0)),
+        ("rise", (1.2, 0.6, 0.1, 1.0)),
+    ] {
+        let t = d.join(format!("{name}-train.csv"));
+        let v = d.join(format!("{name}-validate.csv"));
+        joint_curve(&t, &train, curve);
+        joint_curve(&v, &validate, curve);
+        let out = d.join(format!("{name}.yaml"));
+        let (code, md, err) = run(&[
+            "fit",
+            t.to_str().unwrap(),
+            "--validate",
+            v.to_str().unwrap(),
+            "--rotary",
+            "--fit",
+            "auto",
+            "--baselines",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 0, "{err}");
+        let (_, ours) = row(&md, "friction-node");
+        let (_, stribeck) = row(&md, "Stribeck");
+        assert!(
+            ours <= 1.05 * stribeck,
+            "{name}: held-out RMS ours {ours}, Stribeck {stribeck}\n{md}"
+        );
+    }
+}
