@@ -4,7 +4,7 @@
 use anyhow::{bail, Result};
 use friction_node::config::Config;
 use friction_node::fit::inputs::{DataRequest, TopicChoice};
-use friction_node::fit::options::{JacobianRule, LaterRuns};
+use friction_node::fit::options::{JacobianRule, LaterRuns, LinearKeys};
 use friction_node::fit::options::{LabelledProgress, SearchSettings};
 use friction_node::fit::request::{param_specs, FitOutputs, FitRequest};
 use friction_node::fit::{Delimiter, Mapping, ParamSpec};
@@ -89,6 +89,13 @@ pub struct FitArgs {
     /// miss a better optimum). The classic models always walk to the end.
     #[arg(long, default_value = "full", value_parser = LaterRuns::parse)]
     pub later_runs: LaterRuns,
+    /// The parameters the friction is linear in (the drivetrain's viscous
+    /// and quadratic losses; map coefficients that only scale or offset
+    /// the measured friction): `solved` exactly at every point the local
+    /// runs evaluate, which then search the others (the default), or
+    /// `searched` like every other parameter (slower on a ridge).
+    #[arg(long, default_value = "solved", value_parser = LinearKeys::parse)]
+    pub linear_keys: LinearKeys,
     /// Column names of headerless CSV data (comma-separated).
     #[arg(long, value_name = "NAME,...", value_delimiter = ',')]
     pub columns: Option<Vec<String>>,
@@ -287,6 +294,7 @@ impl FitArgs {
                 max_evaluations: self.max_evaluations,
                 jacobian: self.jacobian,
                 later_runs: self.later_runs,
+                linear_keys: self.linear_keys,
             },
             baselines: self.baselines,
         })

@@ -94,7 +94,12 @@ pub fn fit(
     let films_before = model.film_solves();
     let mut problem = Problem::new(model, data, map_fit)?;
     problem.stop = options.stop.clone();
-    let optima = super::multistart::search(&problem, options);
+    let separable = if options.linear_keys == super::options::LinearKeys::Solved {
+        super::separable::Separable::new(&problem)
+    } else {
+        None
+    };
+    let optima = super::multistart::search(&problem, separable.as_ref(), options);
     options.stop.check()?;
     let best = optima[0].clone();
     let statistics = if options.statistics {

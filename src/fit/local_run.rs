@@ -38,6 +38,7 @@
 
 use super::options::{JacobianRule, LaterRuns};
 use super::problem::Problem;
+use super::separable::{Separable, Variables};
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt, TerminationReason};
 use nalgebra::{storage::Owned, DMatrix, DVector, Dyn};
 use rayon::prelude::*;
@@ -76,12 +77,14 @@ pub fn canonical(u: &[f64]) -> Vec<f64> {
 }
 
 /// An optimum found by an earlier run: its point in the optimiser's
-/// variables (canonical), its cost and the curvature JᵀJ there (in the
-/// canonical variables).
+/// variables (canonical) and whole, its cost and the curvature JᵀJ there
+/// (in the canonical variables).
 #[derive(Debug, Clone)]
 pub struct Found {
-    /// The point, unbounded variables.
+    /// The point, unbounded variables (the searched parameters').
     pub u: Vec<f64>,
+    /// The whole point, every parameter.
+    pub x: Vec<f64>,
     /// ½Σr² there.
     pub cost: f64,
     /// JᵀJ there.
@@ -124,19 +127,31 @@ const FD_STEP: f64 = 1e-4;
 /// the secant updates since differences were taken.
 struct LastJacobian {
     u: DVector<f64>,
+    /// The whole point of `u` (the linear parameters solved).
+    x: Vec<f64>,
     r: DVector<f64>,
     j: DMatrix<f64>,
     secant_updates: usize,
+    /// Whether every column was taken by differences at `u` (else the
+    /// costly columns are secant estimates).
+    exact: bool,
 }
 
 struct Lm<'p, 'a> {
     problem: &'p Problem<'a>,
+    /// The searched variables (the linear parameters solved at each point).
+    vars: Variables<'p, 'a>,
     u: DVector<f64>,
+    /// The whole point of `u`.
+    x: Vec<f64>,
     r: DVector<f64>,
-    /// Every point evaluated: (cost, u), for what was still moving when a
-    /// run stops on its budget.
+    /// Every point evaluated: (cost, whole point), for what was still
+    /// moving when a run stops on its budget.
     trail: Vec<(f64, Vec<f64>)>,
     rule: JacobianRule,
+    /// Per variable, whether a change of it alone needs a whole simulation
+    /// (None: all cost the same).
+    costly: Option<Vec<bool>>,
     last: Mutex<Option<LastJacobian>>,
     /// Residual evaluations since the last Jacobian.
     trials: AtomicUsize,
@@ -157,14 +172,17 @@ struct Lm<'p, 'a> {
 impl<'p, 'a> Lm<'p, 'a> {
     /// A run from `u0` (its residuals not yet taken).
     fn new(
-        problem: &'p Problem<'a>,
+        vars: Variables<'p, 'a>,
         u0: &DVector<f64>,
         (rule, later): (JacobianRule, LaterRuns),
         earlier: &'p [Found],
     ) -> Self {
         Lm {
-            problem,
+            problem: vars.problem(),
+            costly: vars.costly(),
+            vars,
             u: u0.clone(),
+            x: Vec::new(),
             r: DVector::zeros(0),
             trail: Vec::new(),
             rule,
@@ -183,23 +201,31 @@ impl<'p, 'a> Lm<'p, 'a> {
         *self.joined.lock().unwrap_or_else(|p| p.into_inner())
     }
 
-    fn differences(&self) -> DMatrix<f64> {
+    /// The Jacobian by forward differences: every column, or the columns
+    /// `only` marks (the others zero).
+    fn differences(&self, only: Option<&[bool]>) -> DMatrix<f64> {
         let n = self.u.len();
+        let taken = |j: usize| only.is_none_or(|o| o[j]);
         let columns: Vec<Vec<f64>> = (0..n)
             .into_par_iter()
             .map(|j| {
+                if !taken(j) {
+                    return vec![0.0; self.r.len()];
+                }
                 let mut u = self.u.clone();
                 u[j] += FD_STEP;
-                let x = self.problem.from_internal(u.as_slice());
-                self.problem
-                    .residuals(&x)
+                self.vars
+                    .evaluate(u.as_slice())
+                    .0
                     .iter()
                     .zip(self.r.iter())
                     .map(|(a, b)| (a - b) / FD_STEP)
                     .collect()
             })
             .collect();
-        self.jacobian_evaluations.fetch_add(n, Ordering::Relaxed);
+        let count = (0..n).filter(|j| taken(*j)).count();
+        self.jacobian_evaluations
+            .fetch_add(count, Ordering::Relaxed);
         let m = self.r.len();
         DMatrix::from_fn(m, n, |i, j| columns[j][i])
     }
@@ -217,7 +243,7 @@ impl<'p, 'a> Lm<'p, 'a> {
         self.earlier.iter().position(|f| {
             let s2 = 2.0 * f.cost / dof;
             let u = canonical(u);
-            let d = DVector::from_iterator(n, u.iter().zip(&f.u).map(|(a, b)| a - b));
+            let d = DVector::from_iterator(u.len(), u.iter().zip(&f.u).map(|(a, b)| a - b));
             let q = (d.transpose() * &f.curvature * &d)[(0, 0)];
             q <= s2 * chi2 && cost <= f.cost + 0.5 * s2 * chi2
         })
@@ -258,7 +284,7 @@ impl<'p, 'a> Lm<'p, 'a> {
                     .zip(&f.u)
                     .map(|(a, b)| a + t * (b - a))
                     .collect();
-                self.problem.cost(&self.problem.from_internal(&u))
+                self.vars.cost(&u)
             })
             .collect();
         self.valley_evaluations
@@ -286,16 +312,18 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Lm<'_, '_> {
             .unwrap_or_else(|p| p.into_inner())
             .as_ref()
             .filter(|l| l.u == *u)
-            .map(|l| l.r.clone());
+            .map(|l| (l.r.clone(), l.x.clone()));
         self.u.copy_from(u);
-        if let Some(r) = back {
+        if let Some((r, x)) = back {
             self.r = r;
+            self.x = x;
             return;
         }
-        let x = self.problem.from_internal(u.as_slice());
-        self.r = DVector::from_vec(self.problem.residuals(&x));
+        let (r, x) = self.vars.evaluate(u.as_slice());
+        self.r = DVector::from_vec(r);
         let cost = 0.5 * self.r.norm_squared();
-        self.trail.push((cost, u.as_slice().to_vec()));
+        self.trail.push((cost, x.clone()));
+        self.x = x;
         self.trials.fetch_add(1, Ordering::Relaxed);
         let joins = self.joins(u.as_slice(), cost);
         let joined = self.joined.get_mut().unwrap_or_else(|p| p.into_inner());
@@ -318,46 +346,73 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Lm<'_, '_> {
         if self.problem.stop.requested() || self.joined().is_some() {
             return None;
         }
-        let trials = self.trials.swap(0, Ordering::Relaxed);
+        self.trials.store(0, Ordering::Relaxed);
         let mut last = self.last.lock().unwrap_or_else(|p| p.into_inner());
         let n = self.u.len();
+        let mut partial = None;
         if let (JacobianRule::Secant, Some(l)) = (self.rule, last.as_mut()) {
             let du = &self.u - &l.u;
             let dd = du.norm_squared();
             let predicted = &l.r + &l.j * &du;
             let (old, now) = (l.r.norm_squared(), self.r.norm_squared());
             let ratio = (old - now) / (old - predicted.norm_squared());
-            let _ = trials;
-            if ratio >= SECANT_TRUST && l.secant_updates < SECANT_SPAN * n && dd > 0.0 {
+            if dd > 0.0 {
                 let miss = &self.r - predicted;
-                l.j += miss * du.transpose() / dd;
-                l.secant_updates += 1;
-                l.u.copy_from(&self.u);
-                l.r.copy_from(&self.r);
-                return Some(l.j.clone());
+                let updated = &l.j + miss * du.transpose() / dd;
+                if ratio >= SECANT_TRUST && l.secant_updates < SECANT_SPAN * n {
+                    l.j = updated;
+                    l.secant_updates += 1;
+                    l.u.copy_from(&self.u);
+                    l.x.clone_from(&self.x);
+                    l.r.copy_from(&self.r);
+                    return Some(l.j.clone());
+                }
+                // The secant model failed one step after an exact
+                // refresh: the cheap columns are taken anew, the costly
+                // ones keep their secant estimates (updated by this step);
+                // the next refresh is exact again, as is one after the
+                // secant span (the whole matrix has drifted).
+                if l.exact && ratio < SECANT_TRUST {
+                    partial = self.costly.as_deref().map(|c| (c, updated));
+                }
             }
         }
         if let Some(k) = self.valley() {
             *self.joined.lock().unwrap_or_else(|p| p.into_inner()) = Some(Joined::Valley(k));
             return None;
         }
-        let j = self.differences();
+        let (j, exact) = match partial {
+            Some((costly, mut j)) => {
+                let cheap: Vec<bool> = costly.iter().map(|c| !c).collect();
+                let fresh = self.differences(Some(&cheap));
+                for (k, take) in cheap.iter().enumerate() {
+                    if *take {
+                        j.set_column(k, &fresh.column(k));
+                    }
+                }
+                (j, false)
+            }
+            None => (self.differences(None), true),
+        };
         *last = Some(LastJacobian {
             u: self.u.clone(),
+            x: self.x.clone(),
             r: self.r.clone(),
             j: j.clone(),
             secant_updates: 0,
+            exact,
         });
         Some(j)
     }
 }
 
 /// One Levenberg–Marquardt run from `x0` with `rule`'s Jacobians (a
-/// secant run is polished on differences); it stops early when it comes
-/// to one of the `earlier` optima (inside its confidence region, or,
-/// with `later` = [`LaterRuns::Valley`], in its valley).
+/// secant run is polished on differences), `separable`'s parameters solved
+/// at every point; it stops early when it comes to one of the `earlier`
+/// optima (inside its confidence region, or, with `later` =
+/// [`LaterRuns::Valley`], in its valley).
 pub fn local_run(
-    problem: &Problem<'_>,
+    (problem, separable): (&Problem<'_>, Option<&Separable>),
     x0: &[f64],
     max_evaluations: usize,
     rule: JacobianRule,
@@ -365,19 +420,35 @@ pub fn local_run(
     later: LaterRuns,
     tolerance: (f64, f64),
 ) -> LocalRun {
-    let one_run = |x: &[f64], budget: usize, rule: JacobianRule, earlier: &[Found]| {
-        one_run(problem, x, budget, (rule, later), earlier, tolerance)
-    };
-    let (first, ended_early) = one_run(x0, max_evaluations, rule, earlier);
+    let vars = |x: &[f64]| Variables::new(problem, separable, x);
+    // A start is moved off its bounds (the sine transform is stationary
+    // there).
+    let u0 = vars(x0).to_internal(x0);
+    let (first, ended_early) = one_run(
+        vars(x0),
+        &u0,
+        max_evaluations,
+        (rule, later),
+        earlier,
+        tolerance,
+    );
     // The budget bounds the whole run: a secant run that spent it is not
     // polished (it did not converge).
     let left = max_evaluations.saturating_sub(first.evaluations);
     if rule == JacobianRule::Differences || ended_early || !first.converged || left < 2 {
         return first;
     }
-    // The polish: the exact method from where the secant run ended, on
-    // the budget that is left.
-    let (polish, _) = one_run(&first.x, left, JacobianRule::Differences, earlier);
+    // The polish: the exact method from where the secant run ended (moved
+    // off a bound as a start is), on the budget that is left.
+    let u1 = vars(&first.x).to_internal(&first.x);
+    let (polish, _) = one_run(
+        vars(&first.x),
+        &u1,
+        left,
+        (JacobianRule::Differences, later),
+        earlier,
+        tolerance,
+    );
     LocalRun {
         evaluations: first.evaluations + polish.evaluations,
         jacobian_evaluations: first.jacobian_evaluations + polish.jacobian_evaluations,
@@ -387,16 +458,20 @@ pub fn local_run(
 
 /// One run; true when it ended early (a stop, or an earlier optimum).
 fn one_run(
-    problem: &Problem<'_>,
-    x0: &[f64],
+    vars: Variables<'_, '_>,
+    u0: &[f64],
     max_evaluations: usize,
     rules: (JacobianRule, LaterRuns),
     earlier: &[Found],
     (ftol, xtol): (f64, f64),
 ) -> (LocalRun, bool) {
-    let u0 = DVector::from_vec(problem.to_internal(x0));
+    let problem = vars.problem();
+    let u0 = DVector::from_column_slice(u0);
     let n = u0.len();
-    let mut lm = Lm::new(problem, &u0, rules, earlier);
+    if n == 0 {
+        return (solved_run(&vars), problem.stop.requested());
+    }
+    let mut lm = Lm::new(vars, &u0, rules, earlier);
     lm.set_params(&u0);
     let patience = max_evaluations.div_ceil(n + 1).max(1);
     let (lm, report) = LevenbergMarquardt::new()
@@ -413,10 +488,7 @@ fn one_run(
     let curvature = curvature(lm.last.into_inner().unwrap_or_else(|p| p.into_inner()));
     let joined = lm.joined.into_inner().unwrap_or_else(|p| p.into_inner());
     if let Some(how) = joined {
-        return (
-            joined_run(problem, earlier, how, &lm.u, &lm.r, evaluations),
-            true,
-        );
+        return (joined_run(earlier, how, &lm.x, &lm.r, evaluations), true);
     }
     let converged = report.termination.was_successful()
         || matches!(
@@ -431,7 +503,7 @@ fn one_run(
         }
     }
     let run = LocalRun {
-        x: problem.from_internal(lm.u.as_slice()),
+        x: lm.x.clone(),
         cost: 0.5 * lm.r.norm_squared(),
         converged,
         termination,
@@ -447,7 +519,7 @@ fn one_run(
 /// step met the convergence test (the curvature hardly changes over that
 /// step). None when the last Jacobian was a secant update.
 fn curvature(last: Option<LastJacobian>) -> Option<DMatrix<f64>> {
-    let l = last.filter(|l| l.secant_updates == 0)?;
+    let l = last.filter(|l| l.secant_updates == 0 && l.exact)?;
     // A column taken on a fold where cos u < 0 changes sign.
     let mut j = l.j;
     for (k, u) in l.u.iter().enumerate() {
@@ -458,26 +530,39 @@ fn curvature(last: Option<LastJacobian>) -> Option<DMatrix<f64>> {
     Some(j.transpose() * &j)
 }
 
-/// A run that came to an earlier optimum (`how`), standing at `u` with
-/// residuals `r` after `(evaluations, jacobian_evaluations)`.
+/// A run with nothing to search (every parameter solved): its one point.
+fn solved_run(vars: &Variables<'_, '_>) -> LocalRun {
+    let (r, x) = vars.evaluate(&[]);
+    LocalRun {
+        x,
+        cost: 0.5 * r.iter().map(|v| v * v).sum::<f64>(),
+        converged: true,
+        termination: "converged (every parameter solved as a linear one)".into(),
+        evaluations: 1,
+        jacobian_evaluations: 0,
+        curvature: None,
+    }
+}
+
+/// A run that came to an earlier optimum (`how`), standing at the whole
+/// point `x` with residuals `r` after `(evaluations, jacobian_evaluations)`.
 fn joined_run(
-    problem: &Problem<'_>,
     earlier: &[Found],
     how: Joined,
-    u: &DVector<f64>,
+    x: &[f64],
     r: &DVector<f64>,
     (evaluations, jacobian_evaluations): (usize, usize),
 ) -> LocalRun {
     let (x, cost, termination) = match how {
         // Where it stopped: the point that came to optimum k.
         Joined::Region(k) => (
-            problem.from_internal(u.as_slice()),
+            x.to_vec(),
             0.5 * r.norm_squared(),
             format!("came to optimum {} of an earlier run", k + 1),
         ),
         // Its end is that optimum: a straight way down leads there.
         Joined::Valley(k) => (
-            problem.from_internal(&earlier[k].u),
+            earlier[k].x.clone(),
             earlier[k].cost,
             format!(
                 "in the valley of optimum {} of an earlier run (from cost {:.4e} the cost \
@@ -500,13 +585,14 @@ fn joined_run(
 
 /// The parameters that moved by more than 0.1 % of their scaled range
 /// between the best point of the first three quarters of a run and the
-/// best point of all of it: what a larger budget would still change.
+/// best point of all of it (the trail's whole points): what a larger
+/// budget would still change.
 fn still_moving(problem: &Problem<'_>, trail: &[(f64, Vec<f64>)]) -> Vec<String> {
     let best = |t: &[(f64, Vec<f64>)]| {
         t.iter()
             .filter(|(c, _)| c.is_finite())
             .min_by(|a, b| a.0.total_cmp(&b.0))
-            .map(|(_, u)| problem.from_internal(u))
+            .map(|(_, x)| x.clone())
     };
     let early = trail.len() * 3 / 4;
     let (Some(a), Some(b)) = (best(&trail[..early.max(1).min(trail.len())]), best(trail)) else {

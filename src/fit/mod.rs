@@ -10,6 +10,7 @@
 //! |---|---|
 //! | scaling | each parameter on its log scale (positive bounds) or linear scale, mapped to an unbounded variable by the sine transform s = lo + (hi − lo)(1 + sin u)/2 |
 //! | global phase | a seeded Latin-hypercube set of starts over the scaled bounds, each scored by one simulation |
+//! | linear parameters | solved, not searched: the parameters the residuals are linear in with fixed slopes (the drivetrain's viscous and quadratic losses, map coefficients that scale or offset the measured friction) are set at every point the local runs evaluate to their best values in their bounds (variable projection; `--linear-keys searched` searches them as the others) |
 //! | local phase | Levenberg–Marquardt (MINPACK, `levenberg-marquardt` on nalgebra) from the given start, then the best distinct global starts side by side, each stopped inside the first optimum's 95 % confidence region or, with `--later-runs valley` (opt-in), as soon as a straight line from it falls all the way to that optimum (the valley test); Jacobian by forward differences of whole simulations run in parallel, kept up to date between them by Broyden's secant update and polished on differences at the end |
 //! | statistics | standard errors s²(JᵀJ)⁻¹ and correlations from the Jacobian in scaled coordinates at the optimum; flags at bounds and for |corr| > 0.95 |
 //!
@@ -39,6 +40,7 @@
 //! | `driver.rs` | one model's whole fit: global phase, local runs, statistics, predictions |
 //! | `multistart.rs` | the global phase, then local runs from the best distinct starts; the distinct optima |
 //! | `local_run.rs` | one Levenberg–Marquardt run: secant or difference Jacobians, the stop inside an earlier optimum's confidence region or valley, what was still moving |
+//! | `separable.rs` | the parameters the residuals are linear in, solved exactly in their bounds at every point; the local runs' variables (the others) |
 //! | `stats.rs` | standard errors, correlations, flags |
 //! | `options.rs` | how a fit searches: the user's settings, each fit's options, the Jacobian and later-run rules |
 //! | `physics_model.rs` | our model as a predictor (transient and steady) |
@@ -82,6 +84,7 @@ pub mod report_plots;
 pub mod request;
 pub mod reversals;
 pub mod select;
+pub mod separable;
 pub mod series;
 pub mod stats;
 pub mod synthetic;

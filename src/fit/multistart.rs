@@ -10,6 +10,7 @@
 use super::local_run::{local_run, Found, LocalRun};
 use super::options::Options;
 use super::problem::Problem;
+use super::separable::{canonical, Separable};
 use rand::rngs::StdRng;
 use rand::seq::SliceRandom;
 use rand::{RngExt, SeedableRng};
@@ -45,10 +46,15 @@ const DISTINCT_START: f64 = 0.1;
 /// Optima closer than this are the same optimum.
 const DISTINCT_OPTIMUM: f64 = 0.02;
 
-/// Global phase, local runs, distinct optima (best first; never empty).
-pub fn search(problem: &Problem<'_>, options: &Options) -> Vec<LocalRun> {
+/// Global phase, local runs (`separable`'s parameters solved at every
+/// point), distinct optima (best first; never empty).
+pub fn search(
+    problem: &Problem<'_>,
+    separable: Option<&Separable>,
+    options: &Options,
+) -> Vec<LocalRun> {
     let starts = starts(problem, options);
-    let runs = local_runs(problem, options, &starts);
+    let runs = local_runs((problem, separable), options, &starts);
     let mut distinct: Vec<LocalRun> = Vec::new();
     for r in runs {
         if distinct
@@ -144,7 +150,11 @@ fn starts(problem: &Problem<'_>, options: &Options) -> Vec<Vec<f64>> {
 /// the other starts side by side, each stopping when it comes to the
 /// first one's optimum (the same for every run, so the outcome does not
 /// depend on which ends first).
-fn local_runs(problem: &Problem<'_>, options: &Options, starts: &[Vec<f64>]) -> Vec<LocalRun> {
+fn local_runs(
+    (problem, separable): (&Problem<'_>, Option<&Separable>),
+    options: &Options,
+    starts: &[Vec<f64>],
+) -> Vec<LocalRun> {
     let total = starts.len();
     let say = |k: usize, run: &LocalRun| {
         options.say(&format!(
@@ -163,7 +173,7 @@ fn local_runs(problem: &Problem<'_>, options: &Options, starts: &[Vec<f64>]) -> 
     };
     let run_from = |x: &Vec<f64>, earlier: &[Found]| {
         local_run(
-            problem,
+            (problem, separable),
             x,
             options.max_evaluations,
             options.jacobian,
@@ -182,12 +192,8 @@ fn local_runs(problem: &Problem<'_>, options: &Options, starts: &[Vec<f64>]) -> 
         .curvature
         .clone()
         .map(|curvature| Found {
-            u: problem
-                .params
-                .iter()
-                .zip(&first.x)
-                .map(|(p, v)| p.to_canonical(*v))
-                .collect(),
+            u: canonical(problem, separable, &first.x),
+            x: first.x.clone(),
             cost: first.cost,
             curvature,
         })
@@ -276,7 +282,7 @@ mod tests {
             later_runs,
             ..Default::default()
         };
-        let runs = search(&problem, &options);
+        let runs = search(&problem, None, &options);
         let simulations = problem
             .simulations
             .load(std::sync::atomic::Ordering::Relaxed);

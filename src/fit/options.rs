@@ -42,6 +42,9 @@ pub struct Options {
     /// Standard errors and correlations at the optimum (one more Jacobian;
     /// a cross-validation fold needs none).
     pub statistics: bool,
+    /// Whether the parameters the residuals are linear in are solved at
+    /// every point (`separable.rs`) or searched as the others.
+    pub linear_keys: LinearKeys,
 }
 
 impl Default for Options {
@@ -60,6 +63,7 @@ impl Default for Options {
             xtol: 1e-8,
             start: None,
             statistics: true,
+            linear_keys: Default::default(),
         }
     }
 }
@@ -89,6 +93,8 @@ pub struct SearchSettings {
     pub jacobian: JacobianRule,
     /// How the runs after the first end.
     pub later_runs: LaterRuns,
+    /// Whether the linear parameters are solved or searched.
+    pub linear_keys: LinearKeys,
 }
 
 impl Default for SearchSettings {
@@ -101,6 +107,7 @@ impl Default for SearchSettings {
             max_evaluations: 200,
             jacobian: Default::default(),
             later_runs: Default::default(),
+            linear_keys: Default::default(),
         }
     }
 }
@@ -154,6 +161,7 @@ impl SearchSettings {
             extra_starts: Vec::new(),
             jacobian: self.jacobian,
             later_runs: self.later_runs,
+            linear_keys: self.linear_keys,
             ..Default::default()
         }
     }
@@ -213,5 +221,34 @@ impl LaterRuns {
             .find(|(n, _)| *n == s)
             .map(|(_, r)| *r)
             .ok_or_else(|| format!("`{s}` is not a rule for later runs: valley or full"))
+    }
+}
+
+/// What the local runs do with the parameters the residuals are linear in
+/// (with slopes no parameter changes: `separable.rs`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum LinearKeys {
+    /// Solved exactly in their bounds at every point the runs evaluate;
+    /// the runs search the others (variable projection).
+    #[default]
+    Solved,
+    /// Searched by the runs as every other parameter.
+    Searched,
+}
+
+impl LinearKeys {
+    /// The rules by name (the command line's values).
+    pub const NAMES: [(&'static str, LinearKeys); 2] = [
+        ("solved", LinearKeys::Solved),
+        ("searched", LinearKeys::Searched),
+    ];
+
+    /// The rule named `s`.
+    pub fn parse(s: &str) -> Result<Self, String> {
+        Self::NAMES
+            .iter()
+            .find(|(n, _)| *n == s)
+            .map(|(_, r)| *r)
+            .ok_or_else(|| format!("`{s}` is not a rule for linear keys: solved or searched"))
     }
 }

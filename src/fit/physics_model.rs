@@ -84,6 +84,10 @@ impl FilmTraces {
     }
 }
 
+/// The keys the friction is linear in, with slopes that depend on the
+/// inputs alone ([`Model::linear_parameters`]).
+const LINEAR_KEYS: [&str; 2] = ["drivetrain.viscous_n_s_m", "drivetrain.quadratic_n_s2_m2"];
+
 /// Film traces kept: enough for the sources of one Jacobian's base point
 /// and the film columns beside it.
 const TRACES_KEPT: usize = 16;
@@ -365,6 +369,23 @@ impl Model for PhysicsModel {
 
     fn film_solves(&self) -> Option<usize> {
         Some(self.solves.load(Ordering::Relaxed))
+    }
+
+    /// The drivetrain's viscous and quadratic losses: b v + c_q v |v| is
+    /// added to the friction beside everything else (outside the bristle,
+    /// after the film), so the prediction is linear in b and c_q with the
+    /// slopes v and v |v| (through the gain), whatever the other keys.
+    fn costly_parameters(&self) -> Option<Vec<usize>> {
+        Some(self.base.film_params.iter().map(|(i, _)| *i).collect())
+    }
+
+    fn linear_parameters(&self) -> Vec<usize> {
+        self.names
+            .iter()
+            .enumerate()
+            .filter(|(_, n)| LINEAR_KEYS.contains(&n.as_str()))
+            .map(|(i, _)| i)
+            .collect()
     }
 
     fn predict(&self, x: &[f64], series: &Series) -> Result<Vec<f64>, PredictError> {
@@ -753,6 +774,47 @@ mod tests {
         // The soft width acts on the film: not a key after it.
         assert!(!acts_after_the_film("contact.width_load_exponent"));
         assert!(acts_after_the_film("contact.boundary_friction"));
+    }
+
+    #[test]
+    fn the_friction_is_linear_in_the_viscous_and_quadratic_losses_with_slopes_no_other_key_moves() {
+        let mut config = Config::default();
+        config.solver.cells = 32;
+        let keys = [
+            ("lubricant.viscosity_pa_s", 0.01, 1.0, 0.0564),
+            ("contact.presliding_stiffness_n_m", 1e5, 1e9, 2e6),
+            ("drivetrain.coulomb_n", 0.0, 1e3, 40.0),
+            ("drivetrain.viscous_n_s_m", 0.0, 1e4, 300.0),
+            ("drivetrain.quadratic_n_s2_m2", 0.0, 1e4, 800.0),
+        ];
+        let t: Vec<f64> = (1..=300).map(|k| k as f64 * 1e-3).collect();
+        let v: Vec<f64> = t.iter().map(|t| 0.05 * (9.0 * t).sin()).collect();
+        let curve = series(vec![0.0, 1.0, 2.0, 3.0], vec![0.01, -0.05, 0.2, 1.0], true);
+        let model = model_of(&config, &keys);
+        assert_eq!(model.linear_parameters(), vec![3, 4]);
+        for s in [series(t, v, false), curve] {
+            // The slope of each linear key at two points that differ in
+            // every other key (the film included), and at twice the step.
+            let slope = |x: &[f64], i: usize, h: f64| -> Vec<f64> {
+                let mut moved = x.to_vec();
+                moved[i] += h;
+                let a = model.predict(x, &s).unwrap();
+                let b = model.predict(&moved, &s).unwrap();
+                b.iter().zip(&a).map(|(b, a)| (b - a) / h).collect()
+            };
+            let x0 = [0.0564, 2e6, 40.0, 300.0, 800.0];
+            let x1 = [0.2, 3e7, 10.0, 50.0, 20.0];
+            for i in [3, 4] {
+                let reference = slope(&x0, i, 100.0);
+                let scale = reference.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                assert!(scale > 0.0);
+                for other in [slope(&x1, i, 100.0), slope(&x0, i, 200.0)] {
+                    for (a, b) in other.iter().zip(&reference) {
+                        assert_relative_eq!(*a, *b, epsilon = 1e-9 * scale);
+                    }
+                }
+            }
+        }
     }
 
     #[test]

@@ -27,6 +27,21 @@ pub trait Model: Sync {
     fn film_solves(&self) -> Option<usize> {
         None
     }
+    /// The parameters every prediction depends on linearly, each with a
+    /// slope that no parameter changes (only the series' inputs): the
+    /// prediction is q(the others) + Σ x_k φ_k. A fit solves them for
+    /// each point of the others instead of searching them
+    /// (`separable.rs`). None by default.
+    fn linear_parameters(&self) -> Vec<usize> {
+        Vec::new()
+    }
+    /// The parameters a change of which needs a whole simulation, when
+    /// the others are cheaper (our model: the keys the film depends on;
+    /// the others recompose the friction along a kept film). None: every
+    /// parameter costs the same.
+    fn costly_parameters(&self) -> Option<Vec<usize>> {
+        None
+    }
 }
 
 /// The data of a fit: training sources, the parts of the given training
@@ -328,6 +343,23 @@ impl<'a> Problem<'a> {
         })
     }
 
+    /// Per parameter (the model's, then the fitted map coefficients):
+    /// whether a change of it alone needs a whole simulation. None when
+    /// every one does, or none is cheaper than another.
+    pub fn costly(&self) -> Option<Vec<bool>> {
+        let costly = self.model.costly_parameters()?;
+        let n = self.model.parameters().len();
+        let mut out: Vec<bool> = (0..n).map(|i| costly.contains(&i)).collect();
+        // A map coefficient that moves the model's inputs is simulated
+        // again; one of the measured friction alone reuses the prediction.
+        out.extend(
+            self.map_fit
+                .iter()
+                .map(|(i, _)| self.data.train.iter().any(|s| s.inputs_read(*i))),
+        );
+        (out.iter().any(|c| *c) && out.iter().any(|c| !*c)).then_some(out)
+    }
+
     /// The starting point (every parameter's start).
     pub fn start(&self) -> Vec<f64> {
         self.params.iter().map(|p| p.start).collect()
@@ -456,25 +488,32 @@ impl<'a> Problem<'a> {
     /// Residuals on the fitted samples; a failed prediction gives large
     /// residuals (a step there is rejected).
     pub fn residuals(&self, x: &[f64]) -> Vec<f64> {
+        self.try_residuals(x).unwrap_or_else(|| self.penalty())
+    }
+
+    /// The large residuals of a point with no prediction.
+    pub fn penalty(&self) -> Vec<f64> {
+        vec![PENALTY * self.friction_scale; self.fitted_samples]
+    }
+
+    /// Residuals on the fitted samples; None when some prediction fails or
+    /// is not finite.
+    pub fn try_residuals(&self, x: &[f64]) -> Option<Vec<f64>> {
         let fits = self.predict_sources(x, Role::Train);
-        let penalty = || vec![PENALTY * self.friction_scale; self.fitted_samples];
         let mut r = Vec::with_capacity(self.fitted_samples);
         for f in fits {
-            let Ok(f) = f else { return penalty() };
+            let f = f.ok()?;
             for k in 0..f.predicted.len() {
                 if f.series.fit[k] {
                     let d = f.predicted[k] - f.series.friction[k];
                     if !d.is_finite() {
-                        return penalty();
+                        return None;
                     }
                     r.push(d);
                 }
             }
         }
-        if r.len() != self.fitted_samples {
-            return penalty();
-        }
-        r
+        (r.len() == self.fitted_samples).then_some(r)
     }
 
     /// ½ Σ r².

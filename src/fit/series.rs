@@ -361,6 +361,33 @@ impl Source {
         self.columns().eval_column(e, what, coeffs)
     }
 
+    /// Whether map coefficient `i` moves the measured friction alone, and
+    /// that affinely: the friction expression is affine in it (checked at
+    /// construction) and no input expression reads it. A fitted such
+    /// coefficient changes every residual by a slope that no parameter
+    /// changes.
+    pub fn moves_only_the_friction_affinely(&self, i: usize) -> bool {
+        self.friction.affine.is_some() && !self.inputs_read(i)
+    }
+
+    /// Whether an input expression (velocity, load, temperature) reads map
+    /// coefficient `i`: the model's inputs then depend on it.
+    pub fn inputs_read(&self, i: usize) -> bool {
+        let reads = |e: &Expr| {
+            e.vars
+                .iter()
+                .any(|(_, v)| matches!(v, Var::Coefficient(k) if *k == i))
+        };
+        [
+            Some(&self.velocity),
+            self.load.as_ref(),
+            self.temperature.as_ref(),
+        ]
+        .into_iter()
+        .flatten()
+        .any(reads)
+    }
+
     /// Whether it is a steady curve.
     pub fn is_steady(&self) -> bool {
         self.steady
