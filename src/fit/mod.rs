@@ -43,7 +43,8 @@
 //! | `separable.rs` | the parameters the residuals are linear in, solved exactly in their bounds at every point; the local runs' variables (the others) |
 //! | `stats.rs` | standard errors, correlations, flags |
 //! | `options.rs` | how a fit searches: the user's settings, each fit's options, the Jacobian and later-run rules |
-//! | `physics_model.rs` | our model as a predictor (transient and steady) |
+//! | `physics_model.rs` | our model as a predictor: its keys, its film reused when only the terms after it change, its linear keys |
+//! | `film_run.rs` | our model's film along a series (transient and steady solves), the trace it keeps, the friction recomposed along it |
 //! | `baselines.rs` | Coulomb + viscous, Stribeck, LuGre |
 //! | `problem.rs` | the problem: model, data (training, held out, validation), map coefficients, residuals, predictions |
 //! | `contact_scale.rs` | the contact's gain and load chosen from the data (a joint's lever, a linear axis's gain); a key's value as it acts on the joint |
@@ -69,6 +70,7 @@ pub mod cross_validate;
 pub mod driver;
 pub mod error;
 mod expr;
+mod film_run;
 pub mod inputs;
 pub mod local_run;
 pub mod models_table;

@@ -28,13 +28,13 @@
 //! Jacobian columns are mostly term keys solves the film about once per
 //! Jacobian instead of once per column.
 
+use super::film_run::{steady, transient, FilmTrace};
 use super::problem::Model;
 use super::series::{mix, Series};
 use super::unknowns::{ConfigKeys, DataScale, FittedParameter, ParamSpec};
 use super::{FitError, PredictError};
-use crate::config::{Config, ViscosityLaw};
-use crate::physics::terms::{acts_after_the_film, BristleMove, FrictionTerms, TermStates};
-use crate::physics::{Estimate, Solver, Status, ViscosityModel};
+use crate::config::Config;
+use crate::physics::terms::{acts_after_the_film, FrictionTerms};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 
@@ -112,93 +112,6 @@ fn film_fingerprint(config: &Config) -> u64 {
         config.contact.load_n.to_bits()
     );
     name_hash(&text)
-}
-
-/// One film solution along a series: per solver step (the first the steady
-/// start), the inputs of the friction's composition.
-struct FilmTrace {
-    /// The fingerprint of the configuration the film depends on (every key
-    /// but those acting after the film) and of the gain.
-    film_key: u64,
-    /// The fingerprint of the series' inputs.
-    inputs: u64,
-    /// A steady curve (each step its own steady state) or a time series.
-    steady: bool,
-    /// Per step: velocity (m/s), load (N), the film's viscous and asperity
-    /// forces (N).
-    steps: Vec<[f64; 4]>,
-    /// Per step, its time (s; a steady curve: unused).
-    times: Vec<f64>,
-    /// The time series' sampling onto the data (see [`transient`]).
-    sampling: Option<Sampling>,
-}
-
-/// Where a time series' samples fall between the solver's steps.
-#[derive(Clone, Copy)]
-struct Sampling {
-    /// The solver's step, s.
-    dt: f64,
-    /// Whether the series starts at rest (its first sample is not the
-    /// steady start's).
-    at_rest: bool,
-}
-
-impl FilmTrace {
-    fn record(e: &Estimate) -> [f64; 4] {
-        [e.velocity, e.load, e.viscous_force, e.asperity_force]
-    }
-
-    /// The friction at the series' samples with `terms` on this film.
-    fn compose(&self, terms: &FrictionTerms, s: &Series) -> Vec<f64> {
-        let mut states = TermStates::default();
-        let mut friction = |st: &[f64; 4], how: BristleMove| {
-            terms
-                .friction((st[0], st[1]), (st[2], st[3]), &mut states, how)
-                .1
-        };
-        if self.steady {
-            return self
-                .steps
-                .iter()
-                .map(|st| friction(st, BristleMove::Steady))
-                .collect();
-        }
-        let sampling = self.sampling.expect("a time series is sampled");
-        let f0 = friction(&self.steps[0], BristleMove::Steady);
-        let mut forces = vec![f0];
-        forces.extend(
-            self.steps[1..]
-                .iter()
-                .map(|st| friction(st, BristleMove::Step(sampling.dt))),
-        );
-        onto_samples(s, &self.times, &forces, sampling)
-    }
-}
-
-/// The friction at the samples of `s` from the friction `forces` at the
-/// steps' `times` (the first the start): linear interpolation between
-/// steps, as the solver's run is read.
-fn onto_samples(s: &Series, times: &[f64], forces: &[f64], sampling: Sampling) -> Vec<f64> {
-    let n = s.len();
-    let mut out = vec![f64::NAN; n];
-    let (mut t_prev, mut f_prev) = (times[0], forces[0]);
-    let mut k = 0;
-    if !sampling.at_rest {
-        out[0] = forces[0];
-        k = 1;
-    }
-    for (&t, &f) in times.iter().zip(forces).skip(1) {
-        while k < n && s.t[k] <= t + 1e-12 * sampling.dt {
-            let w = ((s.t[k] - t_prev) / (t - t_prev)).clamp(0.0, 1.0);
-            out[k] = f_prev + w * (f - f_prev);
-            k += 1;
-        }
-        (t_prev, f_prev) = (t, f);
-    }
-    for o in out.iter_mut().skip(k) {
-        *o = f_prev;
-    }
-    out
 }
 
 impl PhysicsModel {
@@ -397,318 +310,10 @@ impl Model for PhysicsModel {
     }
 }
 
-/// Linear interpolation in a sampled signal with a moving cursor (times
-/// are asked in increasing order).
-struct Cursor<'a> {
-    t: &'a [f64],
-    y: &'a [f64],
-    j: usize,
-}
-
-impl<'a> Cursor<'a> {
-    fn new(t: &'a [f64], y: &'a [f64]) -> Self {
-        Self { t, y, j: 0 }
-    }
-
-    fn at(&mut self, t: f64) -> f64 {
-        let n = self.t.len();
-        while self.j + 2 < n && self.t[self.j + 1] <= t {
-            self.j += 1;
-        }
-        let (t0, t1) = (self.t[self.j], self.t[self.j + 1]);
-        let w = ((t - t0) / (t1 - t0)).clamp(0.0, 1.0);
-        self.y[self.j] + w * (self.y[self.j + 1] - self.y[self.j])
-    }
-}
-
-fn follows_temperature(config: &Config, s: &Series) -> bool {
-    s.temperature.is_some() && config.viscosity_model() != ViscosityModel::Constant
-}
-
-/// The liquid viscosity at `t_c` °C by the configuration's law, or why
-/// these parameters give none there (the rule of every entry point).
-fn viscosity(law: &ViscosityLaw, t_c: f64) -> Result<f64, PredictError> {
-    law.viscosity_at(t_c)
-        .map_err(|e| PredictError::Viscosity(e.to_string()))
-}
-
-/// Where a simulated series starts (see the module documentation).
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct Start {
-    /// The time the simulation starts, s.
-    t: f64,
-    /// The first sample's time and velocity, s and m/s.
-    first: (f64, f64),
-    /// Whether it starts at rest (one sample interval before the first sample).
-    at_rest: bool,
-}
-
-impl Start {
-    fn of(s: &Series) -> Self {
-        let (t, v) = (&s.t, &s.velocity);
-        let first = (t[0], v[0]);
-        let at_rest =
-            v[0] == 0.0 || (t.len() >= 2 && t[1] > t[0] && v[0].abs() <= 2.0 * (v[1] - v[0]).abs());
-        let start = if at_rest && t.len() >= 2 {
-            t[0] - (t[1] - t[0])
-        } else {
-            t[0]
-        };
-        Self {
-            t: start,
-            first,
-            at_rest,
-        }
-    }
-
-    /// The steady velocity the solver starts from, m/s.
-    fn initial_velocity(&self) -> f64 {
-        if self.at_rest {
-            0.0
-        } else {
-            self.first.1
-        }
-    }
-
-    /// The velocity at `t`: ramped from rest before the first sample.
-    fn velocity(&self, t: f64, v_at: &mut Cursor) -> f64 {
-        let (t1, v1) = self.first;
-        if self.at_rest && t < t1 {
-            v1 * ((t - self.t) / (t1 - self.t)).clamp(0.0, 1.0)
-        } else {
-            v_at.at(t)
-        }
-    }
-}
-
-/// The friction at the samples of time series `s` and its film trace (the
-/// caller fills in the trace's keys).
-fn transient(config: &Config, s: &Series) -> Result<(Vec<f64>, FilmTrace), PredictError> {
-    let settings = config.solver_settings();
-    let dt = settings.dt;
-    let mut solver =
-        Solver::new(&config.model(), &settings).map_err(|e| PredictError::Solver(e.to_string()))?;
-    let n = s.len();
-    let start = Start::of(s);
-    let t0 = start.t;
-    let steps = ((s.t[n - 1] - t0) / dt).ceil() as u64;
-    let default_load = vec![config.contact.load_n; n];
-    let load = s.load.as_deref().unwrap_or(&default_load);
-    let follows = follows_temperature(config, s);
-    let law = ViscosityLaw::of(config);
-    let mut v_at = Cursor::new(&s.t, &s.velocity);
-    let mut f_at = Cursor::new(&s.t, load);
-    let mut temp_at = s.temperature.as_deref().map(|y| Cursor::new(&s.t, y));
-    if follows {
-        let temp = temp_at.as_mut().expect("follows").at(t0);
-        solver.set_liquid_viscosity(viscosity(&law, temp)?);
-    }
-    let first = solver.initialize_steady(start.initial_velocity(), f_at.at(t0));
-    let len = usize::try_from(steps).unwrap_or(0).saturating_add(1);
-    let (mut trace, mut times, mut forces) = (
-        Vec::with_capacity(len),
-        Vec::with_capacity(len),
-        Vec::with_capacity(len),
-    );
-    trace.push(FilmTrace::record(&first));
-    times.push(t0);
-    forces.push(first.friction_force);
-    // Parameters that make the inputs unreachable (a load the contact cannot
-    // carry) leave the solver at its iteration bound step after step, each
-    // at the cost of its fallbacks: such a run is no prediction.
-    const STUCK_STEPS: u32 = 50;
-    let mut stuck = 0u32;
-    for step in 1..=steps {
-        let t = t0 + step as f64 * dt;
-        if follows {
-            let temp = temp_at.as_mut().expect("follows").at(t);
-            solver.set_liquid_viscosity(viscosity(&law, temp)?);
-        }
-        let e = solver.step(start.velocity(t, &mut v_at), f_at.at(t));
-        if !e.friction_force.is_finite()
-            || !matches!(e.status, Status::Converged | Status::MaxIterations)
-        {
-            return Err(PredictError::Step {
-                t_s: t,
-                status: e.status.as_str(),
-                iterations: e.diagnostics.iterations,
-            });
-        }
-        stuck = if e.status == Status::MaxIterations {
-            stuck + 1
-        } else {
-            0
-        };
-        if stuck >= STUCK_STEPS {
-            return Err(PredictError::Stuck {
-                steps: STUCK_STEPS,
-                t_s: t,
-            });
-        }
-        trace.push(FilmTrace::record(&e));
-        times.push(t);
-        forces.push(e.friction_force);
-    }
-    let sampling = Sampling {
-        dt,
-        at_rest: start.at_rest,
-    };
-    let out = onto_samples(s, &times, &forces, sampling);
-    Ok((
-        out,
-        FilmTrace {
-            film_key: 0,
-            inputs: 0,
-            steady: false,
-            steps: trace,
-            times,
-            sampling: Some(sampling),
-        },
-    ))
-}
-
-/// The friction at the points of steady curve `s` and its film trace.
-fn steady(config: &Config, s: &Series) -> Result<(Vec<f64>, FilmTrace), PredictError> {
-    let mut solver = Solver::new(&config.model(), &config.solver_settings())
-        .map_err(|e| PredictError::Solver(e.to_string()))?;
-    let follows = follows_temperature(config, s);
-    let law = ViscosityLaw::of(config);
-    let mut trace = Vec::with_capacity(s.len());
-    let out = (0..s.len())
-        .map(|k| {
-            if follows {
-                let temp = s.temperature.as_ref().expect("follows")[k];
-                solver.set_liquid_viscosity(viscosity(&law, temp)?);
-            }
-            let e = solver.steady(s.velocity[k], s.load_at(k, config.contact.load_n));
-            if e.status.is_converged() && e.friction_force.is_finite() {
-                trace.push(FilmTrace::record(&e));
-                Ok(e.friction_force)
-            } else {
-                Err(PredictError::Steady {
-                    velocity_m_s: s.velocity[k],
-                    status: e.status.as_str(),
-                })
-            }
-        })
-        .collect::<Result<Vec<_>, _>>()?;
-    Ok((
-        out,
-        FilmTrace {
-            film_key: 0,
-            inputs: 0,
-            steady: true,
-            steps: trace,
-            times: Vec::new(),
-            sampling: None,
-        },
-    ))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use approx::assert_relative_eq;
-
-    fn series(t: Vec<f64>, v: Vec<f64>, steady: bool) -> Series {
-        let n = t.len();
-        Series {
-            name: "s".into(),
-            steady,
-            friction: vec![0.0; n],
-            t,
-            velocity: v,
-            load: None,
-            temperature: None,
-            fit: vec![true; n],
-        }
-    }
-
-    #[test]
-    fn a_transient_prediction_on_the_step_grid_equals_the_solver_run_directly() {
-        let mut config = Config::default();
-        config.solver.cells = 64;
-        let t: Vec<f64> = (0..=200).map(|k| k as f64 * 1e-3).collect();
-        let v: Vec<f64> = t.iter().map(|t| 0.3 * (6.0 * t).sin() + 0.05).collect();
-        let s = series(t.clone(), v.clone(), false);
-        let got = transient(&config, &s).unwrap().0;
-        let mut solver = Solver::new(&config.model(), &config.solver_settings()).unwrap();
-        let first = solver.initialize_steady(v[0], config.contact.load_n);
-        assert_eq!(got[0], first.friction_force);
-        for k in 1..t.len() {
-            let e = solver.step(v[k], config.contact.load_n);
-            assert_relative_eq!(got[k], e.friction_force, max_relative = 1e-9);
-        }
-    }
-
-    #[test]
-    fn the_fit_recomposes_a_term_added_to_the_list_as_the_solver_computes_it() {
-        // physics/terms/test_term.rs: a term added in its file and one line
-        // of the list. The fit sets its key on the terms and recomposes the
-        // friction along the kept film, with the bristle carrying it.
-        let mut config = Config::default();
-        config.solver.cells = 32;
-        config.contact.presliding_stiffness_n_m = 5e7;
-        let t: Vec<f64> = (0..=150).map(|k| k as f64 * 1e-3).collect();
-        let v: Vec<f64> = t.iter().map(|t| 0.02 * (20.0 * t).sin()).collect();
-        let s = series(t.clone(), v.clone(), false);
-        let (_, trace) = transient(&config, &s).unwrap();
-        let mut terms = config.model().terms;
-        assert!(terms.set("probe.drag_n", 40.0));
-        let got = trace.compose(&terms, &s);
-        let mut model = config.model();
-        model.terms.probe.drag = 40.0;
-        let mut solver = Solver::new(&model, &config.solver_settings()).unwrap();
-        let first = solver.initialize_steady(v[0], config.contact.load_n);
-        assert_relative_eq!(got[0], first.friction_force, max_relative = 1e-9);
-        for k in 1..t.len() {
-            let e = solver.step(v[k], config.contact.load_n);
-            assert_relative_eq!(
-                got[k],
-                e.friction_force,
-                max_relative = 1e-9,
-                epsilon = 1e-9
-            );
-        }
-    }
-
-    #[test]
-    fn a_series_that_starts_at_rest_is_predicted_as_simulate_ran_it() {
-        // simulate starts at rest at t = 0 and writes its first row at t = dt:
-        // with the bristle on, a start in steady sliding would begin it fully
-        // deflected (the biased fit).
-        let mut config = Config::default();
-        config.solver.cells = 32;
-        config.contact.presliding_stiffness_n_m = 5e7;
-        let dt = config.solver.dt_s;
-        let mut solver = Solver::new(&config.model(), &config.solver_settings()).unwrap();
-        solver.initialize_steady(0.0, config.contact.load_n);
-        let (mut t, mut v, mut f) = (Vec::new(), Vec::new(), Vec::new());
-        for k in 1..=300 {
-            let tk = k as f64 * dt;
-            let vk = 0.05 * (std::f64::consts::TAU * tk).sin();
-            f.push(solver.step(vk, config.contact.load_n).friction_force);
-            t.push(tk);
-            v.push(vk);
-        }
-        let s = series(t, v, false);
-        assert!(Start::of(&s).at_rest);
-        let got = transient(&config, &s).unwrap().0;
-        for (g, e) in got.iter().zip(&f) {
-            assert_relative_eq!(g, e, max_relative = 1e-9);
-        }
-    }
-
-    #[test]
-    fn a_series_in_motion_starts_in_steady_sliding_and_one_at_zero_speed_at_rest() {
-        let moving = series(vec![0.0, 1e-3, 2e-3], vec![0.05, 0.0502, 0.0504], false);
-        assert!(!Start::of(&moving).at_rest);
-        assert_eq!(Start::of(&moving).t, 0.0);
-        let resting = series(vec![1.0, 1.001], vec![0.0, 0.0], false);
-        let start = Start::of(&resting);
-        assert!(start.at_rest);
-        assert_relative_eq!(start.t, 0.999, max_relative = 1e-12);
-    }
+    use crate::fit::film_run::tests::series;
 
     /// A model of `keys` (each with its bounds and start) on `config`.
     fn model_of(config: &Config, keys: &[(&str, f64, f64, f64)]) -> PhysicsModel {
@@ -729,6 +334,8 @@ mod tests {
         };
         PhysicsModel::new(config, &specs, &scale).unwrap()
     }
+
+    use approx::assert_relative_eq;
 
     #[test]
     fn a_change_of_keys_that_act_after_the_film_recomposes_its_trace_bit_for_bit() {
@@ -862,19 +469,5 @@ mod tests {
         let not = model_of(&config, &[("contact.boundary_friction", 0.01, 1.0, 0.3)]);
         assert_eq!(fits.film_key(&[0.0564]), not.film_key(&[0.3]));
         assert_ne!(fits.film_key(&[0.06]), not.film_key(&[0.3]));
-    }
-
-    #[test]
-    fn a_steady_prediction_is_the_steady_solver_point_by_point() {
-        let mut config = Config::default();
-        config.solver.cells = 64;
-        let v = vec![0.01, 0.1, 1.0];
-        let s = series(vec![0.0, 1.0, 2.0], v.clone(), true);
-        let got = steady(&config, &s).unwrap().0;
-        let mut solver = Solver::new(&config.model(), &config.solver_settings()).unwrap();
-        for (k, v) in v.iter().enumerate() {
-            let e = solver.steady(*v, config.contact.load_n);
-            assert_relative_eq!(got[k], e.friction_force, max_relative = 1e-9);
-        }
     }
 }
