@@ -629,7 +629,85 @@ fn termination_text(t: &TerminationReason) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fit::problem::{Data, HoldOut, Model};
+    use crate::fit::series::{Mapping, Series, Source};
+    use crate::fit::unknowns::FittedParameter;
+    use crate::fit::PredictError;
+    use crate::table::{Delimiter, Table};
     use approx::assert_relative_eq;
+    use std::path::Path;
+
+    /// Friction = a² v + b: `a` costly (a change of it needs a whole
+    /// simulation), `b` cheap.
+    struct Costly(Vec<FittedParameter>);
+
+    impl Model for Costly {
+        fn label(&self) -> String {
+            "costly".into()
+        }
+        fn parameters(&self) -> &[FittedParameter] {
+            &self.0
+        }
+        fn predict(&self, x: &[f64], s: &Series) -> Result<Vec<f64>, PredictError> {
+            Ok(s.velocity.iter().map(|v| x[0] * x[0] * v + x[1]).collect())
+        }
+        fn costly_parameters(&self) -> Option<Vec<usize>> {
+            Some(vec![0])
+        }
+    }
+
+    #[test]
+    fn a_secant_model_that_fails_after_an_exact_jacobian_is_refreshed_in_its_cheap_columns_alone() {
+        let mut text = String::from("t_s,velocity_m_s,friction_n\n");
+        for k in 0..20 {
+            let v = (k as f64 * 0.4).sin();
+            text += &format!("{},{v},{}\n", k as f64 * 0.01, 4.0 * v + 1.0);
+        }
+        let table = Table::parse(&text, Path::new("d.csv"), Delimiter::Auto, None, 0).unwrap();
+        let data = Data {
+            train: vec![Source::new(table, &Mapping::default()).unwrap()],
+            held_out: vec![],
+            validate: vec![],
+            holdout: HoldOut::None,
+            map_names: vec![],
+            map_values: vec![],
+            units: Default::default(),
+        };
+        let model = Costly(vec![
+            FittedParameter::new("a", 1.0, 0.0, 10.0),
+            FittedParameter::new("b", 0.0, -5.0, 5.0),
+        ]);
+        let problem = Problem::new(&model, &data, vec![]).unwrap();
+        assert_eq!(problem.costly(), Some(vec![true, false]));
+        let vars = Variables::new(&problem, None, &[1.0, 0.0]);
+        let u0 = DVector::from_vec(vars.to_internal(&[1.0, 0.0]));
+        let mut lm = Lm::new(vars, &u0, (JacobianRule::Secant, LaterRuns::Full), &[]);
+        lm.set_params(&u0);
+        let columns = |lm: &Lm| lm.jacobian_evaluations.load(Ordering::Relaxed);
+        let exact = lm.jacobian().unwrap();
+        assert_eq!(columns(&lm), 2, "the first Jacobian takes every column");
+        // A step in the costly key that the tangent says lowers the cost
+        // (a from 1 towards 2.2) but that goes to a = 4.4, where a² is far
+        // from its tangent: the cost rises, the secant model failed.
+        let mut u1 = u0.clone();
+        u1[0] += 0.8;
+        lm.set_params(&u1);
+        let partial = lm.jacobian().unwrap();
+        assert_eq!(columns(&lm), 3, "only the cheap column is taken anew");
+        let fresh = lm.differences(None);
+        assert_relative_eq!(partial.column(1), fresh.column(1), epsilon = 1e-12);
+        // The costly column is the secant's: (r₁ − r₀) / du, not the
+        // tangent at either end.
+        let r0 = DVector::from_vec(lm.vars.evaluate(u0.as_slice()).0);
+        let secant = (&lm.r - r0) / 0.8;
+        assert_relative_eq!(partial.column(0), secant.column(0), max_relative = 1e-9);
+        assert!((partial.column(0) - fresh.column(0)).norm() > 0.1 * fresh.column(0).norm());
+        assert!((partial.column(0) - exact.column(0)).norm() > 0.1 * exact.column(0).norm());
+        // Not exact: it gives no curvature for a confidence region.
+        let last = lm.last.lock().unwrap().take();
+        assert!(!last.as_ref().unwrap().exact);
+        assert!(curvature(last).is_none());
+    }
 
     #[test]
     fn the_chi_square_quantile_matches_the_tables() {
