@@ -32,6 +32,6 @@ for round in $(seq 1 "${ROUNDS:-2}"); do
       --fit "$KEYS" --later-runs full ${EXTRA:-} \
       --out "$log.yaml" > "$log.md" 2> "$log.log" || true
     end=$(date +%s.%N)
-    echo "round $round, $bin: wall $(python3 -c "print(round($end - $start, 1))") s; $(grep -E '^[0-9]+ simulations' "$log.md" | cut -d, -f1); $(grep -m1 '^training RMS' "$log.md" | cut -d, -f1)"
+    echo "round $round, $bin: wall $(python3 -c "print(round($end - $start, 1))") s; $(grep -E '^[0-9]+ simulations' "$log.md" | sed 's/, [0-9.]* ms each.*//'); $(grep -m1 '^training RMS' "$log.md" | cut -d, -f1)"
   done
 done
