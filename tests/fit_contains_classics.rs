@@ -99,23 +99,26 @@ fn row(md: &str, label: &str) -> (f64, f64) {
     (cells[5].parse().unwrap(), cells[7].parse().unwrap())
 }
 
-fn fit_auto(data: &Path) -> String {
+/// `fit DATA EXTRA… --fit auto --baselines --out DATA.yaml`: its summary
+/// (the exit status checked).
+fn fit_auto_with(data: &Path, extra: &[&str]) -> String {
     let out = data.with_extension("yaml");
-    let (code, stdout, err) = run(&[
-        "fit",
-        data.to_str().unwrap(),
-        "--holdout",
-        "0.3",
-        "--set",
-        "solver.cells=16",
+    let mut args = vec!["fit", data.to_str().unwrap()];
+    args.extend_from_slice(extra);
+    args.extend([
         "--fit",
         "auto",
         "--baselines",
         "--out",
         out.to_str().unwrap(),
     ]);
+    let (code, stdout, err) = run(&args);
     assert_eq!(code, 0, "{err}");
     stdout
+}
+
+fn fit_auto(data: &Path) -> String {
+    fit_auto_with(data, &["--holdout", "0.3", "--set", "solver.cells=16"])
 }
 
 fn assert_ours_contains(md: &str, classic: &str) {
@@ -192,20 +195,7 @@ fn a_joint_fitted_on_0_5_to_20_deg_s_predicts_25_to_90_deg_s_within_5_percent_of
         let v = d.join(format!("{name}-validate.csv"));
         joint_curve(&t, &train, curve);
         joint_curve(&v, &validate, curve);
-        let out = d.join(format!("{name}.yaml"));
-        let (code, md, err) = run(&[
-            "fit",
-            t.to_str().unwrap(),
-            "--validate",
-            v.to_str().unwrap(),
-            "--rotary",
-            "--fit",
-            "auto",
-            "--baselines",
-            "--out",
-            out.to_str().unwrap(),
-        ]);
-        assert_eq!(code, 0, "{err}");
+        let md = fit_auto_with(&t, &["--validate", v.to_str().unwrap(), "--rotary"]);
         let (_, ours) = row(&md, "friction-node");
         let (_, stribeck) = row(&md, "Stribeck");
         assert!(

@@ -133,10 +133,9 @@ pub fn cv_rms(mse: &[f64]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fit::series::{Series, Source};
+    use crate::fit::problem::tests_data;
+    use crate::fit::series::Series;
     use crate::fit::{Mapping, PredictError};
-    use crate::table::{Delimiter, Table};
-    use std::path::Path;
 
     /// Friction = a + b v (two parameters).
     struct Line(Vec<FittedParameter>);
@@ -164,16 +163,7 @@ mod tests {
             let f = 1.0 + 2.0 * x + if *x > 0.65 { 1.0 } else { 0.0 };
             text += &format!("{x},{f}\n");
         }
-        let table = Table::parse(&text, Path::new("c.csv"), Delimiter::Auto, None, 0).unwrap();
-        let data = Data {
-            train: vec![Source::new(table, &Mapping::default()).unwrap()],
-            held_out: vec![],
-            validate: vec![],
-            holdout: HoldOut::None,
-            map_names: vec![],
-            map_values: vec![],
-            units: Default::default(),
-        };
+        let data = tests_data(&text, &Mapping::default());
         let folds = folds_for(&data);
         assert_eq!(folds, Folds::Within(FOLDS));
         let s = data.train[0].series(&[]).unwrap();

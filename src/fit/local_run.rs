@@ -629,13 +629,11 @@ fn termination_text(t: &TerminationReason) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fit::problem::{Data, HoldOut, Model};
-    use crate::fit::series::{Mapping, Series, Source};
+    use crate::fit::problem::{tests_data, Model};
+    use crate::fit::series::{Mapping, Series};
     use crate::fit::unknowns::FittedParameter;
     use crate::fit::PredictError;
-    use crate::table::{Delimiter, Table};
     use approx::assert_relative_eq;
-    use std::path::Path;
 
     /// Friction = a² v + b: `a` costly (a change of it needs a whole
     /// simulation), `b` cheap.
@@ -663,16 +661,7 @@ mod tests {
             let v = (k as f64 * 0.4).sin();
             text += &format!("{},{v},{}\n", k as f64 * 0.01, 4.0 * v + 1.0);
         }
-        let table = Table::parse(&text, Path::new("d.csv"), Delimiter::Auto, None, 0).unwrap();
-        let data = Data {
-            train: vec![Source::new(table, &Mapping::default()).unwrap()],
-            held_out: vec![],
-            validate: vec![],
-            holdout: HoldOut::None,
-            map_names: vec![],
-            map_values: vec![],
-            units: Default::default(),
-        };
+        let data = tests_data(&text, &Mapping::default());
         let model = Costly(vec![
             FittedParameter::new("a", 1.0, 0.0, 10.0),
             FittedParameter::new("b", 0.0, -5.0, 5.0),

@@ -222,11 +222,9 @@ fn local_runs(
 mod tests {
     use super::*;
     use crate::fit::options::LaterRuns;
-    use crate::fit::problem::{Data, HoldOut, Model};
-    use crate::fit::series::{Mapping, Series, Source};
+    use crate::fit::problem::{tests_data, Data, Model};
+    use crate::fit::series::{Mapping, Series};
     use crate::fit::unknowns::FittedParameter;
-    use crate::table::{Delimiter, Table};
-    use std::path::Path;
 
     /// Two valleys in one parameter a ∈ [−3, 3]: residuals a² − 1 and
     /// 0.3 (a + 1), so ½Σr² has its best optimum at a = −1 (cost 0), a
@@ -255,16 +253,7 @@ mod tests {
         for k in 0..8 {
             text += &format!("{},0.1,1\n", k as f64 * 0.01);
         }
-        let table = Table::parse(&text, Path::new("d.csv"), Delimiter::Auto, None, 0).unwrap();
-        let data = Data {
-            train: vec![Source::new(table, &Mapping::default()).unwrap()],
-            held_out: vec![],
-            validate: vec![],
-            holdout: HoldOut::None,
-            map_names: vec![],
-            map_values: vec![],
-            units: Default::default(),
-        };
+        let data = tests_data(&text, &Mapping::default());
         // The given start, a = 2, lies in the worse valley.
         let model = TwoValleys(vec![FittedParameter::new("a", 2.0, -3.0, 3.0)]);
         (model, data)

@@ -545,12 +545,34 @@ impl<'a> Problem<'a> {
     }
 }
 
+/// Data of one training source, the CSV `text` through `mapping` (its
+/// coefficients the maps' values), nothing held out (for tests).
+#[cfg(test)]
+pub(crate) fn tests_data(text: &str, mapping: &super::series::Mapping) -> Data {
+    use crate::table::{Delimiter, Table};
+    let table = Table::parse(
+        text,
+        std::path::Path::new("d.csv"),
+        Delimiter::Auto,
+        None,
+        0,
+    )
+    .expect("a test's table parses");
+    Data {
+        train: vec![Source::new(table, mapping).expect("a test's mapping compiles")],
+        held_out: vec![],
+        validate: vec![],
+        holdout: HoldOut::None,
+        map_names: mapping.coefficients.iter().map(|c| c.0.clone()).collect(),
+        map_values: mapping.coefficients.iter().map(|c| c.1).collect(),
+        units: Default::default(),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::fit::series::Mapping;
-    use crate::table::{Delimiter, Table};
-    use std::path::Path;
 
     /// Friction = c · velocity, one parameter c.
     struct Linear(Vec<FittedParameter>);
@@ -572,22 +594,13 @@ mod tests {
         for k in 0..50 {
             text += &format!("{},{},{}\n", k as f64 * 0.01, (k as f64 * 0.3).sin(), k);
         }
-        let table = Table::parse(&text, Path::new("d.csv"), Delimiter::Auto, None, 0).unwrap();
         let mapping = Mapping {
             velocity: "v * g".into(),
             friction: friction.into(),
-            coefficients: coefficients.clone(),
+            coefficients,
             ..Default::default()
         };
-        Data {
-            train: vec![Source::new(table, &mapping).unwrap()],
-            held_out: vec![],
-            validate: vec![],
-            holdout: HoldOut::None,
-            map_names: coefficients.iter().map(|c| c.0.clone()).collect(),
-            map_values: coefficients.iter().map(|c| c.1).collect(),
-            units: Default::default(),
-        }
+        tests_data(&text, &mapping)
     }
 
     #[test]

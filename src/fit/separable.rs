@@ -392,13 +392,11 @@ pub fn canonical(problem: &Problem<'_>, separable: Option<&Separable>, x: &[f64]
 mod tests {
     use super::*;
     use crate::fit::options::{LinearKeys, Options};
-    use crate::fit::problem::{Data, HoldOut};
-    use crate::fit::series::{Mapping, Series, Source};
+    use crate::fit::problem::{tests_data, Data};
+    use crate::fit::series::{Mapping, Series};
     use crate::fit::unknowns::FittedParameter;
     use crate::fit::PredictError;
-    use crate::table::{Delimiter, Table};
     use approx::assert_relative_eq;
-    use std::path::Path;
 
     /// Friction = a (1 − e^(−|v|/s)) sgn v + b v: `b` linear with a fixed
     /// slope v (declared), `a` linear with a slope that `s` moves (not
@@ -445,22 +443,13 @@ mod tests {
             let noise = 0.01 * (k as f64 * 1.7).cos();
             text += &format!("{},{},{}\n", k as f64 * 0.01, v, f + 0.7 + noise);
         }
-        let table = Table::parse(&text, Path::new("d.csv"), Delimiter::Auto, None, 0).unwrap();
         let mapping = Mapping {
             velocity: velocity.into(),
             friction: "f - o".into(),
-            coefficients: coefficients.clone(),
+            coefficients,
             ..Default::default()
         };
-        Data {
-            train: vec![Source::new(table, &mapping).unwrap()],
-            held_out: vec![],
-            validate: vec![],
-            holdout: HoldOut::None,
-            map_names: coefficients.iter().map(|c| c.0.clone()).collect(),
-            map_values: coefficients.iter().map(|c| c.1).collect(),
-            units: Default::default(),
-        }
+        tests_data(&text, &mapping)
     }
 
     #[test]
