@@ -204,3 +204,67 @@ fn a_joint_fitted_on_0_5_to_20_deg_s_predicts_25_to_90_deg_s_within_5_percent_of
         );
     }
 }
+
+/// The lead screw's steady curve (`data/lead-screw`, drive 1, forward),
+/// split as docs/real-data-benchmarks.sh's (b): fitted at ≤ 100 rpm,
+/// predicting 120–200 rpm. Written as `velocity_rad_s,friction_nm`.
+fn lead_screw_faster_speeds(train: &Path, validate: &Path) {
+    let table =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("data/lead-screw/steady_state_summary.csv");
+    let mut r = csv::Reader::from_path(&table).unwrap();
+    let h = r.headers().unwrap().clone();
+    let col = |name: &str| h.iter().position(|c| c == name).unwrap();
+    let (drive, label, speed, torque) = (
+        col("drive"),
+        col("file_label"),
+        col("motor_speed_rad_s"),
+        col("motor_torque_mNm"),
+    );
+    let (mut t, mut v) = (String::new(), String::new());
+    for s in [&mut t, &mut v] {
+        s.push_str("velocity_rad_s,friction_nm\n");
+    }
+    for rec in r.records() {
+        let rec = rec.unwrap();
+        if &rec[drive] != "1" || rec[label].starts_with('n') {
+            continue;
+        }
+        let rpm: u32 = rec[label].parse().unwrap();
+        let nm: f64 = rec[torque].parse::<f64>().unwrap() / 1000.0;
+        let out = if rpm <= 100 { &mut t } else { &mut v };
+        writeln!(out, "{},{nm}", &rec[speed]).unwrap();
+    }
+    std::fs::write(train, t).unwrap();
+    std::fs::write(validate, v).unwrap();
+}
+
+#[test]
+fn a_term_that_paid_only_at_its_trial_fit_gives_way_when_the_final_optimum_does_not_confirm_it() {
+    // On the lead screw's faster speeds the film pays at the selection's
+    // trial fit (every fold lower), and the final fit, searching more
+    // widely, puts its transition elsewhere: there the set cross-validates
+    // worse than the drivetrain's Stribeck curve alone, and predicting
+    // 120–200 rpm doubles the error. The final fit is checked on the same
+    // folds, the film gives way, and ours is the Stribeck curve it
+    // contains: as good held out as the classic, to 1e-4.
+    let d = dir("lead-screw-faster");
+    let (t, v) = (d.join("train.csv"), d.join("validate.csv"));
+    lead_screw_faster_speeds(&t, &v);
+    let md = fit_auto_with(&t, &["--validate", v.to_str().unwrap(), "--rotary"]);
+    let chosen = md.lines().find(|l| l.starts_with("Chosen:")).unwrap();
+    assert!(
+        chosen.starts_with("Chosen: boundary friction, drivetrain Stribeck."),
+        "{chosen}"
+    );
+    let removed = md
+        .lines()
+        .find(|l| l.starts_with("Removed: film: at the final fit's optimum"))
+        .unwrap_or_else(|| panic!("the film is not removed at the final optimum\n{md}"));
+    assert!(removed.contains("does not pay"), "{removed}");
+    let (_, ours) = row(&md, "friction-node");
+    let (_, stribeck) = row(&md, "Stribeck");
+    assert!(
+        ours <= (1.0 + 1e-4) * stribeck,
+        "held-out RMS ours {ours}, Stribeck {stribeck}\n{md}"
+    );
+}

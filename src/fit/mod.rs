@@ -26,6 +26,7 @@
 //! |---|---|
 //! | `request.rs` | a calibration as data ([`request::FitRequest`]) and its one flow, `run`, for the command line and Python: prepare → select → fit ours → the fitted file → the classic models → the report |
 //! | `prepare.rs` | data → our model: the sources (the held-out part cut off first), scales, keys, maps, the contact's scale |
+//! | `confirm.rs` | `--fit auto`'s choice confirmed at the final fit's optimum: scored on the same folds, it falls back to the best set with one term fewer when it no longer pays over it |
 //! | `select.rs` | `--fit auto`'s rule: stepwise with removal on cross-validation, terms that pay, dead terms dropped; its report |
 //! | `trial.rs` | one set of terms tried: fitted on the training data, scored by cross-validation |
 //! | `candidates.rs` | the candidate terms, the keys of a set, which candidates the data allow, the keys `--fit auto` starts from |
@@ -65,6 +66,7 @@ pub mod by_direction;
 pub mod calibrated_range;
 pub mod candidates;
 pub mod compare;
+pub mod confirm;
 pub mod contact_scale;
 pub mod cross_validate;
 pub mod driver;

@@ -130,23 +130,16 @@ impl FitRequest {
             .as_deref()
             .map(crate::output::prepare_output_dir)
             .transpose()?;
-        let selection = if auto {
+        let mut selection = if auto {
             Some(select_terms(&mut p, &given, &self.search, &say, stop)?)
         } else {
             None
         };
+        let mut ours =
+            self.fit_confirmed(&mut p, &given, selection.as_mut(), progress, stop, &say)?;
         let mut extra_md = selection
             .as_ref()
             .map_or(String::new(), |s| super::select::report(s, p.data.units));
-        say(&format!(
-            "{} parameter(s) on {} file(s) ({} validation), {} local run(s), {} global points",
-            p.model.parameters_len() + p.map_fit.len(),
-            p.data.train.len(),
-            p.data.validate.len(),
-            self.search.starts,
-            self.search.global_points
-        ));
-        let mut ours = fit_ours(&p, &self.search, progress, stop, self.baselines)?;
         // The range the calibration saw, into the fitted file and the report.
         let gain = p.contact_scale.as_ref().map_or(1.0, |s| s.gain);
         let section = super::calibrated_range::attach(&mut ours.config, &ours.outcome, gain);
@@ -177,6 +170,48 @@ impl FitRequest {
             extra_md,
             report_files,
         })
+    }
+}
+
+impl FitRequest {
+    /// Our fit; under `--fit auto` (`selection`) cross-validated on the
+    /// selection's folds and confirmed there (`confirm.rs`): a chosen set
+    /// that does not pay at its final optimum over the best set with one
+    /// term fewer gives way to that set, which is fitted in its place.
+    fn fit_confirmed(
+        &self,
+        p: &mut Prepared,
+        given: &[ParamSpec],
+        mut selection: Option<&mut Selection>,
+        progress: Option<&LabelledProgress>,
+        stop: &Stop,
+        say: &dyn Fn(&str),
+    ) -> Result<OursFitted, FitError> {
+        let cross_validated = self.baselines || selection.is_some();
+        loop {
+            say(&format!(
+                "{} parameter(s) on {} file(s) ({} validation), {} local run(s), {} global points",
+                p.model.parameters_len() + p.map_fit.len(),
+                p.data.train.len(),
+                p.data.validate.len(),
+                self.search.starts,
+                self.search.global_points
+            ));
+            let ours = fit_ours(p, &self.search, progress, stop, cross_validated)?;
+            let Some(s) = selection.as_deref_mut() else {
+                return Ok(ours);
+            };
+            let fallback = ours
+                .outcome
+                .fold_mse
+                .as_deref()
+                .and_then(|m| super::confirm::unconfirmed(s, m, p.data.units));
+            let Some(f) = fallback else {
+                return Ok(ours);
+            };
+            say(&format!("auto: not confirmed: {}", f.why));
+            super::confirm::fall_back(p, given, s, f)?;
+        }
     }
 }
 

@@ -48,9 +48,7 @@
 //! The report lists every set tried with its CV error per fold, the set
 //! chosen and why the selection stopped.
 
-use super::candidates::{
-    candidates_here, lighter_forms, set_keys, set_specs, Candidate, CANDIDATES,
-};
+use super::candidates::{candidates_here, lighter_forms, set_keys, Candidate, CANDIDATES};
 use super::options::SearchSettings;
 use super::prepared::{model_for, Prepared};
 use super::trial::{Ctx, Scored, Tried};
@@ -84,6 +82,9 @@ pub struct Selection {
     pub why: String,
     /// Wall time, s.
     pub wall_s: f64,
+    /// Every set scored, with its optimum: the sets a final fit that no
+    /// longer confirms the choice falls back to (`confirm.rs`).
+    pub(super) scored: Vec<Scored>,
 }
 
 /// The step's choice: the candidate with the lowest CV error, unless a
@@ -114,7 +115,7 @@ fn simplest_that_predicts_as_well(step: Vec<Scored>) -> Scored {
 /// Whether going from `from` to `to` pays: it lowers the folds' mean
 /// squared error by more than the standard error of that lowering and by
 /// more than [`TERM_COST`] of it. Returns (pays, lowering, its SE, share).
-fn pays(from: &Tried, to: &Tried) -> (bool, f64, f64, f64) {
+pub(super) fn pays(from: &Tried, to: &Tried) -> (bool, f64, f64, f64) {
     let (gain, se) = paired(&from.fold_mse, &to.fold_mse);
     let mse = from.cv_rms * from.cv_rms;
     let share = gain / mse;
@@ -205,6 +206,7 @@ pub fn select(
         folds: super::cross_validate::describe(folds, p.data.train.iter().all(|s| s.is_steady())),
         why,
         wall_s: wall.elapsed().as_secs_f64(),
+        scored: ctx.scored.into_inner().unwrap_or_else(|p| p.into_inner()),
     })
 }
 
@@ -238,7 +240,7 @@ fn does_not_pay(name: &str, gain: f64, se: f64, share: f64) -> String {
 
 /// The keys the chosen set fits: its terms' keys, then the names given
 /// after `auto` that are not tied to a term's choice, each once.
-fn fitted_keys(terms: &[&'static str], given: &[ParamSpec]) -> Vec<String> {
+pub(super) fn fitted_keys(terms: &[&'static str], given: &[ParamSpec]) -> Vec<String> {
     set_keys(terms)
         .into_iter()
         .map(String::from)
@@ -521,8 +523,7 @@ pub fn select_terms(
     stop: &crate::interrupt::Stop,
 ) -> Result<Selection, FitError> {
     let s = select(p, search, given, say, stop)?;
-    let keys: Vec<&str> = s.keys.iter().map(String::as_str).collect();
-    let specs = set_specs(given, &keys);
+    let specs = super::trial::set_specs_for(p, given, &s.chosen);
     let (model, map_fit) = model_for(p, &specs, &s.optimum)?;
     p.model = model;
     p.map_fit = map_fit;

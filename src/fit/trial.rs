@@ -32,7 +32,7 @@ pub(super) type Optimum = Vec<(String, f64)>;
 
 /// A set fitted and scored: its report line, its optimum (by name) and
 /// what its fit says of each key.
-#[derive(Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub(super) struct Scored {
     pub(super) tried: Tried,
     pub(super) optimum: Optimum,
@@ -93,6 +93,29 @@ fn placements(p: &Prepared, key: &str) -> Vec<f64> {
     }
 }
 
+/// The parameter specs of the set `terms`, the same for its trial and for
+/// the final fit of the chosen set (the final fit starts at the trial's
+/// optimum, which must lie inside its bounds): the keys of `given` as
+/// given; with the film placed inside the data ([`film_placements`]) the
+/// viscosity key's bounds wide enough for every placement, unless given.
+pub(super) fn set_specs_for(
+    p: &Prepared,
+    given: &[ParamSpec],
+    terms: &[&'static str],
+) -> Vec<ParamSpec> {
+    let mut specs = set_specs(given, &set_keys(terms));
+    if terms.contains(&FILM) && !film_placements(p).is_empty() {
+        if let Some(s) = specs
+            .iter_mut()
+            .find(|s| s.name == FILM_KEY && s.bounds.is_none())
+        {
+            let mu0 = p.model_config.lubricant.viscosity_pa_s;
+            s.bounds = Some((mu0 / 10.0, 100.0));
+        }
+    }
+    specs
+}
+
 impl Ctx<'_> {
     /// Fit the set `terms` on the training data, warm-started from `warm`,
     /// and score it by cross-validation (each fold refitted without it).
@@ -116,25 +139,15 @@ impl Ctx<'_> {
         Ok(scored)
     }
 
-    /// The set's parameter specs and the film's placements (the viscosity
-    /// key's bounds wide enough for every placement, unless given).
+    /// The set's parameter specs ([`set_specs_for`]) and the film's
+    /// placements.
     fn specs_and_placements(&self, terms: &[&'static str]) -> (Vec<ParamSpec>, Vec<f64>) {
-        let mut specs = set_specs(self.given, &set_keys(terms));
         let placements = if terms.contains(&FILM) {
             film_placements(self.p)
         } else {
             Vec::new()
         };
-        if !placements.is_empty() {
-            if let Some(s) = specs
-                .iter_mut()
-                .find(|s| s.name == FILM_KEY && s.bounds.is_none())
-            {
-                let mu0 = self.p.model_config.lubricant.viscosity_pa_s;
-                s.bounds = Some((mu0 / 10.0, 100.0));
-            }
-        }
-        (specs, placements)
+        (set_specs_for(self.p, self.given, terms), placements)
     }
 
     /// The starts besides the warm one: each key new to the set (not in

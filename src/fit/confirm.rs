@@ -1,0 +1,190 @@
+//! `--fit auto`'s choice confirmed at the optimum that is shipped.
+//!
+//! The selection scores each set at a trial fit: a warm start and the new
+//! keys' placements, at a loose tolerance. The final fit of the chosen set
+//! searches more widely (more starts, a tighter tolerance) and can end at
+//! another optimum of the same set, one that predicts the folds worse. A
+//! film whose transition the data hardly constrain does this: its
+//! viscosity is poorly identified, and where it ends decides the
+//! extrapolation. The choice was made for the trial's optimum, not for
+//! this one.
+//!
+//! So the final fit is scored on the same folds (each refitted from the
+//! final optimum). The best set with one term fewer, by its score in the
+//! selection, must be beaten by the rule every term meets (`select::pays`:
+//! the folds' mean squared error lowered by more than its standard error
+//! and by more than the cost of a term). If it is not beaten, that set is
+//! fitted instead, and is confirmed the same way in turn. Every step takes
+//! a term away, so this ends, at the base set at the latest.
+
+use super::cross_validate::cv_rms;
+use super::prepared::{model_for, Prepared};
+use super::select::{fitted_keys, pays, Selection};
+use super::trial::{set_specs_for, Scored, Tried};
+use super::unknowns::ParamSpec;
+use super::FitError;
+use crate::text::Num;
+
+/// The set the final fit falls back to, and why.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Fallback {
+    /// The set with one term fewer, as the selection scored it.
+    set: Scored,
+    /// Why the final fit does not confirm the choice.
+    pub why: String,
+}
+
+/// The best set with one term fewer than `s.chosen` (the lowest CV error
+/// in the selection), when the chosen set at its final optimum (folds'
+/// mean squared errors `final_mse`) does not pay over it; `None` when the
+/// final fit confirms the choice or the chosen set is the base.
+pub fn unconfirmed(s: &Selection, final_mse: &[f64], units: super::Units) -> Option<Fallback> {
+    let chosen = &s.chosen;
+    let fewer = s
+        .scored
+        .iter()
+        .filter(|t| {
+            t.tried.terms.len() + 1 == chosen.len()
+                && t.tried.terms.iter().all(|x| chosen.contains(x))
+        })
+        .min_by(|a, b| a.tried.cv_rms.total_cmp(&b.tried.cv_rms))?;
+    let at_final = Tried {
+        terms: chosen.clone(),
+        fold_mse: final_mse.to_vec(),
+        cv_rms: cv_rms(final_mse),
+        simulations: 0,
+    };
+    let (ok, gain, se, share) = pays(&fewer.tried, &at_final);
+    if ok {
+        return None;
+    }
+    let term = chosen
+        .iter()
+        .find(|t| !fewer.tried.terms.contains(t))
+        .copied()
+        .unwrap_or_default();
+    let u = units.force();
+    let why = format!(
+        "{term}: at the final fit's optimum the chosen set cross-validates at {} {u} (the selection's trial fit: {} {u}); without {term}, {} {u}. The term lowers the folds' mean squared error by {} ± {} (standard error), {:.2} % of it, which does not pay at the optimum the fit reached, so the set without it is fitted",
+        Num::sig(at_final.cv_rms, 5),
+        s.scored
+            .iter()
+            .find(|t| same_terms(&t.tried.terms, chosen))
+            .map_or_else(|| "—".to_string(), |t| Num::sig(t.tried.cv_rms, 5).to_string()),
+        Num::sig(fewer.tried.cv_rms, 5),
+        Num::sig(gain, 5),
+        Num::sig(se, 5),
+        100.0 * share,
+    );
+    Some(Fallback {
+        set: fewer.clone(),
+        why,
+    })
+}
+
+/// Whether two sets hold the same terms.
+fn same_terms(a: &[&'static str], b: &[&'static str]) -> bool {
+    a.len() == b.len() && a.iter().all(|x| b.contains(x))
+}
+
+/// Take `f`: `s` records it (chosen terms, keys, optimum, why) and `p`'s
+/// model is remade for its keys, started from its optimum in the
+/// selection. `given` are the names after `auto`.
+pub fn fall_back(
+    p: &mut Prepared,
+    given: &[ParamSpec],
+    s: &mut Selection,
+    f: Fallback,
+) -> Result<(), FitError> {
+    let terms = f.set.tried.terms;
+    let (model, map_fit) = model_for(p, &set_specs_for(p, given, &terms), &f.set.optimum)?;
+    p.model = model;
+    p.map_fit = map_fit;
+    s.keys = fitted_keys(&terms, given);
+    s.optimum = f.set.optimum;
+    s.chosen = terms;
+    s.removed.push(f.why);
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scored(terms: &[&'static str], fold_mse: &[f64]) -> Scored {
+        Scored {
+            tried: Tried {
+                terms: terms.to_vec(),
+                fold_mse: fold_mse.to_vec(),
+                cv_rms: cv_rms(fold_mse),
+                simulations: 0,
+            },
+            optimum: vec![("contact.boundary_friction".into(), 0.2)],
+            flags: Vec::new(),
+        }
+    }
+
+    fn selection(chosen: &[&'static str], scored: Vec<Scored>) -> Selection {
+        Selection {
+            tried: scored.iter().map(|t| t.tried.clone()).collect(),
+            excluded: Vec::new(),
+            removed: Vec::new(),
+            folds: String::new(),
+            optimum: Vec::new(),
+            chosen: chosen.to_vec(),
+            keys: Vec::new(),
+            why: String::new(),
+            wall_s: 0.0,
+            scored,
+        }
+    }
+
+    const UNITS: super::super::Units = super::super::Units::Linear;
+
+    /// The selection of lead screw (b) in miniature: the film paid at its
+    /// trial fit (every fold lower), not at the final fit's optimum.
+    fn lead_screw_b() -> Selection {
+        selection(
+            &["drivetrain Stribeck", "film"],
+            vec![
+                scored(&[], &[25.0, 6.5, 9.0, 0.5]),
+                scored(&["drivetrain Stribeck"], &[0.32, 1.12, 0.97, 0.58]),
+                scored(&["film"], &[25.0, 11.4, 7.0, 4.6]),
+                scored(&["drivetrain Stribeck", "film"], &[0.1, 1.07, 0.15, 0.06]),
+            ],
+        )
+    }
+
+    #[test]
+    fn a_final_fit_that_predicts_the_folds_as_well_as_its_trial_confirms_the_choice() {
+        let s = lead_screw_b();
+        assert_eq!(unconfirmed(&s, &[0.1, 1.07, 0.15, 0.06], UNITS), None);
+    }
+
+    #[test]
+    fn a_final_fit_that_no_longer_beats_the_set_without_its_last_term_falls_back_to_that_set() {
+        let s = lead_screw_b();
+        // The final optimum predicts the fastest fold worse than the trial's.
+        let f = unconfirmed(&s, &[0.3, 1.1, 0.9, 6.0], UNITS).expect("not confirmed");
+        assert_eq!(f.set.tried.terms, vec!["drivetrain Stribeck"]);
+        assert!(f.why.starts_with("film: "), "{}", f.why);
+        assert!(f.why.contains("does not pay"), "{}", f.why);
+    }
+
+    #[test]
+    fn the_fallback_is_the_best_set_with_one_term_fewer() {
+        let mut s = lead_screw_b();
+        // Were the film alone the better of the two smaller sets, it would
+        // be the one taken.
+        s.scored[2] = scored(&["film"], &[0.2, 0.2, 0.2, 0.2]);
+        let f = unconfirmed(&s, &[0.3, 1.1, 0.9, 6.0], UNITS).expect("not confirmed");
+        assert_eq!(f.set.tried.terms, vec!["film"]);
+        assert!(f.why.starts_with("drivetrain Stribeck: "), "{}", f.why);
+    }
+
+    #[test]
+    fn the_base_set_is_confirmed_as_it_is() {
+        let s = selection(&[], vec![scored(&[], &[1.0, 1.0])]);
+        assert_eq!(unconfirmed(&s, &[9.0, 9.0], UNITS), None);
+    }
+}
