@@ -13,29 +13,7 @@
 //! secant Jacobians is polished by a run on differences from its end
 //! point, so the convergence test and the optimum are the exact method's.
 //!
-//! A run that enters the 95 % joint confidence region of an optimum an
-//! earlier run found (within it by that optimum's curvature JᵀJ, and its
-//! cost within ½ s² χ²₀.₉₅(n) of that optimum's) stops there: going on could only find that optimum again, or a point
-//! the data cannot tell from it (kept among the distinct optima when it
-//! lies apart).
-//!
-//! With the valley test on (our model's fits; `--later-runs valley`, the
-//! default), a run that is not the first also asks, before it takes
-//! differences, whether it already sits in the valley of an earlier
-//! optimum u₁ (the hill–valley test of Ursem 2000, made monotone): the
-//! cost at `VALLEY_POINTS` evenly spaced points of the straight line from
-//! its point u to u₁ (in the unbounded variables) falls at every point,
-//! c(u) ≥ c(u + ⅕(u₁ − u)) ≥ … ≥ c₁. Then a descent from u has a straight
-//! way down to u₁ with no hill on it, and the run stops there ("in the
-//! valley of optimum 1") for a few simulations instead of the dozens of
-//! Jacobians it would take to walk down. A line with a rise on it
-//! (another valley between) lets the run go on; it asks again once its
-//! cost has fallen tenfold since the last time. The test is evidence, not
-//! proof: from a start far up the slopes most straight lines fall, and a
-//! better optimum whose basin holds such a start would be missed;
-//! `--later-runs full` walks every run to its end. The first run (no
-//! earlier optimum) is the same either way.
-
+use super::earlier_optima::{EarlierOptima, Found, Joined, VALLEY_POINTS};
 use super::options::{JacobianRule, LaterRuns};
 use super::problem::Problem;
 use super::separable::{Separable, Variables};
@@ -66,59 +44,11 @@ pub struct LocalRun {
     pub curvature: Option<DMatrix<f64>>,
 }
 
-/// The optimiser's variables u on their canonical fold: the variables are
-/// periodic (x = x(sin u)), so a run that went over a bound stands at
-/// the same point as asin(sin u) + 2π; distances between runs' points
-/// are taken there.
-pub fn canonical(u: &[f64]) -> Vec<f64> {
-    u.iter()
-        .map(|v| v.sin().asin() + std::f64::consts::TAU)
-        .collect()
-}
-
-/// An optimum found by an earlier run: its point in the optimiser's
-/// variables (canonical) and whole, its cost and the curvature JᵀJ there
-/// (in the canonical variables).
-#[derive(Debug, Clone)]
-pub struct Found {
-    /// The point, unbounded variables (the searched parameters').
-    pub u: Vec<f64>,
-    /// The whole point, every parameter.
-    pub x: Vec<f64>,
-    /// ½Σr² there.
-    pub cost: f64,
-    /// JᵀJ there.
-    pub curvature: DMatrix<f64>,
-}
-
 /// The secant model is kept while the accepted step's actual reduction
 /// of the cost is at least this fraction of the reduction it predicted.
 const SECANT_TRUST: f64 = 0.25;
 /// Secant updates between differences, per parameter.
 const SECANT_SPAN: usize = 2;
-
-/// The 95 % quantile of χ² with `n` degrees of freedom (Wilson–Hilferty:
-/// 2.5 % low at n = 1, within 1 % from n = 3).
-pub fn chi_square_95(n: usize) -> f64 {
-    let n = n.max(1) as f64;
-    let a = 2.0 / (9.0 * n);
-    n * (1.0 - a + 1.644_853_626_951_472_6 * a.sqrt()).powi(3)
-}
-
-/// Interior points of the valley test's line.
-pub const VALLEY_POINTS: usize = 4;
-/// A run asks the valley test again once its cost has fallen by this
-/// factor since the last time.
-const VALLEY_RETEST: f64 = 10.0;
-
-/// How a run came to an earlier optimum.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Joined {
-    /// Inside its 95 % confidence region.
-    Region(usize),
-    /// On a straight line down to it with no rise (the valley test).
-    Valley(usize),
-}
 
 /// Forward-difference step in the unbounded variable.
 const FD_STEP: f64 = 1e-4;
@@ -157,16 +87,8 @@ struct Lm<'p, 'a> {
     trials: AtomicUsize,
     /// Simulations the differences took.
     jacobian_evaluations: AtomicUsize,
-    /// Optima of earlier runs.
-    earlier: &'p [Found],
-    /// The earlier optimum this run came to.
-    joined: Mutex<Option<Joined>>,
-    /// Whether the valley test is asked.
-    later: LaterRuns,
-    /// The cost at the last valley test (none yet: infinite).
-    valley_cost: Mutex<f64>,
-    /// Simulations the valley tests took.
-    valley_evaluations: AtomicUsize,
+    /// Optima of earlier runs, and which one this run came to.
+    earlier: EarlierOptima<'p>,
 }
 
 impl<'p, 'a> Lm<'p, 'a> {
@@ -189,16 +111,8 @@ impl<'p, 'a> Lm<'p, 'a> {
             last: Mutex::new(None),
             trials: AtomicUsize::new(0),
             jacobian_evaluations: AtomicUsize::new(0),
-            earlier,
-            joined: Mutex::new(None),
-            later,
-            valley_cost: Mutex::new(f64::INFINITY),
-            valley_evaluations: AtomicUsize::new(0),
+            earlier: EarlierOptima::new(earlier, later),
         }
-    }
-
-    fn joined(&self) -> Option<Joined> {
-        *self.joined.lock().unwrap_or_else(|p| p.into_inner())
     }
 
     /// The Jacobian by forward differences: every column, or the columns
@@ -228,72 +142,6 @@ impl<'p, 'a> Lm<'p, 'a> {
             .fetch_add(count, Ordering::Relaxed);
         let m = self.r.len();
         DMatrix::from_fn(m, n, |i, j| columns[j][i])
-    }
-
-    /// The earlier optimum whose 95 % joint confidence region this point
-    /// (u, its cost) has entered: dᵀ JᵀJ d ≤ s² χ²₀.₉₅(n), d = u − u₁ and
-    /// s² = 2c₁/(m − n) the residual variance at that optimum (the region
-    /// of the linearised model), with the cost itself within ½ s² χ²₀.₉₅(n)
-    /// of c₁. The data cannot tell such a point from that optimum; going
-    /// on could only find it again, or a point that fits as well.
-    fn joins(&self, u: &[f64], cost: f64) -> Option<usize> {
-        let n = self.problem.params.len();
-        let dof = self.problem.fitted_samples().saturating_sub(n).max(1) as f64;
-        let chi2 = chi_square_95(n);
-        self.earlier.iter().position(|f| {
-            let s2 = 2.0 * f.cost / dof;
-            let u = canonical(u);
-            let d = DVector::from_iterator(u.len(), u.iter().zip(&f.u).map(|(a, b)| a - b));
-            let q = (d.transpose() * &f.curvature * &d)[(0, 0)];
-            q <= s2 * chi2 && cost <= f.cost + 0.5 * s2 * chi2
-        })
-    }
-
-    /// The earlier optimum whose valley the current point is in: the cost
-    /// falls at every one of `VALLEY_POINTS` evenly spaced points of the
-    /// straight line to it. Asked once the cost has fallen `VALLEY_RETEST`
-    /// times since the last asking (the first time always).
-    fn valley(&self) -> Option<usize> {
-        let cost = 0.5 * self.r.norm_squared();
-        {
-            let mut last = self.valley_cost.lock().unwrap_or_else(|p| p.into_inner());
-            if self.later != LaterRuns::Valley
-                || self.earlier.is_empty()
-                || !cost.is_finite()
-                || cost * VALLEY_RETEST > *last
-            {
-                return None;
-            }
-            *last = cost;
-        }
-        self.earlier
-            .iter()
-            .position(|f| f.cost <= cost && self.falls_to(cost, f))
-    }
-
-    /// Whether the cost falls at every interior point of the straight
-    /// line from the current point (cost `cost`) to `f`, and on to `f`.
-    fn falls_to(&self, cost: f64, f: &Found) -> bool {
-        let from = canonical(self.u.as_slice());
-        let costs: Vec<f64> = (1..=VALLEY_POINTS)
-            .into_par_iter()
-            .map(|k| {
-                let t = k as f64 / (VALLEY_POINTS + 1) as f64;
-                let u: Vec<f64> = from
-                    .iter()
-                    .zip(&f.u)
-                    .map(|(a, b)| a + t * (b - a))
-                    .collect();
-                self.vars.cost(&u)
-            })
-            .collect();
-        self.valley_evaluations
-            .fetch_add(VALLEY_POINTS, Ordering::Relaxed);
-        let line: Vec<f64> = std::iter::once(cost)
-            .chain(costs)
-            .chain(std::iter::once(f.cost))
-            .collect();
-        line.windows(2).all(|w| w[1].is_finite() && w[1] <= w[0])
     }
 }
 
@@ -325,11 +173,7 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Lm<'_, '_> {
         self.trail.push((cost, x.clone()));
         self.x = x;
         self.trials.fetch_add(1, Ordering::Relaxed);
-        let joins = self.joins(u.as_slice(), cost);
-        let joined = self.joined.get_mut().unwrap_or_else(|p| p.into_inner());
-        if joined.is_none() {
-            *joined = joins.map(Joined::Region);
-        }
+        self.earlier.check_region(self.problem, u.as_slice(), cost);
     }
 
     fn params(&self) -> DVector<f64> {
@@ -339,11 +183,11 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Lm<'_, '_> {
     fn residuals(&self) -> Option<DVector<f64>> {
         // None ends the run (TerminationReason::User) when a stop is asked
         // or the run came to an earlier optimum.
-        (!self.problem.stop.requested() && self.joined().is_none()).then(|| self.r.clone())
+        (!self.problem.stop.requested() && self.earlier.joined().is_none()).then(|| self.r.clone())
     }
 
     fn jacobian(&self) -> Option<DMatrix<f64>> {
-        if self.problem.stop.requested() || self.joined().is_some() {
+        if self.problem.stop.requested() || self.earlier.joined().is_some() {
             return None;
         }
         self.trials.store(0, Ordering::Relaxed);
@@ -377,8 +221,11 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Lm<'_, '_> {
                 }
             }
         }
-        if let Some(k) = self.valley() {
-            *self.joined.lock().unwrap_or_else(|p| p.into_inner()) = Some(Joined::Valley(k));
+        let cost = 0.5 * self.r.norm_squared();
+        if self
+            .earlier
+            .check_valley(&self.vars, self.u.as_slice(), cost)
+        {
             return None;
         }
         let (j, exact) = match partial {
@@ -482,12 +329,11 @@ fn one_run(
         .minimize(lm);
     // Valley tests are counted with the Jacobians' simulations: both are
     // simulations besides the optimiser's own evaluations.
-    let jacobian_evaluations = lm.jacobian_evaluations.load(Ordering::Relaxed)
-        + lm.valley_evaluations.load(Ordering::Relaxed);
+    let jacobian_evaluations =
+        lm.jacobian_evaluations.load(Ordering::Relaxed) + lm.earlier.valley_evaluations();
     let evaluations = (report.number_of_evaluations, jacobian_evaluations);
     let curvature = curvature(lm.last.into_inner().unwrap_or_else(|p| p.into_inner()));
-    let joined = lm.joined.into_inner().unwrap_or_else(|p| p.into_inner());
-    if let Some(how) = joined {
+    if let Some(how) = lm.earlier.joined() {
         return (joined_run(earlier, how, &lm.x, &lm.r, evaluations), true);
     }
     let converged = report.termination.was_successful()
@@ -696,15 +542,6 @@ mod tests {
         let last = lm.last.lock().unwrap().take();
         assert!(!last.as_ref().unwrap().exact);
         assert!(curvature(last).is_none());
-    }
-
-    #[test]
-    fn the_chi_square_quantile_matches_the_tables() {
-        // χ²₀.₉₅: 3.841 (1), 11.070 (5), 18.307 (10), 31.410 (20).
-        assert_relative_eq!(chi_square_95(1), 3.841, max_relative = 0.03);
-        for (n, q) in [(3, 7.815), (5, 11.070), (10, 18.307), (20, 31.410)] {
-            assert_relative_eq!(chi_square_95(n), q, max_relative = 0.01);
-        }
     }
 
     #[test]

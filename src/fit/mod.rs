@@ -40,7 +40,8 @@
 //! | `prepared.rs` | what `prepare` makes: the data and our model for them; our model for another set of keys |
 //! | `driver.rs` | one model's whole fit: global phase, local runs, statistics, predictions |
 //! | `multistart.rs` | the global phase, then local runs from the best distinct starts; the distinct optima |
-//! | `local_run.rs` | one Levenberg–Marquardt run: secant or difference Jacobians, the stop inside an earlier optimum's confidence region or valley, what was still moving |
+//! | `local_run.rs` | one Levenberg–Marquardt run: secant or difference Jacobians, the partial refresh, the polish, what was still moving |
+//! | `earlier_optima.rs` | the optima earlier runs found: a later run's stop inside one's confidence region or, opt-in, in its valley |
 //! | `separable.rs` | the parameters the residuals are linear in, solved exactly in their bounds at every point; the local runs' variables (the others) |
 //! | `stats.rs` | standard errors, correlations, flags |
 //! | `options.rs` | how a fit searches: the user's settings, each fit's options, the Jacobian and later-run rules |
@@ -70,6 +71,7 @@ pub mod confirm;
 pub mod contact_scale;
 pub mod cross_validate;
 pub mod driver;
+pub mod earlier_optima;
 pub mod error;
 mod expr;
 mod film_run;

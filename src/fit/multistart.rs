@@ -7,7 +7,8 @@
 //! start already taken; their end points, sorted by cost and with
 //! near-duplicates merged, are the distinct optima.
 
-use super::local_run::{local_run, Found, LocalRun};
+use super::earlier_optima::Found;
+use super::local_run::{local_run, LocalRun};
 use super::options::Options;
 use super::problem::Problem;
 use super::separable::{canonical, Separable};
@@ -291,7 +292,7 @@ mod tests {
         // nothing more: it stopped there.
         assert_eq!(
             with_valley,
-            first_run + 1 + crate::fit::local_run::VALLEY_POINTS
+            first_run + 1 + crate::fit::earlier_optima::VALLEY_POINTS
         );
     }
 
