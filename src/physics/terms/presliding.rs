@@ -43,7 +43,10 @@
 //!
 //! Integration: over a step the velocity and the level are taken at its
 //! end, so ż is linear in z and the step is exact for them:
-//! `z ← z_ss + (z − z_ss) e^(−a Δt)`, and ż = Δz/Δt for the damping term.
+//! `z ← z_ss + (z − z_ss) e^(−a Δt)`, and the damping term takes ż at the
+//! step's end, a (z_ss − z) — LuGre's ż = v − σ0 |v| z / g(v) there, not
+//! the step's mean rate Δz/Δt, which exceeds it by the factor
+//! (e^(a Δt) − 1)/(a Δt) while the bristle moves.
 //! This is stable for any σ0 and Δt: a bristle stiffer than the step can
 //! resolve (a Δt ≫ 1) relaxes within the step, and the rigid model
 //! results. At rest (v = 0) z is held.
@@ -182,7 +185,13 @@ impl Presliding {
         let decay = (-rate * dt).exp();
         // e^(−∞) = 0 (no level: no displacement); 0 · ∞ never arises.
         let z_new = z_ss + (z - z_ss) * decay;
-        let z_dot = (z_new - z) / dt;
+        // ż at the step's end, exact for the step: a (z_ss − z). A bristle
+        // that relaxed within the step (a infinite: no level) stands still.
+        let z_dot = if rate.is_finite() {
+            rate * (z_ss - z_new)
+        } else {
+            0.0
+        };
         let spring = self.stiffness * z_new;
         let force = spring + self.damping * z_dot;
         // The damping cannot carry the force past the sliding level (or the
@@ -298,10 +307,29 @@ mod tests {
         assert_relative_eq!(f, 1.0, max_relative = 1e-12);
         // Pre-sliding from z = 0: ż ≈ v, so damping adds about σ1 v.
         let (z, f) = p.advance(0.0, 2.0, 1e-3, 1e-3);
-        let z_dot = z / 1e-3;
+        let z_dot = 1e-3 - 1e4 * 1e-3 * z / 2.0;
         assert_relative_eq!(f, 1e4 * z + 50.0 * z_dot, max_relative = 1e-12);
         assert!((z_dot - 1e-3).abs() < 1e-5, "{z_dot}");
         // No level: no displacement.
         assert_eq!(p.advance(1e-4, 0.0, 0.1, 1e-3).0, 0.0);
+    }
+
+    #[test]
+    fn the_force_is_lugres_with_the_displacement_rate_at_the_step_end() {
+        // F = σ0 z + σ1 ż, ż = v − σ0 |v| z / g(v) at the step's end, on a
+        // step the bristle takes a visible part of (a Δt = 0.5): the step's
+        // mean rate Δz/Δt, (e^(a Δt) − 1)/(a Δt) times ż at the end, would be
+        // 30 % higher here.
+        let p = Presliding {
+            stiffness: 1e6,
+            damping: 2e3,
+        };
+        let (level, v, dt) = (200.0, 0.1, 1e-3);
+        let z0 = p.steady_displacement(-level);
+        let (z, f) = p.advance(z0, level, v, dt);
+        let z_dot = v - 1e6 * v * z / level;
+        assert_relative_eq!(f, 1e6 * z + 2e3 * z_dot, max_relative = 1e-12);
+        let mean = (z - z0) / dt;
+        assert_relative_eq!(mean / z_dot, (0.5f64.exp() - 1.0) / 0.5, max_relative = 1e-9);
     }
 }
