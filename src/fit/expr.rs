@@ -119,39 +119,7 @@ pub(super) fn compile(
         text: crate::expression::shorten(text),
         message,
     })?;
-    // ddt(NAME) → ddt__NAME, a derived column; innermost first, so that
-    // ddt(ddt(x)) (an acceleration) is ddt__ddt__x, the derivative of
-    // ddt__x, smoothed the same way.
-    let mut t = text.to_string();
-    while let Some(i) = t.rfind("ddt(") {
-        let rest = &t[i + 4..];
-        let Some(j) = rest.find(')') else {
-            return Err(FitError::Expression {
-                what: what.into(),
-                text: text.into(),
-                message: "`ddt(` without `)`".into(),
-            });
-        };
-        let col = rest[..j].trim().to_string();
-        let is_derived = derived.iter().any(|(d, _)| *d == col);
-        if !is_derived && (!is_name(&col) || table.column(&col).is_none()) {
-            let why = if is_name(&col) {
-                table.column_error(&col).to_string()
-            } else {
-                "ddt() takes a column name (or ddt(COLUMN) for a second derivative)".into()
-            };
-            return Err(FitError::Expression {
-                what: what.into(),
-                text: text.into(),
-                message: format!("ddt({col}): {why}"),
-            });
-        }
-        let id = format!("ddt__{col}");
-        if !derived.iter().any(|(d, _)| *d == id) {
-            derived.push((id.clone(), col));
-        }
-        t = format!("{}{}{}", &t[..i], id, &rest[j + 1..]);
-    }
+    let t = derivatives_as_columns(what, text, table, derived)?;
     let t = crate::expression::with_functions(&t);
     let node =
         build_operator_tree::<DefaultNumericTypes>(&t).map_err(|e| FitError::Expression {
@@ -194,6 +162,49 @@ pub(super) fn compile(
         fixed: None,
         affine: None,
     })
+}
+
+/// `text` with each `ddt(NAME)` replaced by the derived column
+/// `ddt__NAME` (added to `derived` with its source column); innermost
+/// first, so that ddt(ddt(x)) (an acceleration) is ddt__ddt__x, the
+/// derivative of ddt__x, smoothed the same way.
+fn derivatives_as_columns(
+    what: &str,
+    text: &str,
+    table: &Table,
+    derived: &mut Vec<(String, String)>,
+) -> Result<String, FitError> {
+    let mut t = text.to_string();
+    while let Some(i) = t.rfind("ddt(") {
+        let rest = &t[i + 4..];
+        let Some(j) = rest.find(')') else {
+            return Err(FitError::Expression {
+                what: what.into(),
+                text: text.into(),
+                message: "`ddt(` without `)`".into(),
+            });
+        };
+        let col = rest[..j].trim().to_string();
+        let is_derived = derived.iter().any(|(d, _)| *d == col);
+        if !is_derived && (!is_name(&col) || table.column(&col).is_none()) {
+            let why = if is_name(&col) {
+                table.column_error(&col).to_string()
+            } else {
+                "ddt() takes a column name (or ddt(COLUMN) for a second derivative)".into()
+            };
+            return Err(FitError::Expression {
+                what: what.into(),
+                text: text.into(),
+                message: format!("ddt({col}): {why}"),
+            });
+        }
+        let id = format!("ddt__{col}");
+        if !derived.iter().any(|(d, _)| *d == id) {
+            derived.push((id.clone(), col));
+        }
+        t = format!("{}{}{}", &t[..i], id, &rest[j + 1..]);
+    }
+    Ok(t)
 }
 
 fn is_name(s: &str) -> bool {

@@ -349,18 +349,16 @@ mod jacobian_tests {
         (s.w.rows.r.clone(), s.w.g)
     }
 
-    #[allow(clippy::too_many_arguments)]
-    fn check(
+    /// The solver of one property-test case, started in steady sliding.
+    fn case_solver(
         profile: Profile,
         pocket: bool,
         flow_factors: bool,
         sigma: f64,
-        p: Vec<f64>,
-        h0: f64,
-        v: f64,
+        cells: usize,
         theta: bool,
         flux: CouetteFlux,
-    ) {
+    ) -> (Solver, SolverSettings) {
         let mut m = ModelParams::default();
         m.geometry.profile = profile;
         if pocket {
@@ -373,7 +371,7 @@ mod jacobian_tests {
         m.roughness.flow_factors = flow_factors;
         m.roughness.sigma = sigma;
         let st = SolverSettings {
-            cells: p.len(),
+            cells,
             scheme: if theta {
                 TimeScheme::PAPER
             } else {
@@ -384,6 +382,50 @@ mod jacobian_tests {
         };
         let mut s = Solver::new(&m, &st).unwrap();
         s.initialize_steady(0.1, 20_000.0);
+        (s, st)
+    }
+
+    /// The analytic Jacobian's element (i, j) from its bands.
+    fn element(rows: &RowColumns, banded: bool, i: usize, j: usize) -> f64 {
+        if i == j {
+            rows.b[i]
+        } else if i + 1 == j {
+            rows.c[i]
+        } else if j + 1 == i {
+            rows.a[i]
+        } else if i + 2 == j && banded {
+            rows.c2[i]
+        } else if j + 2 == i && banded {
+            rows.a2[i]
+        } else {
+            0.0
+        }
+    }
+
+    /// The largest |element| of row i, for the tolerance of its elements.
+    fn row_scale(rows: &RowColumns, i: usize) -> f64 {
+        let outer = rows.a2[i].abs().max(rows.c2[i].abs());
+        rows.a[i]
+            .abs()
+            .max(rows.b[i].abs())
+            .max(rows.c[i].abs())
+            .max(outer)
+            + 1e-300
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn check(
+        profile: Profile,
+        pocket: bool,
+        flow_factors: bool,
+        sigma: f64,
+        p: Vec<f64>,
+        h0: f64,
+        v: f64,
+        theta: bool,
+        flux: CouetteFlux,
+    ) {
+        let (mut s, st) = case_solver(profile, pocket, flow_factors, sigma, p.len(), theta, flux);
         let coef = StepCoefficients::for_scheme(st.scheme);
         let ctx = Ctx {
             v,
@@ -401,17 +443,7 @@ mod jacobian_tests {
             + ctx.load
             + s.d.mass * h0 / (st.dt * st.dt);
         let n = p.len();
-        let scale: Vec<f64> = (0..p.len())
-            .map(|i| {
-                let outer = rows.a2[i].abs().max(rows.c2[i].abs());
-                rows.a[i]
-                    .abs()
-                    .max(rows.b[i].abs())
-                    .max(rows.c[i].abs())
-                    .max(outer)
-                    + 1e-300
-            })
-            .collect();
+        let scale: Vec<f64> = (0..n).map(|i| row_scale(&rows, i)).collect();
         // Magnitude of the terms of each mass residual (storage levels and
         // face fluxes), for the rounding error of a difference quotient.
         let g_max = s.d.grid.g_cell.iter().cloned().fold(0.0, f64::max);
@@ -434,19 +466,7 @@ mod jacobian_tests {
             let (rm, gm) = residual(&mut s, &pm, h0, &ctx);
             for i in 0..n {
                 let fd = (rp[i] - rm[i]) / (2.0 * h);
-                let an = if i == j {
-                    rows.b[i]
-                } else if i + 1 == j {
-                    rows.c[i]
-                } else if j + 1 == i {
-                    rows.a[i]
-                } else if i + 2 == j && s.w.banded {
-                    rows.c2[i]
-                } else if j + 2 == i && s.w.banded {
-                    rows.a2[i]
-                } else {
-                    0.0
-                };
+                let an = element(&rows, s.w.banded, i, j);
                 let round = 8.0 * f64::EPSILON * r_mag[i] / h;
                 close(fd, an, scale[i], round, &format!("dR{i}/dp{j}"));
             }

@@ -103,20 +103,13 @@ fn up(start: usize, j: usize) -> usize {
     start - j
 }
 
-/// Factor the bordered system and solve it for the Newton direction.
-/// Direction into `w.dp`; returns Δh0, or None when the system is singular
-/// or non-finite.
+/// The four elimination chains of both blocks, interleaved (block 1 from
+/// its top and bottom towards row k1, block 2 likewise towards k2): each
+/// row's factor into `fs`, its partial solution into `y`; returns the
+/// chains' states at their meeting rows.
 #[inline(always)]
-pub(crate) fn factor_solve(w: &mut Work) -> Option<f64> {
-    if w.banded {
-        return super::banded::factor_solve(w);
-    }
-    let n = w.rows.len();
-    let pl = Plan::new(n);
-    let (m, k1, k2) = (pl.m, pl.k1, pl.k2);
-    let rows = &w.rows;
-    let fs = &mut w.factors[..n];
-    let y = &mut w.dp[..n];
+fn sweep_chains(rows: &RowColumns, fs: &mut [Factor], y: &mut [f64], pl: Plan) -> [Chain; 4] {
+    let (n, m, k1, k2) = (y.len(), pl.m, pl.k1, pl.k2);
     // Chain lengths: block 1 top 0..k1, bottom m−1..k1+1; block 2 top
     // m..k2, bottom n−1..k2+1.
     let lens = [k1, m - 1 - k1, k2 - m, n - 1 - k2];
@@ -144,6 +137,24 @@ pub(crate) fn factor_solve(w: &mut Work) -> Option<f64> {
             ch[3].step(rows, i, (rows.c[i], rows.a[i]), 0.0, &mut fs[i], &mut y[i]);
         }
     }
+    ch
+}
+
+/// Factor the bordered system and solve it for the Newton direction.
+/// Direction into `w.dp`; returns Δh0, or None when the system is singular
+/// or non-finite.
+#[inline(always)]
+pub(crate) fn factor_solve(w: &mut Work) -> Option<f64> {
+    if w.banded {
+        return super::banded::factor_solve(w);
+    }
+    let n = w.rows.len();
+    let pl = Plan::new(n);
+    let (m, k1, k2) = (pl.m, pl.k1, pl.k2);
+    let rows = &w.rows;
+    let fs = &mut w.factors[..n];
+    let y = &mut w.dp[..n];
+    let ch = sweep_chains(rows, fs, y, pl);
     // Meeting rows: the block's chains from above (a) and below (c). In the
     // first block the row below the meeting row is dropped at m (c_(m−1) is
     // the spike's), and likewise a_m in the second.

@@ -25,7 +25,8 @@
 //!
 //! `Solver`'s fields this file uses: `d`, `settings`, `p`, `h0`, `hist`, `w`.
 
-use super::{Ctx, H0Mode, Outcome, Solver};
+use super::work::Work;
+use super::{Ctx, Disc, H0Mode, Outcome, Solver};
 use crate::physics::estimate::Status;
 
 impl Solver {
@@ -122,27 +123,7 @@ impl Solver {
                 w.cells.rho[i] = s.rho;
                 w.cells.gr[i] = s.rho / s.mu;
             }
-            // Face conductances K_f (stored in dql) and Couette fluxes (q).
-            for f in 0..=n {
-                let hf = h0 + d.grid.g_face[f];
-                let inv_df = if f == 0 || f == n { 2.0 / dx } else { 1.0 / dx };
-                let (phi, phis) = match &d.ff {
-                    Some(ff) => (ff.pressure(hf).0, ff.shear(hf).0),
-                    None => (1.0, 0.0),
-                };
-                let (rl, gl) = if f == 0 {
-                    (d.rho_edge, d.gr_edge)
-                } else {
-                    (w.cells.rho[f - 1], w.cells.gr[f - 1])
-                };
-                let (rr, gr) = if f == n {
-                    (d.rho_edge, d.gr_edge)
-                } else {
-                    (w.cells.rho[f], w.cells.gr[f])
-                };
-                w.faces.dql[f] = phi * hf * hf * hf * inv_df / 12.0 * 0.5 * (gl + gr);
-                w.faces.q[f] = half_v * (hf + d.sigma * phis) * 0.5 * (rl + rr);
-            }
+            faces(d, w, h0, half_v);
             for i in 0..n {
                 let (kl, kr) = (w.faces.dql[i], w.faces.dql[i + 1]);
                 let mut rhs = -w0 * (w.faces.q[i + 1] - w.faces.q[i]);
@@ -169,20 +150,7 @@ impl Solver {
                 w.rows.c[i] = if i + 1 == n { 0.0 } else { -w0 * kr };
                 w.rows.r[i] = rhs;
             }
-            // Thomas: P̂ into w.tmp.
-            let mut prev_cp = 0.0;
-            let mut prev = 0.0;
-            for i in 0..n {
-                let (ra, rb, rc, rr) = (w.rows.a[i], w.rows.b[i], w.rows.c[i], w.rows.r[i]);
-                let m = rb - ra * prev_cp;
-                prev_cp = rc / m;
-                prev = (rr - ra * prev) / m;
-                w.factors[i].cp = prev_cp;
-                w.tmp[i] = prev;
-            }
-            for i in (0..n - 1).rev() {
-                w.tmp[i] -= w.factors[i].cp * w.tmp[i + 1];
-            }
+            thomas(w, n);
             let mut pmax = d.p_amb;
             let mut change: f64 = 0.0;
             for i in 0..n {
@@ -212,21 +180,74 @@ impl Solver {
                 break;
             }
         }
-        // Load residual ΔF = weighted net force − inertia.
+        let df = self.load_residual(h0, ctx);
+        (df, iters, converged)
+    }
+
+    /// The load residual ΔF (N) at h0 with the current pressures: the
+    /// weighted net force − inertia.
+    fn load_residual(&self, h0: f64, ctx: &Ctx) -> f64 {
+        let d = &self.d;
+        let dx = d.grid.dx;
+        let n = d.grid.n;
         let bdx = d.grid.width * dx;
         let mut sum = 0.0;
         for i in 0..n {
             sum += self.p[i] - d.p_amb + d.gw.pressure(h0 + d.grid.g_cell[i]).0;
         }
         let f_net = bdx * sum - ctx.load;
-        let df = match ctx.time {
+        match ctx.time {
             Some((c, dt)) => {
                 let acc = (h0 - 2.0 * self.hist[0].h0 + self.hist[1].h0) / (dt * dt);
                 c.w[0] * f_net + c.w[1] * self.hist[0].f_net + c.w[2] * self.hist[1].f_net
                     - d.mass * acc
             }
             None => f_net,
+        }
+    }
+}
+
+/// Face conductances K_f (stored in `w.faces.dql`) and Couette fluxes
+/// (`w.faces.q`) at h0 from the cells' density and ρ/μ.
+fn faces(d: &Disc, w: &mut Work, h0: f64, half_v: f64) {
+    let n = d.grid.n;
+    let dx = d.grid.dx;
+    for f in 0..=n {
+        let hf = h0 + d.grid.g_face[f];
+        let inv_df = if f == 0 || f == n { 2.0 / dx } else { 1.0 / dx };
+        let (phi, phis) = match &d.ff {
+            Some(ff) => (ff.pressure(hf).0, ff.shear(hf).0),
+            None => (1.0, 0.0),
         };
-        (df, iters, converged)
+        let (rl, gl) = if f == 0 {
+            (d.rho_edge, d.gr_edge)
+        } else {
+            (w.cells.rho[f - 1], w.cells.gr[f - 1])
+        };
+        let (rr, gr) = if f == n {
+            (d.rho_edge, d.gr_edge)
+        } else {
+            (w.cells.rho[f], w.cells.gr[f])
+        };
+        w.faces.dql[f] = phi * hf * hf * hf * inv_df / 12.0 * 0.5 * (gl + gr);
+        w.faces.q[f] = half_v * (hf + d.sigma * phis) * 0.5 * (rl + rr);
+    }
+}
+
+/// Thomas's algorithm on the tridiagonal rows of `w` (n of them): P̂ into
+/// `w.tmp`.
+fn thomas(w: &mut Work, n: usize) {
+    let mut prev_cp = 0.0;
+    let mut prev = 0.0;
+    for i in 0..n {
+        let (ra, rb, rc, rr) = (w.rows.a[i], w.rows.b[i], w.rows.c[i], w.rows.r[i]);
+        let m = rb - ra * prev_cp;
+        prev_cp = rc / m;
+        prev = (rr - ra * prev) / m;
+        w.factors[i].cp = prev_cp;
+        w.tmp[i] = prev;
+    }
+    for i in (0..n - 1).rev() {
+        w.tmp[i] -= w.factors[i].cp * w.tmp[i + 1];
     }
 }
