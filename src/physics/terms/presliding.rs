@@ -330,6 +330,10 @@ mod tests {
         let z_dot = v - 1e6 * v * z / level;
         assert_relative_eq!(f, 1e6 * z + 2e3 * z_dot, max_relative = 1e-12);
         let mean = (z - z0) / dt;
-        assert_relative_eq!(mean / z_dot, (0.5f64.exp() - 1.0) / 0.5, max_relative = 1e-9);
+        assert_relative_eq!(
+            mean / z_dot,
+            (0.5f64.exp() - 1.0) / 0.5,
+            max_relative = 1e-9
+        );
     }
 }
