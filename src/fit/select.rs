@@ -43,7 +43,10 @@
 //!    data (at their top speed, their slowest sliding speed, and between),
 //!    so that the data decide whether a film regime shows in them.
 //! 6. The chosen set is fitted on all the training data with the usual
-//!    search (global phase, local runs).
+//!    search (global phase, local runs), with the bounds its trial had
+//!    (`trial::set_specs_for`), and confirmed at that optimum
+//!    (`confirm.rs`): scored on the same folds, it gives way to the best
+//!    set with one term fewer when it no longer pays over it.
 //!
 //! The report lists every set tried with its CV error per fold, the set
 //! chosen and why the selection stopped.
@@ -469,7 +472,7 @@ fn cv(t: &Tried, p: &Prepared) -> String {
 pub fn report(s: &Selection, units: super::Units) -> String {
     let u = units.force();
     let mut md = format!(
-        "## Terms chosen by the data (`--fit auto`)\n\nRule: stepwise selection on cross-validation of the training data ({}; each fold predicted by the set refitted without it); each step takes the candidate with the lowest CV error, unless one with fewer keys predicts as well (the best does not pay for its extra keys over it); a term is added only if it lowers the folds' mean squared error by more than the standard error of that lowering and by more than {:.0} % of it (the cost of a term), and a term chosen earlier goes, or gives way to a lighter form of it (the Stribeck curve to its viscous rise), when it no longer pays beside a later one; a term that ends at zero or at a bound, or that the data cannot tell from another (|ρ| > 0.95), is dropped or reduced and the set fitted again unless that predicts worse. Neither --validate nor --holdout data are used.\n\n| set (boundary friction +) | CV RMS ({u}) | RMS per fold ({u}) | film solves |\n|---|---|---|---|\n",
+        "## Terms chosen by the data (`--fit auto`)\n\nRule: stepwise selection on cross-validation of the training data ({}; each fold predicted by the set refitted without it); each step takes the candidate with the lowest CV error, unless one with fewer keys predicts as well (the best does not pay for its extra keys over it); a term is added only if it lowers the folds' mean squared error by more than the standard error of that lowering and by more than {:.0} % of it (the cost of a term), and a term chosen earlier goes, or gives way to a lighter form of it (the Stribeck curve to its viscous rise), when it no longer pays beside a later one; a term that ends at zero or at a bound, or that the data cannot tell from another (|ρ| > 0.95), is dropped or reduced and the set fitted again unless that predicts worse; the chosen set's final fit is scored on the same folds, and gives way to the best set with one term fewer when it no longer pays over it. Neither --validate nor --holdout data are used.\n\n| set (boundary friction +) | CV RMS ({u}) | RMS per fold ({u}) | film solves |\n|---|---|---|---|\n",
         s.folds,
         100.0 * TERM_COST
     );
