@@ -132,7 +132,7 @@ impl<'p> EarlierOptima<'p> {
     }
 
     /// Record it when the point `u` (cost `cost`) of a run on `problem`
-    /// has entered an earlier optimum's confidence region ([`Self::joins`]).
+    /// has entered an earlier optimum's confidence region (`joins`).
     pub fn check_region(&self, problem: &Problem<'_>, u: &[f64], cost: f64) {
         if let Some(k) = self.joins(problem, u, cost) {
             self.join(Joined::Region(k));
@@ -140,7 +140,7 @@ impl<'p> EarlierOptima<'p> {
     }
 
     /// Whether the run at `u` (cost `cost`) sits in an earlier optimum's
-    /// valley ([`Self::valley`]); recorded when it does.
+    /// valley (`valley`); recorded when it does.
     pub fn check_valley(&self, vars: &Variables<'_, '_>, u: &[f64], cost: f64) -> bool {
         let k = self.valley(vars, u, cost);
         if let Some(k) = k {
