@@ -186,27 +186,7 @@ impl BagWriter {
             .map_err(mcap_err)?;
         let table = TopicTable::new(config, names);
         let slots = table.slots();
-        let mut channels = vec![None; slots];
-        let mut schemas: BTreeMap<String, u16> = BTreeMap::new();
-        for (id, topic, ty, qos) in table.topics {
-            let name = ty.full_name();
-            let schema = match schemas.get(&name) {
-                Some(s) => *s,
-                None => {
-                    let s = w
-                        .add_schema(&name, "ros2msg", ty.ros2msg_schema().as_bytes())
-                        .map_err(mcap_err)?;
-                    schemas.insert(name, s);
-                    s
-                }
-            };
-            let mut meta = BTreeMap::new();
-            meta.insert("offered_qos_profiles".to_string(), qos);
-            channels[id.index()] = Some(
-                w.add_channel(schema, &topic, "cdr", &meta)
-                    .map_err(mcap_err)?,
-            );
-        }
+        let channels = add_channels(&mut w, table).map_err(mcap_err)?;
         let mut meta = extra;
         meta.insert("config_yaml".to_string(), config.to_yaml());
         meta.insert("version".to_string(), env!("CARGO_PKG_VERSION").to_string());
@@ -303,4 +283,29 @@ impl BagWriter {
         drop(self.w);
         Ok(std::fs::metadata(&self.path).map_or(0, |m| m.len()))
     }
+}
+
+/// One schema per message type and one channel per topic of `table`, with
+/// its QoS as `offered_qos_profiles`: the channel ids by topic slot.
+fn add_channels(
+    w: &mut McapWriter,
+    table: TopicTable,
+) -> Result<Vec<Option<u16>>, mcap::McapError> {
+    let mut channels = vec![None; table.slots()];
+    let mut schemas: BTreeMap<String, u16> = BTreeMap::new();
+    for (id, topic, ty, qos) in table.topics {
+        let name = ty.full_name();
+        let schema = match schemas.get(&name) {
+            Some(s) => *s,
+            None => {
+                let s = w.add_schema(&name, "ros2msg", ty.ros2msg_schema().as_bytes())?;
+                schemas.insert(name, s);
+                s
+            }
+        };
+        let mut meta = BTreeMap::new();
+        meta.insert("offered_qos_profiles".to_string(), qos);
+        channels[id.index()] = Some(w.add_channel(schema, &topic, "cdr", &meta)?);
+    }
+    Ok(channels)
 }

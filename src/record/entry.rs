@@ -7,7 +7,7 @@ use crate::config::{CommandType, OutputPlan};
 use crate::link::FilmProfileData;
 use crate::link::RecordItem;
 use crate::msgs::command_codec::CommandMessage;
-use crate::msgs::{self, Command, CommandKind, Float64, Header, Time};
+use crate::msgs::{self, Command, CommandKind, EstimateRecord, Float64, Header, Time};
 
 /// The node's recorded topics.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -160,53 +160,9 @@ impl Encoder {
             }),
             &RecordItem::Estimate {
                 record: ref e,
-                logged_ns: log_ns,
+                logged_ns,
                 contact,
-            } => {
-                if let OutputPlan::Joints(joints) = &self.plan {
-                    if usize::from(contact) >= joints.len() {
-                        return Err(WriteError::NoSuchContact {
-                            what: "an estimate",
-                            contact,
-                            contacts: joints.len(),
-                        });
-                    }
-                    out.push(Entry {
-                        topic: TopicId::ContactFriction(contact),
-                        log_ns,
-                        publish_ns: e.stamp_ns,
-                        data: cdr(
-                            TopicId::ContactFriction(contact),
-                            &e.to_wire(&self.frame_id),
-                        )?,
-                    });
-                    return Ok(());
-                }
-                if contact != 0 {
-                    return Err(WriteError::NoSuchContact {
-                        what: "an estimate",
-                        contact,
-                        contacts: 1,
-                    });
-                }
-                out.push(Entry {
-                    topic: TopicId::Friction,
-                    log_ns,
-                    publish_ns: e.stamp_ns,
-                    data: cdr(TopicId::Friction, &e.to_wire(&self.frame_id))?,
-                });
-                out.push(Entry {
-                    topic: TopicId::FrictionForce,
-                    log_ns,
-                    publish_ns: e.stamp_ns,
-                    data: cdr(
-                        TopicId::FrictionForce,
-                        &Float64 {
-                            data: e.friction_force_n,
-                        },
-                    )?,
-                });
-            }
+            } => self.estimate(e, logged_ns, contact, out)?,
             &RecordItem::Statistics {
                 record: ref s,
                 logged_ns: log_ns,
@@ -227,6 +183,61 @@ impl Encoder {
                 data: cdr.clone(),
             }),
         }
+        Ok(())
+    }
+
+    /// An estimate's entries: per joint its contact-friction topic; with
+    /// one contact the full estimate and the plain friction force.
+    fn estimate(
+        &self,
+        e: &EstimateRecord,
+        log_ns: u64,
+        contact: u16,
+        out: &mut Vec<Entry>,
+    ) -> Result<(), WriteError> {
+        if let OutputPlan::Joints(joints) = &self.plan {
+            if usize::from(contact) >= joints.len() {
+                return Err(WriteError::NoSuchContact {
+                    what: "an estimate",
+                    contact,
+                    contacts: joints.len(),
+                });
+            }
+            out.push(Entry {
+                topic: TopicId::ContactFriction(contact),
+                log_ns,
+                publish_ns: e.stamp_ns,
+                data: cdr(
+                    TopicId::ContactFriction(contact),
+                    &e.to_wire(&self.frame_id),
+                )?,
+            });
+            return Ok(());
+        }
+        if contact != 0 {
+            return Err(WriteError::NoSuchContact {
+                what: "an estimate",
+                contact,
+                contacts: 1,
+            });
+        }
+        out.push(Entry {
+            topic: TopicId::Friction,
+            log_ns,
+            publish_ns: e.stamp_ns,
+            data: cdr(TopicId::Friction, &e.to_wire(&self.frame_id))?,
+        });
+        out.push(Entry {
+            topic: TopicId::FrictionForce,
+            log_ns,
+            publish_ns: e.stamp_ns,
+            data: cdr(
+                TopicId::FrictionForce,
+                &Float64 {
+                    data: e.friction_force_n,
+                },
+            )?,
+        });
         Ok(())
     }
 
