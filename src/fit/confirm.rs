@@ -20,7 +20,7 @@
 use super::cross_validate::cv_rms;
 use super::prepared::{model_for, Prepared};
 use super::select::{fitted_keys, pays, Selection};
-use super::trial::{set_specs_for, Scored, Tried};
+use super::trial::{final_specs, Scored, Tried};
 use super::unknowns::ParamSpec;
 use super::FitError;
 use crate::text::Num;
@@ -97,7 +97,7 @@ pub fn fall_back(
     f: Fallback,
 ) -> Result<(), FitError> {
     let terms = f.set.tried.terms;
-    let (model, map_fit) = model_for(p, &set_specs_for(p, given, &terms), &f.set.optimum)?;
+    let (model, map_fit) = model_for(p, &final_specs(given, &terms), &f.set.optimum)?;
     p.model = model;
     p.map_fit = map_fit;
     s.keys = fitted_keys(&terms, given);

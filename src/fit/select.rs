@@ -43,8 +43,9 @@
 //!    data (at their top speed, their slowest sliding speed, and between),
 //!    so that the data decide whether a film regime shows in them.
 //! 6. The chosen set is fitted on all the training data with the usual
-//!    search (global phase, local runs), with the bounds its trial had
-//!    (`trial::set_specs_for`), and confirmed at that optimum
+//!    search (global phase, local runs), each key in its own range
+//!    (`trial::final_specs`: a film a trial placed inside the data is not
+//!    shipped there), and confirmed at that optimum
 //!    (`confirm.rs`): scored on the same folds, it gives way to the best
 //!    set with one term fewer when it no longer pays over it.
 //!
@@ -526,7 +527,7 @@ pub fn select_terms(
     stop: &crate::interrupt::Stop,
 ) -> Result<Selection, FitError> {
     let s = select(p, search, given, say, stop)?;
-    let specs = super::trial::set_specs_for(p, given, &s.chosen);
+    let specs = super::trial::final_specs(given, &s.chosen);
     let (model, map_fit) = model_for(p, &specs, &s.optimum)?;
     p.model = model;
     p.map_fit = map_fit;
