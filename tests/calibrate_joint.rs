@@ -342,6 +342,37 @@ fn a_rotary_report_speaks_in_the_joints_units_and_names_its_lever() {
 }
 
 #[test]
+fn a_joints_column_names_are_read_in_its_held_out_part_as_in_its_training_part() {
+    let d = dir("holdout-columns");
+    // `velocity_rad_s` and `torque_nm`, no --velocity / --friction: the
+    // held-out cut reads the file through the same joint's names (it read
+    // `velocity_m_s` and failed before).
+    let joint = joint_record(&d, 0.5, 4.0);
+    let (code, stdout, err) = run(&[
+        "fit",
+        joint.to_str().unwrap(),
+        "--rotary",
+        "--holdout",
+        "0.25",
+        "--set",
+        "solver.cells=32",
+        "--fit",
+        "contact.boundary_friction",
+        "--starts",
+        "1",
+        "--global-points",
+        "0",
+        "--max-evaluations",
+        "20",
+        "--out",
+        d.join("f.yaml").to_str().unwrap(),
+    ]);
+    assert!(code == 0 || code == 4, "{err}");
+    assert!(stdout.contains("held-out RMS "), "{stdout}");
+    assert!(d.join("f.yaml").exists());
+}
+
+#[test]
 fn friction_whose_sign_opposes_the_velocity_is_refused_naming_the_sign_not_fitted() {
     let d = dir("sign");
     let joint = joint_record(&d, 0.5, 2.0);

@@ -180,7 +180,9 @@ type Sources = (Vec<Source>, Vec<Source>, Vec<Source>);
 /// here, before anything reads it: from then on every choice sees the
 /// training part alone.
 fn read_sources(req: &DataRequest, notes: &mut Vec<String>) -> Result<Sources, FitError> {
-    let mut source = |p: &PathBuf| -> Result<Source, FitError> {
+    // Each file with the mapping it is read through (a joint's column
+    // names under --rotary), which its held-out cut keeps.
+    let mut source = |p: &PathBuf| -> Result<(Source, super::Mapping), FitError> {
         let (table, note) = req.table(p)?;
         notes.extend(note);
         let mapping = if req.rotary {
@@ -188,7 +190,7 @@ fn read_sources(req: &DataRequest, notes: &mut Vec<String>) -> Result<Sources, F
         } else {
             req.mapping.clone()
         };
-        Source::new(table, &mapping)
+        Ok((Source::new(table, &mapping)?, mapping))
     };
     let given = req
         .files
@@ -198,17 +200,21 @@ fn read_sources(req: &DataRequest, notes: &mut Vec<String>) -> Result<Sources, F
     let validate = req
         .validate
         .iter()
-        .map(&mut source)
+        .map(|p| source(p).map(|(s, _)| s))
         .collect::<Result<Vec<_>, _>>()?;
     if req.holdout > 0.0 {
         let parts = given
             .iter()
-            .map(|s| s.split_held_out(req.holdout, &req.mapping))
+            .map(|(s, mapping)| s.split_held_out(req.holdout, mapping))
             .collect::<Result<Vec<_>, _>>()?;
         let (train, held_out) = parts.into_iter().unzip();
         Ok((train, held_out, validate))
     } else {
-        Ok((given, Vec::new(), validate))
+        Ok((
+            given.into_iter().map(|(s, _)| s).collect(),
+            Vec::new(),
+            validate,
+        ))
     }
 }
 
