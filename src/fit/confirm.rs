@@ -18,9 +18,9 @@
 //! a term away, so this ends, at the base set at the latest.
 
 use super::cross_validate::cv_rms;
-use super::prepared::{model_for, Prepared};
+use super::prepared::Prepared;
 use super::select::{fitted_keys, pays, Selection};
-use super::trial::{final_specs, Scored, Tried};
+use super::trial::{set_final_model, Scored, Tried};
 use super::unknowns::ParamSpec;
 use super::FitError;
 use crate::text::Num;
@@ -97,9 +97,7 @@ pub fn fall_back(
     f: Fallback,
 ) -> Result<(), FitError> {
     let terms = f.set.tried.terms;
-    let (model, map_fit) = model_for(p, &final_specs(given, &terms), &f.set.optimum)?;
-    p.model = model;
-    p.map_fit = map_fit;
+    set_final_model(p, given, &terms, &f.set.optimum)?;
     s.keys = fitted_keys(&terms, given);
     s.optimum = f.set.optimum;
     s.chosen = terms;

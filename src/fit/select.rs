@@ -54,7 +54,7 @@
 
 use super::candidates::{candidates_here, lighter_forms, set_keys, Candidate, CANDIDATES};
 use super::options::SearchSettings;
-use super::prepared::{model_for, Prepared};
+use super::prepared::Prepared;
 use super::trial::{Ctx, Scored, Tried};
 use super::unknowns::ParamSpec;
 use super::FitError;
@@ -527,10 +527,7 @@ pub fn select_terms(
     stop: &crate::interrupt::Stop,
 ) -> Result<Selection, FitError> {
     let s = select(p, search, given, say, stop)?;
-    let specs = super::trial::final_specs(given, &s.chosen);
-    let (model, map_fit) = model_for(p, &specs, &s.optimum)?;
-    p.model = model;
-    p.map_fit = map_fit;
+    super::trial::set_final_model(p, given, &s.chosen, &s.optimum)?;
     Ok(s)
 }
 

@@ -108,15 +108,25 @@ pub(super) fn final_specs(given: &[ParamSpec], terms: &[&'static str]) -> Vec<Pa
     set_specs(given, &set_keys(terms))
 }
 
+/// Set `p`'s model to the final fit's of the set `terms` ([`final_specs`]),
+/// started from `optimum` (the set's in the selection).
+pub(super) fn set_final_model(
+    p: &mut Prepared,
+    given: &[ParamSpec],
+    terms: &[&'static str],
+    optimum: &Optimum,
+) -> Result<(), FitError> {
+    let (model, map_fit) = model_for(p, &final_specs(given, terms), optimum)?;
+    p.model = model;
+    p.map_fit = map_fit;
+    Ok(())
+}
+
 /// The parameter specs of the set `terms` for its trial: the keys of
 /// `given` as given; with the film placed inside the data
 /// ([`film_placements`]) the viscosity key's bounds wide enough for every
 /// placement, unless given.
-pub(super) fn set_specs_for(
-    p: &Prepared,
-    given: &[ParamSpec],
-    terms: &[&'static str],
-) -> Vec<ParamSpec> {
+fn set_specs_for(p: &Prepared, given: &[ParamSpec], terms: &[&'static str]) -> Vec<ParamSpec> {
     let mut specs = set_specs(given, &set_keys(terms));
     if terms.contains(&FILM) && !film_placements(p).is_empty() {
         if let Some(s) = specs
