@@ -2,6 +2,7 @@
 //! reports and the replay report.
 
 use crate::output::{write_file, OutputError};
+use plotters::coord::ranged1d::ValueFormatter;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 
@@ -168,69 +169,89 @@ where
         .margin(12)
         .x_label_area_size(38)
         .y_label_area_size(62);
-    macro_rules! body {
-        ($chart:expr) => {{
-            let mut chart = $chart;
-            let (xs, ys) = (x1 - x0, y1 - y0);
-            chart
-                .configure_mesh()
-                .x_desc(ax.x)
-                .y_desc(ax.y)
-                .x_label_formatter(&|v| tick(*v, xs, ax.log_x))
-                .y_label_formatter(&|v| tick(*v, ys, ax.log_y))
-                .light_line_style(RGBColor(235, 235, 235))
-                .draw()
-                .map_err(|e| e.to_string())?;
-            let mut labelled = false;
-            for l in &p.lines {
-                let pts = plottable(l, ax);
-                let style = ShapeStyle::from(&l.color).stroke_width(if l.dashed { 1 } else { 2 });
-                let s = if l.dashed {
-                    chart
-                        .draw_series(DashedLineSeries::new(pts, 6, 4, style))
-                        .map_err(|e| e.to_string())?
-                } else {
-                    chart
-                        .draw_series(LineSeries::new(pts, style))
-                        .map_err(|e| e.to_string())?
-                };
-                if let Some(label) = &l.label {
-                    let (c, dashed) = (l.color, l.dashed);
-                    s.label(label.clone()).legend(move |(x, y)| {
-                        // A dashed line's key is dashed too.
-                        let (a, b) = if dashed { (7, 11) } else { (18, 18) };
-                        EmptyElement::at((x, y))
-                            + PathElement::new(vec![(0, 0), (a, 0)], c.stroke_width(2))
-                            + PathElement::new(vec![(b, 0), (18, 0)], c.stroke_width(2))
-                    });
-                    labelled = true;
-                }
-            }
-            if labelled && legend {
-                chart
-                    .configure_series_labels()
-                    .background_style(WHITE.mix(0.85))
-                    .border_style(RGBColor(180, 180, 180))
-                    .label_font(("sans-serif", 12))
-                    .position(ax.legend.clone())
-                    .draw()
-                    .map_err(|e| e.to_string())?;
-            }
-        }};
-    }
+    let spans = (x1 - x0, y1 - y0);
+    let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
     match (ax.log_x, ax.log_y) {
-        (false, false) => body!(b
-            .build_cartesian_2d(x0..x1, y0..y1)
-            .map_err(|e| e.to_string())?),
-        (true, false) => body!(b
-            .build_cartesian_2d((x0..x1).log_scale(), y0..y1)
-            .map_err(|e| e.to_string())?),
-        (false, true) => body!(b
-            .build_cartesian_2d(x0..x1, (y0..y1).log_scale())
-            .map_err(|e| e.to_string())?),
-        (true, true) => body!(b
-            .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
-            .map_err(|e| e.to_string())?),
+        (false, false) => {
+            let chart = b.build_cartesian_2d(x0..x1, y0..y1).map_err(e)?;
+            draw_chart(chart, p, ax, legend, spans)
+        }
+        (true, false) => {
+            let chart = b
+                .build_cartesian_2d((x0..x1).log_scale(), y0..y1)
+                .map_err(e)?;
+            draw_chart(chart, p, ax, legend, spans)
+        }
+        (false, true) => {
+            let chart = b
+                .build_cartesian_2d(x0..x1, (y0..y1).log_scale())
+                .map_err(e)?;
+            draw_chart(chart, p, ax, legend, spans)
+        }
+        (true, true) => {
+            let chart = b
+                .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
+                .map_err(e)?;
+            draw_chart(chart, p, ax, legend, spans)
+        }
+    }
+}
+
+/// A panel's mesh, lines and legend on a chart of any axis scales; `spans`
+/// are the axes' ranges (for the ticks' digits).
+fn draw_chart<'a, DB, X, Y>(
+    mut chart: ChartContext<'a, DB, Cartesian2d<X, Y>>,
+    p: &Panel,
+    ax: &Axes<'_>,
+    legend: bool,
+    (xs, ys): (f64, f64),
+) -> Result<(), String>
+where
+    DB: DrawingBackend + 'a,
+    DB::ErrorType: 'static,
+    X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
+    chart
+        .configure_mesh()
+        .x_desc(ax.x)
+        .y_desc(ax.y)
+        .x_label_formatter(&|v| tick(*v, xs, ax.log_x))
+        .y_label_formatter(&|v| tick(*v, ys, ax.log_y))
+        .light_line_style(RGBColor(235, 235, 235))
+        .draw()
+        .map_err(|e| e.to_string())?;
+    let mut labelled = false;
+    for l in &p.lines {
+        let pts = plottable(l, ax);
+        let style = ShapeStyle::from(&l.color).stroke_width(if l.dashed { 1 } else { 2 });
+        let s = if l.dashed {
+            chart.draw_series(DashedLineSeries::new(pts, 6, 4, style))
+        } else {
+            chart.draw_series(LineSeries::new(pts, style))
+        }
+        .map_err(|e| e.to_string())?;
+        if let Some(label) = &l.label {
+            let (c, dashed) = (l.color, l.dashed);
+            s.label(label.clone()).legend(move |(x, y)| {
+                // A dashed line's key is dashed too.
+                let (a, b) = if dashed { (7, 11) } else { (18, 18) };
+                EmptyElement::at((x, y))
+                    + PathElement::new(vec![(0, 0), (a, 0)], c.stroke_width(2))
+                    + PathElement::new(vec![(b, 0), (18, 0)], c.stroke_width(2))
+            });
+            labelled = true;
+        }
+    }
+    if labelled && legend {
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(RGBColor(180, 180, 180))
+            .label_font(("sans-serif", 12))
+            .position(ax.legend.clone())
+            .draw()
+            .map_err(|e| e.to_string())?;
     }
     Ok(())
 }
