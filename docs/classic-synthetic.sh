@@ -13,6 +13,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 OUT=${1:-out/classic-synthetic}
 BIN=${2:-target/release/friction-node}
+. docs/bench-lib.sh
 mkdir -p "$OUT"
 [ -x "$BIN" ] || cargo build --release --quiet
 python3 docs/point-to-point-motion.py "$OUT/motion.csv" 10
@@ -63,37 +64,26 @@ for name, f in cases.items():
 PY
 
 for name in coulomb-viscous stribeck-peak stribeck-rise lugre; do
-    start=$(date +%s.%N)
-    "$BIN" fit "$OUT/$name.csv" --holdout 0.3 --set solver.cells=32 --fit auto --baselines \
-        --out "$OUT/$name.yaml" > "$OUT/$name.md" 2> "$OUT/$name.log" || true
-    end=$(date +%s.%N)
-    python3 -c "print(round($end - $start, 1))" > "$OUT/$name.wall"
+    timed "$name" "$BIN" fit "$OUT/$name.csv" --holdout 0.3 --set solver.cells=32 --fit auto \
+        --baselines --out "$OUT/$name.yaml"
 done
 
 python3 - "$OUT" <<'PY'
-import re, sys
+import sys
+sys.path.insert(0, "docs")
+from fit_runs import Run
 out = sys.argv[1]
 gen = {"coulomb-viscous": "Coulomb + viscous", "stribeck-peak": "Stribeck",
        "stribeck-rise": "Stribeck", "lugre": "LuGre"}
 print("| record | noise (generator's training RMS) | ours: training RMS | ours / noise | ours: held-out RMS | generator's classic, as fitted: held-out RMS | ours chose | wall (s) |")
 print("|---|---|---|---|---|---|---|---|")
 for name, classic in gen.items():
-    md = open(f"{out}/{name}.md").read()
+    run = Run(out, name)
     noise = float(open(f"{out}/{name}.noise").read())
-    wall = open(f"{out}/{name}.wall").read().strip()
-    rows = {}
-    for l in md.splitlines():
-        m = re.match(r"^\| (friction-node|Coulomb \+ viscous|Stribeck|LuGre) \|", l)
-        if m:
-            c = [x.strip() for x in l.strip("|").split("|")]
-            rows[c[0]] = c
-    chosen = re.search(r"^Chosen: (.*?)\. Stopped", md, re.M)
-    if "friction-node" not in rows:
-        log = open(f"{out}/{name}.log").read().strip().splitlines()
-        print(f"| {name} | {noise:.4g} N | failed: {log[-1] if log else '?'} | | | | | {wall} |")
+    if run.ours is None:
+        print(f"| {name} | {noise:.4g} N | failed: {run.failure()} | | | | | {run.wall} |")
         continue
-    ours, cl = rows["friction-node"], rows.get(classic)
-    train = float(ours[4])
-    print(f"| {name} | {noise:.4g} N | {ours[4]} N | {train / noise:.3f} | {ours[6]} N | "
-          f"{classic}: {cl[6] if cl else '—'} N | {chosen.group(1) if chosen else '—'} | {wall} |")
+    ours, cl = run.ours, run.rows.get(classic)
+    print(f"| {name} | {noise:.4g} N | {ours[4]} N | {float(ours[4]) / noise:.3f} | {ours[6]} N | "
+          f"{classic}: {cl[6] if cl else '—'} N | {run.chosen or '—'} | {run.wall} |")
 PY

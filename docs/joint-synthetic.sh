@@ -16,6 +16,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 OUT=${1:-out/joint-synthetic}
 BIN=${2:-target/release/friction-node}
+. docs/bench-lib.sh
 mkdir -p "$OUT"
 [ -x "$BIN" ] || cargo build --release --quiet
 
@@ -66,37 +67,26 @@ for name, p in cases.items():
 PY
 
 for name in joint-peak joint-rise; do
-    start=$(date +%s.%N)
-    "$BIN" fit "$OUT/$name-train.csv" --rotary --holdout 0.33 --validate "$OUT/$name-fast.csv" \
-        --fit auto --baselines --out "$OUT/$name.yaml" > "$OUT/$name.md" 2> "$OUT/$name.log" || true
-    end=$(date +%s.%N)
-    python3 -c "print(round($end - $start, 1))" > "$OUT/$name.wall"
+    timed "$name" "$BIN" fit "$OUT/$name-train.csv" --rotary --holdout 0.33 \
+        --validate "$OUT/$name-fast.csv" --fit auto --baselines --out "$OUT/$name.yaml"
 done
 
 python3 - "$OUT" <<'PY'
-import re, sys
+import sys
+sys.path.insert(0, "docs")
+from fit_runs import Run
 out = sys.argv[1]
 print("| record | noise | ours: training RMS | ours: later part | ours: faster motion | "
       "Coulomb + viscous / Stribeck / LuGre: faster motion | ours chose | wall (s) |")
 print("|---|---|---|---|---|---|---|---|")
 for name in ("joint-peak", "joint-rise"):
-    md = open(f"{out}/{name}.md").read()
+    run = Run(out, name)
     noise = float(open(f"{out}/{name}.noise").read())
-    wall = open(f"{out}/{name}.wall").read().strip()
-    rows = {}
-    for l in md.splitlines():
-        m = re.match(r"^\| (friction-node|Coulomb \+ viscous|Stribeck|LuGre) \|", l)
-        if m:
-            c = [x.strip() for x in l.strip("|").split("|")]
-            rows[c[0]] = c
-    later = re.search(r"^held-out RMS ([0-9.e+-]+)", md, re.M)
-    if "friction-node" not in rows or not later:
-        log = open(f"{out}/{name}.log").read().strip().splitlines()
-        print(f"| {name} | {noise:.4g} | failed: {log[-1] if log else '?'} | | | | | {wall} |")
+    if run.ours is None or run.held_out is None:
+        print(f"| {name} | {noise:.4g} | failed: {run.failure()} | | | | | {run.wall} |")
         continue
-    chosen = re.search(r"^Chosen: (.*?)\. Stopped", md, re.M)
-    classics = " / ".join(rows[c][6] if c in rows else "—"
+    classics = " / ".join(run.rows[c][6] if c in run.rows else "—"
                           for c in ("Coulomb + viscous", "Stribeck", "LuGre"))
-    print(f"| {name} | {noise:.4g} | {rows['friction-node'][4]} | {later.group(1)} | "
-          f"{rows['friction-node'][6]} | {classics} | {chosen.group(1) if chosen else '—'} | {wall} |")
+    print(f"| {name} | {noise:.4g} | {run.ours[4]} | {run.held_out} | {run.ours[6]} | "
+          f"{classics} | {run.chosen or '—'} | {run.wall} |")
 PY

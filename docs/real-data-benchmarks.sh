@@ -22,6 +22,7 @@ OUT=${1:-out/real-data}
 mkdir -p "$OUT"
 if [ -z "${2:-}" ]; then cargo build --release --quiet; fi
 BIN=${2:-target/release/friction-node}
+. docs/bench-lib.sh
 SETS=${SETS:-seal emps lead-a lead-b}
 
 # The lead screw's steady curves: drive 1, positive direction, motor speed
@@ -47,13 +48,9 @@ for name, train in splits.items():
 PY
 
 run() {
-    local name=$1; shift
-    local start end
-    start=$(date +%s.%N)
-    "$BIN" fit "$@" --baselines --out "$OUT/$name.yaml" --report "$OUT/$name-report" \
-        > "$OUT/$name.md" 2> "$OUT/$name.log" || true
-    end=$(date +%s.%N)
-    python3 -c "print(round($end - $start, 1))" > "$OUT/$name.wall"
+    local name=$1
+    shift
+    timed "$name" "$BIN" fit "$@" --baselines --out "$OUT/$name.yaml" --report "$OUT/$name-report"
 }
 
 for set in $SETS; do
@@ -83,30 +80,26 @@ for set in $SETS; do
 done
 
 python3 - "$OUT" $SETS <<'PY'
-import re, sys
+import sys
+sys.path.insert(0, "docs")
+from fit_runs import Run
 out, sets = sys.argv[1], sys.argv[2:]
 labels = {"seal": "O-ring seal (5 + 7 bar from 1 + 3)", "emps": "EMPS (pulses record)",
           "lead-a": "lead screw (a) every other speed", "lead-b": "lead screw (b) faster speeds"}
 print("| recording | model | terms / parameters | training RMS | CV RMS | held-out RMS | held-out / friction | fit | wall (s) |")
 print("|---|---|---|---|---|---|---|---|---|")
 for s in sets:
-    md = open(f"{out}/{s}.md").read()
-    wall = open(f"{out}/{s}.wall").read().strip()
+    run = Run(out, s)
     unit = "N·m" if s.startswith("lead") else "N"
-    chosen = re.search(r"^Chosen: (.*?)\. Stopped", md, re.M)
-    table = [l for l in md.splitlines() if re.match(r"^\| (friction-node|Coulomb|Stribeck|LuGre)", l)]
-    if not table:
-        log = open(f"{out}/{s}.log").read().strip().splitlines()
-        print(f"| {labels[s]} | — | failed: {log[-1] if log else '?'} | | | | | | {wall} |")
+    if not run.rows:
+        print(f"| {labels[s]} | — | failed: {run.failure()} | | | | | | {run.wall} |")
         continue
-    for row in table:
-        c = [x.strip() for x in row.strip("|").split("|")]
+    for c in run.rows.values():
         model, n, params, fit, train, cv, held, rel = c[:8]
         ours = model == "friction-node"
-        what = chosen.group(1) if (ours and chosen) else f"{n} parameters"
+        what = run.chosen if (ours and run.chosen) else f"{n} parameters"
         fitted = "converged" if fit == "converged" else "not converged"
-        print(f"| {labels[s]} | {model} | {what} | {train} {unit} | {cv} {unit} | {held} {unit} | {rel} | {fitted} | {wall if ours else ''} |")
-    verdict = re.search(r"^\*\*Verdict.*$", md, re.M)
-    if verdict:
-        print(f"| {labels[s]} | | {verdict.group(0).replace('|', '/')} | | | | | | |")
+        print(f"| {labels[s]} | {model} | {what} | {train} {unit} | {cv} {unit} | {held} {unit} | {rel} | {fitted} | {run.wall if ours else ''} |")
+    if run.verdict:
+        print(f"| {labels[s]} | | {run.verdict.replace('|', '/')} | | | | | | |")
 PY
