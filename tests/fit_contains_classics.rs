@@ -240,30 +240,39 @@ fn lead_screw_faster_speeds(train: &Path, validate: &Path) {
     std::fs::write(validate, v).unwrap();
 }
 
+/// The line of `md` that says the film was removed, and the set chosen.
+fn film_removed(md: &str) -> (&str, &str) {
+    let chosen = md.lines().find(|l| l.starts_with("Chosen:")).unwrap();
+    let removed = md
+        .lines()
+        .find(|l| l.starts_with("Removed: − film: "))
+        .unwrap_or_else(|| panic!("the film is not removed\n{md}"));
+    (removed, chosen)
+}
+
 #[test]
-fn a_term_that_paid_only_at_its_trial_fit_gives_way_when_the_final_optimum_does_not_confirm_it() {
-    // On the lead screw's faster speeds the film pays at the selection's
-    // trial fit (its transition placed inside the data; every fold lower).
-    // The final fit keeps the transition far above the data, where the set
-    // cross-validates no better than the drivetrain's Stribeck curve alone
-    // (the film at its bound, doing nothing: 0.14 % worse held out before
-    // this check). The final fit is checked on the same folds, the film
-    // gives way, and ours is the Stribeck curve it contains: as good held
-    // out as the classic, to 1e-4.
+fn on_the_lead_screws_faster_speeds_the_film_the_data_cannot_tell_from_the_stribeck_rise_goes() {
+    // On the lead screw's faster speeds the film pays at its trial fit
+    // (its transition placed inside the data; every fold lower), but its
+    // viscosity correlates 0.999 with the Stribeck curve's viscous rise:
+    // over the training speeds the film's rise is the viscous one. Kept to
+    // the final fit (its transition far above the data), it did nothing
+    // there and predicted 0.14 % worse than the Stribeck curve alone. It
+    // goes at the selection, and ours is the Stribeck curve it contains:
+    // as good held out as the classic, to 1e-4.
     let d = dir("lead-screw-faster");
     let (t, v) = (d.join("train.csv"), d.join("validate.csv"));
     lead_screw_faster_speeds(&t, &v);
     let md = fit_auto_with(&t, &["--validate", v.to_str().unwrap(), "--rotary"]);
-    let chosen = md.lines().find(|l| l.starts_with("Chosen:")).unwrap();
+    let (removed, chosen) = film_removed(&md);
     assert!(
         chosen.starts_with("Chosen: boundary friction, drivetrain Stribeck."),
         "{chosen}"
     );
-    let removed = md
-        .lines()
-        .find(|l| l.starts_with("Removed: film: at the final fit's optimum"))
-        .unwrap_or_else(|| panic!("the film is not removed at the final optimum\n{md}"));
-    assert!(removed.contains("does not pay"), "{removed}");
+    assert!(
+        removed.contains("the data cannot tell film from drivetrain Stribeck"),
+        "{removed}"
+    );
     assert_held_out_within(&md, "Stribeck", 1.0 + 1e-4);
 }
 
@@ -275,9 +284,10 @@ fn a_film_placed_inside_a_joints_data_by_its_trial_is_not_shipped_there() {
     // split). The film's trial, its transition placed inside the data,
     // pays in cross-validation (0.0082 against 0.0105 N·m); shipped there,
     // the film bent the curve below the data's rise past them (2.5 % low):
-    // 0.092 N·m held out, 6.5 × the Stribeck curve's 0.014. The final fit keeps the film's
-    // transition far above the data, where it no longer pays: it goes, and
-    // ours is the Stribeck curve.
+    // 0.092 N·m held out, 6.5 × the Stribeck curve's 0.014. Its viscosity
+    // correlates 0.998 with the Stribeck curve's viscous rise: the data
+    // cannot tell the two apart, the film goes, and ours is the Stribeck
+    // curve.
     let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures");
     let d = dir("joint-peak-film");
     let t = d.join("train.csv");
@@ -285,9 +295,42 @@ fn a_film_placed_inside_a_joints_data_by_its_trial_is_not_shipped_there() {
     let v = fixtures.join("joint-peak-validate.csv");
     let md = fit_auto_with(&t, &["--validate", v.to_str().unwrap(), "--rotary"]);
     assert_held_out_within(&md, "Stribeck", 1.05);
+    let (removed, chosen) = film_removed(&md);
+    assert!(!chosen.contains("film"), "{chosen}");
+    assert!(
+        removed.contains("the data cannot tell film from drivetrain Stribeck"),
+        "{removed}"
+    );
+}
+
+#[test]
+fn a_term_the_data_cannot_tell_from_a_chosen_one_goes_even_where_the_folds_favour_it() {
+    // A joint's Stribeck curve (a peak) with 1 % noise, 0.5 to 20 deg/s both
+    // ways, predicted at 25 to 90 deg/s: one draw of the held-back arm's
+    // split (`tests/fixtures/joint-peak-draw5-*.csv`). On it the folds favour
+    // the drivetrain's quadratic loss beside the Stribeck curve (CV 0.0418
+    // against 0.0472 N·m), but its key correlates 0.987 with the Stribeck
+    // curve's viscous one: the training speeds cannot tell v² from v. Kept
+    // on the folds' word, it rose without end past the data: 1.22 N·m held
+    // out, 25 × the Stribeck curve's 0.049. Confounded, one of the two goes.
+    let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures");
+    let d = dir("joint-peak-confounded");
+    let t = d.join("train.csv");
+    std::fs::copy(fixtures.join("joint-peak-draw5-train.csv"), &t).unwrap();
+    let v = fixtures.join("joint-peak-draw5-validate.csv");
+    let md = fit_auto_with(&t, &["--validate", v.to_str().unwrap(), "--rotary"]);
+    let chosen = md.lines().find(|l| l.starts_with("Chosen:")).unwrap();
+    assert!(
+        chosen.starts_with("Chosen: boundary friction, drivetrain Stribeck."),
+        "{chosen}"
+    );
     assert!(
         md.lines()
-            .any(|l| l.starts_with("Removed: film: at the final fit's optimum")),
+            .any(|l| l.starts_with("Removed: − drivetrain quadratic: ")
+                && l.contains(
+                    "the data cannot tell drivetrain quadratic from drivetrain Stribeck"
+                )),
         "{md}"
     );
+    assert_held_out_within(&md, "Stribeck", 1.05);
 }

@@ -36,7 +36,11 @@
 //! 4. A term whose key ends at zero or at a bound, or correlates above 0.95
 //!    with another parameter, is dropped (or reduced to a lighter form
 //!    without that key) and the set fitted again, unless that predicts
-//!    worse.
+//!    worse. When the other parameter is a key of another chosen term, the
+//!    two terms are confounded: the data cannot tell them apart, each
+//!    extrapolates its own way (a quadratic loss against a viscous one),
+//!    and the folds' preference between them is noise. One of the two
+//!    goes, whichever the folds miss least.
 //! 5. The film: when the contact's scale was chosen from the data (its
 //!    transition far above them, `contact_scale.rs`), the film candidate is
 //!    also started with viscosities that place the transition inside the
@@ -347,9 +351,13 @@ impl Ctx<'_> {
 
     /// Drop the terms whose keys ended at zero or at a bound, or correlate
     /// above [`super::stats::CORRELATION_FLAG`] with another parameter
-    /// (the latest chosen first), refitting after each — unless the set
-    /// without the term cross-validates worse by more than a term's cost
-    /// (a flag makes a term suspect; the folds decide).
+    /// (the latest chosen first), refitting after each. A term whose key
+    /// correlates so with a key of another chosen term is confounded with
+    /// it: the data cannot tell the two apart, and each extrapolates its
+    /// own way, so one of them goes, whichever the folds miss least. Any
+    /// other flagged term goes unless the set without it cross-validates
+    /// worse by more than a term's cost (a flag makes a term suspect; the
+    /// folds decide).
     fn drop_flagged(
         &self,
         mut current: Scored,
@@ -359,60 +367,104 @@ impl Ctx<'_> {
     ) -> Result<Scored, FitError> {
         let mut kept: Vec<&'static str> = Vec::new();
         loop {
-            let flagged = current.tried.terms.iter().rev().find_map(|t| {
-                if kept.contains(t) {
-                    return None;
-                }
-                let c = CANDIDATES.iter().find(|c| c.name == *t)?;
-                let (key, why) = c.keys.iter().find_map(|k| {
-                    let (_, edge, rho) = current.flags.iter().find(|(n, _, _)| n == k)?;
-                    if *edge {
-                        Some((*k, format!("{k} ended at zero or at a bound")))
-                    } else if *rho > super::stats::CORRELATION_FLAG {
-                        Some((
-                            *k,
-                            format!(
-                                "{k} correlates {} with another parameter",
-                                crate::text::Num::sig(*rho, 3)
-                            ),
-                        ))
-                    } else {
-                        None
-                    }
-                })?;
-                Some((*t, key, why))
-            });
-            let Some((t, key, why)) = flagged else {
+            let Some(f) = flagged(&current, &kept) else {
                 return Ok(current);
             };
             // Its lighter forms without the flagged key, then the set
-            // without it: the best that the term does not pay over.
-            let scored: Vec<(Option<&'static str>, Scored)> =
-                lighter(&current.tried.terms, t, Some(key))
-                    .par_iter()
-                    .map(|(_, form, terms)| Ok((*form, self.try_set(terms, &current.optimum)?)))
-                    .collect::<Result<_, FitError>>()?;
-            tried.extend(scored.iter().map(|(_, s)| s.tried.clone()));
+            // without it; when confounded, the same for the other term.
+            let mut options = lighter(&current.tried.terms, f.term, Some(f.key));
+            if let Some((other, other_key)) = f.confounded {
+                options.extend(lighter(&current.tried.terms, other, Some(other_key)));
+            }
+            let scored: Vec<(&'static str, Option<&'static str>, Scored)> = options
+                .par_iter()
+                .map(|(t, form, terms)| Ok((*t, *form, self.try_set(terms, &current.optimum)?)))
+                .collect::<Result<_, FitError>>()?;
+            tried.extend(scored.iter().map(|(_, _, s)| s.tried.clone()));
             let best = scored
                 .into_iter()
-                .filter(|(_, s)| !pays(&s.tried, &current.tried).0)
-                .min_by(|a, b| a.1.tried.cv_rms.total_cmp(&b.1.tried.cv_rms));
-            let Some((form, next)) = best else {
+                .filter(|(_, _, s)| f.confounded.is_some() || !pays(&s.tried, &current.tried).0)
+                .min_by(|a, b| a.2.tried.cv_rms.total_cmp(&b.2.tried.cv_rms));
+            let Some((t, form, next)) = best else {
                 say(&format!(
-                    "auto: {t} kept: {why}, but the set without it cross-validates worse"
+                    "auto: {} kept: {}, but the set without it cross-validates worse",
+                    f.term, f.why
                 ));
-                kept.push(t);
+                kept.push(f.term);
                 continue;
             };
             let change = change_text(t, form);
+            let outcome = if f.confounded.is_some() {
+                "so one of the two goes (the one the folds miss least)"
+            } else {
+                "and that set predicts as well"
+            };
             say(&format!(
-                "auto: {change}: {why}, and that set predicts as well (CV RMS {})",
+                "auto: {change}: {}, {outcome} (CV RMS {})",
+                f.why,
                 cv(&next.tried, self.p)
             ));
-            removed.push(format!("{change}: {why}, and that set predicts as well"));
+            removed.push(format!("{change}: {}, {outcome}", f.why));
             current = next;
         }
     }
+}
+
+/// A flagged term of a set: its key that ended at zero or at a bound or
+/// correlates above [`super::stats::CORRELATION_FLAG`] with another, why,
+/// and the other chosen term whose key that is, if any.
+struct Flagged {
+    term: &'static str,
+    key: &'static str,
+    why: String,
+    /// The other term and its key, when the flag is a correlation with a
+    /// key of another chosen term (not the base's, not a given name's).
+    confounded: Option<(&'static str, &'static str)>,
+}
+
+/// The latest flagged term of `s` not in `kept`.
+fn flagged(s: &Scored, kept: &[&'static str]) -> Option<Flagged> {
+    let terms = &s.tried.terms;
+    terms
+        .iter()
+        .rev()
+        .filter(|t| !kept.contains(t))
+        .find_map(|t| {
+            let c = CANDIDATES.iter().find(|c| c.name == *t)?;
+            c.keys.iter().find_map(|k| {
+                let f = s.flags.iter().find(|f| f.name == *k)?;
+                if f.edge {
+                    return Some(Flagged {
+                        term: t,
+                        key: k,
+                        why: format!("{k} ended at zero or at a bound"),
+                        confounded: None,
+                    });
+                }
+                if f.rho <= super::stats::CORRELATION_FLAG {
+                    return None;
+                }
+                let partner = f.partner.as_deref().unwrap_or("another parameter");
+                let confounded = terms.iter().filter(|o| *o != t).find_map(|o| {
+                    let other = CANDIDATES.iter().find(|c| c.name == *o)?;
+                    let key = other.keys.iter().find(|x| **x == partner)?;
+                    (!c.keys.contains(key)).then_some((*o, *key))
+                });
+                let rho = crate::text::Num::sig(f.rho, 3);
+                let why = match confounded {
+                    Some((o, _)) => format!(
+                    "{k} correlates {rho} with {partner} ({o}): the data cannot tell {t} from {o}"
+                ),
+                    None => format!("{k} correlates {rho} with {partner}"),
+                };
+                Some(Flagged {
+                    term: t,
+                    key: k,
+                    why,
+                    confounded,
+                })
+            })
+        })
 }
 
 /// The sets lighter than `set` by its term `t`: `t` replaced by each of
@@ -473,7 +525,7 @@ fn cv(t: &Tried, p: &Prepared) -> String {
 pub fn report(s: &Selection, units: super::Units) -> String {
     let u = units.force();
     let mut md = format!(
-        "## Terms chosen by the data (`--fit auto`)\n\nRule: stepwise selection on cross-validation of the training data ({}; each fold predicted by the set refitted without it); each step takes the candidate with the lowest CV error, unless one with fewer keys predicts as well (the best does not pay for its extra keys over it); a term is added only if it lowers the folds' mean squared error by more than the standard error of that lowering and by more than {:.0} % of it (the cost of a term), and a term chosen earlier goes, or gives way to a lighter form of it (the Stribeck curve to its viscous rise), when it no longer pays beside a later one; a term that ends at zero or at a bound, or that the data cannot tell from another (|ρ| > 0.95), is dropped or reduced and the set fitted again unless that predicts worse; the chosen set's final fit is scored on the same folds, and gives way to the best set with one term fewer when it no longer pays over it. Neither --validate nor --holdout data are used.\n\n| set (boundary friction +) | CV RMS ({u}) | RMS per fold ({u}) | film solves |\n|---|---|---|---|\n",
+        "## Terms chosen by the data (`--fit auto`)\n\nRule: stepwise selection on cross-validation of the training data ({}; each fold predicted by the set refitted without it); each step takes the candidate with the lowest CV error, unless one with fewer keys predicts as well (the best does not pay for its extra keys over it); a term is added only if it lowers the folds' mean squared error by more than the standard error of that lowering and by more than {:.0} % of it (the cost of a term), and a term chosen earlier goes, or gives way to a lighter form of it (the Stribeck curve to its viscous rise), when it no longer pays beside a later one; a term that ends at zero or at a bound, or that the data cannot tell from another parameter (|ρ| > 0.95), is dropped or reduced and the set fitted again unless that predicts worse, and of two chosen terms that the data cannot tell apart (a key of one correlated so with a key of the other) one goes, whichever the folds miss least; the chosen set's final fit is scored on the same folds, and gives way to the best set with one term fewer when it no longer pays over it. Neither --validate nor --holdout data are used.\n\n| set (boundary friction +) | CV RMS ({u}) | RMS per fold ({u}) | film solves |\n|---|---|---|---|\n",
         s.folds,
         100.0 * TERM_COST
     );
@@ -533,6 +585,7 @@ pub fn select_terms(
 
 #[cfg(test)]
 mod tests {
+    use super::super::trial::KeyFlag;
     use super::*;
 
     fn scored(terms: &[&'static str], fold_mse: &[f64]) -> Scored {
@@ -603,6 +656,72 @@ mod tests {
             simplest_that_predicts_as_well(step).tried.terms,
             ["drivetrain Stribeck"]
         );
+    }
+
+    fn with_flag(terms: &[&'static str], key: &str, rho: f64, partner: &str) -> Scored {
+        let mut s = scored(terms, &[1.0]);
+        s.flags = vec![KeyFlag {
+            name: key.into(),
+            edge: false,
+            rho,
+            partner: Some(partner.into()),
+        }];
+        s
+    }
+
+    #[test]
+    fn a_term_correlated_with_another_chosen_terms_key_is_confounded_with_that_term() {
+        let set = ["drivetrain quadratic", "drivetrain Stribeck"];
+        let q = "drivetrain.quadratic_n_s2_m2";
+        let f = flagged(&with_flag(&set, q, 0.987, "drivetrain.viscous_n_s_m"), &[]).unwrap();
+        assert_eq!((f.term, f.key), ("drivetrain quadratic", q));
+        assert_eq!(
+            f.confounded,
+            Some(("drivetrain Stribeck", "drivetrain.viscous_n_s_m"))
+        );
+        assert!(
+            f.why
+                .contains("cannot tell drivetrain quadratic from drivetrain Stribeck"),
+            "{}",
+            f.why
+        );
+    }
+
+    #[test]
+    fn a_term_correlated_with_the_base_or_with_its_own_key_is_only_suspect() {
+        let set = ["drivetrain Stribeck"];
+        // With the base's boundary friction: the folds decide.
+        let base = with_flag(
+            &set,
+            "drivetrain.stribeck_n",
+            0.99,
+            "contact.boundary_friction",
+        );
+        let f = flagged(&base, &[]).unwrap();
+        assert_eq!(f.confounded, None);
+        assert!(
+            f.why
+                .ends_with("correlates 0.99 with contact.boundary_friction"),
+            "{}",
+            f.why
+        );
+        // With a key of its own: not another term.
+        let own = with_flag(
+            &set,
+            "drivetrain.stribeck_n",
+            0.99,
+            "drivetrain.stribeck_speed_m_s",
+        );
+        assert_eq!(flagged(&own, &[]).unwrap().confounded, None);
+        // At 0.95 or below: no flag; a term kept is not flagged again.
+        let low = with_flag(
+            &set,
+            "drivetrain.stribeck_n",
+            0.95,
+            "contact.boundary_friction",
+        );
+        assert!(flagged(&low, &[]).is_none());
+        assert!(flagged(&base, &["drivetrain Stribeck"]).is_none());
     }
 
     #[test]

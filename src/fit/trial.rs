@@ -36,9 +36,23 @@ pub(super) type Optimum = Vec<(String, f64)>;
 pub(super) struct Scored {
     pub(super) tried: Tried,
     pub(super) optimum: Optimum,
-    /// Per fitted parameter: (name, at a bound or at zero, the largest
-    /// |correlation| with another parameter).
-    pub(super) flags: Vec<(String, bool, f64)>,
+    /// What its fit says of each fitted parameter.
+    pub(super) flags: Vec<KeyFlag>,
+}
+
+/// What a set's fit says of one fitted parameter: whether it ended at a
+/// bound or at zero, and the parameter it correlates with most.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct KeyFlag {
+    /// The parameter.
+    pub(super) name: String,
+    /// At a bound or at zero.
+    pub(super) edge: bool,
+    /// The largest |correlation| with another parameter (1 where it is
+    /// undefined).
+    pub(super) rho: f64,
+    /// That other parameter.
+    pub(super) partner: Option<String>,
 }
 
 /// What a selection's fits share: the data, the settings, the names given.
@@ -281,7 +295,7 @@ impl Ctx<'_> {
 
 /// Per fitted parameter of `o`: its name, whether it ended at a bound or
 /// at zero, and its largest |correlation| with another parameter.
-fn flags_of(o: &super::driver::FitOutcome) -> Vec<(String, bool, f64)> {
+fn flags_of(o: &super::driver::FitOutcome) -> Vec<KeyFlag> {
     let st = &o.statistics;
     o.params
         .iter()
@@ -289,18 +303,25 @@ fn flags_of(o: &super::driver::FitOutcome) -> Vec<(String, bool, f64)> {
         .map(|(j, q)| {
             let at_bound = st.at_bound.get(j).copied().unwrap_or(false);
             let zero = o.best[j] == 0.0;
-            let rho = st
+            let (partner, rho) = st
                 .correlation
                 .get(j)
-                .map(|row| {
+                .and_then(|row| {
                     row.iter()
                         .enumerate()
                         .filter(|(i, _)| *i != j)
-                        .map(|(_, r)| if r.is_nan() { 1.0 } else { r.abs() })
-                        .fold(0.0, f64::max)
+                        .map(|(i, r)| (i, if r.is_nan() { 1.0 } else { r.abs() }))
+                        .max_by(|a, b| a.1.total_cmp(&b.1))
                 })
-                .unwrap_or(0.0);
-            (q.name.clone(), at_bound || zero, rho)
+                .map_or((None, 0.0), |(i, r)| {
+                    (o.params.get(i).map(|p| p.name.clone()), r)
+                });
+            KeyFlag {
+                name: q.name.clone(),
+                edge: at_bound || zero,
+                rho,
+                partner,
+            }
         })
         .collect()
 }
