@@ -413,6 +413,9 @@ def fit(
     report: Optional[PathLike] = None,
     progress: bool = False,
     rotary: bool = False,
+    jacobian: str = "secant",
+    later_runs: str = "full",
+    linear_keys: str = "solved",
 ) -> FitResult:
     """Calibrate configuration keys (and input-map coefficients) to
     recorded friction, as ``friction-node fit`` does (same arguments, same
@@ -423,7 +426,10 @@ def fit(
     ``fit=["auto", ...]`` lets the data choose the physical terms (the
     names after ``auto`` are fitted as well); ``rotary=True`` takes a
     joint's velocity in rad/s and friction in N·m (the lever arm and the
-    contact's load are chosen from the data)."""
+    contact's load are chosen from the data). ``jacobian`` (``"secant"`` or
+    ``"differences"``), ``later_runs`` (``"full"`` or ``"valley"``) and
+    ``linear_keys`` (``"solved"`` or ``"searched"``) choose how the search
+    runs, as ``--jacobian``, ``--later-runs`` and ``--linear-keys`` do."""
     if isinstance(data, (str, os.PathLike)):
         data = [data]
     if isinstance(fit, str):
@@ -461,5 +467,8 @@ def fit(
         report_dir=_path(report),
         progress=bool(progress),
         rotary=bool(rotary),
+        jacobian=jacobian,
+        later_runs=later_runs,
+        linear_keys=linear_keys,
     )
     return FitResult(raw)

@@ -108,4 +108,7 @@ def fit(
     report_dir: Optional[str] = None,
     progress: bool = False,
     rotary: bool = False,
+    jacobian: str = "secant",
+    later_runs: str = "full",
+    linear_keys: str = "solved",
 ) -> Dict[str, Any]: ...

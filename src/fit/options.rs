@@ -167,6 +167,19 @@ impl SearchSettings {
     }
 }
 
+/// The rule of `names` named `s`, or what `s` is not (`what`) and the
+/// names it could be.
+fn named<T: Copy>(names: &[(&'static str, T)], s: &str, what: &str) -> Result<T, String> {
+    names
+        .iter()
+        .find(|(n, _)| *n == s)
+        .map(|(_, r)| *r)
+        .ok_or_else(|| {
+            let all: Vec<&str> = names.iter().map(|(n, _)| *n).collect();
+            format!("`{s}` is not {what}: {}", all.join(" or "))
+        })
+}
+
 /// How a local run gets its Jacobian.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum JacobianRule {
@@ -187,11 +200,7 @@ impl JacobianRule {
 
     /// The rule named `s`.
     pub fn parse(s: &str) -> Result<Self, String> {
-        Self::NAMES
-            .iter()
-            .find(|(n, _)| *n == s)
-            .map(|(_, r)| *r)
-            .ok_or_else(|| format!("`{s}` is not a Jacobian rule: secant or differences"))
+        named(&Self::NAMES, s, "a Jacobian rule")
     }
 }
 
@@ -216,11 +225,7 @@ impl LaterRuns {
 
     /// The rule named `s`.
     pub fn parse(s: &str) -> Result<Self, String> {
-        Self::NAMES
-            .iter()
-            .find(|(n, _)| *n == s)
-            .map(|(_, r)| *r)
-            .ok_or_else(|| format!("`{s}` is not a rule for later runs: valley or full"))
+        named(&Self::NAMES, s, "a rule for later runs")
     }
 }
 
@@ -245,10 +250,6 @@ impl LinearKeys {
 
     /// The rule named `s`.
     pub fn parse(s: &str) -> Result<Self, String> {
-        Self::NAMES
-            .iter()
-            .find(|(n, _)| *n == s)
-            .map(|(_, r)| *r)
-            .ok_or_else(|| format!("`{s}` is not a rule for linear keys: solved or searched"))
+        named(&Self::NAMES, s, "a rule for linear keys")
     }
 }

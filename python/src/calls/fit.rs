@@ -5,7 +5,9 @@ use crate::errors;
 use crate::model::load_config;
 use friction_node::fit::compare::OursFitted;
 use friction_node::fit::inputs::{DataRequest, TopicChoice};
-use friction_node::fit::options::{LabelledProgress, SearchSettings};
+use friction_node::fit::options::{
+    JacobianRule, LabelledProgress, LaterRuns, LinearKeys, SearchSettings,
+};
 use friction_node::fit::request::{param_specs, Calibration, FitOutputs, FitRequest};
 use friction_node::fit::{models_table, report};
 use friction_node::fit::{Delimiter, FitOutcome, Mapping};
@@ -99,7 +101,8 @@ fn outcome_dict<'py>(py: Python<'py>, o: &FitOutcome) -> PyResult<Bound<'py, PyD
     time=None, velocity="velocity_m_s".to_string(), friction="friction_n".to_string(),
     load=None, temperature=None, smooth=0.05, map=Vec::new(), velocity_topic=None,
     friction_topic=None, joint=None, load_topic=None, temperature_topic=None, out=None,
-    report_dir=None, progress=false, rotary=false))]
+    report_dir=None, progress=false, rotary=false, jacobian="secant", later_runs="full",
+    linear_keys="solved"))]
 #[allow(clippy::too_many_arguments)]
 pub fn fit<'py>(
     py: Python<'py>,
@@ -135,6 +138,9 @@ pub fn fit<'py>(
     report_dir: Option<PathBuf>,
     progress: bool,
     rotary: bool,
+    jacobian: &str,
+    later_runs: &str,
+    linear_keys: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     let config = match &config_path {
         Some(p) => load_config(None, Some(&p.display().to_string()), &overrides)?,
@@ -178,7 +184,9 @@ pub fn fit<'py>(
             global_points,
             seed,
             max_evaluations,
-            ..Default::default()
+            jacobian: JacobianRule::parse(jacobian).map_err(|e| argument("jacobian", e))?,
+            later_runs: LaterRuns::parse(later_runs).map_err(|e| argument("later_runs", e))?,
+            linear_keys: LinearKeys::parse(linear_keys).map_err(|e| argument("linear_keys", e))?,
         },
         baselines,
     };
@@ -261,6 +269,11 @@ fn range_dict<'py>(
 }
 
 /// `delimiter` by its Python name.
+/// A bad value of the argument `name`: a `ValueError` naming it.
+fn argument(name: &str, why: String) -> PyErr {
+    errors::value(format!("{name}: {why}"))
+}
+
 fn delimiter_named(name: &str) -> PyResult<Delimiter> {
     Ok(match name {
         "auto" => Delimiter::Auto,
