@@ -240,6 +240,17 @@ fn lead_screw_faster_speeds(train: &Path, validate: &Path) {
     std::fs::write(validate, v).unwrap();
 }
 
+/// `--rotary --fit auto` on the joint fixture `tests/fixtures/NAME-train.csv`
+/// (copied into a fresh directory), validated on `NAME-validate.csv`.
+fn fit_joint_fixture(name: &str) -> String {
+    let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures");
+    let d = dir(name);
+    let t = d.join("train.csv");
+    std::fs::copy(fixtures.join(format!("{name}-train.csv")), &t).unwrap();
+    let v = fixtures.join(format!("{name}-validate.csv"));
+    fit_auto_with(&t, &["--validate", v.to_str().unwrap(), "--rotary"])
+}
+
 /// The line of `md` that says the film was removed, and the set chosen.
 fn film_removed(md: &str) -> (&str, &str) {
     let chosen = md.lines().find(|l| l.starts_with("Chosen:")).unwrap();
@@ -288,12 +299,7 @@ fn a_film_placed_inside_a_joints_data_by_its_trial_is_not_shipped_there() {
     // correlates 0.998 with the Stribeck curve's viscous rise: the data
     // cannot tell the two apart, the film goes, and ours is the Stribeck
     // curve.
-    let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures");
-    let d = dir("joint-peak-film");
-    let t = d.join("train.csv");
-    std::fs::copy(fixtures.join("joint-peak-train.csv"), &t).unwrap();
-    let v = fixtures.join("joint-peak-validate.csv");
-    let md = fit_auto_with(&t, &["--validate", v.to_str().unwrap(), "--rotary"]);
+    let md = fit_joint_fixture("joint-peak");
     assert_held_out_within(&md, "Stribeck", 1.05);
     let (removed, chosen) = film_removed(&md);
     assert!(!chosen.contains("film"), "{chosen}");
@@ -313,12 +319,7 @@ fn a_term_the_data_cannot_tell_from_a_chosen_one_goes_even_where_the_folds_favou
     // curve's viscous one: the training speeds cannot tell v² from v. Kept
     // on the folds' word, it rose without end past the data: 1.22 N·m held
     // out, 25 × the Stribeck curve's 0.049. Confounded, one of the two goes.
-    let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures");
-    let d = dir("joint-peak-confounded");
-    let t = d.join("train.csv");
-    std::fs::copy(fixtures.join("joint-peak-draw5-train.csv"), &t).unwrap();
-    let v = fixtures.join("joint-peak-draw5-validate.csv");
-    let md = fit_auto_with(&t, &["--validate", v.to_str().unwrap(), "--rotary"]);
+    let md = fit_joint_fixture("joint-peak-draw5");
     let chosen = md.lines().find(|l| l.starts_with("Chosen:")).unwrap();
     assert!(
         chosen.starts_with("Chosen: boundary friction, drivetrain Stribeck."),

@@ -11,7 +11,7 @@
 //!
 //! So the final fit is scored on the same folds (each refitted from the
 //! final optimum). The best set with one term fewer, by its score in the
-//! selection, must be beaten by the rule every term meets (`select::pays`:
+//! selection, must be beaten by the rule every term meets (`removal::pays`:
 //! the folds' mean squared error lowered by more than its standard error
 //! and by more than the cost of a term). If it is not beaten, that set is
 //! fitted instead, and is confirmed the same way in turn. Every step takes
@@ -19,7 +19,8 @@
 
 use super::cross_validate::cv_rms;
 use super::prepared::Prepared;
-use super::select::{fitted_keys, pays, Selection};
+use super::removal::pays;
+use super::select::{fitted_keys, Selection};
 use super::trial::{set_final_model, Scored, Tried};
 use super::unknowns::ParamSpec;
 use super::FitError;

@@ -28,6 +28,7 @@
 //! | `prepare.rs` | data → our model: the sources (the held-out part cut off first), scales, keys, maps, the contact's scale |
 //! | `confirm.rs` | `--fit auto`'s choice confirmed at the final fit's optimum: scored on the same folds, it falls back to the best set with one term fewer when it no longer pays over it |
 //! | `select.rs` | `--fit auto`'s rule: stepwise with removal on cross-validation, terms that pay, dead terms dropped; its report |
+//! | `removal.rs` | terms taken away during the selection: one that no longer pays, one flagged dead, one of two confounded terms; the lighter forms; whether a change pays |
 //! | `trial.rs` | one set of terms tried: fitted on the training data, scored by cross-validation |
 //! | `candidates.rs` | the candidate terms, the keys of a set, which candidates the data allow, the keys `--fit auto` starts from |
 //! | `compare.rs` | ours and the classic models fitted on the same data with the same optimiser |
@@ -84,6 +85,7 @@ pub mod physics_model;
 pub mod prepare;
 pub mod prepared;
 pub mod problem;
+mod removal;
 pub mod report;
 #[cfg(feature = "plots")]
 pub mod report_plots;

@@ -1,0 +1,383 @@
+//! Terms taken away during `--fit auto`'s selection (`select.rs`, rules
+//! 2 and 4): a term chosen earlier that no longer pays beside a later
+//! one; a term whose key ended at zero or at a bound, or correlates above
+//! [`super::stats::CORRELATION_FLAG`] with another parameter; of two
+//! confounded terms (a key of one correlated so with a key of the other),
+//! one. A term gives way to a lighter form of it where one fits (the
+//! Stribeck curve to its viscous rise) before it is removed. Whether a
+//! change pays is [`pays`], the one yardstick of the selection and of its
+//! confirmation (`confirm.rs`).
+
+use super::candidates::{lighter_forms, CANDIDATES};
+use super::cross_validate::{paired, TERM_COST};
+use super::prepared::Prepared;
+use super::trial::{Ctx, Scored, Tried};
+use super::FitError;
+use rayon::prelude::*;
+
+/// Whether going from `from` to `to` pays: it lowers the folds' mean
+/// squared error by more than the standard error of that lowering and by
+/// more than [`TERM_COST`] of it. Returns (pays, lowering, its SE, share).
+pub(super) fn pays(from: &Tried, to: &Tried) -> (bool, f64, f64, f64) {
+    let (gain, se) = paired(&from.fold_mse, &to.fold_mse);
+    let mse = from.cv_rms * from.cv_rms;
+    let share = gain / mse;
+    (
+        gain.is_finite() && gain > se && gain > TERM_COST * mse,
+        gain,
+        se,
+        share,
+    )
+}
+
+impl Ctx<'_> {
+    /// Remove, one at a time, each chosen term (but `newest`) that does not
+    /// pay beside the others any more: the one whose removal costs least.
+    pub(super) fn prune(
+        &self,
+        mut current: Scored,
+        newest: &'static str,
+        tried: &mut Vec<Tried>,
+        removed: &mut Vec<String>,
+        say: &(dyn Fn(&str) + Sync),
+    ) -> Result<Scored, FitError> {
+        loop {
+            let older: Vec<&'static str> = current
+                .tried
+                .terms
+                .iter()
+                .copied()
+                .filter(|t| *t != newest)
+                // A term others need stays while they are there.
+                .filter(|t| {
+                    !current.tried.terms.iter().any(|o| {
+                        CANDIDATES
+                            .iter()
+                            .any(|c| c.name == *o && c.requires == Some(t))
+                    })
+                })
+                .collect();
+            if older.is_empty() {
+                return Ok(current);
+            }
+            let alternatives: Vec<(&'static str, Option<&'static str>, Vec<&'static str>)> = older
+                .iter()
+                .flat_map(|t| lighter(&current.tried.terms, t, None))
+                .collect();
+            let scored: Vec<(&'static str, Option<&'static str>, Scored)> = alternatives
+                .par_iter()
+                .map(|(t, form, terms)| Ok((*t, *form, self.try_set(terms, &current.optimum)?)))
+                .collect::<Result<_, FitError>>()?;
+            tried.extend(scored.iter().map(|(_, _, s)| s.tried.clone()));
+            // The one whose removal (or reduction) costs least, if the term
+            // does not pay over it.
+            let Some((t, form, lighter)) = scored
+                .into_iter()
+                .filter(|(_, _, s)| !pays(&s.tried, &current.tried).0)
+                .min_by(|a, b| a.2.tried.cv_rms.total_cmp(&b.2.tried.cv_rms))
+            else {
+                return Ok(current);
+            };
+            let change = change_text(t, form);
+            say(&format!(
+                "auto: {change}: no longer pays beside {newest} (CV RMS {})",
+                cv(&lighter.tried, self.p)
+            ));
+            removed.push(format!(
+                "{change}: no longer paid for itself beside {newest}"
+            ));
+            current = lighter;
+        }
+    }
+
+    /// Drop the terms whose keys ended at zero or at a bound, or correlate
+    /// above [`super::stats::CORRELATION_FLAG`] with another parameter
+    /// (the latest chosen first), refitting after each. A term whose key
+    /// correlates so with a key of another chosen term is confounded with
+    /// it: the data cannot tell the two apart, and each extrapolates its
+    /// own way, so one of them goes, whichever the folds miss least. Any
+    /// other flagged term goes unless the set without it cross-validates
+    /// worse by more than a term's cost (a flag makes a term suspect; the
+    /// folds decide).
+    pub(super) fn drop_flagged(
+        &self,
+        mut current: Scored,
+        tried: &mut Vec<Tried>,
+        removed: &mut Vec<String>,
+        say: &(dyn Fn(&str) + Sync),
+    ) -> Result<Scored, FitError> {
+        let mut kept: Vec<&'static str> = Vec::new();
+        loop {
+            let Some(f) = flagged(&current, &kept) else {
+                return Ok(current);
+            };
+            // Its lighter forms without the flagged key, then the set
+            // without it; when confounded, the same for the other term.
+            let mut options = lighter(&current.tried.terms, f.term, Some(f.key));
+            if let Some((other, other_key)) = f.confounded {
+                options.extend(lighter(&current.tried.terms, other, Some(other_key)));
+            }
+            let scored: Vec<(&'static str, Option<&'static str>, Scored)> = options
+                .par_iter()
+                .map(|(t, form, terms)| Ok((*t, *form, self.try_set(terms, &current.optimum)?)))
+                .collect::<Result<_, FitError>>()?;
+            tried.extend(scored.iter().map(|(_, _, s)| s.tried.clone()));
+            let best = scored
+                .into_iter()
+                .filter(|(_, _, s)| f.confounded.is_some() || !pays(&s.tried, &current.tried).0)
+                .min_by(|a, b| a.2.tried.cv_rms.total_cmp(&b.2.tried.cv_rms));
+            let Some((t, form, next)) = best else {
+                say(&format!(
+                    "auto: {} kept: {}, but the set without it cross-validates worse",
+                    f.term, f.why
+                ));
+                kept.push(f.term);
+                continue;
+            };
+            let change = change_text(t, form);
+            let outcome = if f.confounded.is_some() {
+                "so one of the two goes (the one the folds miss least)"
+            } else {
+                "and that set predicts as well"
+            };
+            say(&format!(
+                "auto: {change}: {}, {outcome} (CV RMS {})",
+                f.why,
+                cv(&next.tried, self.p)
+            ));
+            removed.push(format!("{change}: {}, {outcome}", f.why));
+            current = next;
+        }
+    }
+}
+
+/// A flagged term of a set: its key that ended at zero or at a bound or
+/// correlates above [`super::stats::CORRELATION_FLAG`] with another, why,
+/// and the other chosen term whose key that is, if any.
+struct Flagged {
+    term: &'static str,
+    key: &'static str,
+    why: String,
+    /// The other term and its key, when the flag is a correlation with a
+    /// key of another chosen term (not the base's, not a given name's).
+    confounded: Option<(&'static str, &'static str)>,
+}
+
+/// The latest flagged term of `s` not in `kept`.
+fn flagged(s: &Scored, kept: &[&'static str]) -> Option<Flagged> {
+    let terms = &s.tried.terms;
+    terms
+        .iter()
+        .rev()
+        .filter(|t| !kept.contains(t))
+        .find_map(|t| {
+            let c = CANDIDATES.iter().find(|c| c.name == *t)?;
+            c.keys.iter().find_map(|k| {
+                let f = s.flags.iter().find(|f| f.name == *k)?;
+                if f.edge {
+                    return Some(Flagged {
+                        term: t,
+                        key: k,
+                        why: format!("{k} ended at zero or at a bound"),
+                        confounded: None,
+                    });
+                }
+                if f.rho <= super::stats::CORRELATION_FLAG {
+                    return None;
+                }
+                let partner = f.partner.as_deref().unwrap_or("another parameter");
+                let confounded = terms.iter().filter(|o| *o != t).find_map(|o| {
+                    let other = CANDIDATES.iter().find(|c| c.name == *o)?;
+                    let key = other.keys.iter().find(|x| **x == partner)?;
+                    (!c.keys.contains(key)).then_some((*o, *key))
+                });
+                let rho = crate::text::Num::sig(f.rho, 3);
+                let why = match confounded {
+                    Some((o, _)) => format!(
+                    "{k} correlates {rho} with {partner} ({o}): the data cannot tell {t} from {o}"
+                ),
+                    None => format!("{k} correlates {rho} with {partner}"),
+                };
+                Some(Flagged {
+                    term: t,
+                    key: k,
+                    why,
+                    confounded,
+                })
+            })
+        })
+}
+
+/// The sets lighter than `set` by its term `t`: `t` replaced by each of
+/// its lighter forms (those without `flagged_key`), then `t` removed with
+/// the terms that require it. Each as (t, the form taking its place, the
+/// set).
+fn lighter(
+    set: &[&'static str],
+    t: &'static str,
+    flagged_key: Option<&str>,
+) -> Vec<(&'static str, Option<&'static str>, Vec<&'static str>)> {
+    let mut out: Vec<(&'static str, Option<&'static str>, Vec<&'static str>)> =
+        lighter_forms(t, set)
+            .into_iter()
+            .filter(|form| {
+                let keys = CANDIDATES.iter().find(|c| c.name == *form).map(|c| c.keys);
+                !keys.is_some_and(|k| flagged_key.is_some_and(|f| k.contains(&f)))
+            })
+            .map(|form| {
+                let terms = set
+                    .iter()
+                    .map(|x| if *x == t { form } else { *x })
+                    .collect();
+                (t, Some(form), terms)
+            })
+            .collect();
+    let without = set
+        .iter()
+        .copied()
+        .filter(|x| {
+            *x != t
+                && CANDIDATES
+                    .iter()
+                    .all(|c| c.name != *x || c.requires != Some(t))
+        })
+        .collect();
+    out.push((t, None, without));
+    out
+}
+
+/// "− t", or "t → form" when a lighter form takes its place.
+fn change_text(t: &str, form: Option<&str>) -> String {
+    match form {
+        Some(f) => format!("{t} → {f}"),
+        None => format!("− {t}"),
+    }
+}
+
+pub(super) fn cv(t: &Tried, p: &Prepared) -> String {
+    format!(
+        "{} {}",
+        crate::text::Num::sig(t.cv_rms, 5),
+        p.data.units.force()
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::trial::KeyFlag;
+    use super::*;
+
+    fn scored(terms: &[&'static str]) -> Scored {
+        Scored {
+            tried: Tried {
+                terms: terms.to_vec(),
+                fold_mse: vec![1.0],
+                cv_rms: 1.0,
+                simulations: 0,
+            },
+            optimum: Vec::new(),
+            flags: Vec::new(),
+        }
+    }
+
+    fn with_flag(terms: &[&'static str], key: &str, rho: f64, partner: &str) -> Scored {
+        let mut s = scored(terms);
+        s.flags = vec![KeyFlag {
+            name: key.into(),
+            edge: false,
+            rho,
+            partner: Some(partner.into()),
+        }];
+        s
+    }
+
+    #[test]
+    fn a_term_correlated_with_another_chosen_terms_key_is_confounded_with_that_term() {
+        let set = ["drivetrain quadratic", "drivetrain Stribeck"];
+        let q = "drivetrain.quadratic_n_s2_m2";
+        let f = flagged(&with_flag(&set, q, 0.987, "drivetrain.viscous_n_s_m"), &[]).unwrap();
+        assert_eq!((f.term, f.key), ("drivetrain quadratic", q));
+        assert_eq!(
+            f.confounded,
+            Some(("drivetrain Stribeck", "drivetrain.viscous_n_s_m"))
+        );
+        assert!(
+            f.why
+                .contains("cannot tell drivetrain quadratic from drivetrain Stribeck"),
+            "{}",
+            f.why
+        );
+    }
+
+    #[test]
+    fn a_term_correlated_with_the_base_or_with_its_own_key_is_only_suspect() {
+        let set = ["drivetrain Stribeck"];
+        // With the base's boundary friction: the folds decide.
+        let base = with_flag(
+            &set,
+            "drivetrain.stribeck_n",
+            0.99,
+            "contact.boundary_friction",
+        );
+        let f = flagged(&base, &[]).unwrap();
+        assert_eq!(f.confounded, None);
+        assert!(
+            f.why
+                .ends_with("correlates 0.99 with contact.boundary_friction"),
+            "{}",
+            f.why
+        );
+        // With a key of its own: not another term.
+        let own = with_flag(
+            &set,
+            "drivetrain.stribeck_n",
+            0.99,
+            "drivetrain.stribeck_speed_m_s",
+        );
+        assert_eq!(flagged(&own, &[]).unwrap().confounded, None);
+        // At 0.95 or below: no flag; a term kept is not flagged again.
+        let low = with_flag(
+            &set,
+            "drivetrain.stribeck_n",
+            0.95,
+            "contact.boundary_friction",
+        );
+        assert!(flagged(&low, &[]).is_none());
+        assert!(flagged(&base, &["drivetrain Stribeck"]).is_none());
+    }
+
+    #[test]
+    fn a_stribeck_curve_gives_way_to_its_viscous_rise_before_it_is_removed() {
+        let set = ["pre-sliding", "drivetrain Stribeck", "drivetrain quadratic"];
+        let alternatives = lighter(&set, "drivetrain Stribeck", None);
+        assert_eq!(
+            alternatives,
+            vec![
+                (
+                    "drivetrain Stribeck",
+                    Some("drivetrain viscous"),
+                    vec!["pre-sliding", "drivetrain viscous", "drivetrain quadratic"]
+                ),
+                (
+                    "drivetrain Stribeck",
+                    None,
+                    vec!["pre-sliding", "drivetrain quadratic"]
+                ),
+            ]
+        );
+        // A flag on the viscous key itself: its form would keep the flag.
+        let flagged = lighter(
+            &set,
+            "drivetrain Stribeck",
+            Some("drivetrain.viscous_n_s_m"),
+        );
+        assert_eq!(flagged.len(), 1);
+        assert_eq!(flagged[0].1, None);
+        // A term without a lighter form is only removed.
+        assert_eq!(lighter(&set, "pre-sliding", None).len(), 1);
+        assert_eq!(
+            change_text("drivetrain Stribeck", Some("drivetrain viscous")),
+            "drivetrain Stribeck → drivetrain viscous"
+        );
+    }
+}
