@@ -349,17 +349,15 @@ impl Drop for OutputDir {
 mod tests {
     use super::*;
 
-    fn dir(name: &str) -> PathBuf {
-        let d = std::env::temp_dir().join(format!("fn-output-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(&d).unwrap();
-        d
+    /// An empty directory that goes when the guard drops.
+    fn dir() -> tempfile::TempDir {
+        tempfile::tempdir().unwrap()
     }
 
     #[test]
     fn a_committed_file_replaces_the_old_one_and_an_abandoned_one_leaves_nothing() {
-        let d = dir("atomic");
-        let p = d.join("out.csv");
+        let d = dir();
+        let p = d.path().join("out.csv");
         std::fs::write(&p, "old\n").unwrap();
         let mut f = AtomicFile::create(&p).unwrap();
         f.line(format_args!("new")).unwrap();
@@ -371,7 +369,7 @@ mod tests {
         drop(f);
         assert_eq!(std::fs::read_to_string(&p).unwrap(), "new\n");
         assert_eq!(
-            std::fs::read_dir(&d).unwrap().count(),
+            std::fs::read_dir(d.path()).unwrap().count(),
             1,
             "no temporary left"
         );
@@ -394,8 +392,8 @@ mod tests {
 
     #[test]
     fn an_output_larger_than_the_free_space_is_refused_with_both_sizes() {
-        let d = dir("room");
-        let p = d.join("big.csv");
+        let d = dir();
+        let p = d.path().join("big.csv");
         let free = free_bytes(&p).expect("statvfs works here") as f64;
         let e = check_room(&p, 2.0 * free + 1e15, "the CSV")
             .unwrap_err()
@@ -419,8 +417,8 @@ mod tests {
             .err()
             .unwrap();
         assert!(e.to_string().contains("does not exist"), "{e}");
-        let d = dir("isdir");
-        let e = AtomicFile::create(&d).err().unwrap();
+        let d = dir();
+        let e = AtomicFile::create(d.path()).err().unwrap();
         assert!(e.to_string().contains("is a directory"), "{e}");
     }
 }

@@ -403,12 +403,25 @@ mod tests {
     use super::*;
     use approx::assert_relative_eq;
 
-    fn tmp(name: &str, text: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("fn-signal-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let p = dir.join(name);
-        std::fs::write(&p, text).unwrap();
-        p
+    /// A file named `name` holding `text`, in a directory of its own that
+    /// goes when the file's guard drops.
+    struct Tmp {
+        _dir: tempfile::TempDir,
+        path: PathBuf,
+    }
+
+    impl std::ops::Deref for Tmp {
+        type Target = std::path::Path;
+        fn deref(&self) -> &std::path::Path {
+            &self.path
+        }
+    }
+
+    fn tmp(name: &str, text: &str) -> Tmp {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join(name);
+        std::fs::write(&path, text).unwrap();
+        Tmp { _dir: dir, path }
     }
 
     #[test]

@@ -3,6 +3,9 @@
 //! the C API's and Python's tests) are refused by `simulate` and by the
 //! node's commands with the envelope's message.
 
+mod common;
+
+use common::cli::fresh_dir;
 use friction_node::clock::SimClock;
 use friction_node::config::{Config, Envelope, StepMode};
 use friction_node::link::LiveStatus;
@@ -74,8 +77,7 @@ fn the_envelope_refuses_every_case_with_the_expected_message() {
 
 #[test]
 fn simulate_refuses_every_case_before_writing_anything() {
-    let dir = std::env::temp_dir().join(format!("fn-envelope-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = fresh_dir("envelope", "refused");
     let out = dir.join("run.csv");
     for c in cases() {
         let v = format!("const:{}", c.value);

@@ -416,10 +416,11 @@ mod node_runs {
 
     use crate::common::{drain, timer_config};
 
-    fn tmp(name: &str) -> std::path::PathBuf {
-        let d = std::env::temp_dir().join(format!("fn-node-{}", std::process::id()));
-        std::fs::create_dir_all(&d).unwrap();
-        d.join(name)
+    /// `name` in a directory of its own, removed when the guard drops.
+    fn tmp(name: &str) -> (crate::common::cli::FreshDir, std::path::PathBuf) {
+        let d = fresh_dir("node", name);
+        let path = d.join(name);
+        (d, path)
     }
 
     /// Decode every message of a finished MCAP file: counts per schema.
@@ -477,7 +478,7 @@ mod node_runs {
         cfg.ros.command_type = CommandType::TwistStamped;
         cfg.node.profile_rate_hz = 100.0;
         cfg.contact.load_n = 15_000.0;
-        let path = tmp("roundtrip.mcap");
+        let (_dir, path) = tmp("roundtrip.mcap");
         let slot = FilmProfileSlot::new(cfg.solver.cells);
         let rec = Recorder::start(
             RecordPlan {
@@ -552,7 +553,7 @@ mod node_runs {
         cfg.ros.qos.commands.reliability = friction_node::config::Reliability::Reliable;
         cfg.ros.qos.commands.durability = friction_node::config::Durability::TransientLocal;
         cfg.ros.qos.commands.depth = 100;
-        let path = tmp("raw.mcap");
+        let (_dir, path) = tmp("raw.mcap");
         let rec = Recorder::start(
             RecordPlan {
                 path: Some(path.clone()),
@@ -684,7 +685,7 @@ mod node_runs {
     #[cfg(feature = "iceoryx2")]
     #[test]
     fn sigterm_finalises_the_recording() {
-        let path = tmp("sigterm.mcap");
+        let (_dir, path) = tmp("sigterm.mcap");
         let mut child = node_cmd(&[
             "run",
             "--transport",
@@ -725,7 +726,7 @@ mod node_runs {
     #[cfg(feature = "iceoryx2")]
     #[test]
     fn a_killed_node_leaves_its_recording_readable_up_to_the_last_chunk() {
-        let path = tmp("killed.mcap");
+        let (_dir, path) = tmp("killed.mcap");
         let mut child = node_cmd(&[
             "run",
             "--transport",
@@ -797,7 +798,7 @@ mod node_runs {
     #[cfg(feature = "ros2")]
     #[test]
     fn a_full_disk_stops_the_recording_not_the_loop() {
-        let path = tmp("full.mcap");
+        let (_dir, path) = tmp("full.mcap");
         let mut c = node_cmd(&[
             "run",
             "--transport",
@@ -825,7 +826,7 @@ mod node_runs {
     #[cfg(feature = "ros2")]
     #[test]
     fn a_split_recording_resumes_in_a_new_file_when_writing_fails() {
-        let dir = tmp("resume");
+        let (_guard, dir) = tmp("resume");
         let _ = std::fs::remove_dir_all(&dir);
         let mut c = node_cmd(&[
             "run",
