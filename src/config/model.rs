@@ -42,8 +42,8 @@ pub struct ContactConfig {
     pub min_film_m: f64,
     /// Pre-sliding (tangential) stiffness σ0 of the contact, N/m; 0: rigid.
     pub presliding_stiffness_n_m: f64,
-    /// Damping σ1 of the pre-sliding displacement, N·s/m; the force it adds never carries |F|
-    /// past the sliding level.
+    /// Damping σ1 of the pre-sliding displacement's rate, N·s/m (LuGre's): while the bristle
+    /// moves it adds at most 2 σ1 |v| to the sliding level, nothing in steady sliding.
     pub presliding_damping_n_s_m: f64,
     /// Soft contact: the width follows (F/F_ref)^κ; 0 = rigid.
     pub width_load_exponent: f64,
