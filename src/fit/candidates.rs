@@ -20,6 +20,11 @@ pub struct Candidate {
     pub requires: Option<&'static str>,
     /// Only when the training loads vary.
     pub needs_varying_load: bool,
+    /// A part of the term it requires, not a rival explanation: LuGre's
+    /// bristle damping σ1 beside its stiffness σ0. Once that term is
+    /// chosen, the part is added unless the folds predict worse with it
+    /// (`select.rs`, rule 4b); rule 4's flags still drop it.
+    pub part_of_requirement: bool,
 }
 
 /// The candidate terms, in the order they are tried.
@@ -29,6 +34,7 @@ pub const CANDIDATES: &[Candidate] = &[
         keys: &["lubricant.viscosity_pa_s"],
         requires: None,
         needs_varying_load: false,
+        part_of_requirement: false,
     },
     Candidate {
         name: "boundary rate",
@@ -38,36 +44,42 @@ pub const CANDIDATES: &[Candidate] = &[
         ],
         requires: None,
         needs_varying_load: false,
+        part_of_requirement: false,
     },
     Candidate {
         name: "pre-sliding",
         keys: &["contact.presliding_stiffness_n_m"],
         requires: None,
         needs_varying_load: false,
+        part_of_requirement: false,
     },
     Candidate {
         name: "pre-sliding damping",
         keys: &["contact.presliding_damping_n_s_m"],
         requires: Some("pre-sliding"),
         needs_varying_load: false,
+        part_of_requirement: true,
     },
     Candidate {
         name: "drivetrain Coulomb",
         keys: &["drivetrain.coulomb_n"],
         requires: None,
         needs_varying_load: false,
+        part_of_requirement: false,
     },
     Candidate {
         name: "drivetrain viscous",
         keys: &["drivetrain.viscous_n_s_m"],
         requires: None,
         needs_varying_load: false,
+        part_of_requirement: false,
     },
     Candidate {
         name: "drivetrain quadratic",
         keys: &["drivetrain.quadratic_n_s2_m2"],
         requires: None,
         needs_varying_load: false,
+        part_of_requirement: false,
     },
     Candidate {
         // The classic Stribeck curve on our level: the static excess, its
@@ -81,18 +93,21 @@ pub const CANDIDATES: &[Candidate] = &[
         ],
         requires: None,
         needs_varying_load: false,
+        part_of_requirement: false,
     },
     Candidate {
         name: "drivetrain asymmetry",
         keys: &["drivetrain.coulomb_asymmetry_n"],
         requires: None,
         needs_varying_load: false,
+        part_of_requirement: false,
     },
     Candidate {
         name: "drivetrain load",
         keys: &["drivetrain.load_coefficient"],
         requires: None,
         needs_varying_load: true,
+        part_of_requirement: false,
     },
 ];
 
@@ -181,6 +196,31 @@ pub(super) fn set_keys(terms: &[&'static str]) -> Vec<&'static str> {
         }
     }
     keys
+}
+
+/// Whether candidate `t` is a part of the term it requires
+/// ([`Candidate::part_of_requirement`]).
+pub(super) fn is_part(t: &str) -> bool {
+    CANDIDATES
+        .iter()
+        .any(|c| c.name == t && c.part_of_requirement)
+}
+
+/// The parts ([`Candidate::part_of_requirement`]) among `candidates` that
+/// `terms` lacks while holding the term each requires, and that add a key
+/// the set does not fit already.
+pub(super) fn parts_to_add(
+    candidates: &[&'static Candidate],
+    terms: &[&'static str],
+) -> Vec<&'static Candidate> {
+    let fitted = set_keys(terms);
+    candidates
+        .iter()
+        .copied()
+        .filter(|c| c.part_of_requirement && !terms.contains(&c.name))
+        .filter(|c| c.requires.is_some_and(|r| terms.contains(&r)))
+        .filter(|c| c.keys.iter().any(|k| !fitted.contains(k)))
+        .collect()
 }
 
 /// The lighter forms of candidate `t` that `set` does not hold: the

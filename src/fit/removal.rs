@@ -8,7 +8,7 @@
 //! change pays is [`pays`], the one yardstick of the selection and of its
 //! confirmation (`confirm.rs`).
 
-use super::candidates::{lighter_forms, CANDIDATES};
+use super::candidates::{is_part, lighter_forms, CANDIDATES};
 use super::cross_validate::{paired, TERM_COST};
 use super::prepared::Prepared;
 use super::trial::{Ctx, Scored, Tried};
@@ -28,6 +28,16 @@ pub(super) fn pays(from: &Tried, to: &Tried) -> (bool, f64, f64, f64) {
         se,
         share,
     )
+}
+
+/// Whether a part of a chosen term ([`super::candidates::is_part`]) stays:
+/// the set `with` it predicts the folds no worse than the set `without`
+/// it (the folds' mean squared error not raised on average). A part is
+/// not a rival explanation that must pay for itself; it goes when the
+/// folds predict worse with it, or by a flag (rule 4).
+pub(super) fn keeps_part(without: &Tried, with: &Tried) -> bool {
+    let (gain, _) = paired(&without.fold_mse, &with.fold_mse);
+    gain.is_finite() && gain >= 0.0
 }
 
 impl Ctx<'_> {
@@ -70,10 +80,16 @@ impl Ctx<'_> {
                 .collect::<Result<_, FitError>>()?;
             tried.extend(scored.iter().map(|(_, _, s)| s.tried.clone()));
             // The one whose removal (or reduction) costs least, if the term
-            // does not pay over it.
+            // does not pay over it (a part: if the set predicts worse with it).
             let Some((t, form, lighter)) = scored
                 .into_iter()
-                .filter(|(_, _, s)| !pays(&s.tried, &current.tried).0)
+                .filter(|(t, _, s)| {
+                    if is_part(t) {
+                        !keeps_part(&s.tried, &current.tried)
+                    } else {
+                        !pays(&s.tried, &current.tried).0
+                    }
+                })
                 .min_by(|a, b| a.2.tried.cv_rms.total_cmp(&b.2.tried.cv_rms))
             else {
                 return Ok(current);

@@ -41,6 +41,15 @@
 //!    extrapolates its own way (a quadratic loss against a viscous one),
 //!    and the folds' preference between them is noise. One of the two
 //!    goes, whichever the folds miss least.
+//!    Rule 4b, before these flags are read: a candidate that is a part of
+//!    a chosen term, not a rival explanation
+//!    ([`Candidate::part_of_requirement`]: the pre-sliding bristle's
+//!    damping, LuGre's σ1 beside its stiffness σ0), comes with that term
+//!    unless the folds predict worse with it. It need not pay by rule 3:
+//!    its effect lasts the milliseconds of a reversal's pre-sliding, which
+//!    a training motion hardly weighs but a faster one does, and LuGre's
+//!    bristle always has it. The flags still drop it: a damping at its
+//!    bound, or confounded with its stiffness (|ρ| > 0.95), goes.
 //! 5. The film: when the contact's scale was chosen from the data (its
 //!    transition far above them, `contact_scale.rs`), the film candidate is
 //!    also started with viscosities that place the transition inside the
@@ -56,10 +65,11 @@
 //! The report lists every set tried with its CV error per fold, the set
 //! chosen and why the selection stopped.
 
-use super::candidates::{candidates_here, set_keys, Candidate};
+use super::candidates::{candidates_here, parts_to_add, set_keys, Candidate};
+use super::cross_validate::paired;
 use super::options::SearchSettings;
 use super::prepared::Prepared;
-use super::removal::{cv, pays};
+use super::removal::{cv, keeps_part, pays};
 use super::trial::{Ctx, Scored, Tried};
 use super::unknowns::ParamSpec;
 use super::FitError;
@@ -77,6 +87,8 @@ pub struct Selection {
     pub excluded: Vec<String>,
     /// Terms chosen and then removed, each with why.
     pub removed: Vec<String>,
+    /// Parts added with the term they belong to (rule 4b), each with why.
+    pub added: Vec<String>,
     /// How the training data were cut for cross-validation.
     pub folds: String,
     /// The chosen set's optimum on the training data, by name (the final
@@ -184,6 +196,10 @@ pub fn select(
         // new one goes (the first choice does not block a better pair).
         current = ctx.prune(current, name, &mut tried, &mut removed, say)?;
     };
+    // A part of a chosen term comes with it unless the folds predict worse
+    // with it (rule 4b).
+    let mut added: Vec<String> = Vec::new();
+    let current = ctx.add_parts(current, &candidates, &mut tried, &mut added, say)?;
     // A term that ends at zero or at a bound, or that the data cannot tell
     // from another, is dropped and the set fitted again.
     let current = ctx.drop_flagged(current, &mut tried, &mut removed, say)?;
@@ -193,6 +209,7 @@ pub fn select(
         tried,
         excluded,
         removed,
+        added,
         optimum: current.optimum,
         chosen: current.tried.terms,
         keys,
@@ -252,6 +269,44 @@ pub(super) fn fitted_keys(terms: &[&'static str], given: &[ParamSpec]) -> Vec<St
 }
 
 impl Ctx<'_> {
+    /// Rule 4b: each part of a chosen term that the set lacks
+    /// ([`parts_to_add`]) is added unless the folds predict worse with it
+    /// ([`keeps_part`]).
+    fn add_parts(
+        &self,
+        mut current: Scored,
+        candidates: &[&'static Candidate],
+        tried: &mut Vec<Tried>,
+        added: &mut Vec<String>,
+        say: &(dyn Fn(&str) + Sync),
+    ) -> Result<Scored, FitError> {
+        for c in parts_to_add(candidates, &current.tried.terms) {
+            let mut terms = current.tried.terms.clone();
+            terms.push(c.name);
+            let with = self.try_set(&terms, &current.optimum)?;
+            tried.push(with.tried.clone());
+            let (gain, se) = paired(&current.tried.fold_mse, &with.tried.fold_mse);
+            let part_of = c.requires.unwrap_or_default();
+            let change = format!(
+                "{} with {part_of}: the folds' mean squared error changes by {} ± {} (CV RMS {})",
+                c.name,
+                crate::text::Num::sig(-gain, 5),
+                crate::text::Num::sig(se, 5),
+                cv(&with.tried, self.p)
+            );
+            if keeps_part(&current.tried, &with.tried) {
+                say(&format!("auto: + {change}: a part of {part_of}, kept as the folds predict no worse with it"));
+                added.push(format!("{change}: a part of {part_of}, which comes with it unless the folds predict worse with it"));
+                current = with;
+            } else {
+                say(&format!(
+                    "auto: {change}: not added, the folds predict worse with it"
+                ));
+            }
+        }
+        Ok(current)
+    }
+
     /// One step: each open candidate added to `current`, fitted and
     /// scored side by side.
     fn step(
@@ -280,7 +335,7 @@ impl Ctx<'_> {
 pub fn report(s: &Selection, units: super::Units) -> String {
     let u = units.force();
     let mut md = format!(
-        "## Terms chosen by the data (`--fit auto`)\n\nRule: stepwise selection on cross-validation of the training data ({}; each fold predicted by the set refitted without it); each step takes the candidate with the lowest CV error, unless one with fewer keys predicts as well (the best does not pay for its extra keys over it); a term is added only if it lowers the folds' mean squared error by more than the standard error of that lowering and by more than {:.0} % of it (the cost of a term), and a term chosen earlier goes, or gives way to a lighter form of it (the Stribeck curve to its viscous rise), when it no longer pays beside a later one; a term that ends at zero or at a bound, or that the data cannot tell from another parameter (|ρ| > 0.95), is dropped or reduced and the set fitted again unless that predicts worse, and of two chosen terms that the data cannot tell apart (a key of one correlated so with a key of the other) one goes, whichever the folds miss least; the chosen set's final fit is scored on the same folds, and gives way to the best set with one term fewer when it no longer pays over it. Neither --validate nor --holdout data are used.\n\n| set (boundary friction +) | CV RMS ({u}) | RMS per fold ({u}) | film solves |\n|---|---|---|---|\n",
+        "## Terms chosen by the data (`--fit auto`)\n\nRule: stepwise selection on cross-validation of the training data ({}; each fold predicted by the set refitted without it); each step takes the candidate with the lowest CV error, unless one with fewer keys predicts as well (the best does not pay for its extra keys over it); a term is added only if it lowers the folds' mean squared error by more than the standard error of that lowering and by more than {:.0} % of it (the cost of a term), and a term chosen earlier goes, or gives way to a lighter form of it (the Stribeck curve to its viscous rise), when it no longer pays beside a later one; a part of a chosen term (the pre-sliding bristle's damping, LuGre's σ1 beside its stiffness σ0) comes with it unless the folds predict worse with it; a term that ends at zero or at a bound, or that the data cannot tell from another parameter (|ρ| > 0.95), is dropped or reduced and the set fitted again unless that predicts worse, and of two chosen terms that the data cannot tell apart (a key of one correlated so with a key of the other) one goes, whichever the folds miss least; the chosen set's final fit is scored on the same folds, and gives way to the best set with one term fewer when it no longer pays over it. Neither --validate nor --holdout data are used.\n\n| set (boundary friction +) | CV RMS ({u}) | RMS per fold ({u}) | film solves |\n|---|---|---|---|\n",
         s.folds,
         100.0 * TERM_COST
     );
@@ -305,6 +360,9 @@ pub fn report(s: &Selection, units: super::Units) -> String {
     }
     for e in &s.excluded {
         let _ = writeln!(md, "\nNot a candidate on these data: {e}");
+    }
+    for a in &s.added {
+        let _ = writeln!(md, "\nAdded: {a}");
     }
     for r in &s.removed {
         let _ = writeln!(md, "\nRemoved: {r}");
@@ -426,6 +484,33 @@ mod tests {
         let sets: Vec<Vec<&str>> = tried.iter().map(|t| t.terms.clone()).collect();
         assert_eq!(sets, [vec!["a"], vec!["a", "b"], vec!["b"]]);
         assert_eq!(tried[1].fold_mse, [2.0]);
+    }
+
+    #[test]
+    fn the_bristles_damping_is_added_with_its_stiffness_and_kept_unless_the_folds_predict_worse() {
+        let all: Vec<&'static Candidate> = CANDIDATES.iter().collect();
+        let names = |c: Vec<&'static Candidate>| c.iter().map(|c| c.name).collect::<Vec<_>>();
+        // Not before its stiffness is chosen, nor once it is in the set.
+        assert!(parts_to_add(&all, &["drivetrain Stribeck"]).is_empty());
+        assert_eq!(
+            names(parts_to_add(&all, &["drivetrain Stribeck", "pre-sliding"])),
+            vec!["pre-sliding damping"]
+        );
+        assert!(parts_to_add(&all, &["pre-sliding", "pre-sliding damping"]).is_empty());
+        // Kept on a lowering that does not pay as a term (within the
+        // folds' spread), dropped when the folds' mean rises.
+        let without = scored(&["pre-sliding"], &[1.0, 1.0, 1.2, 1.1]);
+        let lower = scored(
+            &["pre-sliding", "pre-sliding damping"],
+            &[0.9, 0.92, 1.35, 1.0],
+        );
+        assert!(!pays(&without.tried, &lower.tried).0);
+        assert!(keeps_part(&without.tried, &lower.tried));
+        let higher = scored(
+            &["pre-sliding", "pre-sliding damping"],
+            &[1.1, 1.0, 1.3, 1.1],
+        );
+        assert!(!keeps_part(&without.tried, &higher.tried));
     }
 
     #[test]
