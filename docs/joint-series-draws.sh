@@ -18,19 +18,21 @@
 # and what ours chose; then the worst ratio.
 #
 # Usage: docs/joint-series-draws.sh [OUT_DIR] [BIN]   (default: out/joint-series-draws)
-# DRAWS=12 sets the number of draws (about 1 min each).
+# DRAWS=12 sets the last draw (about 1 min each), FIRST=1 the first: draws
+# 1-12 are those the rule was developed on, 13-24 were first run after it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 OUT=${1:-out/joint-series-draws}
 BIN=${2:-target/release/friction-node}
 DRAWS=${DRAWS:-12}
+FIRST=${FIRST:-1}
 mkdir -p "$OUT"
 [ -x "$BIN" ] || cargo build --release --quiet
 . docs/bench-lib.sh
 
-python3 - "$OUT" "$DRAWS" <<'PY'
+python3 - "$OUT" "$DRAWS" "$FIRST" <<'PY'
 import math, random, sys
-out, draws = sys.argv[1], int(sys.argv[2])
+out, draws, first = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
 
 def motion(rnd, top):
     """A smooth multi-sine ω(s) with its top speed over the first 60 s at `top`."""
@@ -60,7 +62,7 @@ def lugre(t, w, p, ripple):
         out.append(tau)
     return out
 
-for d in range(1, draws + 1):
+for d in range(first, draws + 1):
     rnd = random.Random(1000 + d)
     fc = rnd.uniform(0.2, 2.0)
     kind = ("peak", "rise", "none")[d % 3]
@@ -88,20 +90,20 @@ for d in range(1, draws + 1):
           f"{'yes' if ripple else 'no'} |", file=open(f"{out}/d{d}.params", "w"))
 PY
 
-for d in $(seq 1 "$DRAWS"); do
+for d in $(seq "$FIRST" "$DRAWS"); do
     timed "d$d" "$BIN" fit "$OUT/d$d-train.csv" --rotary --holdout 0.33 \
         --validate "$OUT/d$d-fast.csv" --fit auto --baselines --out "$OUT/d$d.yaml"
 done
 
-python3 - "$OUT" "$DRAWS" <<'PY'
+python3 - "$OUT" "$DRAWS" "$FIRST" <<'PY'
 import sys
 sys.path.insert(0, "docs")
 from fit_runs import Run
-out, draws = sys.argv[1], int(sys.argv[2])
+out, draws, first = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
 print("| draw | joint: f_c, f_s, ω_s, b, σ0, σ1, top speed, ripple | ours: faster motion | best classic: faster motion | ours / best | ours: later part | ours chose | wall (s) |")
 print("|---|---|---|---|---|---|---|---|")
 worst = None
-for d in range(1, draws + 1):
+for d in range(first, draws + 1):
     run = Run(out, f"d{d}")
     joint = open(f"{out}/d{d}.params").read().strip().strip("|").split("|")[1:]
     joint = ", ".join(x.strip() for x in joint)

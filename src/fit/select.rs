@@ -48,8 +48,12 @@
 //!    unless the folds predict worse with it. It need not pay by rule 3:
 //!    its effect lasts the milliseconds of a reversal's pre-sliding, which
 //!    a training motion hardly weighs but a faster one does, and LuGre's
-//!    bristle always has it. The flags still drop it: a damping at its
-//!    bound, or confounded with its stiffness (|ρ| > 0.95), goes.
+//!    bristle always has it. The flags still read it: a damping at zero
+//!    or at its bound goes. Its correlation with its own stiffness is not
+//!    a confounding (a part and its term are one element, not two
+//!    explanations that extrapolate each their own way): it is a plain
+//!    flag, and the damping goes only if the set without it predicts as
+//!    well.
 //! 5. The film: when the contact's scale was chosen from the data (its
 //!    transition far above them, `contact_scale.rs`), the film candidate is
 //!    also started with viscosities that place the transition inside the
