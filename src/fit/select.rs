@@ -48,12 +48,11 @@
 //!    unless the folds predict worse with it. It need not pay by rule 3:
 //!    its effect lasts the milliseconds of a reversal's pre-sliding, which
 //!    a training motion hardly weighs but a faster one does, and LuGre's
-//!    bristle always has it. The flags still read it: a damping at zero
-//!    or at its bound goes. Its correlation with its own stiffness is not
-//!    a confounding (a part and its term are one element, not two
-//!    explanations that extrapolate each their own way): it is a plain
-//!    flag, and the damping goes only if the set without it predicts as
-//!    well.
+//!    bristle always has it. The flags still read it as any term's: a
+//!    damping at zero or at its bound goes unless the set without it
+//!    predicts worse. Its correlation with its own stiffness is such a
+//!    plain flag, not a confounding (a part and its term are one element,
+//!    not two explanations that extrapolate each their own way).
 //! 5. The film: when the contact's scale was chosen from the data (its
 //!    transition far above them, `contact_scale.rs`), the film candidate is
 //!    also started with viscosities that place the transition inside the
@@ -339,7 +338,7 @@ impl Ctx<'_> {
 pub fn report(s: &Selection, units: super::Units) -> String {
     let u = units.force();
     let mut md = format!(
-        "## Terms chosen by the data (`--fit auto`)\n\nRule: stepwise selection on cross-validation of the training data ({}; each fold predicted by the set refitted without it); each step takes the candidate with the lowest CV error, unless one with fewer keys predicts as well (the best does not pay for its extra keys over it); a term is added only if it lowers the folds' mean squared error by more than the standard error of that lowering and by more than {:.0} % of it (the cost of a term), and a term chosen earlier goes, or gives way to a lighter form of it (the Stribeck curve to its viscous rise), when it no longer pays beside a later one; a part of a chosen term (the pre-sliding bristle's damping, LuGre's σ1 beside its stiffness σ0) comes with it unless the folds predict worse with it; a term that ends at zero or at a bound, or that the data cannot tell from another parameter (|ρ| > 0.95), is dropped or reduced and the set fitted again unless that predicts worse, and of two chosen terms that the data cannot tell apart (a key of one correlated so with a key of the other) one goes, whichever the folds miss least; the chosen set's final fit is scored on the same folds, and gives way to the best set with one term fewer when it no longer pays over it. Neither --validate nor --holdout data are used.\n\n| set (boundary friction +) | CV RMS ({u}) | RMS per fold ({u}) | film solves |\n|---|---|---|---|\n",
+        "## Terms chosen by the data (`--fit auto`)\n\nRule: stepwise selection on cross-validation of the training data ({}; each fold predicted by the set refitted without it); each step takes the candidate with the lowest CV error, unless one with fewer keys predicts as well (the best does not pay for its extra keys over it); a term is added only if it lowers the folds' mean squared error by more than the standard error of that lowering and by more than {:.0} % of it (the cost of a term), and a term chosen earlier goes, or gives way to a lighter form of it (the Stribeck curve to its viscous rise), when it no longer pays beside a later one; a part of a chosen term (the pre-sliding bristle's damping, LuGre's σ1 beside its stiffness σ0) comes with it unless the folds predict worse with it; a term that ends at zero or at a bound, or that the data cannot tell from another parameter (|ρ| > 0.95), is dropped or reduced and the set fitted again unless that predicts worse, and of two chosen terms that the data cannot tell apart (a key of one correlated so with a key of the other; a part and its own term are one element, not two) one goes, whichever the folds miss least; the chosen set's final fit is scored on the same folds, and gives way to the best set with one term fewer when it no longer pays over it. Neither --validate nor --holdout data are used.\n\n| set (boundary friction +) | CV RMS ({u}) | RMS per fold ({u}) | film solves |\n|---|---|---|---|\n",
         s.folds,
         100.0 * TERM_COST
     );
