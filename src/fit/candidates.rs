@@ -206,6 +206,18 @@ pub(super) fn is_part(t: &str) -> bool {
         .any(|c| c.name == t && c.part_of_requirement)
 }
 
+/// Whether terms `a` and `b` are one element: one is a part of the other
+/// ([`Candidate::part_of_requirement`], the bristle's damping beside its
+/// stiffness), so they are not two explanations of the data.
+pub(super) fn one_element(a: &str, b: &str) -> bool {
+    let part_of = |p: &str, t: &str| {
+        CANDIDATES
+            .iter()
+            .any(|c| c.name == p && c.part_of_requirement && c.requires == Some(t))
+    };
+    part_of(a, b) || part_of(b, a)
+}
+
 /// The parts ([`Candidate::part_of_requirement`]) among `candidates` that
 /// `terms` lacks while holding the term each requires, and that add a key
 /// the set does not fit already.

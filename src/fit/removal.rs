@@ -3,12 +3,13 @@
 //! one; a term whose key ended at zero or at a bound, or correlates above
 //! [`super::stats::CORRELATION_FLAG`] with another parameter; of two
 //! confounded terms (a key of one correlated so with a key of the other,
-//! not a part and the term it belongs to), one. A term gives way to a lighter form of it where one fits (the
-//! Stribeck curve to its viscous rise) before it is removed. Whether a
+//! not a part and the term it belongs to), one. A term gives way to a
+//! lighter form of it where one fits (the Stribeck curve to its viscous
+//! rise) before it is removed. Whether a
 //! change pays is [`pays`], the one yardstick of the selection and of its
 //! confirmation (`confirm.rs`).
 
-use super::candidates::{is_part, lighter_forms, CANDIDATES};
+use super::candidates::{is_part, lighter_forms, one_element, CANDIDATES};
 use super::cross_validate::{paired, TERM_COST};
 use super::prepared::Prepared;
 use super::trial::{Ctx, Scored, Tried};
@@ -205,12 +206,9 @@ fn flagged(s: &Scored, kept: &[&'static str]) -> Option<Flagged> {
                 let confounded = terms.iter().filter(|o| *o != t).find_map(|o| {
                     let other = CANDIDATES.iter().find(|c| c.name == *o)?;
                     let key = other.keys.iter().find(|x| **x == partner)?;
-                    // A part and the term it belongs to are one element
-                    // (the bristle's damping and its stiffness), not two
-                    // explanations: their correlation is a plain flag.
-                    let one_element = (c.part_of_requirement && c.requires == Some(*o))
-                        || (other.part_of_requirement && other.requires == Some(*t));
-                    (!c.keys.contains(key) && !one_element).then_some((*o, *key))
+                    // A part and the term it belongs to are one element,
+                    // not two explanations: their correlation is a plain flag.
+                    (!c.keys.contains(key) && !one_element(t, o)).then_some((*o, *key))
                 });
                 let rho = crate::text::Num::sig(f.rho, 3);
                 let why = match confounded {
@@ -386,10 +384,7 @@ mod tests {
         let f = flagged(&with_flag(&set, k0, 0.988, k1), &[]).unwrap();
         assert_eq!((f.term, f.confounded), ("pre-sliding", None));
         // Another term's key correlated with the stiffness is a confounding.
-        let f = flagged(
-            &with_flag(&set, "drivetrain.stribeck_n", 0.97, k0),
-            &["pre-sliding damping"],
-        );
+        let f = flagged(&with_flag(&set, "drivetrain.stribeck_n", 0.97, k0), &[]);
         assert_eq!(
             f.map(|f| (f.term, f.confounded)),
             Some(("drivetrain Stribeck", Some(("pre-sliding", k0))))
