@@ -416,6 +416,7 @@ def fit(
     jacobian: str = "secant",
     later_runs: str = "full",
     linear_keys: str = "solved",
+    cheap_keys: str = "profiled",
 ) -> FitResult:
     """Calibrate configuration keys (and input-map coefficients) to
     recorded friction, as ``friction-node fit`` does (same arguments, same
@@ -427,9 +428,11 @@ def fit(
     names after ``auto`` are fitted as well); ``rotary=True`` takes a
     joint's velocity in rad/s and friction in N·m (the lever arm and the
     contact's load are chosen from the data). ``jacobian`` (``"secant"`` or
-    ``"differences"``), ``later_runs`` (``"full"`` or ``"valley"``) and
-    ``linear_keys`` (``"solved"`` or ``"searched"``) choose how the search
-    runs, as ``--jacobian``, ``--later-runs`` and ``--linear-keys`` do."""
+    ``"differences"``), ``later_runs`` (``"full"`` or ``"valley"``),
+    ``linear_keys`` (``"solved"`` or ``"searched"``) and ``cheap_keys``
+    (``"profiled"`` or ``"searched"``) choose how the search runs, as
+    ``--jacobian``, ``--later-runs``, ``--linear-keys`` and ``--cheap-keys``
+    do."""
     if isinstance(data, (str, os.PathLike)):
         data = [data]
     if isinstance(fit, str):
@@ -470,5 +473,6 @@ def fit(
         jacobian=jacobian,
         later_runs=later_runs,
         linear_keys=linear_keys,
+        cheap_keys=cheap_keys,
     )
     return FitResult(raw)

@@ -151,12 +151,13 @@ def test_the_search_rules_are_the_clis_and_a_bad_rule_is_named(cli, tmp_path):
     np.savetxt(data, np.column_stack([t, np.sin(2 * np.pi * t), run["friction_n"]]), delimiter=",",
                header="t_s,velocity_m_s,friction_n", comments="")
     keys = ["contact.boundary_friction", "drivetrain.viscous_n_s_m"]
-    rules = {"jacobian": "differences", "later_runs": "valley", "linear_keys": "searched"}
+    rules = {"jacobian": "differences", "later_runs": "valley", "linear_keys": "searched",
+             "cheap_keys": "searched"}
     r = fn.fit(data, keys, overrides={"solver.cells": 32}, starts=2, global_points=4, **rules)
     out = tmp_path / "cli.yaml"
     cli("--set", "solver.cells=32", "fit", data, "--fit", ",".join(keys), "--starts", "2",
         "--global-points", "4", "--jacobian", "differences", "--later-runs", "valley",
-        "--linear-keys", "searched", "--out", out)
+        "--linear-keys", "searched", "--cheap-keys", "searched", "--out", out)
     assert r.fitted_yaml == out.read_text()
     # The defaults solve the viscous loss instead of searching it: another path
     # to the same optimum, so the same value to the fit's tolerance.
@@ -165,7 +166,8 @@ def test_the_search_rules_are_the_clis_and_a_bad_rule_is_named(cli, tmp_path):
     assert r.value("contact.boundary_friction") == pytest.approx(0.22, rel=1e-3)
     for name, value, allowed in [("jacobian", "exact", "secant or differences"),
                                  ("later_runs", "some", "valley or full"),
-                                 ("linear_keys", "fixed", "solved or searched")]:
+                                 ("linear_keys", "fixed", "solved or searched"),
+                                 ("cheap_keys", "held", "profiled or searched")]:
         with pytest.raises(ValueError) as e:
             fn.fit(data, keys, **{name: value})
         assert f"{name}: `{value}`" in str(e.value) and allowed in str(e.value)

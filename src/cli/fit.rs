@@ -4,7 +4,7 @@
 use anyhow::{bail, Result};
 use friction_node::config::Config;
 use friction_node::fit::inputs::{DataRequest, TopicChoice};
-use friction_node::fit::options::{JacobianRule, LaterRuns, LinearKeys};
+use friction_node::fit::options::{CheapKeys, JacobianRule, LaterRuns, LinearKeys};
 use friction_node::fit::options::{LabelledProgress, SearchSettings};
 use friction_node::fit::request::{param_specs, FitOutputs, FitRequest};
 use friction_node::fit::{Delimiter, Mapping, ParamSpec};
@@ -96,6 +96,14 @@ pub struct FitArgs {
     /// `searched` like every other parameter (slower on a ridge).
     #[arg(long, default_value = "solved", value_parser = LinearKeys::parse)]
     pub linear_keys: LinearKeys,
+    /// The keys whose change only recomposes the friction along the kept
+    /// film (the friction terms' keys), when keys that need a film solve
+    /// (the film's own: viscosity, roughness, load…) are fitted beside
+    /// them: `profiled`, fitted at every point of the film's keys with the
+    /// film held, the local runs searching the film's keys alone (the
+    /// default), or `searched` with them (more film solves).
+    #[arg(long, default_value = "profiled", value_parser = CheapKeys::parse)]
+    pub cheap_keys: CheapKeys,
     /// Column names of headerless CSV data (comma-separated).
     #[arg(long, value_name = "NAME,...", value_delimiter = ',')]
     pub columns: Option<Vec<String>>,
@@ -295,6 +303,7 @@ impl FitArgs {
                 jacobian: self.jacobian,
                 later_runs: self.later_runs,
                 linear_keys: self.linear_keys,
+                cheap_keys: self.cheap_keys,
             },
             baselines: self.baselines,
         })

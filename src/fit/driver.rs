@@ -94,6 +94,7 @@ pub fn fit(
     let films_before = model.film_solves();
     let mut problem = Problem::new(model, data, map_fit)?;
     problem.stop = options.stop.clone();
+    problem.profile_cheap = options.cheap_keys == super::options::CheapKeys::Profiled;
     let separable = if options.linear_keys == super::options::LinearKeys::Solved {
         super::separable::Separable::new(&problem)
     } else {

@@ -129,7 +129,7 @@ impl<'p, 'a> Lm<'p, 'a> {
                 let mut u = self.u.clone();
                 u[j] += FD_STEP;
                 self.vars
-                    .evaluate(u.as_slice())
+                    .evaluate_near(u.as_slice(), &self.x)
                     .0
                     .iter()
                     .zip(self.r.iter())
@@ -167,7 +167,16 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Lm<'_, '_> {
             self.x = x;
             return;
         }
-        let (r, x) = self.vars.evaluate(u.as_slice());
+        // A profiled point's cheap keys are fitted from the last accepted
+        // point's (the run's start at first).
+        let (r, x) = {
+            let last = self.last.lock().unwrap_or_else(|p| p.into_inner());
+            match last.as_ref() {
+                Some(l) => self.vars.evaluate_near(u.as_slice(), &l.x),
+                None if !self.x.is_empty() => self.vars.evaluate_near(u.as_slice(), &self.x),
+                None => self.vars.evaluate(u.as_slice()),
+            }
+        };
         self.r = DVector::from_vec(r);
         let cost = 0.5 * self.r.norm_squared();
         self.trail.push((cost, x.clone()));
@@ -304,7 +313,7 @@ pub fn local_run(
 }
 
 /// One run; true when it ended early (a stop, or an earlier optimum).
-fn one_run(
+pub(super) fn one_run(
     vars: Variables<'_, '_>,
     u0: &[f64],
     max_evaluations: usize,

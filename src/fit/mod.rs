@@ -85,6 +85,7 @@ pub mod physics_model;
 pub mod prepare;
 pub mod prepared;
 pub mod problem;
+mod profile;
 mod removal;
 pub mod report;
 #[cfg(feature = "plots")]

@@ -11,7 +11,7 @@ use super::earlier_optima::Found;
 use super::local_run::{local_run, LocalRun};
 use super::options::Options;
 use super::problem::Problem;
-use super::separable::{canonical, Separable};
+use super::separable::{Separable, Variables};
 use rand::rngs::StdRng;
 use rand::seq::SliceRandom;
 use rand::{RngExt, SeedableRng};
@@ -193,7 +193,7 @@ fn local_runs(
         .curvature
         .clone()
         .map(|curvature| Found {
-            u: canonical(problem, separable, &first.x),
+            u: Variables::new(problem, separable, &first.x).canonical(&first.x),
             x: first.x.clone(),
             cost: first.cost,
             curvature,

@@ -45,6 +45,9 @@ pub struct Options {
     /// Whether the parameters the residuals are linear in are solved at
     /// every point (`separable.rs`) or searched as the others.
     pub linear_keys: LinearKeys,
+    /// Whether the cheap keys are fitted at every point of the costly
+    /// ones (`profile.rs`) or searched with them.
+    pub cheap_keys: CheapKeys,
 }
 
 impl Default for Options {
@@ -64,6 +67,7 @@ impl Default for Options {
             start: None,
             statistics: true,
             linear_keys: Default::default(),
+            cheap_keys: Default::default(),
         }
     }
 }
@@ -95,6 +99,8 @@ pub struct SearchSettings {
     pub later_runs: LaterRuns,
     /// Whether the linear parameters are solved or searched.
     pub linear_keys: LinearKeys,
+    /// Whether the cheap parameters are profiled or searched.
+    pub cheap_keys: CheapKeys,
 }
 
 impl Default for SearchSettings {
@@ -108,6 +114,7 @@ impl Default for SearchSettings {
             jacobian: Default::default(),
             later_runs: Default::default(),
             linear_keys: Default::default(),
+            cheap_keys: Default::default(),
         }
     }
 }
@@ -162,6 +169,7 @@ impl SearchSettings {
             jacobian: self.jacobian,
             later_runs: self.later_runs,
             linear_keys: self.linear_keys,
+            cheap_keys: self.cheap_keys,
             ..Default::default()
         }
     }
@@ -251,5 +259,31 @@ impl LinearKeys {
     /// The rule named `s`.
     pub fn parse(s: &str) -> Result<Self, String> {
         named(&Self::NAMES, s, "a rule for linear keys")
+    }
+}
+
+/// What the local runs do with the cheap keys (a change of one only
+/// recomposes the friction along the kept film) when costly ones (a change
+/// needs a film solve) are fitted beside them (`profile.rs`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum CheapKeys {
+    /// Fitted at every point of the costly keys, the film held; the runs
+    /// search the costly keys alone (variable projection).
+    #[default]
+    Profiled,
+    /// Searched by the runs with the costly keys.
+    Searched,
+}
+
+impl CheapKeys {
+    /// The rules by name (the command line's values).
+    pub const NAMES: [(&'static str, CheapKeys); 2] = [
+        ("profiled", CheapKeys::Profiled),
+        ("searched", CheapKeys::Searched),
+    ];
+
+    /// The rule named `s`.
+    pub fn parse(s: &str) -> Result<Self, String> {
+        named(&Self::NAMES, s, "a rule for cheap keys")
     }
 }

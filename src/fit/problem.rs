@@ -269,6 +269,9 @@ pub struct Problem<'a> {
     predictions: Mutex<Vec<PredictionEntry>>,
     /// A stop requested from outside ends the local runs at once.
     pub stop: crate::interrupt::Stop,
+    /// Whether the local runs fit the cheap keys at every point of the
+    /// costly ones (`profile.rs`), or search them all together.
+    pub profile_cheap: bool,
     /// Model evaluations so far.
     pub simulations: AtomicUsize,
     /// Their total wall time, ns.
@@ -338,6 +341,7 @@ impl<'a> Problem<'a> {
             recent: Mutex::new(Vec::new()),
             predictions: Mutex::new(Vec::new()),
             stop: crate::interrupt::Stop::new(),
+            profile_cheap: false,
             simulations: AtomicUsize::new(0),
             simulation_ns: AtomicU64::new(0),
         })

@@ -190,7 +190,7 @@ fn linear_candidates(problem: &Problem<'_>) -> Vec<usize> {
 /// positive semidefinite: the unconstrained minimum when it lies in the
 /// box, else the best minimum over the faces (each y_j free, at its lower
 /// or at its upper bound).
-fn box_minimum(gram: &DMatrix<f64>, b: &DVector<f64>, boxed: &[(f64, f64)]) -> Vec<f64> {
+pub(super) fn box_minimum(gram: &DMatrix<f64>, b: &DVector<f64>, boxed: &[(f64, f64)]) -> Vec<f64> {
     let k = boxed.len();
     let free: Vec<Option<f64>> = vec![None; k];
     if let Some(y) = face_minimum(gram, b, &free) {
@@ -275,7 +275,10 @@ fn face_minimum(gram: &DMatrix<f64>, b: &DVector<f64>, face: &[Option<f64>]) -> 
 
 /// The local runs' variables: the searched parameters' unbounded
 /// variables u (every parameter's when nothing is solved); the solved
-/// ones are set at each point from their values in `reference`.
+/// ones are set at each point from their values in `reference`. With
+/// `Problem::profile_cheap`, the searched ones are the costly parameters
+/// alone and the cheap ones are fitted at each point (`profile.rs`).
+#[derive(Clone)]
 pub struct Variables<'p, 'a> {
     problem: &'p Problem<'a>,
     separable: Option<&'p Separable>,
@@ -283,17 +286,46 @@ pub struct Variables<'p, 'a> {
     /// taken at before they are solved (any fixed values: the residuals
     /// are affine in them).
     reference: Vec<f64>,
+    /// The searched parameters' indices.
+    searched: Vec<usize>,
+    /// The cheap parameters fitted at each point (the film held), when
+    /// the searched ones are the costly ones alone.
+    profiled: Vec<usize>,
 }
 
 impl<'p, 'a> Variables<'p, 'a> {
     /// The variables of `problem` with `separable`'s parameters solved,
     /// taken from the whole point `x0`.
     pub fn new(problem: &'p Problem<'a>, separable: Option<&'p Separable>, x0: &[f64]) -> Self {
+        let all: Vec<usize> = match separable {
+            Some(s) => s.searched().to_vec(),
+            None => (0..problem.params.len()).collect(),
+        };
+        let (searched, profiled) = match problem.costly().filter(|_| problem.profile_cheap) {
+            Some(c) if all.iter().any(|i| c[*i]) && all.iter().any(|i| !c[*i]) => {
+                all.iter().partition(|i| c[**i])
+            }
+            _ => (all, Vec::new()),
+        };
         Self {
             problem,
             separable,
             reference: x0.to_vec(),
+            searched,
+            profiled,
         }
+    }
+
+    /// The variables of the cheap parameters alone at the whole point
+    /// `x` (the others held there): the inner fit of a profiled point.
+    pub(super) fn cheap_at(&self, x: &[f64]) -> Option<Self> {
+        (!self.profiled.is_empty()).then(|| Self {
+            problem: self.problem,
+            separable: self.separable,
+            reference: x.to_vec(),
+            searched: self.profiled.clone(),
+            profiled: Vec::new(),
+        })
     }
 
     /// The problem.
@@ -302,25 +334,21 @@ impl<'p, 'a> Variables<'p, 'a> {
     }
 
     /// The searched parameters' indices.
-    fn searched(&self) -> Vec<usize> {
-        match self.separable {
-            Some(s) => s.searched().to_vec(),
-            None => (0..self.problem.params.len()).collect(),
-        }
+    pub(super) fn searched(&self) -> &[usize] {
+        &self.searched
     }
 
     /// Per searched variable: whether a change of it alone needs a whole
     /// simulation (None: every one costs the same).
     pub fn costly(&self) -> Option<Vec<bool>> {
         let all = self.problem.costly()?;
-        let out: Vec<bool> = self.searched().iter().map(|i| all[*i]).collect();
+        let out: Vec<bool> = self.searched.iter().map(|i| all[*i]).collect();
         (out.iter().any(|c| *c) && out.iter().any(|c| !*c)).then_some(out)
     }
 
     /// How many variables are searched.
     pub fn len(&self) -> usize {
-        self.separable
-            .map_or(self.problem.params.len(), |s| s.searched().len())
+        self.searched.len()
     }
 
     /// Whether nothing is searched.
@@ -330,7 +358,7 @@ impl<'p, 'a> Variables<'p, 'a> {
 
     /// The whole point `x` as the searched variables u.
     pub fn to_internal(&self, x: &[f64]) -> Vec<f64> {
-        self.searched()
+        self.searched
             .iter()
             .map(|i| self.problem.params[*i].to_internal(x[*i]))
             .collect()
@@ -339,23 +367,46 @@ impl<'p, 'a> Variables<'p, 'a> {
     /// The whole point `x` in the searched variables, on their canonical
     /// fold (where distances between runs' points are taken).
     pub fn canonical(&self, x: &[f64]) -> Vec<f64> {
-        canonical(self.problem, self.separable, x)
+        self.searched
+            .iter()
+            .map(|i| self.problem.params[*i].to_canonical(x[*i]))
+            .collect()
     }
 
-    /// The whole point at u before the linear parameters are solved.
-    fn point(&self, u: &[f64]) -> Vec<f64> {
-        let mut x = self.reference.clone();
-        for (i, v) in self.searched().iter().zip(u) {
+    /// The whole point at u before the linear parameters are solved, the
+    /// others taken from `near`.
+    fn point(&self, u: &[f64], near: &[f64]) -> Vec<f64> {
+        let mut x = near.to_vec();
+        for (i, v) in self.searched.iter().zip(u) {
             x[*i] = self.problem.params[*i].from_internal(*v);
         }
         x
     }
 
-    /// The residuals at u, with the linear parameters solved, and the
+    /// The residuals at u, with the linear parameters solved (and the
+    /// profiled ones fitted from their values in the reference), and the
     /// whole point they belong to. A point with no prediction gives the
     /// problem's large residuals (nothing is solved there).
     pub fn evaluate(&self, u: &[f64]) -> (Vec<f64>, Vec<f64>) {
-        let mut x = self.point(u);
+        self.evaluate_near(u, &self.reference)
+    }
+
+    /// [`Self::evaluate`] with the profiled parameters fitted from their
+    /// values in the whole point `near` (the run's last point).
+    pub fn evaluate_near(&self, u: &[f64], near: &[f64]) -> (Vec<f64>, Vec<f64>) {
+        if self.profiled.is_empty() {
+            return self.solved_at(self.point(u, &self.reference));
+        }
+        let x = self.point(u, near);
+        match self.cheap_at(&x) {
+            Some(inner) => super::profile::fit_cheap(inner, &x),
+            None => self.solved_at(x),
+        }
+    }
+
+    /// The residuals at the whole point `x` with the linear parameters
+    /// solved, and the point.
+    pub(super) fn solved_at(&self, mut x: Vec<f64>) -> (Vec<f64>, Vec<f64>) {
         let Some(mut r) = self.problem.try_residuals(&x) else {
             return (self.problem.penalty(), x);
         };
@@ -369,23 +420,6 @@ impl<'p, 'a> Variables<'p, 'a> {
     pub fn cost(&self, u: &[f64]) -> f64 {
         0.5 * self.evaluate(u).0.iter().map(|r| r * r).sum::<f64>()
     }
-}
-
-/// The whole point `x` in the searched variables of `problem` (all when
-/// `separable` is None), on their canonical fold.
-pub fn canonical(problem: &Problem<'_>, separable: Option<&Separable>, x: &[f64]) -> Vec<f64> {
-    let all: Vec<usize>;
-    let searched = match separable {
-        Some(s) => s.searched(),
-        None => {
-            all = (0..problem.params.len()).collect();
-            &all
-        }
-    };
-    searched
-        .iter()
-        .map(|i| problem.params[*i].to_canonical(x[*i]))
-        .collect()
 }
 
 #[cfg(test)]

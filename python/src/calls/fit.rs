@@ -6,7 +6,7 @@ use crate::model::load_config;
 use friction_node::fit::compare::OursFitted;
 use friction_node::fit::inputs::{DataRequest, TopicChoice};
 use friction_node::fit::options::{
-    JacobianRule, LabelledProgress, LaterRuns, LinearKeys, SearchSettings,
+    CheapKeys, JacobianRule, LabelledProgress, LaterRuns, LinearKeys, SearchSettings,
 };
 use friction_node::fit::request::{param_specs, Calibration, FitOutputs, FitRequest};
 use friction_node::fit::{models_table, report};
@@ -102,7 +102,7 @@ fn outcome_dict<'py>(py: Python<'py>, o: &FitOutcome) -> PyResult<Bound<'py, PyD
     load=None, temperature=None, smooth=0.05, map=Vec::new(), velocity_topic=None,
     friction_topic=None, joint=None, load_topic=None, temperature_topic=None, out=None,
     report_dir=None, progress=false, rotary=false, jacobian="secant", later_runs="full",
-    linear_keys="solved"))]
+    linear_keys="solved", cheap_keys="profiled"))]
 #[allow(clippy::too_many_arguments)]
 pub fn fit<'py>(
     py: Python<'py>,
@@ -141,6 +141,7 @@ pub fn fit<'py>(
     jacobian: &str,
     later_runs: &str,
     linear_keys: &str,
+    cheap_keys: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     let config = match &config_path {
         Some(p) => load_config(None, Some(&p.display().to_string()), &overrides)?,
@@ -187,6 +188,7 @@ pub fn fit<'py>(
             jacobian: JacobianRule::parse(jacobian).map_err(|e| argument("jacobian", e))?,
             later_runs: LaterRuns::parse(later_runs).map_err(|e| argument("later_runs", e))?,
             linear_keys: LinearKeys::parse(linear_keys).map_err(|e| argument("linear_keys", e))?,
+            cheap_keys: CheapKeys::parse(cheap_keys).map_err(|e| argument("cheap_keys", e))?,
         },
         baselines,
     };

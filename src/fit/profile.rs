@@ -1,0 +1,304 @@
+//! The cheap keys fitted at every point of the costly ones (variable
+//! projection with a nonlinear inner problem; Golub & Pereyra 2003, §4).
+//!
+//! | symbol | meaning | unit |
+//! |---|---|---|
+//! | θ | the costly parameters: a change of one needs a film solve | theirs |
+//! | c | the cheap parameters: a change recomposes the friction along the kept film | theirs |
+//! | f | c as fractions of their scaled bounds (0 … 1; log-scaled where the bounds are) | 1 |
+//! | r(θ, c) | the residuals on the fitted samples (the linear keys solved) | N |
+//! | J | ∂r/∂f at fixed θ, by forward differences | N |
+//! | c*(θ) | argmin over the box of ‖r(θ, c)‖², from the last accepted point's c | theirs |
+//!
+//! The local runs search θ alone on the profiled residuals r(θ, c*(θ)).
+//! Every point θ costs one film solve; the inner fit of c at it only
+//! recomposes the friction along that film. A pair the data hardly
+//! separate (a bristle's stiffness and damping, a boundary friction and
+//! its rate) is then walked by recompositions, not by film solves. The
+//! optimum is the joint one: at c*(θ) the gradient in c is zero (or points
+//! out of the box), and the profiled cost's gradient in θ is the joint
+//! cost's (Kaufman 1975).
+//!
+//! The inner fit is a Levenberg–Marquardt on f with the bounds kept
+//! exactly: each step minimises ‖r + J d‖² + λ Σ_j (J_jᵀJ_j) d_j² over the
+//! box 0 ≤ f + d ≤ 1 (the same exact box solver as the linear keys'), so a
+//! key at its bound stays there in one step instead of creeping to it.
+
+use super::separable::{box_minimum, Variables};
+use nalgebra::{DMatrix, DVector};
+
+/// Forward-difference step, as a fraction of a key's scaled range.
+const STEP: f64 = 1e-6;
+/// Most inner iterations (Jacobians).
+const MAX_ITERATIONS: usize = 30;
+/// An accepted step that lowers the cost by less than this fraction ends
+/// the inner fit.
+const COST_TOLERANCE: f64 = 1e-12;
+/// So does one shorter than this, in fractions of the ranges.
+const STEP_TOLERANCE: f64 = 1e-10;
+/// Levenberg–Marquardt damping: first value, and its factors on an
+/// accepted and a rejected step.
+const DAMPING: (f64, f64, f64) = (1e-3, 1.0 / 3.0, 4.0);
+/// The damping's floor, and the value at which a step is given up (the
+/// model is flat).
+const DAMPING_MIN: f64 = 1e-12;
+const DAMPING_MAX: f64 = 1e12;
+
+fn half_sum(r: &[f64]) -> f64 {
+    0.5 * r.iter().map(|v| v * v).sum::<f64>()
+}
+
+/// The residuals at the whole point `x` with `inner`'s parameters (the
+/// cheap ones) fitted from their values in `x`, and the whole point they
+/// belong to.
+pub(super) fn fit_cheap(inner: Variables<'_, '_>, x: &[f64]) -> (Vec<f64>, Vec<f64>) {
+    let problem = inner.problem();
+    let (mut r, mut x) = inner.solved_at(x.to_vec());
+    let mut cost = half_sum(&r);
+    if !cost.is_finite() || problem.stop.requested() {
+        return (r, x);
+    }
+    let mut lambda = DAMPING.0;
+    for _ in 0..MAX_ITERATIONS {
+        let f = fractions(&inner, &x);
+        let Some(linear) = Linearised::at(&inner, &x, &f, &r) else {
+            break;
+        };
+        // Steps from this Jacobian, the damping raised until one lowers
+        // the cost (or the step is too short to matter).
+        let done = loop {
+            let d = linear.step(&f, lambda);
+            if d.iter().all(|v| v.abs() < STEP_TOLERANCE) {
+                break true;
+            }
+            let trial: Vec<f64> = f.iter().zip(&d).map(|(a, b)| a + b).collect();
+            let (rt, xt) = inner.solved_at(with_fractions(&inner, &x, &trial));
+            let ct = half_sum(&rt);
+            if ct < cost {
+                let small = cost - ct < COST_TOLERANCE * cost;
+                (r, x, cost) = (rt, xt, ct);
+                lambda = (lambda * DAMPING.1).max(DAMPING_MIN);
+                break small;
+            }
+            lambda *= DAMPING.2;
+            if lambda > DAMPING_MAX {
+                break true;
+            }
+        };
+        if done || problem.stop.requested() {
+            break;
+        }
+    }
+    (r, x)
+}
+
+/// The searched keys of `inner` at `x`, as fractions of their ranges.
+fn fractions(inner: &Variables<'_, '_>, x: &[f64]) -> Vec<f64> {
+    let params = &inner.problem().params;
+    inner
+        .searched()
+        .iter()
+        .map(|i| params[*i].fraction(x[*i]))
+        .collect()
+}
+
+/// `x` with the searched keys of `inner` set at fractions `f`.
+fn with_fractions(inner: &Variables<'_, '_>, x: &[f64], f: &[f64]) -> Vec<f64> {
+    let params = &inner.problem().params;
+    let mut y = x.to_vec();
+    for (i, fj) in inner.searched().iter().zip(f) {
+        y[*i] = params[*i].from_fraction(*fj);
+    }
+    y
+}
+
+/// The residuals' linear model at a point: ψ_j = J_j / ‖J_j‖, the norms
+/// ‖J_j‖, ψᵀψ and ψᵀr.
+struct Linearised {
+    norms: Vec<f64>,
+    gram: DMatrix<f64>,
+    b: DVector<f64>,
+}
+
+impl Linearised {
+    /// J by forward differences at `x` (fractions `f`, residuals `r`;
+    /// backward at an upper bound). None when no key moves the residuals.
+    fn at(inner: &Variables<'_, '_>, x: &[f64], f: &[f64], r: &[f64]) -> Option<Self> {
+        let mut columns: Vec<Vec<f64>> = Vec::with_capacity(f.len());
+        let mut norms = Vec::with_capacity(f.len());
+        for j in 0..f.len() {
+            let h = if f[j] + STEP <= 1.0 { STEP } else { -STEP };
+            let mut g = f.to_vec();
+            g[j] += h;
+            let (rj, _) = inner.solved_at(with_fractions(inner, x, &g));
+            let col: Vec<f64> = rj.iter().zip(r).map(|(a, b)| (a - b) / h).collect();
+            let norm = dot(&col, &col).sqrt();
+            // A key that does not move the residuals keeps a column of
+            // zeros (and a unit norm): its step is then zero.
+            let norm = if norm.is_finite() && norm > 0.0 { norm } else { 1.0 };
+            columns.push(col.iter().map(|v| v / norm).collect());
+            norms.push(norm);
+        }
+        if norms.iter().all(|n| *n == 1.0) {
+            return None;
+        }
+        let k = columns.len();
+        Some(Self {
+            gram: DMatrix::from_fn(k, k, |a, c| dot(&columns[a], &columns[c])),
+            b: DVector::from_fn(k, |a, _| dot(&columns[a], r)),
+            norms,
+        })
+    }
+
+    /// The step d in fractions minimising ‖r + J d‖² + λ Σ_j ‖J_j‖² d_j²
+    /// over the box 0 ≤ f + d ≤ 1.
+    fn step(&self, f: &[f64], lambda: f64) -> Vec<f64> {
+        let mut gram = self.gram.clone();
+        for j in 0..f.len() {
+            gram[(j, j)] = 1.0 + lambda;
+        }
+        let boxed: Vec<(f64, f64)> = f
+            .iter()
+            .zip(&self.norms)
+            .map(|(fj, n)| (-fj * n, (1.0 - fj) * n))
+            .collect();
+        box_minimum(&gram, &self.b, &boxed)
+            .iter()
+            .zip(&self.norms)
+            .map(|(y, n)| y / n)
+            .collect()
+    }
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fit::local_run::local_run;
+    use crate::fit::options::{JacobianRule, LaterRuns};
+    use crate::fit::problem::{tests_data, Model, Problem};
+    use crate::fit::series::{Mapping, Series};
+    use crate::fit::unknowns::FittedParameter;
+    use crate::fit::PredictError;
+    use approx::assert_relative_eq;
+    use std::sync::Mutex;
+
+    /// Friction = a v + k (1 − e^(−|v|/s)) sgn v: `a` costly (a change of it
+    /// needs a whole simulation), `s` and `k` cheap; the costly values
+    /// every prediction was asked at are kept.
+    struct Film {
+        params: Vec<FittedParameter>,
+        costly_seen: Mutex<Vec<u64>>,
+    }
+
+    impl Film {
+        fn new(k_hi: f64) -> Self {
+            Film {
+                params: vec![
+                    FittedParameter::new("a", 1.0, 0.1, 10.0),
+                    FittedParameter::new("s", 0.1, 0.01, 1.0),
+                    FittedParameter::new("k", 0.5, 0.0, k_hi),
+                ],
+                costly_seen: Mutex::new(Vec::new()),
+            }
+        }
+        /// How many distinct values of the costly key were simulated.
+        fn solves(&self) -> usize {
+            let mut seen = self.costly_seen.lock().unwrap().clone();
+            seen.sort_unstable();
+            seen.dedup();
+            seen.len()
+        }
+    }
+
+    impl Model for Film {
+        fn label(&self) -> String {
+            "film".into()
+        }
+        fn parameters(&self) -> &[FittedParameter] {
+            &self.params
+        }
+        fn predict(&self, x: &[f64], s: &Series) -> Result<Vec<f64>, PredictError> {
+            self.costly_seen.lock().unwrap().push(x[0].to_bits());
+            let (a, speed, k) = (x[0], x[1], x[2]);
+            Ok(s.velocity
+                .iter()
+                .map(|v| a * v + k * (1.0 - (-v.abs() / speed).exp()) * v.signum())
+                .collect())
+        }
+        fn costly_parameters(&self) -> Option<Vec<usize>> {
+            Some(vec![0])
+        }
+    }
+
+    /// Samples of a = 2, s = 0.3, k = 1.5 over ±1.5 m/s.
+    fn data() -> crate::fit::problem::Data {
+        let mut text = String::from("t_s,velocity_m_s,friction_n\n");
+        for i in 0..200 {
+            let v = 1.5 * (i as f64 * 0.05).sin();
+            let f = 2.0 * v + 1.5 * (1.0 - (-v.abs() / 0.3).exp()) * v.signum();
+            text += &format!("{},{v},{f}\n", i as f64 * 0.01);
+        }
+        tests_data(&text, &Mapping::default())
+    }
+
+    /// The fitted point and the distinct costly values simulated.
+    fn fit(profiled: bool) -> (Vec<f64>, usize) {
+        let model = Film::new(5.0);
+        let data = data();
+        let mut problem = Problem::new(&model, &data, vec![]).unwrap();
+        problem.profile_cheap = profiled;
+        let run = local_run(
+            (&problem, None),
+            &problem.start(),
+            200,
+            JacobianRule::Secant,
+            &[],
+            LaterRuns::Full,
+            (1e-10, 1e-8),
+        );
+        assert!(run.converged, "{}", run.termination);
+        (run.x, model.solves())
+    }
+
+    #[test]
+    fn profiling_the_cheap_keys_reaches_the_joint_optimum_with_fewer_costly_simulations() {
+        let (profiled, profiled_solves) = fit(true);
+        let (searched, searched_solves) = fit(false);
+        for (x, truth) in [(&profiled, [2.0, 0.3, 1.5]), (&searched, [2.0, 0.3, 1.5])] {
+            for (v, t) in x.iter().zip(truth) {
+                assert_relative_eq!(*v, t, max_relative = 1e-5);
+            }
+        }
+        assert!(
+            profiled_solves < searched_solves,
+            "profiled {profiled_solves} costly simulations, searched {searched_solves}"
+        );
+    }
+
+    #[test]
+    fn a_cheap_key_whose_optimum_lies_past_its_bound_ends_on_the_bound() {
+        // k's best value 1.5 lies past its upper bound 1.2: the inner fit
+        // puts it on the bound exactly, with a and s at their optimum for it.
+        let model = Film::new(1.2);
+        let data = data();
+        let mut problem = Problem::new(&model, &data, vec![]).unwrap();
+        problem.profile_cheap = true;
+        let start = [2.0, 0.1, 0.5];
+        let vars = Variables::new(&problem, None, &start);
+        let inner = vars.cheap_at(&start).expect("s and k are profiled");
+        assert_eq!(inner.searched(), &[1, 2]);
+        let (r, x) = fit_cheap(inner, &start);
+        assert_eq!(x[2], 1.2);
+        assert_eq!(x[0], 2.0, "the costly key is held");
+        assert_relative_eq!(half_sum(&r), problem.cost(&x), max_relative = 1e-12);
+        // Nothing near it fits better: s moved either way, k inside.
+        for (ds, dk) in [(1.001, 1.0), (0.999, 1.0), (1.0, 0.999)] {
+            let y = [x[0], x[1] * ds, x[2] * dk];
+            assert!(problem.cost(&y) > half_sum(&r));
+        }
+    }
+}
