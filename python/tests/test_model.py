@@ -152,12 +152,12 @@ def test_the_search_rules_are_the_clis_and_a_bad_rule_is_named(cli, tmp_path):
                header="t_s,velocity_m_s,friction_n", comments="")
     keys = ["contact.boundary_friction", "drivetrain.viscous_n_s_m"]
     rules = {"jacobian": "differences", "later_runs": "valley", "linear_keys": "searched",
-             "cheap_keys": "searched"}
+             "cheap_keys": "profiled"}
     r = fn.fit(data, keys, overrides={"solver.cells": 32}, starts=2, global_points=4, **rules)
     out = tmp_path / "cli.yaml"
     cli("--set", "solver.cells=32", "fit", data, "--fit", ",".join(keys), "--starts", "2",
         "--global-points", "4", "--jacobian", "differences", "--later-runs", "valley",
-        "--linear-keys", "searched", "--cheap-keys", "searched", "--out", out)
+        "--linear-keys", "searched", "--cheap-keys", "profiled", "--out", out)
     assert r.fitted_yaml == out.read_text()
     # The defaults solve the viscous loss instead of searching it: another path
     # to the same optimum, so the same value to the fit's tolerance.

@@ -11,6 +11,7 @@
 //! | scaling | each parameter on its log scale (positive bounds) or linear scale, mapped to an unbounded variable by the sine transform s = lo + (hi − lo)(1 + sin u)/2 |
 //! | global phase | a seeded Latin-hypercube set of starts over the scaled bounds, each scored by one simulation |
 //! | linear parameters | solved, not searched: the parameters the residuals are linear in with fixed slopes (the drivetrain's viscous and quadratic losses, map coefficients that scale or offset the measured friction) are set at every point the local runs evaluate to their best values in their bounds (variable projection; `--linear-keys searched` searches them as the others) |
+//! | cheap parameters | searched with the film's keys; opt-in (`--cheap-keys profiled`), fitted at every point of the film's keys with the film held (`profile.rs`) |
 //! | local phase | Levenberg–Marquardt (MINPACK, `levenberg-marquardt` on nalgebra) from the given start, then the best distinct global starts side by side, each stopped inside the first optimum's 95 % confidence region or, with `--later-runs valley` (opt-in), as soon as a straight line from it falls all the way to that optimum (the valley test); Jacobian by forward differences of whole simulations run in parallel, kept up to date between them by Broyden's secant update and polished on differences at the end |
 //! | statistics | standard errors s²(JᵀJ)⁻¹ and correlations from the Jacobian in scaled coordinates at the optimum; flags at bounds and for |corr| > 0.95 |
 //!
@@ -44,6 +45,8 @@
 //! | `local_run.rs` | one Levenberg–Marquardt run: secant or difference Jacobians, the partial refresh, the polish, what was still moving |
 //! | `earlier_optima.rs` | the optima earlier runs found: a later run's stop inside one's confidence region or, opt-in, in its valley |
 //! | `separable.rs` | the parameters the residuals are linear in, solved exactly in their bounds at every point; the local runs' variables (the others) |
+//! | `profile.rs` | the cheap keys (a change recomposes the friction along the kept film) fitted at every point of the film's keys, in their bounds |
+//! | `box_qp.rs` | a convex quadratic's exact minimum over a box: the linear keys' solve, the cheap keys' steps |
 //! | `stats.rs` | standard errors, correlations, flags |
 //! | `options.rs` | how a fit searches: the user's settings, each fit's options, the Jacobian and later-run rules |
 //! | `physics_model.rs` | our model as a predictor: its keys, its film reused when only the terms after it change, its linear keys |
@@ -64,6 +67,7 @@
 #[cfg(feature = "mcap")]
 pub mod bag_input;
 pub mod baselines;
+mod box_qp;
 pub mod by_direction;
 pub mod calibrated_range;
 pub mod candidates;

@@ -268,10 +268,11 @@ impl LinearKeys {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum CheapKeys {
     /// Fitted at every point of the costly keys, the film held; the runs
-    /// search the costly keys alone (variable projection).
-    #[default]
+    /// search the costly keys alone (variable projection): far fewer film
+    /// solves, but another path, which can end in another basin (opt-in).
     Profiled,
-    /// Searched by the runs with the costly keys.
+    /// Searched by the runs with the costly keys (the default).
+    #[default]
     Searched,
 }
 

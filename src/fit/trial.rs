@@ -253,6 +253,8 @@ impl Ctx<'_> {
             max_evaluations: self.search.max_evaluations,
             stop: self.stop.clone(),
             jacobian: self.search.jacobian,
+            linear_keys: self.search.linear_keys,
+            cheap_keys: self.search.cheap_keys,
             // The selection compares sets at the percent level: a looser
             // convergence than the final fit's.
             ftol: 1e-6,

@@ -102,7 +102,7 @@ fn outcome_dict<'py>(py: Python<'py>, o: &FitOutcome) -> PyResult<Bound<'py, PyD
     load=None, temperature=None, smooth=0.05, map=Vec::new(), velocity_topic=None,
     friction_topic=None, joint=None, load_topic=None, temperature_topic=None, out=None,
     report_dir=None, progress=false, rotary=false, jacobian="secant", later_runs="full",
-    linear_keys="solved", cheap_keys="profiled"))]
+    linear_keys="solved", cheap_keys="searched"))]
 #[allow(clippy::too_many_arguments)]
 pub fn fit<'py>(
     py: Python<'py>,
