@@ -174,7 +174,7 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Lm<'_, '_> {
             match last.as_ref() {
                 Some(l) => self.vars.evaluate_near(u.as_slice(), &l.x),
                 None if !self.x.is_empty() => self.vars.evaluate_near(u.as_slice(), &self.x),
-                None => self.vars.evaluate(u.as_slice()),
+                None => self.vars.evaluate_first(u.as_slice()),
             }
         };
         self.r = DVector::from_vec(r);

@@ -20,15 +20,18 @@
 //! profiled cost's gradient in θ is the joint cost's (Kaufman 1975): a
 //! stationary point of the profile is one of the joint problem.
 //!
-//! Why it is not the default: the path differs, and where the cheap keys
-//! have several optima of their own (a Stribeck speed bends the curve
-//! wherever the data have a place for it) the inner fit at the start's
-//! film settles in one of them and the outer search over the film's keys
-//! cannot leave it. On the lead screw's faster-speed split (b) the film
-//! with the Stribeck curve, from the default start, ends at training RMS
-//! 6.86e-5 N·m where the joint search reaches 1.38e-5. On the EMPS
-//! record's 10-key bench it reaches the joint search's optimum with 44
-//! film solves instead of 335.
+//! A cheap key that bends the curve at a speed (a Stribeck speed, an
+//! activation speed) has several optima of its own, one per place the data
+//! give the bend: a run's first inner fit also starts it at three places
+//! of its range and keeps the best (`Variables::evaluate_first`); the
+//! later points follow that basin. Without it, on the lead screw's
+//! faster-speed split (b) the film with the Stribeck curve ended at
+//! training RMS 6.86e-5 N·m where the joint search reaches 1.38e-5 (the
+//! bend at 0.2 rad/s instead of 4.1); with it, the same optimum as the
+//! joint search from each of three starts, with 47–80 film solves against
+//! 133–261. On the EMPS record's 10-key bench: the joint search's optimum
+//! with 44 film solves instead of 335. It is opt-in until it has been
+//! checked on every benchmark the default is judged by.
 //!
 //! The inner fit is a Levenberg–Marquardt on f with the bounds kept
 //! exactly: each step minimises ‖r + J d‖² + λ Σ_j (J_jᵀJ_j) d_j² over the

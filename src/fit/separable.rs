@@ -40,6 +40,11 @@ use nalgebra::{DMatrix, DVector};
 /// linear ones are searched.
 pub const MAX_LINEAR: usize = 6;
 
+/// Where a profiled key that bends the curve at a speed also starts at a
+/// run's first point: fractions of its scaled (log) range, near its slow
+/// end, in its middle and near its fast end.
+const BEND_PLACES: [f64; 3] = [0.1, 0.5, 0.9];
+
 /// The linear parameters of a problem and their fixed slopes.
 #[derive(Debug, Clone)]
 pub struct Separable {
@@ -292,6 +297,33 @@ impl<'p, 'a> Variables<'p, 'a> {
     /// problem's large residuals (nothing is solved there).
     pub fn evaluate(&self, u: &[f64]) -> (Vec<f64>, Vec<f64>) {
         self.evaluate_near(u, &self.reference)
+    }
+
+    /// [`Self::evaluate`] at a run's first point: with the profiled
+    /// parameters fitted from their values in the reference and, for each
+    /// profiled key that bends the curve at a speed
+    /// ([`super::unknowns::BEND_SPEED_KEYS`]), from that key at
+    /// three places of its range (`BEND_PLACES`) as well; the best of these fits. The
+    /// later points follow the basin it chose, warm-started.
+    pub fn evaluate_first(&self, u: &[f64]) -> (Vec<f64>, Vec<f64>) {
+        let mut best = self.evaluate(u);
+        let x0 = self.point(u, &self.reference);
+        let sum = |r: &[f64]| r.iter().map(|v| v * v).sum::<f64>();
+        for i in &self.profiled {
+            let p = &self.problem.params[*i];
+            if !super::unknowns::BEND_SPEED_KEYS.contains(&p.name.as_str()) {
+                continue;
+            }
+            for f in BEND_PLACES {
+                let mut near = x0.clone();
+                near[*i] = p.from_fraction(f);
+                let tried = self.evaluate_near(u, &near);
+                if sum(&tried.0) < sum(&best.0) {
+                    best = tried;
+                }
+            }
+        }
+        best
     }
 
     /// [`Self::evaluate`] with the profiled parameters fitted from their

@@ -96,7 +96,7 @@ fn film_placements(p: &Prepared) -> Vec<f64> {
 fn placements(p: &Prepared, key: &str) -> Vec<f64> {
     match key {
         FILM_KEY => film_placements(p),
-        "drivetrain.stribeck_speed_m_s" | "contact.boundary_activation_speed_m_s" => {
+        k if super::unknowns::BEND_SPEED_KEYS.contains(&k) => {
             let gain = p.contact_scale.as_ref().map_or(1.0, |s| s.gain);
             let top = p.model_scale.velocity_m_s;
             let slow =

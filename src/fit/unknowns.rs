@@ -48,6 +48,15 @@ pub struct FittedParameter {
 /// moved inside: the sine transform is stationary at its bounds.
 const START_MARGIN: f64 = 0.02;
 
+/// The keys that place a bend of the friction curve at a speed (a Stribeck
+/// speed, a boundary film's activation speed): such a key has as many
+/// optima as the data have places to bend the curve, and one start finds
+/// one of them.
+pub const BEND_SPEED_KEYS: [&str; 2] = [
+    "drivetrain.stribeck_speed_m_s",
+    "contact.boundary_activation_speed_m_s",
+];
+
 impl FittedParameter {
     /// This parameter started at `v`, kept inside its bounds (clear of
     /// them by the start margin, where the sine transform is stationary);
