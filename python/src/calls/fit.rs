@@ -93,6 +93,30 @@ fn outcome_dict<'py>(py: Python<'py>, o: &FitOutcome) -> PyResult<Bound<'py, PyD
     Ok(d)
 }
 
+/// `search` with its rules named as the command line names them: the
+/// Jacobian, the later runs, the linear keys and the cheap keys.
+fn with_rules(search: SearchSettings, names: [&str; 4]) -> PyResult<SearchSettings> {
+    let [jacobian, later_runs, linear_keys, cheap_keys] = names;
+    Ok(SearchSettings {
+        jacobian: JacobianRule::parse(jacobian).map_err(|e| argument("jacobian", e))?,
+        later_runs: LaterRuns::parse(later_runs).map_err(|e| argument("later_runs", e))?,
+        linear_keys: LinearKeys::parse(linear_keys).map_err(|e| argument("linear_keys", e))?,
+        cheap_keys: CheapKeys::parse(cheap_keys).map_err(|e| argument("cheap_keys", e))?,
+        ..search
+    })
+}
+
+/// A map coefficient's name has no dots (dotted names are configuration
+/// keys).
+fn check_map_names(map: &[(String, f64)]) -> PyResult<()> {
+    match map.iter().find(|(n, _)| n.contains('.')) {
+        Some((n, _)) => Err(errors::value(format!(
+            "map {n}: a map coefficient's name has no dots (dotted names are configuration keys)"
+        ))),
+        None => Ok(()),
+    }
+}
+
 /// Calibrate (see the Python wrapper): the command line's `fit`.
 #[pyfunction]
 #[pyo3(signature = (data, keys, config_path=None, overrides=Vec::new(), bounds=Vec::new(),
@@ -148,11 +172,7 @@ pub fn fit<'py>(
         None => load_config(None, None, &overrides)?,
     };
     let delimiter = delimiter_named(delimiter)?;
-    if let Some((n, _)) = map.iter().find(|(n, _)| n.contains('.')) {
-        return Err(errors::value(format!(
-            "map {n}: a map coefficient's name has no dots (dotted names are configuration keys)"
-        )));
-    }
+    check_map_names(&map)?;
     let req = FitRequest {
         data: DataRequest {
             files: data,
@@ -180,16 +200,16 @@ pub fn fit<'py>(
             rotary,
         },
         params: param_specs(&keys, &bounds, &starts_at).map_err(errors::fit)?,
-        search: SearchSettings {
-            starts,
-            global_points,
-            seed,
-            max_evaluations,
-            jacobian: JacobianRule::parse(jacobian).map_err(|e| argument("jacobian", e))?,
-            later_runs: LaterRuns::parse(later_runs).map_err(|e| argument("later_runs", e))?,
-            linear_keys: LinearKeys::parse(linear_keys).map_err(|e| argument("linear_keys", e))?,
-            cheap_keys: CheapKeys::parse(cheap_keys).map_err(|e| argument("cheap_keys", e))?,
-        },
+        search: with_rules(
+            SearchSettings {
+                starts,
+                global_points,
+                seed,
+                max_evaluations,
+                ..Default::default()
+            },
+            [jacobian, later_runs, linear_keys, cheap_keys],
+        )?,
         baselines,
     };
     let progress = progress.then(|| {
