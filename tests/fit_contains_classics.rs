@@ -261,28 +261,49 @@ fn film_removed(md: &str) -> (&str, &str) {
     (removed, chosen)
 }
 
+/// The selection table's cross-validated RMS of the set `terms` (beside
+/// the boundary friction).
+fn selection_cv(md: &str, terms: &str) -> f64 {
+    let line = md
+        .lines()
+        .find(|l| l.starts_with(&format!("| {terms} |")))
+        .unwrap_or_else(|| panic!("no selection row {terms} in\n{md}"));
+    line.split('|')
+        .map(str::trim)
+        .nth(2)
+        .unwrap()
+        .parse()
+        .unwrap()
+}
+
 #[test]
-fn on_the_lead_screws_faster_speeds_the_film_the_data_cannot_tell_from_the_stribeck_rise_goes() {
-    // On the lead screw's faster speeds the film pays at its trial fit
-    // (its transition placed inside the data; every fold lower), but its
-    // viscosity correlates 0.999 with the Stribeck curve's viscous rise:
-    // over the training speeds the film's rise is the viscous one. Kept to
-    // the final fit (its transition far above the data), it did nothing
-    // there and predicted 0.14 % worse than the Stribeck curve alone. It
-    // goes at the selection, and ours is the Stribeck curve it contains:
+fn on_the_lead_screws_faster_speeds_the_film_scored_by_refitted_folds_does_not_pay_beside_the_stribeck_curve(
+) {
+    // Each fold of a set's trial is refitted from the set's fit on all the
+    // training points, which saw the fold. With the film's keys and the
+    // friction terms' searched together, the folds of the film beside the
+    // Stribeck curve hardly moved from there: three of four ended with a
+    // higher training error than the Stribeck curve alone on the same fold
+    // (the set contains it) and predicted the points their start was
+    // fitted on, CV 1.86e-5 N·m against the Stribeck curve's refitted
+    // 2.73e-5: the film seemed to pay, and only the correlation rule took
+    // it out again. With the friction terms profiled, the folds converge:
+    // the film pays nothing, and ours is the Stribeck curve it contains,
     // as good held out as the classic, to 1e-4.
     let d = dir("lead-screw-faster");
     let (t, v) = (d.join("train.csv"), d.join("validate.csv"));
     lead_screw_faster_speeds(&t, &v);
     let md = fit_auto_with(&t, &["--validate", v.to_str().unwrap(), "--rotary"]);
-    let (removed, chosen) = film_removed(&md);
+    let stribeck = selection_cv(&md, "drivetrain Stribeck");
+    let with_film = selection_cv(&md, "drivetrain Stribeck, film");
+    assert!(
+        with_film >= stribeck,
+        "the film beside the Stribeck curve: CV {with_film}, the curve alone {stribeck}\n{md}"
+    );
+    let chosen = md.lines().find(|l| l.starts_with("Chosen:")).unwrap();
     assert!(
         chosen.starts_with("Chosen: boundary friction, drivetrain Stribeck."),
         "{chosen}"
-    );
-    assert!(
-        removed.contains("the data cannot tell film from drivetrain Stribeck"),
-        "{removed}"
     );
     assert_held_out_within(&md, "Stribeck", 1.0 + 1e-4);
 }

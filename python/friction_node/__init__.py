@@ -416,7 +416,7 @@ def fit(
     jacobian: str = "secant",
     later_runs: str = "full",
     linear_keys: str = "solved",
-    cheap_keys: str = "searched",
+    cheap_keys: str = "profiled",
 ) -> FitResult:
     """Calibrate configuration keys (and input-map coefficients) to
     recorded friction, as ``friction-node fit`` does (same arguments, same

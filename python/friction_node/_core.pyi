@@ -111,5 +111,5 @@ def fit(
     jacobian: str = "secant",
     later_runs: str = "full",
     linear_keys: str = "solved",
-    cheap_keys: str = "searched",
+    cheap_keys: str = "profiled",
 ) -> Dict[str, Any]: ...

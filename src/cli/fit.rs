@@ -99,11 +99,11 @@ pub struct FitArgs {
     /// The keys whose change only recomposes the friction along the kept
     /// film (the friction terms' keys), when keys that need a film solve
     /// (the film's own: viscosity, roughness, load…) are fitted beside
-    /// them: `searched` with them (the default), or `profiled`: fitted at
-    /// every point of the film's keys with the film held, the local runs
-    /// searching the film's keys alone (far fewer film solves, but another
-    /// path that can end at another optimum: see the README).
-    #[arg(long, default_value = "searched", value_parser = CheapKeys::parse)]
+    /// them: `profiled`, fitted at every point of the film's keys with the
+    /// film held, the local runs searching the film's keys alone (the
+    /// default: far fewer film solves), or `searched` with them as every
+    /// other key (see the README).
+    #[arg(long, default_value = "profiled", value_parser = CheapKeys::parse)]
     pub cheap_keys: CheapKeys,
     /// Column names of headerless CSV data (comma-separated).
     #[arg(long, value_name = "NAME,...", value_delimiter = ',')]

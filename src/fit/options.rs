@@ -269,10 +269,10 @@ impl LinearKeys {
 pub enum CheapKeys {
     /// Fitted at every point of the costly keys, the film held; the runs
     /// search the costly keys alone (variable projection): far fewer film
-    /// solves, but another path, which can end in another basin (opt-in).
-    Profiled,
-    /// Searched by the runs with the costly keys (the default).
+    /// solves (the default).
     #[default]
+    Profiled,
+    /// Searched by the runs with the costly keys, as every other key.
     Searched,
 }
 

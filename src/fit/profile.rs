@@ -1,6 +1,6 @@
 //! The cheap keys fitted at every point of the costly ones (variable
-//! projection with a nonlinear inner problem; Golub & Pereyra 2003, §4),
-//! opt-in: `--cheap-keys profiled`.
+//! projection with a nonlinear inner problem; Golub & Pereyra 2003, §4):
+//! the default, `--cheap-keys profiled`.
 //!
 //! | symbol | meaning | unit |
 //! |---|---|---|
@@ -30,8 +30,7 @@
 //! bend at 0.2 rad/s instead of 4.1); with it, the same optimum as the
 //! joint search from each of three starts, with 47–80 film solves against
 //! 133–261. On the EMPS record's 10-key bench: the joint search's optimum
-//! with 44 film solves instead of 335. It is opt-in until it has been
-//! checked on every benchmark the default is judged by.
+//! with 44 film solves instead of 335.
 //!
 //! The inner fit is a Levenberg–Marquardt on f with the bounds kept
 //! exactly: each step minimises ‖r + J d‖² + λ Σ_j (J_jᵀJ_j) d_j² over the

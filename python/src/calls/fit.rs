@@ -126,7 +126,7 @@ fn check_map_names(map: &[(String, f64)]) -> PyResult<()> {
     load=None, temperature=None, smooth=0.05, map=Vec::new(), velocity_topic=None,
     friction_topic=None, joint=None, load_topic=None, temperature_topic=None, out=None,
     report_dir=None, progress=false, rotary=false, jacobian="secant", later_runs="full",
-    linear_keys="solved", cheap_keys="searched"))]
+    linear_keys="solved", cheap_keys="profiled"))]
 #[allow(clippy::too_many_arguments)]
 pub fn fit<'py>(
     py: Python<'py>,
