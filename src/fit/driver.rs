@@ -95,6 +95,7 @@ pub fn fit(
     let mut problem = Problem::new(model, data, map_fit)?;
     problem.stop = options.stop.clone();
     problem.profile_cheap = options.cheap_keys == super::options::CheapKeys::Profiled;
+    problem.cheap_ftol = super::profile::INNER_FTOL * options.ftol;
     let separable = if options.linear_keys == super::options::LinearKeys::Solved {
         super::separable::Separable::new(&problem)
     } else {

@@ -272,6 +272,10 @@ pub struct Problem<'a> {
     /// Whether the local runs fit the cheap keys at every point of the
     /// costly ones (`profile.rs`), or search them all together.
     pub profile_cheap: bool,
+    /// The profiled inner fit ends on a step that lowers its cost by less
+    /// than this fraction: [`super::profile::INNER_FTOL`] × the runs'
+    /// `ftol`, so the inner fits stay well inside the runs' tolerance.
+    pub cheap_ftol: f64,
     /// Model evaluations so far.
     pub simulations: AtomicUsize,
     /// Their total wall time, ns.
@@ -342,6 +346,7 @@ impl<'a> Problem<'a> {
             predictions: Mutex::new(Vec::new()),
             stop: crate::interrupt::Stop::new(),
             profile_cheap: false,
+            cheap_ftol: super::profile::INNER_FTOL * super::options::Options::default().ftol,
             simulations: AtomicUsize::new(0),
             simulation_ns: AtomicU64::new(0),
         })

@@ -41,9 +41,10 @@
 use super::box_qp::box_minimum;
 use super::problem::Problem;
 use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
 
 /// What the inner fit needs of the local runs' variables.
-pub(super) trait CheapFit {
+pub(super) trait CheapFit: Sync {
     /// The problem.
     fn problem(&self) -> &Problem<'_>;
     /// The cheap keys fitted (indices into the problem's parameters).
@@ -57,9 +58,12 @@ pub(super) trait CheapFit {
 const STEP: f64 = 1e-6;
 /// Most inner iterations (Jacobians).
 const MAX_ITERATIONS: usize = 100;
-/// An accepted step that lowers the cost by less than this fraction ends
-/// the inner fit.
-const COST_TOLERANCE: f64 = 1e-12;
+/// An accepted step that lowers the cost by less than `Problem::cheap_ftol`
+/// (this fraction of the runs' `ftol`) ends the inner fit: 1e-12 for a
+/// final fit (`ftol` 1e-10), 1e-8 for a selection's trial (1e-6), whose
+/// inner fits along a ridge the data hardly resolve (a bristle's stiffness
+/// and damping) otherwise crawl on at 1e-12.
+pub(super) const INNER_FTOL: f64 = 1e-2;
 /// So does one shorter than this, in fractions of the ranges.
 const STEP_TOLERANCE: f64 = 1e-10;
 /// Levenberg–Marquardt damping: first value, and its factors on an
@@ -101,7 +105,7 @@ pub(super) fn fit_cheap(inner: &dyn CheapFit, x: &[f64]) -> (Vec<f64>, Vec<f64>)
             let (rt, xt) = inner.solved_at(with_fractions(inner, &x, &trial));
             let ct = half_sum(&rt);
             if ct < cost {
-                let small = cost - ct < COST_TOLERANCE * cost;
+                let small = cost - ct < problem.cheap_ftol * cost;
                 (r, x, cost) = (rt, xt, ct);
                 lambda = (lambda * DAMPING.1).max(DAMPING_MIN);
                 break small;
@@ -150,25 +154,27 @@ impl Linearised {
     /// J by forward differences at `x` (fractions `f`, residuals `r`;
     /// backward at an upper bound). None when no key moves the residuals.
     fn at(inner: &dyn CheapFit, x: &[f64], f: &[f64], r: &[f64]) -> Option<Self> {
-        let mut columns: Vec<Vec<f64>> = Vec::with_capacity(f.len());
-        let mut norms = Vec::with_capacity(f.len());
-        for j in 0..f.len() {
-            let h = if f[j] + STEP <= 1.0 { STEP } else { -STEP };
-            let mut g = f.to_vec();
-            g[j] += h;
-            let (rj, _) = inner.solved_at(with_fractions(inner, x, &g));
-            let col: Vec<f64> = rj.iter().zip(r).map(|(a, b)| (a - b) / h).collect();
-            let norm = dot(&col, &col).sqrt();
-            // A key that does not move the residuals keeps a column of
-            // zeros (and a unit norm): its step is then zero.
-            let norm = if norm.is_finite() && norm > 0.0 {
-                norm
-            } else {
-                1.0
-            };
-            columns.push(col.iter().map(|v| v / norm).collect());
-            norms.push(norm);
-        }
+        // The columns side by side: a run's outer Jacobian often has one
+        // column (the film's one key), so this is where the cores work.
+        let (columns, norms): (Vec<Vec<f64>>, Vec<f64>) = (0..f.len())
+            .into_par_iter()
+            .map(|j| {
+                let h = if f[j] + STEP <= 1.0 { STEP } else { -STEP };
+                let mut g = f.to_vec();
+                g[j] += h;
+                let (rj, _) = inner.solved_at(with_fractions(inner, x, &g));
+                let col: Vec<f64> = rj.iter().zip(r).map(|(a, b)| (a - b) / h).collect();
+                let norm = dot(&col, &col).sqrt();
+                // A key that does not move the residuals keeps a column of
+                // zeros (and a unit norm): its step is then zero.
+                let norm = if norm.is_finite() && norm > 0.0 {
+                    norm
+                } else {
+                    1.0
+                };
+                (col.iter().map(|v| v / norm).collect(), norm)
+            })
+            .unzip();
         if norms.iter().all(|n| *n == 1.0) {
             return None;
         }
