@@ -273,7 +273,7 @@ pub struct Problem<'a> {
     /// costly ones (`profile.rs`), or search them all together.
     pub profile_cheap: bool,
     /// The profiled inner fit ends on a step that lowers its cost by less
-    /// than this fraction: [`super::profile::INNER_FTOL`] × the runs'
+    /// than this fraction: `profile::INNER_FTOL` (1e-2) × the runs'
     /// `ftol`, so the inner fits stay well inside the runs' tolerance.
     pub cheap_ftol: f64,
     /// Model evaluations so far.
