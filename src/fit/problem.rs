@@ -346,7 +346,8 @@ impl<'a> Problem<'a> {
             predictions: Mutex::new(Vec::new()),
             stop: crate::interrupt::Stop::new(),
             profile_cheap: false,
-            cheap_ftol: super::profile::INNER_FTOL * super::options::Options::default().ftol,
+            // The driver sets it from the runs' ftol; this is a final fit's.
+            cheap_ftol: 1e-12,
             simulations: AtomicUsize::new(0),
             simulation_ns: AtomicU64::new(0),
         })
