@@ -220,10 +220,10 @@ impl PhysicsModel {
     /// the contact's speed is the data's times the gain) at values `x`:
     /// recomposed along a kept film trace when one matches, else solved,
     /// its trace kept. The contact's series is built only for a solve (a
-    /// trace's film key holds the gain, its inputs the data's).
-    fn run(&self, x: &[f64], s: &Series) -> Result<Vec<f64>, PredictError> {
+    /// trace's film key holds the gain, its inputs the data's; `inputs`
+    /// is `s`'s `Series::inputs_fingerprint`).
+    fn run(&self, x: &[f64], s: &Series, inputs: u64) -> Result<Vec<f64>, PredictError> {
         let film_key = self.film_key(x);
-        let inputs = s.inputs_fingerprint();
         let lock = || self.traces.kept.lock().unwrap_or_else(|p| p.into_inner());
         let kept = lock()
             .iter()
@@ -302,7 +302,16 @@ impl Model for PhysicsModel {
     }
 
     fn predict(&self, x: &[f64], series: &Series) -> Result<Vec<f64>, PredictError> {
-        let mut f = self.run(x, series)?;
+        self.predict_fingerprinted(x, series, series.inputs_fingerprint())
+    }
+
+    fn predict_fingerprinted(
+        &self,
+        x: &[f64],
+        series: &Series,
+        inputs: u64,
+    ) -> Result<Vec<f64>, PredictError> {
+        let mut f = self.run(x, series, inputs)?;
         if self.gain != 1.0 {
             f.iter_mut().for_each(|f| *f *= self.gain);
         }

@@ -22,6 +22,19 @@ pub trait Model: Sync {
     /// measured friction or which samples are fitted: a prediction is
     /// reused when only those change (a map coefficient of the friction).
     fn predict(&self, x: &[f64], series: &Series) -> Result<Vec<f64>, PredictError>;
+    /// [`Model::predict`] given `inputs`, the series'
+    /// [`Series::inputs_fingerprint`] (the fit computes it once per
+    /// series): a model that keys kept work on it need not hash the
+    /// series' columns again at every evaluation. By default, `predict`.
+    fn predict_fingerprinted(
+        &self,
+        x: &[f64],
+        series: &Series,
+        inputs: u64,
+    ) -> Result<Vec<f64>, PredictError> {
+        let _ = inputs;
+        self.predict(x, series)
+    }
     /// The film solves so far, for a model that solves a film (None: a
     /// model whose every evaluation costs the same).
     fn film_solves(&self) -> Option<usize> {
@@ -256,9 +269,10 @@ pub struct Problem<'a> {
     pub params: Vec<FittedParameter>,
     fitted_samples: usize,
     friction_scale: f64,
-    /// The series of every source (training, held out, validation) when
-    /// no map coefficient is fitted (they do not change).
-    fixed: Option<[Vec<Arc<Series>>; 3]>,
+    /// The series of every source (training, held out, validation) with
+    /// their inputs' fingerprints, when no map coefficient is fitted (they
+    /// do not change).
+    fixed: Option<[Vec<Fingerprinted>; 3]>,
     /// The series of the last few map-coefficient values (training or
     /// validation): a Jacobian column that moves only a model parameter
     /// reuses them instead of evaluating the column expressions again.
@@ -322,7 +336,8 @@ impl<'a> Problem<'a> {
                     .map(|(i, s)| {
                         let mut se = s.series(&data.map_values)?;
                         holdout.apply(&mut se, i);
-                        Ok(Arc::new(se))
+                        let print = se.inputs_fingerprint();
+                        Ok((Arc::new(se), print))
                     })
                     .collect::<Result<Vec<_>, super::FitError>>()
             };
@@ -403,11 +418,8 @@ impl<'a> Problem<'a> {
             .into_par_iter()
             .map(|i| {
                 let (series, print) = match (&self.fixed, &computed) {
-                    (Some(fixed), _) => (fixed[role as usize][i].clone(), None),
-                    (None, Some(c)) => {
-                        let (s, print) = c[i].clone()?;
-                        (s, Some(print))
-                    }
+                    (Some(fixed), _) => fixed[role as usize][i].clone(),
+                    (None, Some(c)) => c[i].clone()?,
                     (None, None) => unreachable!("computed when not fixed"),
                 };
                 let predicted = self.predict_one(&x[..n], role, i, &series, print)?;
@@ -419,19 +431,18 @@ impl<'a> Problem<'a> {
     /// The model on one source: a kept prediction when the parameters and
     /// the series' inputs (their fingerprint `print`) are those of one,
     /// else a simulation (kept when map coefficients are fitted, the only
-    /// case where it is reused and the only one with a fingerprint).
+    /// case where it is reused).
     fn predict_one(
         &self,
         x: &[f64],
         role: Role,
         source: usize,
         series: &Series,
-        print: Option<u64>,
+        print: u64,
     ) -> Result<Vec<f64>, PredictError> {
         let bits: Vec<u64> = x.iter().map(|v| v.to_bits()).collect();
         let lock = || self.predictions.lock().unwrap_or_else(|p| p.into_inner());
-        let keep = print.is_some();
-        let print = print.unwrap_or(0);
+        let keep = self.fixed.is_none();
         if keep {
             if let Some(e) = lock()
                 .iter()
@@ -441,7 +452,7 @@ impl<'a> Problem<'a> {
             }
         }
         let start = Instant::now();
-        let predicted = self.model.predict(x, series);
+        let predicted = self.model.predict_fingerprinted(x, series, print);
         self.simulations.fetch_add(1, Ordering::Relaxed);
         self.simulation_ns.fetch_add(
             u64::try_from(start.elapsed().as_nanos()).unwrap_or(u64::MAX),
