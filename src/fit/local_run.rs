@@ -116,11 +116,13 @@ impl<'p, 'a> Lm<'p, 'a> {
     }
 
     /// The Jacobian by forward differences: every column, or the columns
-    /// `only` marks (the others zero).
+    /// `only` marks (the others zero). Profiled, each column is taken
+    /// with the cheap keys held at the point's fit and projected out of
+    /// their span (`profile::project_out_cheap`), not by a second inner fit.
     fn differences(&self, only: Option<&[bool]>) -> DMatrix<f64> {
         let n = self.u.len();
         let taken = |j: usize| only.is_none_or(|o| o[j]);
-        let columns: Vec<Vec<f64>> = (0..n)
+        let mut columns: Vec<Vec<f64>> = (0..n)
             .into_par_iter()
             .map(|j| {
                 if !taken(j) {
@@ -129,14 +131,16 @@ impl<'p, 'a> Lm<'p, 'a> {
                 let mut u = self.u.clone();
                 u[j] += FD_STEP;
                 self.vars
-                    .evaluate_near(u.as_slice(), &self.x)
-                    .0
+                    .evaluate_held(u.as_slice(), &self.x)
                     .iter()
                     .zip(self.r.iter())
                     .map(|(a, b)| (a - b) / FD_STEP)
                     .collect()
             })
             .collect();
+        if let Some(inner) = self.vars.cheap_at(&self.x) {
+            super::profile::project_out_cheap(&inner, &self.x, self.r.as_slice(), &mut columns);
+        }
         let count = (0..n).filter(|j| taken(*j)).count();
         self.jacobian_evaluations
             .fetch_add(count, Ordering::Relaxed);

@@ -339,6 +339,18 @@ impl<'p, 'a> Variables<'p, 'a> {
         }
     }
 
+    /// The residuals at u with the profiled parameters held at their
+    /// values in `near` (not fitted there) and the linear ones solved: a
+    /// profiled Jacobian's column before its projection
+    /// (`profile::project_out_cheap`). Without profiled parameters,
+    /// [`Self::evaluate_near`]'s.
+    pub(super) fn evaluate_held(&self, u: &[f64], near: &[f64]) -> Vec<f64> {
+        if self.profiled.is_empty() {
+            return self.evaluate_near(u, near).0;
+        }
+        self.solved_at(self.point(u, near)).0
+    }
+
     /// The residuals at the whole point `x` with the linear parameters
     /// solved, and the point.
     pub(super) fn solved_at(&self, mut x: Vec<f64>) -> (Vec<f64>, Vec<f64>) {
