@@ -386,6 +386,70 @@ mod tests {
         );
     }
 
+    /// At the costly key a, the cheap keys s and k fitted tightly there:
+    /// the relative distances of the column taken with them held, before
+    /// and after its projection, from the central difference of the
+    /// profiled residuals r(a, c*(a)) (each side fitted again), and the
+    /// relative error of the projected column's gradient Jᵀr against the
+    /// profiled cost's central difference.
+    fn projected_column_errors(a: f64) -> (f64, f64, f64) {
+        let model = Film::new(5.0);
+        let data = data();
+        let mut problem = Problem::new(&model, &data, vec![]).unwrap();
+        problem.profile_cheap = true;
+        problem.cheap_ftol = 1e-16;
+        let start = [a, 0.2, 1.0];
+        let vars = Variables::new(&problem, None, &start);
+        let profiled = |a: f64| {
+            let mut x = start.to_vec();
+            x[0] = a;
+            fit_cheap(&vars.cheap_at(&x).unwrap(), &x)
+        };
+        let (r, x) = profiled(a);
+        let h = 1e-4;
+        let (rp, _) = profiled(a + h);
+        let (rm, _) = profiled(a - h);
+        let exact: Vec<f64> = rp
+            .iter()
+            .zip(&rm)
+            .map(|(p, m)| (p - m) / (2.0 * h))
+            .collect();
+        let mut held = x.clone();
+        held[0] += 1e-7;
+        let (rh, _) = CheapFit::solved_at(&vars, held);
+        let column: Vec<f64> = rh.iter().zip(&r).map(|(a, b)| (a - b) / 1e-7).collect();
+        let mut projected = vec![column.clone()];
+        project_out_cheap(&vars.cheap_at(&x).unwrap(), &x, &r, &mut projected);
+        let distance = |a: &[f64]| {
+            let d: Vec<f64> = a.iter().zip(&exact).map(|(p, q)| p - q).collect();
+            dot(&d, &d).sqrt() / dot(&exact, &exact).sqrt()
+        };
+        let slope = (half_sum(&rp) - half_sum(&rm)) / (2.0 * h);
+        let gradient = (dot(&projected[0], &r) - slope).abs() / slope.abs();
+        (distance(&column), distance(&projected[0]), gradient)
+    }
+
+    #[test]
+    fn near_the_optimum_the_projected_jacobian_is_the_derivative_of_the_profiled_residuals() {
+        // Small residuals (the data are the model's at a = 2: the
+        // Gauss–Newton limit): the projected column is the profile's
+        // derivative, to an error that falls with the residuals (1.6 % at
+        // a = 1.98, 18 % at 1.7); the column before it is not (a and k both
+        // raise the friction with the speed, so c* moves with a).
+        let (held, projected, gradient) = projected_column_errors(1.999);
+        assert!(projected < 2e-3, "{projected}");
+        assert!(held > 0.05, "{held}");
+        assert!(gradient < 1e-3, "{gradient}");
+    }
+
+    #[test]
+    fn far_from_the_optimum_the_projected_jacobians_gradient_is_the_profiled_costs() {
+        // Large residuals: the column carries the Gauss–Newton error of
+        // dc*/da, but Jᵀr, what the runs descend on, is exact at c*.
+        let (_, _, gradient) = projected_column_errors(1.7);
+        assert!(gradient < 1e-3, "{gradient}");
+    }
+
     #[test]
     fn a_cheap_key_whose_optimum_lies_past_its_bound_ends_on_the_bound() {
         // k's best value 1.5 lies past its upper bound 1.2: the inner fit
