@@ -68,7 +68,7 @@ pub const CANDIDATES: &[Candidate] = &[
         part_of_requirement: false,
     },
     Candidate {
-        name: "drivetrain viscous",
+        name: VISCOUS,
         keys: &["drivetrain.viscous_n_s_m"],
         requires: None,
         needs_varying_load: false,
@@ -85,7 +85,7 @@ pub const CANDIDATES: &[Candidate] = &[
         // The classic Stribeck curve on our level: the static excess, its
         // speed and the viscous rise (a dip needs the rise beside it; alone
         // neither pays).
-        name: "drivetrain Stribeck",
+        name: STRIBECK,
         keys: &[
             "drivetrain.stribeck_n",
             "drivetrain.stribeck_speed_m_s",
@@ -296,6 +296,12 @@ pub(super) fn candidates_here(
 
 /// The candidate named `film` (the viscosity), and its key.
 pub(super) const FILM: &str = "film";
+/// The drivetrain's Stribeck curve, one of the classic shapes a steady
+/// curve may be presumed to have (`select.rs`, rule 7).
+pub(super) const STRIBECK: &str = "drivetrain Stribeck";
+/// The drivetrain's viscous rise (Coulomb + viscous with the base), the
+/// other classic shape of rule 7.
+pub(super) const VISCOUS: &str = "drivetrain viscous";
 /// See [`FILM`].
 pub(super) const FILM_KEY: &str = "lubricant.viscosity_pa_s";
 

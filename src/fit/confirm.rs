@@ -65,13 +65,24 @@ pub fn unconfirmed(s: &Selection, final_mse: &[f64], units: super::Units) -> Opt
         .unwrap_or_default();
     let (ok, gain, se, share) = pays(&fewer.tried, &at_final);
     // A part of a chosen term (rule 4b) stays unless the folds predict
-    // worse with it; any other term must pay.
+    // worse with it; a presumed term (rule 7) unless the set without it
+    // pays over it; any other term must pay.
     let part = is_part(term);
-    if (part && keeps_part(&fewer.tried, &at_final)) || (!part && ok) {
+    let presumed = s.presumed.contains(&term);
+    let stays = if part {
+        keeps_part(&fewer.tried, &at_final)
+    } else if presumed {
+        !pays(&at_final, &fewer.tried).0
+    } else {
+        ok
+    };
+    if stays {
         return None;
     }
     let verdict = if part {
         "which predicts the folds worse at the optimum the fit reached than without this part"
+    } else if presumed {
+        "and the set without this presumed term pays over it at the optimum the fit reached"
     } else {
         "which does not pay at the optimum the fit reached"
     };
@@ -131,11 +142,14 @@ mod tests {
             },
             optimum: vec![("contact.boundary_friction".into(), 0.2)],
             flags: Vec::new(),
+            aicc: f64::NAN,
         }
     }
 
     fn selection(chosen: &[&'static str], scored: Vec<Scored>) -> Selection {
         Selection {
+            presumed: Vec::new(),
+            start: String::new(),
             tried: scored.iter().map(|t| t.tried.clone()).collect(),
             excluded: Vec::new(),
             removed: Vec::new(),

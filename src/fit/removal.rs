@@ -42,6 +42,26 @@ pub(super) fn keeps_part(without: &Tried, with: &Tried) -> bool {
 }
 
 impl Ctx<'_> {
+    /// Whether term `t` may leave the set `with` it for the set `without`
+    /// it (or its lighter form): a part of a chosen term when the folds
+    /// predict worse with it; a presumed term (rule 7) when the set
+    /// without it pays over the set with it; any other term when it does
+    /// not pay over the set without it.
+    pub(super) fn may_leave(&self, t: &str, without: &Tried, with: &Tried) -> bool {
+        if is_part(t) {
+            !keeps_part(without, with)
+        } else if self.is_presumed(t) {
+            pays(with, without).0
+        } else {
+            !pays(without, with).0
+        }
+    }
+
+    /// Whether `t` is a presumed term (`select.rs`, rule 7).
+    pub(super) fn is_presumed(&self, t: &str) -> bool {
+        self.presumed.get().is_some_and(|p| p.contains(&t))
+    }
+
     /// Remove, one at a time, each chosen term (but `newest`) that does not
     /// pay beside the others any more: the one whose removal costs least.
     pub(super) fn prune(
@@ -84,13 +104,7 @@ impl Ctx<'_> {
             // does not pay over it (a part: if the set predicts worse with it).
             let Some((t, form, lighter)) = scored
                 .into_iter()
-                .filter(|(t, _, s)| {
-                    if is_part(t) {
-                        !keeps_part(&s.tried, &current.tried)
-                    } else {
-                        !pays(&s.tried, &current.tried).0
-                    }
-                })
+                .filter(|(t, _, s)| self.may_leave(t, &s.tried, &current.tried))
                 .min_by(|a, b| a.2.tried.cv_rms.total_cmp(&b.2.tried.cv_rms))
             else {
                 return Ok(current);
@@ -141,7 +155,15 @@ impl Ctx<'_> {
             tried.extend(scored.iter().map(|(_, _, s)| s.tried.clone()));
             let best = scored
                 .into_iter()
-                .filter(|(_, _, s)| f.confounded.is_some() || !pays(&s.tried, &current.tried).0)
+                .filter(|(t, _, s)| {
+                    if self.is_presumed(t) {
+                        // Confounded or flagged, a presumed shape leaves
+                        // only when the set without it pays over it.
+                        pays(&current.tried, &s.tried).0
+                    } else {
+                        f.confounded.is_some() || !pays(&s.tried, &current.tried).0
+                    }
+                })
                 .min_by(|a, b| a.2.tried.cv_rms.total_cmp(&b.2.tried.cv_rms));
             let Some((t, form, next)) = best else {
                 say(&format!(
@@ -296,6 +318,7 @@ mod tests {
             },
             optimum: Vec::new(),
             flags: Vec::new(),
+            aicc: f64::NAN,
         }
     }
 

@@ -38,6 +38,27 @@ pub(super) struct Scored {
     pub(super) optimum: Optimum,
     /// What its fit says of each fitted parameter.
     pub(super) flags: Vec<KeyFlag>,
+    /// The small-sample Akaike criterion of its fit on all the training
+    /// data ([`aicc`]; infinite when it could not be fitted).
+    pub(super) aicc: f64,
+}
+
+/// The small-sample Akaike information criterion (Hurvich & Tsai 1989) of
+/// a least-squares fit of `k` parameters to `n` samples with residual
+/// sum of squares n·rms²: n ln(rms²) + 2k + 2k(k+1)/(n−k−1); +∞ when
+/// n ≤ k + 1 or the fit failed, −∞ for an exact fit. Lower is better; it estimates the fit's error on new
+/// samples of the same kind (asymptotically leave-one-out
+/// cross-validation, Stone 1977) from all the samples at once.
+pub(super) fn aicc(rms: f64, n: usize, k: usize) -> f64 {
+    if n <= k + 1 || !rms.is_finite() || rms < 0.0 {
+        return f64::INFINITY;
+    }
+    if rms == 0.0 {
+        // An exact fit: nothing is better.
+        return f64::NEG_INFINITY;
+    }
+    let (n, k) = (n as f64, k as f64);
+    n * (rms * rms).ln() + 2.0 * k + 2.0 * k * (k + 1.0) / (n - k - 1.0)
 }
 
 /// What a set's fit says of one fitted parameter: whether it ended at a
@@ -63,6 +84,10 @@ pub(super) struct Ctx<'a> {
     pub(super) search: &'a SearchSettings,
     pub(super) stop: &'a crate::interrupt::Stop,
     pub(super) given: &'a [ParamSpec],
+    /// The terms presumed (`select.rs`, rule 7): they leave the set only
+    /// when the set without them predicts the folds better, by the rule a
+    /// term must meet to enter.
+    pub(super) presumed: std::sync::OnceLock<Vec<&'static str>>,
     /// Every set scored so far, by its terms in catalogue order: a set
     /// that the removal or the flag checks come back to is the same
     /// problem on the same folds, and is not fitted again.
@@ -240,6 +265,7 @@ impl Ctx<'_> {
             },
             optimum: Vec::new(),
             flags: Vec::new(),
+            aicc: f64::INFINITY,
         }
     }
 
@@ -277,6 +303,12 @@ impl Ctx<'_> {
         )?;
         let cv_rms = super::cross_validate::cv_rms(&fold_mse);
         let flags = flags_of(&fitted);
+        let samples = fitted
+            .train
+            .iter()
+            .map(|f| f.series.fit.iter().filter(|b| **b).count())
+            .sum();
+        let aicc = aicc(fitted.train_rms, samples, fitted.best.len());
         Ok(Scored {
             tried: Tried {
                 terms: terms.to_vec(),
@@ -291,6 +323,7 @@ impl Ctx<'_> {
                 .zip(fitted.best.iter().copied())
                 .collect(),
             flags,
+            aicc,
         })
     }
 }
@@ -326,4 +359,29 @@ fn flags_of(o: &super::driver::FitOutcome) -> Vec<KeyFlag> {
             }
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::aicc;
+    use approx::assert_relative_eq;
+
+    #[test]
+    fn the_small_sample_akaike_criterion_is_n_ln_mse_plus_its_corrected_penalty() {
+        // n = 20, k = 4, rms 0.1: 20 ln 0.01 + 8 + 40/15.
+        assert_relative_eq!(
+            aicc(0.1, 20, 4),
+            20.0 * 0.01f64.ln() + 8.0 + 40.0 / 15.0,
+            max_relative = 1e-12
+        );
+        // Two extra parameters must lower the mean square by more than
+        // their penalty: at n = 20 a 2-key fit at rms 0.1 (−87.4) beats a
+        // 4-key fit at rms 0.09 (−85.7), not one at 0.08 (−90.4).
+        assert!(aicc(0.1, 20, 2) < aicc(0.09, 20, 4));
+        assert!(aicc(0.1, 20, 2) > aicc(0.08, 20, 4));
+        // No degrees of freedom left or no fit: +∞; an exact fit: −∞.
+        assert_eq!(aicc(0.1, 5, 4), f64::INFINITY);
+        assert_eq!(aicc(f64::NAN, 20, 2), f64::INFINITY);
+        assert_eq!(aicc(0.0, 20, 2), f64::NEG_INFINITY);
+    }
 }
