@@ -29,6 +29,7 @@
 //! | `prepare.rs` | data → our model: the sources (the held-out part cut off first), scales, keys, maps, the contact's scale |
 //! | `confirm.rs` | `--fit auto`'s choice confirmed at the final fit's optimum: scored on the same folds, it falls back to the best set with one term fewer when it no longer pays over it |
 //! | `select.rs` | `--fit auto`'s rule: stepwise with removal on cross-validation, terms that pay, dead terms dropped; its report |
+//! | `classic_shape.rs` | `--fit auto`'s rule 7: a steady curve starts from the classic shape its points support (AICc), which is presumed |
 //! | `removal.rs` | terms taken away during the selection: one that no longer pays, one flagged dead, one of two confounded terms; the lighter forms; whether a change pays |
 //! | `trial.rs` | one set of terms tried: fitted on the training data, scored by cross-validation |
 //! | `candidates.rs` | the candidate terms, the keys of a set, which candidates the data allow, the keys `--fit auto` starts from |
@@ -71,6 +72,7 @@ mod box_qp;
 pub mod by_direction;
 pub mod calibrated_range;
 pub mod candidates;
+pub mod classic_shape;
 pub mod compare;
 pub mod confirm;
 pub mod contact_scale;
