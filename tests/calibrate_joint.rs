@@ -590,20 +590,9 @@ fn fitted_torque(d: &Path, fitted: &Path, omega: &[f64]) -> Vec<f64> {
         .collect()
 }
 
-#[test]
-fn a_joint_fitted_at_slow_speeds_predicts_neither_a_collapse_nor_a_sign_change_up_to_five_times_faster(
-) {
-    let d = dir("past-the-data");
-    // A joint whose friction rises and saturates (a Stribeck curve with its
-    // static level below its Coulomb level) plus a viscous part, measured
-    // steadily at 0.5 to 20 deg/s.
-    let torque = |w: f64| 0.5 + 0.3 * (1.0 - (-(w / 0.05).powi(2)).exp()) + 0.2 * w;
-    let mut text = String::from("velocity_rad_s,torque_nm\n");
-    for k in 0..12 {
-        let deg = 0.5 * (40.0f64).powf(k as f64 / 11.0);
-        let w = deg.to_radians();
-        text += &format!("{w},{}\n", torque(w));
-    }
+/// Write the steady curve `text` (rad/s, N·m) into `d` and fit it with
+/// `--rotary --fit auto` (32 cells); the summary and the fitted file.
+fn fit_steady_auto(d: &std::path::Path, text: &str) -> (String, std::path::PathBuf) {
     let data = d.join("steady.csv");
     std::fs::write(&data, text).unwrap();
     let fitted = d.join("joint.yaml");
@@ -619,6 +608,24 @@ fn a_joint_fitted_at_slow_speeds_predicts_neither_a_collapse_nor_a_sign_change_u
         fitted.to_str().unwrap(),
     ]);
     assert!(code == 0 || code == 4, "{err}");
+    (stdout, fitted)
+}
+
+#[test]
+fn a_joint_fitted_at_slow_speeds_predicts_neither_a_collapse_nor_a_sign_change_up_to_five_times_faster(
+) {
+    let d = dir("past-the-data");
+    // A joint whose friction rises and saturates (a Stribeck curve with its
+    // static level below its Coulomb level) plus a viscous part, measured
+    // steadily at 0.5 to 20 deg/s.
+    let torque = |w: f64| 0.5 + 0.3 * (1.0 - (-(w / 0.05).powi(2)).exp()) + 0.2 * w;
+    let mut text = String::from("velocity_rad_s,torque_nm\n");
+    for k in 0..12 {
+        let deg = 0.5 * (40.0f64).powf(k as f64 / 11.0);
+        let w = deg.to_radians();
+        text += &format!("{w},{}\n", torque(w));
+    }
+    let (stdout, fitted) = fit_steady_auto(&d, &text);
     assert!(stdout.contains("Chosen:"), "{stdout}");
     // Up to 100 deg/s, five times the fastest point: no collapse, no sign
     // change, no explosion.
@@ -662,21 +669,7 @@ fn a_steady_curve_whose_stribeck_dip_lies_at_its_slowest_speeds_is_predicted_pas
             text += &format!("{w},{}\n", torque(w) * (1.0 + noise));
         }
     }
-    let data = d.join("steady.csv");
-    std::fs::write(&data, text).unwrap();
-    let fitted = d.join("joint.yaml");
-    let (code, stdout, err) = run(&[
-        "fit",
-        data.to_str().unwrap(),
-        "--rotary",
-        "--set",
-        "solver.cells=32",
-        "--fit",
-        "auto",
-        "--out",
-        fitted.to_str().unwrap(),
-    ]);
-    assert!(code == 0 || code == 4, "{err}");
+    let (stdout, fitted) = fit_steady_auto(&d, &text);
     assert!(
         stdout.contains("Start: the selection starts from drivetrain Stribeck"),
         "{stdout}"
