@@ -9,7 +9,10 @@
 #   O-ring seal        fit 1 + 3 bar, predict 5 + 7 bar (maps: effective area,
 #                      sensor offset, preload; the script docs/calibrate-oring-seal.sh)
 #   EMPS ball screw    fit DATA_EMPS, predict DATA_EMPS_PULSES (pulses ignored);
-#                      friction = 35.15 vir − M q̈ − offset, M and offset fitted maps
+#                      friction = 35.15 vir − M q̈ − offset, M and offset fitted maps;
+#                      the force smoothed as q̈ is (smooth(smooth(vir)) beside
+#                      ddt(ddt(qm)): the parallel filtering of the benchmark's
+#                      own IDIM-LS reference)
 #   lead screw drive 1 positive direction, steady torque against motor speed
 #                      (a) fit every other speed, predict the rest
 #                      (b) fit ≤ 100 rpm, predict 120–200 rpm
@@ -70,7 +73,7 @@ for set in $SETS; do
         D=data/emps-ball-screw
         run emps "$D/DATA_EMPS.csv" --validate "$D/DATA_EMPS_PULSES.csv" \
             --time t --velocity 'ddt(qm)' --smooth 0.01 \
-            --friction '35.15 * vir - m * ddt(ddt(qm)) - off' \
+            --friction '35.15 * smooth(smooth(vir)) - m * ddt(ddt(qm)) - off' \
             --map m=95 --map off=0 --bounds m=50:150 --bounds off=-20:20 \
             --fit auto,m,off ;;
     lead-a|lead-b)

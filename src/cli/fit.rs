@@ -124,7 +124,9 @@ pub struct FitArgs {
         allow_hyphen_values = true
     )]
     pub velocity: String,
-    /// Friction, N: an expression of the columns and map coefficients.
+    /// Friction, N: an expression of the columns and map coefficients;
+    /// `smooth(COL)` smooths a column as `ddt` does (a measured force beside
+    /// `ddt(ddt(x))`: `smooth(smooth(F))`).
     #[arg(
         long,
         value_name = "EXPR",
@@ -138,7 +140,7 @@ pub struct FitArgs {
     /// Temperature, °C (default: `temperature_c` if present).
     #[arg(long, value_name = "EXPR", allow_hyphen_values = true)]
     pub temperature: Option<String>,
-    /// Half-width of the smoothing window of ddt(), s, in (0, 1e3].
+    /// Half-width of the smoothing window of ddt() and smooth(), s, in (0, 1e3].
     #[arg(long, value_name = "S", default_value = "0.05", value_parser = smooth)]
     pub smooth: f64,
     /// A map coefficient and its value (repeatable): fixed, or the start

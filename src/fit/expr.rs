@@ -1,7 +1,9 @@
 //! Column expressions of calibration data (`evalexpr`): compiled once per
 //! source, evaluated row by row or, when affine in the map coefficients,
-//! from a base column and slopes; `ddt(COLUMN)`'s smoothed derivative.
+//! from a base column and slopes; `ddt(COLUMN)` and `smooth(COLUMN)`
+//! replaced by their windowed columns (`windowed.rs`).
 
+use super::windowed::{Windowed, WindowedColumn};
 use super::FitError;
 use crate::table::Table;
 use evalexpr::{
@@ -111,7 +113,7 @@ pub(super) fn compile(
     what: &str,
     text: &str,
     table: &Table,
-    derived: &mut Vec<(String, String)>,
+    derived: &mut Vec<WindowedColumn>,
     coefficients: &[(String, f64)],
 ) -> Result<Expr, FitError> {
     crate::expression::check_size(text).map_err(|message| FitError::Expression {
@@ -119,7 +121,7 @@ pub(super) fn compile(
         text: crate::expression::shorten(text),
         message,
     })?;
-    let t = derivatives_as_columns(what, text, table, derived)?;
+    let t = windowed_as_columns(what, text, table, derived)?;
     let t = crate::expression::with_functions(&t);
     let node =
         build_operator_tree::<DefaultNumericTypes>(&t).map_err(|e| FitError::Expression {
@@ -141,7 +143,7 @@ pub(super) fn compile(
             });
         }
         let known = table.column(id).is_some()
-            || derived.iter().any(|(d, _)| d == id)
+            || derived.iter().any(|d| d.id == id)
             || coefficients.iter().any(|(c, _)| c == id);
         if !known {
             return Err(FitError::Expression {
@@ -164,43 +166,68 @@ pub(super) fn compile(
     })
 }
 
-/// `text` with each `ddt(NAME)` replaced by the derived column
-/// `ddt__NAME` (added to `derived` with its source column); innermost
-/// first, so that ddt(ddt(x)) (an acceleration) is ddt__ddt__x, the
-/// derivative of ddt__x, smoothed the same way.
-fn derivatives_as_columns(
+/// `text` with each `ddt(NAME)` and `smooth(NAME)` replaced by its
+/// windowed column (`ddt__NAME`, `smooth__NAME`, added to `derived` with
+/// its source column); innermost first, so that ddt(ddt(x)) (an
+/// acceleration) is ddt__ddt__x, the derivative of ddt__x, smoothed the
+/// same way, and smooth(smooth(f)) is f smoothed as that acceleration is.
+fn windowed_as_columns(
     what: &str,
     text: &str,
     table: &Table,
-    derived: &mut Vec<(String, String)>,
+    derived: &mut Vec<WindowedColumn>,
 ) -> Result<String, FitError> {
     let mut t = text.to_string();
-    while let Some(i) = t.rfind("ddt(") {
-        let rest = &t[i + 4..];
+    // The last call's opening: an identifier character before it would make
+    // it another name's tail (`my_ddt(`), which evalexpr then rejects.
+    let last_call = |t: &str| {
+        Windowed::ALL
+            .iter()
+            .filter_map(|&(op, name)| {
+                let pat = format!("{name}(");
+                t.match_indices(&pat)
+                    .filter(|(i, _)| {
+                        !t[..*i]
+                            .chars()
+                            .next_back()
+                            .is_some_and(|c| c.is_alphanumeric() || c == '_')
+                    })
+                    .map(|(i, _)| (i, op, pat.len()))
+                    .last()
+            })
+            .max_by_key(|(i, _, _)| *i)
+    };
+    while let Some((i, op, open)) = last_call(&t) {
+        let name = op.function();
+        let rest = &t[i + open..];
         let Some(j) = rest.find(')') else {
             return Err(FitError::Expression {
                 what: what.into(),
                 text: text.into(),
-                message: "`ddt(` without `)`".into(),
+                message: format!("`{name}(` without `)`"),
             });
         };
         let col = rest[..j].trim().to_string();
-        let is_derived = derived.iter().any(|(d, _)| *d == col);
+        let is_derived = derived.iter().any(|d| d.id == col);
         if !is_derived && (!is_name(&col) || table.column(&col).is_none()) {
             let why = if is_name(&col) {
                 table.column_error(&col).to_string()
             } else {
-                "ddt() takes a column name (or ddt(COLUMN) for a second derivative)".into()
+                format!("{name}() takes a column name, or another of ddt() and smooth() of one")
             };
             return Err(FitError::Expression {
                 what: what.into(),
                 text: text.into(),
-                message: format!("ddt({col}): {why}"),
+                message: format!("{name}({col}): {why}"),
             });
         }
-        let id = format!("ddt__{col}");
-        if !derived.iter().any(|(d, _)| *d == id) {
-            derived.push((id.clone(), col));
+        let id = op.column_id(&col);
+        if !derived.iter().any(|d| d.id == id) {
+            derived.push(WindowedColumn {
+                id: id.clone(),
+                source: col,
+                op,
+            });
         }
         t = format!("{}{}{}", &t[..i], id, &rest[j + 1..]);
     }
@@ -211,43 +238,8 @@ fn is_name(s: &str) -> bool {
     !s.is_empty() && s.chars().all(|c| c.is_alphanumeric() || c == '_')
 }
 
-/// d/dt of `y` by a local linear fit over ±`half` s (at least ±1 sample).
-pub(super) fn derivative(t: &[f64], y: &[f64], half: f64) -> Vec<f64> {
-    let n = t.len();
-    let reach = half * (1.0 + 1e-9);
-    let (mut lo, mut hi) = (0usize, 0usize);
-    (0..n)
-        .map(|k| {
-            // Samples exactly `half` away count on both sides (up to
-            // rounding): on a uniform grid the window is symmetric, and the
-            // fit's slope is exact for a quadratic.
-            while t[k] - t[lo] > reach && lo + 1 < k {
-                lo += 1;
-            }
-            while hi + 1 < n && (t[hi + 1] - t[k] <= reach || hi < k + 1) {
-                hi += 1;
-            }
-            let a = lo.min(k.saturating_sub(1));
-            let b = hi.max((k + 1).min(n - 1));
-            let m = (b - a + 1) as f64;
-            let (st, sy) = (t[a..=b].iter().sum::<f64>(), y[a..=b].iter().sum::<f64>());
-            let (mt, my) = (st / m, sy / m);
-            let (mut num, mut den) = (0.0, 0.0);
-            for j in a..=b {
-                num += (t[j] - mt) * (y[j] - my);
-                den += (t[j] - mt) * (t[j] - mt);
-            }
-            if den > 0.0 {
-                num / den
-            } else {
-                0.0
-            }
-        })
-        .collect()
-}
-
 /// The columns an expression reads: a source's table and its derived
-/// (`ddt`) columns, under the source's name (for messages).
+/// (`ddt`, `smooth`) columns, under the source's name (for messages).
 pub(super) struct Columns<'a> {
     pub(super) name: &'a str,
     pub(super) table: &'a Table,

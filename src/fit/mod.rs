@@ -60,7 +60,8 @@
 //! | `inputs.rs` | what is read: the data files, held out and validation files, their mapping, a bag's topics; one file into a table |
 //! | `bag_input.rs` | topics of a bag → a table |
 //! | `series.rs` | a table and its mapping → the model's inputs; the held-out rows |
-//! | `expr.rs` | column expressions: compiling, affine fast path, `ddt` |
+//! | `expr.rs` | column expressions: compiling, affine fast path, `ddt` and `smooth` replaced by their columns |
+//! | `windowed.rs` | columns made over ±`--smooth` windows: `ddt`'s local linear slope, `smooth`'s kernel that slope implies |
 //! | `synthetic.rs` | synthetic data: the model along a motion, with noise |
 //! | `error.rs` | [`FitError`] (setup) and [`PredictError`] (no prediction at some parameter values) |
 //! | `units.rs` | the data's units: m/s and N, or rad/s and N·m |
@@ -106,6 +107,7 @@ pub mod synthetic;
 pub mod trial;
 pub mod units;
 pub mod unknowns;
+mod windowed;
 
 pub use crate::table::{Delimiter, Table, TableError};
 pub use baselines::{Baseline, BaselineKind, LoadForm};

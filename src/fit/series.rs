@@ -1,7 +1,9 @@
 //! From recorded columns to the model's inputs: time, velocity, friction,
 //! load and temperature, each an expression of the columns (`evalexpr`),
-//! with map coefficients that can themselves be fitted and `ddt(COLUMN)`
-//! for a smoothed time derivative (a position to a velocity).
+//! with map coefficients that can themselves be fitted, `ddt(COLUMN)` for a
+//! smoothed time derivative (a position to a velocity) and `smooth(COLUMN)`
+//! for a column smoothed as that derivative is (a force beside a derived
+//! acceleration: `windowed.rs`).
 //!
 //! ```text
 //! --time 't_ms / 1000' --velocity 'ddt(position_mm) / 1000'
@@ -11,7 +13,8 @@
 //! A table without a time column (and no `--time`) is a steady curve: each
 //! row a steady operating point.
 
-use super::expr::{compile, derivative, Affine, Columns, Expr, Var};
+use super::expr::{compile, Affine, Columns, Expr, Var};
+use super::windowed::WindowedColumn;
 use super::FitError;
 use crate::table::Table;
 
@@ -140,7 +143,7 @@ pub struct Source {
     friction: Expr,
     load: Option<Expr>,
     temperature: Option<Expr>,
-    /// Derived columns `ddt__NAME`.
+    /// Windowed columns `ddt__NAME`, `smooth__NAME`.
     pub(super) derived: Vec<(String, Vec<f64>)>,
     coefficients: Vec<String>,
     /// The times (they cannot depend on coefficients).
@@ -152,7 +155,7 @@ impl Source {
     /// (it cannot depend on coefficients) and checked.
     pub fn new(table: Table, mapping: &Mapping) -> Result<Self, FitError> {
         let coeffs = &mapping.coefficients;
-        let mut derived_cols: Vec<(String, String)> = Vec::new();
+        let mut derived_cols: Vec<WindowedColumn> = Vec::new();
         let mut expr = |what: &str, text: Option<String>, default: &str, c: &[(String, f64)]| {
             text.or_else(|| table.column(default).map(|_| default.to_string()))
                 .as_deref()
@@ -194,22 +197,23 @@ impl Source {
         Ok(s)
     }
 
-    /// The `ddt` columns the expressions read, in order (a nested ddt reads
-    /// a derived column made before it), over the times `t`.
+    /// The windowed columns (`ddt`, `smooth`) the expressions read, in
+    /// order (a nested one reads a column made before it), over the times `t`.
     fn derive_columns(
         &mut self,
-        derived_cols: Vec<(String, String)>,
+        derived_cols: Vec<WindowedColumn>,
         t: &[f64],
         smooth_s: f64,
     ) -> Result<(), FitError> {
-        let Some((_, first)) = derived_cols.first() else {
+        let Some(first) = derived_cols.first() else {
             return Ok(());
         };
+        let name = format!("{}()", first.op.function());
         if self.steady {
             return Err(FitError::Expression {
-                what: "ddt()".into(),
-                text: first.clone(),
-                message: "a steady curve has no time to differentiate over".into(),
+                what: name,
+                text: first.source.clone(),
+                message: "a steady curve has no time to differentiate or smooth over".into(),
             });
         }
         let span = t.last().copied().unwrap_or(0.0) - t[0];
@@ -217,23 +221,23 @@ impl Source {
             return Err(FitError::Data {
                 what: self.name.clone(),
                 message: format!(
-                    "ddt() needs at least 5 samples over twice the smoothing window ({} s); the data has {} over {span} s",
+                    "{name} needs at least 5 samples over twice the smoothing window ({} s); the data has {} over {span} s",
                     2.0 * smooth_s,
                     t.len()
                 ),
             });
         }
-        for (id, col) in derived_cols {
-            let y = match self.table.column(&col) {
+        for d in derived_cols {
+            let y = match self.table.column(&d.source) {
                 Some(y) => y.to_vec(),
                 None => self
                     .derived
                     .iter()
-                    .find(|(d, _)| *d == col)
+                    .find(|(id, _)| *id == d.source)
                     .map(|(_, y)| y.clone())
                     .expect("checked when compiled"),
             };
-            self.derived.push((id, derivative(t, &y, smooth_s)));
+            self.derived.push((d.id, d.op.apply(t, &y, smooth_s)));
         }
         Ok(())
     }
@@ -562,6 +566,56 @@ mod tests {
         .unwrap()
         .to_string();
         assert!(e.contains("ddt() takes a column name"), "{e}");
+    }
+
+    #[test]
+    fn a_force_read_as_smooth_smooth_is_filtered_as_the_acceleration_beside_it() {
+        // F = M ẍ, the force stepping from 0 to 4 N at 1 s, M = 2 kg: the
+        // friction `F − m ẍ` is zero but for the derivation. With the force
+        // as measured the step leaves half of it (2 N); smoothed twice, as
+        // ddt(ddt(x)) smooths the acceleration, under 3 % of it.
+        let mut text = String::from("t_s,x_m,force_n\n");
+        for k in 0..2000 {
+            let t = k as f64 * 1e-3;
+            let (x, f) = if t >= 1.0 {
+                ((t - 1.0).powi(2), 4.0)
+            } else {
+                (0.0, 0.0)
+            };
+            text += &format!("{t},{x},{f}\n");
+        }
+        let worst = |friction: &str| {
+            let m = Mapping {
+                velocity: "ddt(x_m)".into(),
+                friction: friction.into(),
+                coefficients: vec![("m".into(), 2.0)],
+                smooth_s: 0.01,
+                ..Default::default()
+            };
+            let se = Source::new(table(&text), &m)
+                .unwrap()
+                .series(&[2.0])
+                .unwrap();
+            se.friction[100..1900]
+                .iter()
+                .fold(0.0f64, |w, f| w.max(f.abs()))
+        };
+        approx::assert_abs_diff_eq!(worst("force_n - m * ddt(ddt(x_m))"), 2.0, epsilon = 1e-6);
+        let filtered = worst("smooth(smooth(force_n)) - m * ddt(ddt(x_m))");
+        assert!(filtered < 0.03 * 4.0, "{filtered}");
+        // smooth() of anything but a column (or a windowed column) is refused.
+        let e = Source::new(
+            table(&text),
+            &Mapping {
+                velocity: "ddt(x_m)".into(),
+                friction: "smooth(force_n * 2)".into(),
+                ..Default::default()
+            },
+        )
+        .err()
+        .unwrap()
+        .to_string();
+        assert!(e.contains("smooth() takes a column name"), "{e}");
     }
 
     #[test]
