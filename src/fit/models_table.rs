@@ -36,6 +36,10 @@ pub struct ModelRow {
     pub held_out_rms: Option<f64>,
     /// Why there is no held-out prediction, when there is none.
     pub held_out_failure: Option<String>,
+    /// RMS residual on the held-out parts of the training files
+    /// (`--holdout`, a later part of each) when the held-out column is the
+    /// validation data's, N: the second thing a calibration is judged on.
+    pub later_part_rms: Option<f64>,
     /// Whether its fit converged.
     pub converged: bool,
     /// How the best local run ended.
@@ -73,6 +77,7 @@ impl From<&FitOutcome> for ModelRow {
             cv_rms: o.fold_mse.as_deref().map(super::cross_validate::cv_rms),
             held_out_rms: o.held_out_rms(),
             held_out_failure: o.validate_failure.clone(),
+            later_part_rms: o.validate_rms.and(o.holdout_rms),
             converged: o.converged,
             termination: o
                 .optima
@@ -87,8 +92,13 @@ impl From<&FitOutcome> for ModelRow {
 /// when given).
 pub fn models_table(rows: &[ModelRow], scale_n: f64) -> String {
     let u = rows.first().map_or("N", |r| r.units.force());
+    // The `--holdout` part's column, after the others, when there is one
+    // beside validation data.
+    let later = rows.iter().any(|r| r.later_part_rms.is_some());
     let mut s = format!(
-        "| model | n | parameters | fit | training RMS ({u}) | CV RMS ({u}) | held-out RMS ({u}) | held-out / friction scale |\n|---|---|---|---|---|---|---|---|\n",
+        "| model | n | parameters | fit | training RMS ({u}) | CV RMS ({u}) | held-out RMS ({u}) | held-out / friction scale |{}\n|---|---|---|---|---|---|---|---|{}\n",
+        if later { format!(" --holdout part RMS ({u}) |") } else { String::new() },
+        if later { "---|" } else { "" },
     );
     for r in rows {
         let params: Vec<String> = r
@@ -102,9 +112,14 @@ pub fn models_table(rows: &[ModelRow], scale_n: f64) -> String {
                 }
             })
             .collect();
+        let later_cell = match (later, r.later_part_rms) {
+            (false, _) => String::new(),
+            (true, Some(h)) => format!(" {} |", Num::sig(h, 5)),
+            (true, None) => " – |".into(),
+        };
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} |{later_cell}",
             r.label,
             r.parameters.len(),
             params.join(", "),
@@ -132,8 +147,13 @@ pub fn models_table(rows: &[ModelRow], scale_n: f64) -> String {
     }
     let _ = writeln!(
         s,
-        "\nCV RMS: the training data's folds, each predicted by the model refitted without it (the same folds for every model). held-out / friction scale: the held-out RMS divided by the RMS of the measured friction on the held-out samples ({} {u}), the same for every model.",
-        Num::sig(scale_n, 5)
+        "\nCV RMS: the training data's folds, each predicted by the model refitted without it (the same folds for every model). held-out / friction scale: the held-out RMS divided by the RMS of the measured friction on the held-out samples ({} {u}), the same for every model.{}",
+        Num::sig(scale_n, 5),
+        if later {
+            " --holdout part RMS: the held-out (later) parts of the training files, which no model was fitted on."
+        } else {
+            ""
+        }
     );
     s
 }
@@ -414,5 +434,44 @@ mod tests {
         approx::assert_relative_eq!(total, x.iter().sum::<f64>(), max_relative = 1e-12);
         assert_eq!(batch_means(&x[..5], 20), x[..5].to_vec());
         assert!(batch_means(&[], 20).is_empty());
+    }
+
+    fn row(label: &str, later: Option<f64>) -> ModelRow {
+        ModelRow {
+            label: label.into(),
+            parameters: vec![("fc_n".into(), 1.0, String::new())],
+            units: crate::fit::Units::Linear,
+            train_rms: 0.5,
+            cv_rms: Some(0.6),
+            held_out_rms: Some(0.7),
+            held_out_failure: None,
+            later_part_rms: later,
+            converged: true,
+            termination: String::new(),
+            cost: 1.0,
+        }
+    }
+
+    #[test]
+    fn the_later_part_of_the_training_files_gets_its_own_column_beside_validation_data() {
+        let with = models_table(&[row("ours", Some(0.25)), row("LuGre", None)], 1.0);
+        let lines: Vec<&str> = with.lines().collect();
+        assert!(
+            lines[0].ends_with("| --holdout part RMS (N) |"),
+            "{}",
+            lines[0]
+        );
+        assert_eq!(lines[1].matches("---").count(), 9);
+        assert!(
+            lines[2].ends_with("| 0.7 | 70.0 % | 0.25 |"),
+            "{}",
+            lines[2]
+        );
+        assert!(lines[3].ends_with("| 70.0 % | – |"), "{}", lines[3]);
+        assert!(with.contains("--holdout part RMS: the held-out (later) parts"));
+        // Without it the table keeps its eight columns.
+        let without = models_table(&[row("ours", None)], 1.0);
+        assert!(!without.contains("--holdout part"), "{without}");
+        assert_eq!(without.lines().nth(1).unwrap().matches("---").count(), 8);
     }
 }
