@@ -423,7 +423,15 @@ impl<'a> Problem<'a> {
                     (None, None) => unreachable!("computed when not fixed"),
                 };
                 let predicted = self.predict_one(&x[..n], role, i, &series, print)?;
-                Ok(SeriesFit { series, predicted })
+                // A held-out part run through the motion before it is
+                // scored on its own rows only.
+                match sources[i].scored_from() {
+                    0 => Ok(SeriesFit { series, predicted }),
+                    from => Ok(SeriesFit {
+                        series: Arc::new(series.tail(from)),
+                        predicted: predicted[from.min(predicted.len())..].to_vec(),
+                    }),
+                }
             })
             .collect()
     }
@@ -622,6 +630,74 @@ mod tests {
             ..Default::default()
         };
         tests_data(&text, &mapping)
+    }
+
+    /// Friction = c · the position (the velocity integrated from the first
+    /// sample): a model with memory, as a bristle is.
+    struct Position(Vec<FittedParameter>);
+
+    impl Model for Position {
+        fn label(&self) -> String {
+            "position".into()
+        }
+        fn parameters(&self) -> &[FittedParameter] {
+            &self.0
+        }
+        fn predict(&self, x: &[f64], s: &Series) -> Result<Vec<f64>, PredictError> {
+            let mut q = 0.0;
+            Ok((0..s.len())
+                .map(|k| {
+                    if k > 0 {
+                        q += s.velocity[k] * (s.t[k] - s.t[k - 1]);
+                    }
+                    x[0] * q
+                })
+                .collect())
+        }
+    }
+
+    #[test]
+    fn a_held_out_later_part_is_predicted_in_the_state_the_motion_before_it_left() {
+        // f = 2 q, q the position from the record's start: the last 30 %
+        // held out. Simulated from its own first row it would start at
+        // q = 0 and be off by 2 q(cut) throughout; run through the motion
+        // before it, it is exact, and only its own rows are scored.
+        let mut text = String::from("t_s,v,f\n");
+        let mut q = 0.0;
+        for k in 0..100 {
+            let v = 1.0 + (k as f64 * 0.2).sin();
+            if k > 0 {
+                q += v * 0.01;
+            }
+            text += &format!("{},{v},{}\n", k as f64 * 0.01, 2.0 * q);
+        }
+        let mapping = Mapping {
+            velocity: "v".into(),
+            friction: "f".into(),
+            ..Default::default()
+        };
+        let whole = tests_data(&text, &mapping);
+        let (train, held) = whole.train[0].split_held_out(0.3, &mapping).unwrap();
+        assert_eq!(held.scored_from(), 70);
+        assert_eq!(train.scored_from(), 0);
+        let d = Data {
+            train: vec![train],
+            held_out: vec![held],
+            ..whole
+        };
+        let model = Position(vec![FittedParameter::new("c", 1.0, 0.1, 10.0)]);
+        let p = Problem::new(&model, &d, vec![]).unwrap();
+        let fits = p.predict_sources(&[2.0], Role::HeldOut);
+        let fit = fits[0].as_ref().unwrap();
+        assert_eq!(fit.predicted.len(), 30);
+        assert_eq!(fit.series.len(), 30);
+        approx::assert_abs_diff_eq!(fit.series.t[0], 0.7, epsilon = 1e-12);
+        for (m, f) in fit.predicted.iter().zip(&fit.series.friction) {
+            approx::assert_abs_diff_eq!(m, f, epsilon = 1e-9);
+        }
+        // The training part is the first 70 rows alone.
+        let train = p.predict_sources(&[2.0], Role::Train);
+        assert_eq!(train[0].as_ref().unwrap().predicted.len(), 70);
     }
 
     #[test]

@@ -82,6 +82,21 @@ pub(super) fn mix(h: u64, w: u64) -> u64 {
 }
 
 impl Series {
+    /// The samples from `from` on (a held-out part after its lead-in).
+    pub fn tail(&self, from: usize) -> Series {
+        let cut = |v: &Vec<f64>| v[from.min(v.len())..].to_vec();
+        Series {
+            name: self.name.clone(),
+            steady: self.steady,
+            t: cut(&self.t),
+            velocity: cut(&self.velocity),
+            friction: cut(&self.friction),
+            load: self.load.as_ref().map(cut),
+            temperature: self.temperature.as_ref().map(cut),
+            fit: self.fit[from.min(self.fit.len())..].to_vec(),
+        }
+    }
+
     /// A fingerprint of the series' model inputs: time, velocity, load,
     /// temperature and whether it is steady (the film traces' and the
     /// problem's kept predictions' key; `mix` over every value).
@@ -148,6 +163,10 @@ pub struct Source {
     coefficients: Vec<String>,
     /// The times (they cannot depend on coefficients).
     times: Vec<f64>,
+    /// The first row that is scored: a time series' held-out part is
+    /// simulated from the start of its file, so that it starts in the
+    /// state the motion before it left, and scored from here (0: every row).
+    scored_from: usize,
 }
 
 impl Source {
@@ -187,6 +206,7 @@ impl Source {
             derived: Vec::new(),
             coefficients: coeffs.iter().map(|(c, _)| c.clone()).collect(),
             times: Vec::new(),
+            scored_from: 0,
         };
         let t = s.compute_times()?;
         s.derive_columns(derived_cols, &t, mapping.smooth_s)?;
@@ -321,18 +341,42 @@ impl Source {
         &self.name
     }
 
+    /// The first row that is scored (0 but for a time series' held-out
+    /// part, which is simulated from the start of its file).
+    pub fn scored_from(&self) -> usize {
+        self.scored_from
+    }
+
     /// `--holdout FRACTION`: the table cut in two before anything reads it,
     /// the training rows and the held-out rows ([`held_out_rows`]), each a
-    /// source of its own with `mapping` (a `ddt()` is taken within each
-    /// part). The held-out part is named `NAME (held out)`.
+    /// source of its own with `mapping`, the held-out part named
+    /// `NAME (held out)`. Nothing of the held-out rows reaches the training
+    /// part (its `ddt()` is taken within it). A time series' held-out part
+    /// is its later part: it is the whole table, scored from its first
+    /// held-out row ([`Source::scored_from`]), so that the model runs
+    /// through the motion before it, as a node that ran all along would,
+    /// and meets the held-out part in the state that motion left (a
+    /// bristle still loaded from the last reversal) instead of a guessed
+    /// one. Only the inputs before it are read: the model's parameters come
+    /// from the training part alone.
     pub fn split_held_out(
         &self,
         fraction: f64,
         mapping: &Mapping,
     ) -> Result<(Source, Source), FitError> {
         let held = held_out_rows(self.table.rows(), self.steady, fraction);
+        // A time series' later part keeps the rows before it, unscored.
+        let lead_in = if self.steady {
+            0
+        } else {
+            held.iter().position(|h| *h).unwrap_or(0)
+        };
         let part = |keep_held: bool, label: &str| -> Result<Source, FitError> {
-            let keep: Vec<bool> = held.iter().map(|h| *h == keep_held).collect();
+            let keep: Vec<bool> = held
+                .iter()
+                .enumerate()
+                .map(|(k, h)| *h == keep_held || (keep_held && k < lead_in))
+                .collect();
             let table = self.table.select_rows(&keep);
             let mut s = Source::new(table, mapping).map_err(|e| FitError::Data {
                 what: format!("{} ({label}, --holdout {fraction})", self.name),
@@ -340,6 +384,7 @@ impl Source {
             })?;
             if keep_held {
                 s.name = format!("{} (held out)", self.name);
+                s.scored_from = lead_in;
             }
             Ok(s)
         };
