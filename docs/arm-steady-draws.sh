@@ -61,8 +61,11 @@ def write(path, speeds, p, seed):
                 f.write(f"{w},{tau * (1 + rng.gauss(0, 0.01))}\n")
 for name, p in curves.items():
     for seed in (range(1, draws + 1) if not name.startswith("random") else [1]):
-        write(f"{out}/{name}-{seed}-train.csv", train, p, seed)
-        write(f"{out}/{name}-{seed}-validate.csv", validate, p, 100 + seed)
+        # Each random joint gets its own noise (until stop 70 every one of
+        # them drew seed 1's, so the family's noise was one draw repeated).
+        noise = seed if not name.startswith("random") else 1000 * family + int(name[6:])
+        write(f"{out}/{name}-{seed}-train.csv", train, p, noise)
+        write(f"{out}/{name}-{seed}-validate.csv", validate, p, 100000 + noise if name.startswith("random") else 100 + seed)
 PY
 
 if [ "$CURVES" = random ]; then
