@@ -9,7 +9,7 @@
 //! change pays is [`pays`], the one yardstick of the selection and of its
 //! confirmation (`confirm.rs`).
 
-use super::candidates::{is_part, lighter_forms, one_element, CANDIDATES};
+use super::candidates::{holds, is_part, lighter_forms, needs, one_element, CANDIDATES};
 use super::cross_validate::{paired, TERM_COST};
 use super::prepared::Prepared;
 use super::trial::{Ctx, Scored, Tried};
@@ -73,28 +73,22 @@ impl Ctx<'_> {
         say: &(dyn Fn(&str) + Sync),
     ) -> Result<Scored, FitError> {
         loop {
-            let older: Vec<&'static str> = current
-                .tried
-                .terms
-                .iter()
-                .copied()
-                .filter(|t| *t != newest)
-                // A term others need stays while they are there.
-                .filter(|t| {
-                    !current.tried.terms.iter().any(|o| {
-                        CANDIDATES
-                            .iter()
-                            .any(|c| c.name == *o && c.requires == Some(t))
-                    })
-                })
-                .collect();
-            if older.is_empty() {
-                return Ok(current);
-            }
+            let set = &current.tried.terms;
+            let older: Vec<&'static str> = set.iter().copied().filter(|t| *t != newest).collect();
+            // A term others need stays while they are there; it may still
+            // give way to a lighter form that keeps what they need (the
+            // Stribeck curve to its viscous rise beside the quadratic).
+            let needed = |t: &str| set.iter().any(|o| needs(o, t, set));
             let alternatives: Vec<(&'static str, Option<&'static str>, Vec<&'static str>)> = older
                 .iter()
-                .flat_map(|t| lighter(&current.tried.terms, t, None))
+                .flat_map(|t| lighter(set, t, None))
+                .filter(|(t, form, terms)| {
+                    !needed(t) || (form.is_some() && terms.iter().all(|o| !needs_unheld(o, terms)))
+                })
                 .collect();
+            if alternatives.is_empty() {
+                return Ok(current);
+            }
             let scored: Vec<(&'static str, Option<&'static str>, Scored)> = alternatives
                 .par_iter()
                 .map(|(t, form, terms)| Ok((*t, *form, self.try_set(terms, &current.optimum)?)))
@@ -193,17 +187,17 @@ impl Ctx<'_> {
 /// A flagged term of a set: its key that ended at zero or at a bound or
 /// correlates above [`super::stats::CORRELATION_FLAG`] with another, why,
 /// and the other chosen term whose key that is, if any.
-struct Flagged {
-    term: &'static str,
-    key: &'static str,
-    why: String,
+pub(super) struct Flagged {
+    pub(super) term: &'static str,
+    pub(super) key: &'static str,
+    pub(super) why: String,
     /// The other term and its key, when the flag is a correlation with a
     /// key of another chosen term (not the base's, not a given name's).
-    confounded: Option<(&'static str, &'static str)>,
+    pub(super) confounded: Option<(&'static str, &'static str)>,
 }
 
 /// The latest flagged term of `s` not in `kept`.
-fn flagged(s: &Scored, kept: &[&'static str]) -> Option<Flagged> {
+pub(super) fn flagged(s: &Scored, kept: &[&'static str]) -> Option<Flagged> {
     let terms = &s.tried.terms;
     terms
         .iter()
@@ -253,7 +247,7 @@ fn flagged(s: &Scored, kept: &[&'static str]) -> Option<Flagged> {
 /// its lighter forms (those without `flagged_key`), then `t` removed with
 /// the terms that require it. Each as (t, the form taking its place, the
 /// set).
-fn lighter(
+pub(super) fn lighter(
     set: &[&'static str],
     t: &'static str,
     flagged_key: Option<&str>,
@@ -276,15 +270,19 @@ fn lighter(
     let without = set
         .iter()
         .copied()
-        .filter(|x| {
-            *x != t
-                && CANDIDATES
-                    .iter()
-                    .all(|c| c.name != *x || c.requires != Some(t))
-        })
+        .filter(|x| *x != t && !needs(x, t, set))
         .collect();
     out.push((t, None, without));
     out
+}
+
+/// Whether term `o` requires a term that `terms` do not hold.
+fn needs_unheld(o: &str, terms: &[&'static str]) -> bool {
+    CANDIDATES
+        .iter()
+        .find(|c| c.name == o)
+        .and_then(|c| c.requires)
+        .is_some_and(|r| !holds(terms, r))
 }
 
 /// "− t", or "t → form" when a lighter form takes its place.
@@ -429,11 +427,9 @@ mod tests {
                     Some("drivetrain viscous"),
                     vec!["pre-sliding", "drivetrain viscous", "drivetrain quadratic"]
                 ),
-                (
-                    "drivetrain Stribeck",
-                    None,
-                    vec!["pre-sliding", "drivetrain quadratic"]
-                ),
+                // Without the curve the quadratic rise has no viscous rise
+                // beneath it, and goes too.
+                ("drivetrain Stribeck", None, vec!["pre-sliding"]),
             ]
         );
         // A flag on the viscous key itself: its form would keep the flag.
@@ -446,6 +442,32 @@ mod tests {
         assert_eq!(flagged[0].1, None);
         // A term without a lighter form is only removed.
         assert_eq!(lighter(&set, "pre-sliding", None).len(), 1);
+        // The viscous rise removed takes the quadratic on top of it along;
+        // the quadratic removed leaves the viscous rise.
+        let rise = ["drivetrain viscous", "drivetrain quadratic", "film"];
+        assert_eq!(
+            lighter(&rise, "drivetrain viscous", None),
+            vec![("drivetrain viscous", None, vec!["film"])]
+        );
+        assert_eq!(
+            lighter(&rise, "drivetrain quadratic", None),
+            vec![(
+                "drivetrain quadratic",
+                None,
+                vec!["drivetrain viscous", "film"]
+            )]
+        );
+        assert!(needs("drivetrain quadratic", "drivetrain viscous", &rise));
+        assert!(!needs("film", "drivetrain viscous", &rise));
+        // Beside the Stribeck curve the quadratic needs the curve, not a
+        // viscous rise it does not hold; with both, neither alone.
+        assert!(needs("drivetrain quadratic", "drivetrain Stribeck", &set));
+        let both = [
+            "drivetrain viscous",
+            "drivetrain Stribeck",
+            "drivetrain quadratic",
+        ];
+        assert!(!needs("drivetrain quadratic", "drivetrain Stribeck", &both));
         assert_eq!(
             change_text("drivetrain Stribeck", Some("drivetrain viscous")),
             "drivetrain Stribeck → drivetrain viscous"

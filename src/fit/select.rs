@@ -86,7 +86,7 @@
 //! The report lists every set tried with its CV error per fold, the set
 //! chosen and why the selection stopped.
 
-use super::candidates::{candidates_here, parts_to_add, set_keys, Candidate};
+use super::candidates::{candidates_here, holds, parts_to_add, set_keys, Candidate};
 use super::classic_shape::{classic_shapes, without_subsumed};
 use super::cross_validate::paired;
 use super::options::SearchSettings;
@@ -274,7 +274,7 @@ fn open_candidates<'c>(
     candidates
         .iter()
         .filter(|c| !terms.contains(&c.name))
-        .filter(|c| c.requires.is_none_or(|r| terms.contains(&r)))
+        .filter(|c| c.requires.is_none_or(|r| holds(terms, r)))
         .filter(|c| c.keys.iter().any(|k| !fitted.contains(k)))
         .collect()
 }
@@ -482,6 +482,23 @@ mod tests {
             beside_viscous.contains(&"drivetrain Stribeck"),
             "{beside_viscous:?}"
         );
+    }
+
+    #[test]
+    fn the_quadratic_rise_is_a_candidate_only_beside_a_viscous_rise() {
+        let all: Vec<&'static Candidate> = CANDIDATES.iter().collect();
+        let names = |terms: &[&'static str]| {
+            open_candidates(&all, terms)
+                .iter()
+                .map(|c| c.name)
+                .collect::<Vec<_>>()
+        };
+        let quadratic = "drivetrain quadratic";
+        assert!(!names(&[]).contains(&quadratic), "{:?}", names(&[]));
+        assert!(!names(&["film", "drivetrain asymmetry"]).contains(&quadratic));
+        assert!(names(&["drivetrain viscous"]).contains(&quadratic));
+        // The Stribeck curve holds the viscous rise.
+        assert!(names(&["drivetrain Stribeck"]).contains(&quadratic));
     }
 
     #[test]
