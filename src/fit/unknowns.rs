@@ -512,12 +512,13 @@ mod tests {
         assert_relative_eq!(p.lo, 5e-5, max_relative = 1e-12);
         assert_relative_eq!(p.hi, 0.5, max_relative = 1e-12);
         assert!(p.log);
-        // The Stribeck speed: from 1e-3 of the top speed to 3 times it.
+        // The Stribeck speed: from 1e-3 of the top speed to the top speed,
+        // where the data still show 63 % of the fall.
         let p = keys
             .parameter(&spec("drivetrain.stribeck_speed_m_s"), &SCALE)
             .unwrap();
         assert_relative_eq!(p.lo, 5e-4, max_relative = 1e-12);
-        assert_relative_eq!(p.hi, 1.5, max_relative = 1e-12);
+        assert_relative_eq!(p.hi, 0.5, max_relative = 1e-12);
         let c = keys.with(&["roughness.sigma_m".into()], &[3.5e-6]).unwrap();
         assert_eq!(c.roughness.sigma_m, 3.5e-6);
     }
