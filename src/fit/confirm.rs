@@ -18,13 +18,18 @@
 //! chosen term (`select.rs`, rule 4b: the bristle's damping) is held to
 //! its own rule: it stays unless the folds predict worse with it. Every step takes
 //! a term away, so this ends, at the base set at the latest.
+//!
+//! Rule 4 is read again at the final optimum: two chosen terms whose keys
+//! correlate above 0.95 there (a quadratic rise that took over from the
+//! viscous rise beneath it, which ended at zero) are confounded, and one
+//! of the two goes (`confounded_at_final`).
 
 use super::candidates::is_part;
 use super::cross_validate::cv_rms;
 use super::prepared::Prepared;
-use super::removal::{keeps_part, pays};
+use super::removal::{flagged, keeps_part, lighter, pays};
 use super::select::{fitted_keys, Selection};
-use super::trial::{set_final_model, Scored, Tried};
+use super::trial::{set_final_model, KeyFlag, Scored, Tried};
 use super::unknowns::ParamSpec;
 use super::FitError;
 use crate::text::Num;
@@ -101,6 +106,65 @@ pub fn unconfirmed(s: &Selection, final_mse: &[f64], units: super::Units) -> Opt
     );
     Some(Fallback {
         set: fewer.clone(),
+        why,
+    })
+}
+
+/// Rule 4 at the optimum that is shipped: when a key of one chosen term
+/// correlates above [`super::stats::CORRELATION_FLAG`] with a key of
+/// another there (`flags`, the final fit's), the data cannot tell the two
+/// apart, yet past the data each extrapolates its own way; one of the two
+/// goes (with what needs it, or giving way to a lighter form), whichever
+/// set the folds missed least in the selection. A presumed term (rule 7)
+/// goes only when the set without it pays over the chosen set at its
+/// final optimum (folds' mean squared errors `final_mse`). `None` when no
+/// two chosen terms are confounded there, or no lighter set was scored.
+pub(super) fn confounded_at_final(
+    s: &Selection,
+    final_mse: &[f64],
+    flags: Vec<KeyFlag>,
+    units: super::Units,
+) -> Option<Fallback> {
+    let at_final = Tried {
+        terms: s.chosen.clone(),
+        fold_mse: final_mse.to_vec(),
+        cv_rms: cv_rms(final_mse),
+        simulations: 0,
+    };
+    let shipped = Scored {
+        tried: at_final.clone(),
+        optimum: Vec::new(),
+        flags,
+        aicc: f64::NAN,
+    };
+    let f = flagged(&shipped, &[])?;
+    let (other, other_key) = f.confounded?;
+    let mut options = lighter(&s.chosen, f.term, Some(f.key));
+    options.extend(lighter(&s.chosen, other, Some(other_key)));
+    let (t, form, set) = options
+        .iter()
+        .filter_map(|(t, form, terms)| {
+            let set = s
+                .scored
+                .iter()
+                .find(|x| same_terms(&x.tried.terms, terms))?;
+            let may = !s.presumed.contains(t) || pays(&at_final, &set.tried).0;
+            may.then_some((*t, *form, set))
+        })
+        .min_by(|a, b| a.2.tried.cv_rms.total_cmp(&b.2.tried.cv_rms))?;
+    let u = units.force();
+    let change = match form {
+        Some(form) => format!("{t} → {form}"),
+        None => format!("− {t}"),
+    };
+    let why = format!(
+        "{change}: at the final fit's optimum {}, so one of the two goes, the one whose set the folds missed least (CV RMS {} {u}; the chosen set at that optimum {} {u})",
+        f.why,
+        Num::sig(set.tried.cv_rms, 5),
+        Num::sig(at_final.cv_rms, 5),
+    );
+    Some(Fallback {
+        set: set.clone(),
         why,
     })
 }
@@ -194,6 +258,57 @@ mod tests {
         assert_eq!(f.set.tried.terms, vec!["drivetrain Stribeck"]);
         assert!(f.why.starts_with("film: "), "{}", f.why);
         assert!(f.why.contains("does not pay"), "{}", f.why);
+    }
+
+    /// Random joint 9 of `CURVES=random SEED=13 docs/arm-steady-draws.sh`
+    /// in miniature: a Coulomb + viscous joint whose final fit carried its
+    /// rise on the quadratic, the viscous key at zero beneath it and
+    /// correlated −0.964 with it.
+    fn confounded_rise() -> (Selection, Vec<KeyFlag>) {
+        let flag = |name: &str, rho: f64, partner: &str| KeyFlag {
+            name: name.into(),
+            edge: false,
+            rho,
+            partner: Some(partner.into()),
+        };
+        let (v, q) = ("drivetrain.viscous_n_s_m", "drivetrain.quadratic_n_s2_m2");
+        let s = selection(
+            &["drivetrain viscous", "drivetrain quadratic"],
+            vec![
+                scored(&[], &[8.5e-5, 4.1e-5, 1.1e-5, 2.1e-4]),
+                scored(&["drivetrain viscous"], &[6.5e-5, 2.3e-5, 2.7e-5, 1.1e-4]),
+                scored(
+                    &["drivetrain viscous", "drivetrain quadratic"],
+                    &[5.3e-5, 2.8e-5, 0.9e-5, 1.1e-4],
+                ),
+            ],
+        );
+        let flags = vec![
+            flag("contact.boundary_friction", 0.796, v),
+            flag(v, 0.964, q),
+            flag(q, 0.964, v),
+        ];
+        (s, flags)
+    }
+
+    #[test]
+    fn two_chosen_terms_confounded_at_the_final_optimum_leave_the_one_the_folds_miss_least() {
+        let (s, flags) = confounded_rise();
+        let at_final = [5.3e-5, 2.8e-5, 0.9e-5, 1.1e-4];
+        // The folds confirm the pair, yet its keys are confounded there.
+        assert_eq!(unconfirmed(&s, &at_final, UNITS), None);
+        let f = confounded_at_final(&s, &at_final, flags.clone(), UNITS).expect("confounded");
+        // The quadratic goes: without the viscous rise beneath it it would
+        // go as well, to the base, which the folds miss more.
+        assert_eq!(f.set.tried.terms, vec!["drivetrain viscous"]);
+        assert!(f.why.starts_with("− drivetrain quadratic: "), "{}", f.why);
+        assert!(f.why.contains("cannot tell"), "{}", f.why);
+        // Below the flag's threshold nothing happens.
+        let weak: Vec<KeyFlag> = flags
+            .into_iter()
+            .map(|k| KeyFlag { rho: 0.9, ..k })
+            .collect();
+        assert_eq!(confounded_at_final(&s, &at_final, weak, UNITS), None);
     }
 
     #[test]

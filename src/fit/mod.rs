@@ -27,7 +27,7 @@
 //! |---|---|
 //! | `request.rs` | a calibration as data ([`request::FitRequest`]) and its one flow, `run`, for the command line and Python: prepare → select → fit ours → the fitted file → the classic models → the report |
 //! | `prepare.rs` | data → our model: the sources (the held-out part cut off first), scales, keys, maps, the contact's scale |
-//! | `confirm.rs` | `--fit auto`'s choice confirmed at the final fit's optimum: scored on the same folds, it falls back to the best set with one term fewer when it no longer pays over it |
+//! | `confirm.rs` | `--fit auto`'s choice confirmed at the final fit's optimum: scored on the same folds, it falls back to the best set with one term fewer when it no longer pays over it, or to the lighter set of two chosen terms that are confounded at that optimum |
 //! | `select.rs` | `--fit auto`'s rule: stepwise with removal on cross-validation, terms that pay, dead terms dropped; its report |
 //! | `classic_shape.rs` | `--fit auto`'s rule 7: a steady curve starts from the classic shape its points support (AICc), which is presumed |
 //! | `removal.rs` | terms taken away during the selection: one that no longer pays, one flagged dead, one of two confounded terms; the lighter forms; whether a change pays |

@@ -177,7 +177,9 @@ impl FitRequest {
     /// Our fit; under `--fit auto` (`selection`) cross-validated on the
     /// selection's folds and confirmed there (`confirm.rs`): a chosen set
     /// that does not pay at its final optimum over the best set with one
-    /// term fewer gives way to that set, which is fitted in its place.
+    /// term fewer, or holds two terms confounded at that optimum, gives way
+    /// to that set (or the lighter set of the two), which is fitted in its
+    /// place.
     fn fit_confirmed(
         &self,
         p: &mut Prepared,
@@ -201,11 +203,12 @@ impl FitRequest {
             let Some(s) = selection.as_deref_mut() else {
                 return Ok(ours);
             };
-            let fallback = ours
-                .outcome
-                .fold_mse
-                .as_deref()
-                .and_then(|m| super::confirm::unconfirmed(s, m, p.data.units));
+            let fallback = ours.outcome.fold_mse.as_deref().and_then(|m| {
+                super::confirm::unconfirmed(s, m, p.data.units).or_else(|| {
+                    let flags = super::trial::flags_of(&ours.outcome);
+                    super::confirm::confounded_at_final(s, m, flags, p.data.units)
+                })
+            });
             let Some(f) = fallback else {
                 return Ok(ours);
             };

@@ -45,7 +45,11 @@ pub(super) struct Scored {
 
 /// The small-sample Akaike information criterion (Hurvich & Tsai 1989) of
 /// a least-squares fit of `k` parameters to `n` samples with residual
-/// sum of squares n·rms²: n ln(rms²) + 2k + 2k(k+1)/(n−k−1); +∞ when
+/// sum of squares n·rms²: n ln(rms²) + 2k + 2k(k+1)/(n−k−1). `k` counts
+/// the fitted parameters, not the noise variance beside them (Hurvich &
+/// Tsai count both): counting σ² too penalises the Stribeck curve more,
+/// and on 96 random joints (README, rule 8's table) that lost more (a
+/// rise started from the viscous rise predicted 14× worse); +∞ when
 /// n ≤ k + 1 or the fit failed, −∞ for an exact fit. Lower is better; it estimates the fit's error on new
 /// samples of the same kind (asymptotically leave-one-out
 /// cross-validation, Stone 1977) from all the samples at once.
@@ -330,7 +334,7 @@ impl Ctx<'_> {
 
 /// Per fitted parameter of `o`: its name, whether it ended at a bound or
 /// at zero, and its largest |correlation| with another parameter.
-fn flags_of(o: &super::driver::FitOutcome) -> Vec<KeyFlag> {
+pub(super) fn flags_of(o: &super::driver::FitOutcome) -> Vec<KeyFlag> {
     let st = &o.statistics;
     o.params
         .iter()
