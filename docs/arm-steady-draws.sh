@@ -90,6 +90,7 @@ rnd = names[0].startswith("random")
 print("| draw | ours: held out (N·m) | best classic: held out (N·m) | ours / best | ours chose |")
 print("|---|---|---|---|---|")
 worst = None
+ratios = []
 for curve in names:
     for seed in ([1] if rnd else range(1, draws + 1)):
         run = Run(out, f"{curve}-{seed}")
@@ -100,7 +101,13 @@ for curve in names:
             continue
         best, label = min(classic)
         ratio = float(ours[6]) / best
+        ratios.append(ratio)
         worst = max(worst or ratio, ratio)
         print(f"| {curve}-{seed} | {ours[6]} | {label} {best:.5g} | {ratio:.3f} | {run.chosen or '—'} |")
 print(f"\nworst ours / best classic: {worst:.3f}" if worst else "\nno draw fitted")
+if ratios:
+    import math, statistics
+    print(f"{len(ratios)} draws: median {statistics.median(ratios):.3f}, geometric mean "
+          f"{math.exp(sum(map(math.log, ratios)) / len(ratios)):.3f}, above 1.05: "
+          f"{sum(r > 1.05 for r in ratios)}, above 2: {sum(r > 2 for r in ratios)}")
 PY
