@@ -17,9 +17,11 @@
 //!    rises without end, or a regime the data do not reach, pays for it
 //!    there). Each fold is predicted by the set refitted without it.
 //! 2. Stepwise selection: each step fits every candidate not yet chosen
-//!    (whose prerequisite is chosen, and that adds a key the set does not
-//!    fit already: beside the Stribeck curve the viscous rise is not tried
-//!    again), warm-started from the current set's
+//!    (whose prerequisite the set holds — the quadratic rise only on top of
+//!    a viscous rise, the viscous term or the Stribeck curve, by the
+//!    marginality principle of polynomial models — and that adds a key the
+//!    set does not fit already: beside the Stribeck curve the viscous rise
+//!    is not tried again), warm-started from the current set's
 //!    optimum with the new keys at their starts, and adds the one with the
 //!    lowest cross-validated error — unless a candidate with fewer keys
 //!    predicts as well (the best does not pay for its extra keys over it,
@@ -63,7 +65,8 @@
 //!    (`trial::final_specs`: a film a trial placed inside the data is not
 //!    shipped there), and confirmed at that optimum
 //!    (`confirm.rs`): scored on the same folds, it gives way to the best
-//!    set with one term fewer when it no longer pays over it.
+//!    set with one term fewer when it no longer pays over it, and rule 4's
+//!    confounding is read again at that optimum.
 //! 7. A steady curve starts from its classic shape. Its four speed ranges
 //!    hold a few points each, and the slowest range predicted from the
 //!    rest misses a Stribeck dip it never saw by far: from the flat base
@@ -82,6 +85,11 @@
 //!    confirmation) only when the set without it pays over it by rule 3.
 //!    Other terms enter by the folds as on a time series, whose blocks
 //!    hold thousands of samples and start from the base.
+//! 8. A Stribeck speed lies inside the data: its range
+//!    (`physics::terms::drivetrain`) ends at the data's top speed, where
+//!    the data still show 63 % of the fall. Past every measured speed a
+//!    Stribeck curve shows the data only a curvature and puts the level it
+//!    falls to past them, a regime change they do not show.
 //!
 //! The report lists every set tried with its CV error per fold, the set
 //! chosen and why the selection stopped.
@@ -377,7 +385,7 @@ impl Ctx<'_> {
 pub fn report(s: &Selection, units: super::Units) -> String {
     let u = units.force();
     let mut md = format!(
-        "## Terms chosen by the data (`--fit auto`)\n\nRule: stepwise selection on cross-validation of the training data ({}; each fold predicted by the set refitted without it); each step takes the candidate with the lowest CV error, unless one with fewer keys predicts as well (the best does not pay for its extra keys over it); a term is added only if it lowers the folds' mean squared error by more than the standard error of that lowering and by more than {:.0} % of it (the cost of a term), and a term chosen earlier goes, or gives way to a lighter form of it (the Stribeck curve to its viscous rise), when it no longer pays beside a later one; a part of a chosen term (the pre-sliding bristle's damping, LuGre's σ1 beside its stiffness σ0) comes with it unless the folds predict worse with it; a term that ends at zero or at a bound, or that the data cannot tell from another parameter (|ρ| > 0.95), is dropped or reduced and the set fitted again unless that predicts worse, and of two chosen terms that the data cannot tell apart (a key of one correlated so with a key of the other; a part and its own term are one element, not two) one goes, whichever the folds miss least; the chosen set's final fit is scored on the same folds, and gives way to the best set with one term fewer when it no longer pays over it; a steady curve starts from its classic shape (the base alone, the viscous rise or the Stribeck curve: the simplest whose small-sample Akaike criterion on all the training points is within 2 of the lowest), which leaves the set only when the set without it pays over it. Neither --validate nor --holdout data are used.\n\n| set (boundary friction +) | CV RMS ({u}) | RMS per fold ({u}) | film solves |\n|---|---|---|---|\n",
+        "## Terms chosen by the data (`--fit auto`)\n\nRule: stepwise selection on cross-validation of the training data ({}; each fold predicted by the set refitted without it); each step takes the candidate with the lowest CV error, unless one with fewer keys predicts as well (the best does not pay for its extra keys over it); a term is added only if it lowers the folds' mean squared error by more than the standard error of that lowering and by more than {:.0} % of it (the cost of a term), and a term chosen earlier goes, or gives way to a lighter form of it (the Stribeck curve to its viscous rise), when it no longer pays beside a later one; a part of a chosen term (the pre-sliding bristle's damping, LuGre's σ1 beside its stiffness σ0) comes with it unless the folds predict worse with it; a term that ends at zero or at a bound, or that the data cannot tell from another parameter (|ρ| > 0.95), is dropped or reduced and the set fitted again unless that predicts worse, and of two chosen terms that the data cannot tell apart (a key of one correlated so with a key of the other; a part and its own term are one element, not two) one goes, whichever the folds miss least; the chosen set's final fit is scored on the same folds, and gives way to the best set with one term fewer when it no longer pays over it; a steady curve starts from its classic shape (the base alone, the viscous rise or the Stribeck curve: the simplest whose small-sample Akaike criterion on all the training points is within 2 of the lowest), which leaves the set only when the set without it pays over it; the quadratic rise comes only on top of a viscous rise, and a Stribeck speed lies within the data's speeds. Neither --validate nor --holdout data are used.\n\n| set (boundary friction +) | CV RMS ({u}) | RMS per fold ({u}) | film solves |\n|---|---|---|---|\n",
         s.folds,
         100.0 * TERM_COST
     );
