@@ -137,8 +137,17 @@ pub(super) fn confounded_at_final(
         flags,
         aicc: f64::NAN,
     };
-    let f = flagged(&shipped, &[])?;
-    let (other, other_key) = f.confounded?;
+    // The latest chosen term confounded with another (a term flagged for
+    // another reason, at a bound or correlated with the base or a map, was
+    // judged by the folds in the selection; it is passed over here).
+    let mut passed: Vec<&'static str> = Vec::new();
+    let (f, (other, other_key)) = loop {
+        let f = flagged(&shipped, &passed)?;
+        match f.confounded {
+            Some(c) => break (f, c),
+            None => passed.push(f.term),
+        }
+    };
     let mut options = lighter(&s.chosen, f.term, Some(f.key));
     options.extend(lighter(&s.chosen, other, Some(other_key)));
     let (t, form, set) = options
@@ -303,6 +312,28 @@ mod tests {
         assert_eq!(f.set.tried.terms, vec!["drivetrain viscous"]);
         assert!(f.why.starts_with("− drivetrain quadratic: "), "{}", f.why);
         assert!(f.why.contains("cannot tell"), "{}", f.why);
+        // A later term flagged for another reason (at a bound) is passed
+        // over, and the confounding behind it still found.
+        let mut later = s.clone();
+        later.chosen.push("drivetrain asymmetry");
+        let mut with_edge = flags.clone();
+        with_edge.push(KeyFlag {
+            name: "drivetrain.coulomb_asymmetry_n".into(),
+            edge: true,
+            rho: 0.1,
+            partner: None,
+        });
+        let mut three = s.scored.clone();
+        three.push(scored(
+            &["drivetrain viscous", "drivetrain asymmetry"],
+            &[6.0e-5, 2.3e-5, 2.7e-5, 1.1e-4],
+        ));
+        later.scored = three;
+        let f = confounded_at_final(&later, &at_final, with_edge, UNITS).expect("confounded");
+        assert_eq!(
+            f.set.tried.terms,
+            vec!["drivetrain viscous", "drivetrain asymmetry"]
+        );
         // Below the flag's threshold nothing happens.
         let weak: Vec<KeyFlag> = flags
             .into_iter()
