@@ -216,16 +216,24 @@ pub(super) fn holds(terms: &[&'static str], r: &str) -> bool {
         .is_some_and(|c| c.keys.iter().all(|k| fitted.contains(k)))
 }
 
+/// The term candidate `o` requires, if any.
+fn requirement(o: &str) -> Option<&'static str> {
+    CANDIDATES
+        .iter()
+        .find(|c| c.name == o)
+        .and_then(|c| c.requires)
+}
+
 /// Whether term `o` of `set` needs its term `t`: `o` requires a term that
 /// `set` holds, and holds no more without `t`.
 pub(super) fn needs(o: &str, t: &str, set: &[&'static str]) -> bool {
     let without: Vec<&'static str> = set.iter().copied().filter(|x| *x != t).collect();
-    o != t
-        && CANDIDATES
-            .iter()
-            .find(|c| c.name == o)
-            .and_then(|c| c.requires)
-            .is_some_and(|r| holds(set, r) && !holds(&without, r))
+    o != t && requirement(o).is_some_and(|r| holds(set, r) && !holds(&without, r))
+}
+
+/// Whether term `o` requires a term that `terms` do not hold.
+pub(super) fn needs_unheld(o: &str, terms: &[&'static str]) -> bool {
+    requirement(o).is_some_and(|r| !holds(terms, r))
 }
 
 /// Whether candidate `t` is a part of the term it requires

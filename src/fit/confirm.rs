@@ -27,7 +27,7 @@
 use super::candidates::is_part;
 use super::cross_validate::cv_rms;
 use super::prepared::Prepared;
-use super::removal::{flagged, keeps_part, lighter, pays};
+use super::removal::{change_text, flagged, keeps_part, lighter, pays};
 use super::select::{fitted_keys, Selection};
 use super::trial::{set_final_model, KeyFlag, Scored, Tried};
 use super::unknowns::ParamSpec;
@@ -162,10 +162,7 @@ pub(super) fn confounded_at_final(
         })
         .min_by(|a, b| a.2.tried.cv_rms.total_cmp(&b.2.tried.cv_rms))?;
     let u = units.force();
-    let change = match form {
-        Some(form) => format!("{t} → {form}"),
-        None => format!("− {t}"),
-    };
+    let change = change_text(t, form);
     let why = format!(
         "{change}: at the final fit's optimum {}, so one of the two goes, the one whose set the folds missed least (CV RMS {} {u}; the chosen set at that optimum {} {u})",
         f.why,

@@ -9,7 +9,7 @@
 //! change pays is [`pays`], the one yardstick of the selection and of its
 //! confirmation (`confirm.rs`).
 
-use super::candidates::{holds, is_part, lighter_forms, needs, one_element, CANDIDATES};
+use super::candidates::{is_part, lighter_forms, needs, needs_unheld, one_element, CANDIDATES};
 use super::cross_validate::{paired, TERM_COST};
 use super::prepared::Prepared;
 use super::trial::{Ctx, Scored, Tried};
@@ -276,17 +276,8 @@ pub(super) fn lighter(
     out
 }
 
-/// Whether term `o` requires a term that `terms` do not hold.
-fn needs_unheld(o: &str, terms: &[&'static str]) -> bool {
-    CANDIDATES
-        .iter()
-        .find(|c| c.name == o)
-        .and_then(|c| c.requires)
-        .is_some_and(|r| !holds(terms, r))
-}
-
 /// "− t", or "t → form" when a lighter form takes its place.
-fn change_text(t: &str, form: Option<&str>) -> String {
+pub(super) fn change_text(t: &str, form: Option<&str>) -> String {
     match form {
         Some(f) => format!("{t} → {f}"),
         None => format!("− {t}"),
