@@ -21,8 +21,9 @@
 //! that part of the error is in the data's mapping, not in any model's
 //! friction.
 
+use super::data::Role;
 use super::driver::FitOutcome;
-use super::problem::{Role, SeriesFit};
+use super::problem::SeriesFit;
 use std::fmt::Write as _;
 
 /// Samples slower than this fraction of their source's top speed count as

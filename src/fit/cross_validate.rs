@@ -16,9 +16,10 @@
 //! score our model's candidate sets and every classic model, so their
 //! cross-validated errors compare on one yardstick.
 
+use super::data::{Data, Folds, HoldOut};
 use super::driver::{fit, FitOutcome};
 use super::options::Options;
-use super::problem::{Data, Folds, HoldOut, Model};
+use super::problem::Model;
 use super::{FitError, FittedParameter};
 use rayon::prelude::*;
 

@@ -3,9 +3,10 @@
 //! predictions and errors on the training and validation data. The problem
 //! it solves is `problem.rs`.
 
+use super::data::{Data, Role};
 use super::local_run::LocalRun;
 use super::options::Options;
-use super::problem::{Data, Model, Problem, Role, SeriesFit};
+use super::problem::{Model, Problem, SeriesFit};
 use super::unknowns::FittedParameter;
 use std::sync::atomic::Ordering;
 use std::time::Instant;

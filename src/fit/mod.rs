@@ -53,13 +53,15 @@
 //! | `physics_model.rs` | our model as a predictor: its keys, its film reused when only the terms after it change, its linear keys |
 //! | `film_run.rs` | our model's film along a series (transient and steady solves), the trace it keeps, the friction recomposed along it |
 //! | `baselines.rs` | Coulomb + viscous, Stribeck, LuGre |
-//! | `problem.rs` | the problem: model, data (training, held out, validation), map coefficients, residuals, predictions |
+//! | `problem.rs` | the problem: a model, the data and its map coefficients, residuals, predictions |
+//! | `data.rs` | the data of a fit: training, held-out and validation sources by role, with the maps' coefficients |
 //! | `contact_scale.rs` | the contact's gain and load chosen from the data (a joint's lever, a linear axis's gain); a key's value as it acts on the joint |
 //! | `unknowns.rs` | the fitted parameters: bounds, scales, configuration keys; the data's scales |
 //! | `reversals.rs` | velocity reversals in the data and the stiffness through them (pre-sliding starts) |
 //! | `inputs.rs` | what is read: the data files, held out and validation files, their mapping, a bag's topics; one file into a table |
 //! | `bag_input.rs` | topics of a bag → a table |
-//! | `series.rs` | a table and its mapping → the model's inputs; the held-out rows |
+//! | `held_out.rs` | `--holdout`: the rows held out, the table cut in two before anything reads it, a later part scored after the motion before it |
+//! | `series.rs` | a table and its mapping → the model's inputs |
 //! | `expr.rs` | column expressions: compiling, affine fast path, `ddt` and `smooth` replaced by their columns |
 //! | `windowed.rs` | columns made over ±`--smooth` windows: `ddt`'s local linear slope, `smooth`'s kernel that slope implies |
 //! | `synthetic.rs` | synthetic data: the model along a motion, with noise |
@@ -78,11 +80,13 @@ pub mod compare;
 pub mod confirm;
 pub mod contact_scale;
 pub mod cross_validate;
+pub mod data;
 pub mod driver;
 pub mod earlier_optima;
 pub mod error;
 mod expr;
 mod film_run;
+mod held_out;
 pub mod inputs;
 pub mod local_run;
 pub mod models_table;
@@ -111,11 +115,12 @@ mod windowed;
 
 pub use crate::table::{Delimiter, Table, TableError};
 pub use baselines::{Baseline, BaselineKind, LoadForm};
+pub use data::Data;
 pub use driver::FitOutcome;
 pub use error::{FitError, PredictError};
 pub use options::Options;
 pub use physics_model::PhysicsModel;
-pub use problem::{Data, Model};
+pub use problem::Model;
 pub use series::{Mapping, Series, Source};
 pub use units::Units;
 pub use unknowns::{FittedParameter, ParamSpec};

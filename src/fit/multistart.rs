@@ -222,8 +222,9 @@ fn local_runs(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fit::data::Data;
     use crate::fit::options::LaterRuns;
-    use crate::fit::problem::{tests_data, Data, Model};
+    use crate::fit::problem::{tests_data, Model};
     use crate::fit::series::{Mapping, Series};
     use crate::fit::unknowns::FittedParameter;
 

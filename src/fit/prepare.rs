@@ -293,7 +293,7 @@ pub fn prepare(
             train,
             held_out,
             validate,
-            holdout: super::problem::HoldOut::None,
+            holdout: super::data::HoldOut::None,
             map_names,
             map_values,
             units: req.units(),

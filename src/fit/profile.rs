@@ -342,7 +342,7 @@ mod tests {
     }
 
     /// Samples of a = 2, s = 0.3, k = 1.5 over ±1.5 m/s.
-    fn data() -> crate::fit::problem::Data {
+    fn data() -> crate::fit::data::Data {
         let mut text = String::from("t_s,velocity_m_s,friction_n\n");
         for i in 0..200 {
             let v = 1.5 * (i as f64 * 0.05).sin();

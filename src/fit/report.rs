@@ -4,9 +4,9 @@
 //! directory, with the models table (`models_table.rs`); the fitted
 //! parameter file.
 
+use super::data::Role;
 use super::driver::FitOutcome;
 use super::models_table::on_joint;
-use super::problem::Role;
 use super::stats::CORRELATION_FLAG;
 use crate::config::Config;
 use crate::output::{AtomicFile, OutputError};

@@ -386,8 +386,9 @@ impl super::profile::CheapFit for Variables<'_, '_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fit::data::Data;
     use crate::fit::options::{LinearKeys, Options};
-    use crate::fit::problem::{tests_data, Data};
+    use crate::fit::problem::tests_data;
     use crate::fit::series::{Mapping, Series};
     use crate::fit::unknowns::FittedParameter;
     use crate::fit::PredictError;

@@ -82,21 +82,6 @@ pub(super) fn mix(h: u64, w: u64) -> u64 {
 }
 
 impl Series {
-    /// The samples from `from` on (a held-out part after its lead-in).
-    pub fn tail(&self, from: usize) -> Series {
-        let cut = |v: &Vec<f64>| v[from.min(v.len())..].to_vec();
-        Series {
-            name: self.name.clone(),
-            steady: self.steady,
-            t: cut(&self.t),
-            velocity: cut(&self.velocity),
-            friction: cut(&self.friction),
-            load: self.load.as_ref().map(cut),
-            temperature: self.temperature.as_ref().map(cut),
-            fit: self.fit[from.min(self.fit.len())..].to_vec(),
-        }
-    }
-
     /// A fingerprint of the series' model inputs: time, velocity, load,
     /// temperature and whether it is steady (the film traces' and the
     /// problem's kept predictions' key; `mix` over every value).
@@ -131,28 +116,12 @@ impl Series {
     }
 }
 
-/// The rows `--holdout FRACTION` holds out of a table of `rows` rows: the
-/// last fraction of a time series, or every k-th point of a steady curve
-/// (k = round(1/fraction), interleaved so both ends stay in the fit).
-pub fn held_out_rows(rows: usize, steady: bool, fraction: f64) -> Vec<bool> {
-    if fraction <= 0.0 {
-        return vec![false; rows];
-    }
-    if steady {
-        let every = (1.0 / fraction).round().max(2.0) as usize;
-        (0..rows).map(|k| k % every == every / 2).collect()
-    } else {
-        let cut = ((1.0 - fraction) * rows as f64).round() as usize;
-        (0..rows).map(|k| k >= cut).collect()
-    }
-}
-
 /// A table with its mapping, ready to give series for any coefficients.
 #[derive(Clone)]
 pub struct Source {
     pub(super) table: Table,
-    name: String,
-    steady: bool,
+    pub(super) name: String,
+    pub(super) steady: bool,
     time: Option<Expr>,
     velocity: Expr,
     friction: Expr,
@@ -166,7 +135,7 @@ pub struct Source {
     /// The first row that is scored: a time series' held-out part is
     /// simulated from the start of its file, so that it starts in the
     /// state the motion before it left, and scored from here (0: every row).
-    scored_from: usize,
+    pub(super) scored_from: usize,
 }
 
 impl Source {
@@ -339,56 +308,6 @@ impl Source {
     /// The source's name (its file).
     pub fn name(&self) -> &str {
         &self.name
-    }
-
-    /// The first row that is scored (0 but for a time series' held-out
-    /// part, which is simulated from the start of its file).
-    pub fn scored_from(&self) -> usize {
-        self.scored_from
-    }
-
-    /// `--holdout FRACTION`: the table cut in two before anything reads it,
-    /// the training rows and the held-out rows ([`held_out_rows`]), each a
-    /// source of its own with `mapping`, the held-out part named
-    /// `NAME (held out)`. Nothing of the held-out rows reaches the training
-    /// part (its `ddt()` is taken within it). A time series' held-out part
-    /// is its later part: it is the whole table, scored from its first
-    /// held-out row ([`Source::scored_from`]), so that the model runs
-    /// through the motion before it, as a node that ran all along would,
-    /// and meets the held-out part in the state that motion left (a
-    /// bristle still loaded from the last reversal) instead of a guessed
-    /// one. Only the inputs before it are read: the model's parameters come
-    /// from the training part alone.
-    pub fn split_held_out(
-        &self,
-        fraction: f64,
-        mapping: &Mapping,
-    ) -> Result<(Source, Source), FitError> {
-        let held = held_out_rows(self.table.rows(), self.steady, fraction);
-        // A time series' later part keeps the rows before it, unscored.
-        let lead_in = if self.steady {
-            0
-        } else {
-            held.iter().position(|h| *h).unwrap_or(0)
-        };
-        let part = |keep_held: bool, label: &str| -> Result<Source, FitError> {
-            let keep: Vec<bool> = held
-                .iter()
-                .enumerate()
-                .map(|(k, h)| *h == keep_held || (keep_held && k < lead_in))
-                .collect();
-            let table = self.table.select_rows(&keep);
-            let mut s = Source::new(table, mapping).map_err(|e| FitError::Data {
-                what: format!("{} ({label}, --holdout {fraction})", self.name),
-                message: e.to_string(),
-            })?;
-            if keep_held {
-                s.name = format!("{} (held out)", self.name);
-                s.scored_from = lead_in;
-            }
-            Ok(s)
-        };
-        Ok((part(false, "training part")?, part(true, "held-out part")?))
     }
 
     /// The columns its expressions read.

@@ -7,10 +7,11 @@
 use super::candidates::{set_keys, set_specs, CANDIDATES, FILM, FILM_KEY};
 use super::contact_scale::slow_speed;
 use super::cross_validate::cross_validate;
+use super::data::{Data, Folds};
 use super::driver::fit;
 use super::options::{Options, SearchSettings};
 use super::prepared::{model_for, Prepared};
-use super::problem::{Data, Folds, Model};
+use super::problem::Model;
 use super::unknowns::ParamSpec;
 use super::FitError;
 
