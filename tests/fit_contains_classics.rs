@@ -420,3 +420,45 @@ fn profiled_cheap_keys_reach_the_lead_screws_optimum_with_the_film_beside_the_st
         "film solves: profiled {profiled_films}, searched {searched_films}"
     );
 }
+
+/// The line `Chosen: …` of a report.
+fn chosen(md: &str) -> &str {
+    md.lines().find(|l| l.starts_with("Chosen:")).unwrap()
+}
+
+#[test]
+fn a_coulomb_plus_viscous_joint_keeps_its_viscous_rise_where_a_boundary_rate_fits_the_folds_as_well(
+) {
+    // Random joint 9 of seed 19 (`CURVES=random SEED=19
+    // docs/arm-steady-draws.sh`): f_c 2.559 N·m, b 0.7595 N·m·s/rad, 1 %
+    // noise. The folds paid 5 % for a boundary rate (a logarithmic rise)
+    // in place of the presumed viscous rise; past the data it fell behind,
+    // 9.9× the Coulomb + viscous line's held-out error.
+    let md = fit_joint_fixture("joint-cv-rate");
+    let chosen = chosen(&md);
+    assert!(
+        chosen.starts_with("Chosen: boundary friction, drivetrain viscous"),
+        "{chosen}"
+    );
+    assert_held_out_within(&md, "Coulomb + viscous", 1.05);
+}
+
+#[test]
+fn a_stribeck_dip_the_noise_made_gives_way_to_the_viscous_rise_beneath_it() {
+    // Random joint 7 of seed 5: f_c 1.459 N·m with a rise below the data
+    // (ω_s 0.005 rad/s), so Coulomb + viscous over 0.5–20 deg/s. The noise
+    // gave the Stribeck curve a dip (AICc 5.7 below the viscous rise, its
+    // keys correlated 0.997), which predicts the folds worse than the rise
+    // and 25–90 deg/s 4.5× worse than Coulomb + viscous.
+    let md = fit_joint_fixture("joint-cv-dip");
+    let chosen = chosen(&md);
+    assert!(
+        chosen.starts_with("Chosen: boundary friction, drivetrain viscous."),
+        "{chosen}"
+    );
+    assert!(
+        md.contains("drivetrain Stribeck → drivetrain viscous"),
+        "the curve gives way to its rise"
+    );
+    assert_held_out_within(&md, "Coulomb + viscous", 1.05);
+}

@@ -1,11 +1,11 @@
 //! Rule 7 of `--fit auto` (`select.rs`): a steady curve starts from its
-//! classic shape — the base alone (Coulomb), the viscous rise or the
-//! Stribeck curve, the simplest whose small-sample Akaike criterion on all
-//! the training points is within [`AICC_SUPPORT`] of the lowest — and that
-//! shape is presumed: it leaves the set only when the set without it pays
-//! over it (`removal.rs`, `confirm.rs`).
+//! classic shape — the viscous rise or the Stribeck curve, the simplest
+//! whose small-sample Akaike criterion on all the training points is
+//! within [`AICC_SUPPORT`] of the lowest — and that shape is presumed with
+//! its viscous rise: the curve gives way only to its rise, and the rise
+//! goes only when its key ends at zero (`removal.rs`, `confirm.rs`).
 
-use super::candidates::{set_keys, Candidate, STRIBECK, VISCOUS};
+use super::candidates::{lighter_forms, set_keys, Candidate, STRIBECK, VISCOUS};
 use super::trial::{Ctx, Scored, Tried};
 use super::FitError;
 
@@ -58,14 +58,45 @@ pub(super) fn classic_shapes(candidates: &[&'static Candidate]) -> Vec<&'static 
         .collect()
 }
 
+/// The start of a steady curve (rule 7), an index of `aiccs` (the base
+/// alone, then each classic shape): the simplest within [`AICC_SUPPORT`] of
+/// the lowest, where the data do not prefer a richer shape over it
+/// (Burnham & Anderson 2002). Where the viscous rise is a candidate
+/// (`rises`), the flat base is not one of the shapes: a lubricated drive's
+/// friction rises with speed, and the fit decides by how much (its
+/// viscous key bounded at zero).
+pub(super) fn start_shape(aiccs: &[f64], rises: bool) -> usize {
+    let from = usize::from(rises).min(aiccs.len().saturating_sub(1));
+    let lowest = aiccs[from..].iter().copied().fold(f64::INFINITY, f64::min);
+    (from..aiccs.len())
+        .find(|&k| aiccs[k] <= lowest + AICC_SUPPORT)
+        .unwrap_or(from)
+}
+
+/// The terms presumed from the start `terms`: those, and each one's
+/// lighter classic shape among `shapes` (the Stribeck curve's viscous
+/// rise), so that a curve that gives way to it (rule 4) leaves a rise, not
+/// the flat base, presumed.
+pub(super) fn presumed_terms(terms: &[&'static str], shapes: &[&'static str]) -> Vec<&'static str> {
+    let mut presumed = terms.to_vec();
+    for t in terms {
+        presumed.extend(
+            lighter_forms(t, terms)
+                .into_iter()
+                .filter(|f| shapes.contains(f)),
+        );
+    }
+    presumed
+}
+
 impl Ctx<'_> {
     /// Rule 7: on a steady curve the selection starts from the classic
-    /// shape that the whole curve supports — the base alone (Coulomb), the
-    /// viscous rise or the Stribeck curve: the simplest whose small-sample
-    /// Akaike criterion on all the training points
-    /// ([`super::trial::aicc`]) is within [`AICC_SUPPORT`] of the lowest —
-    /// and that shape is presumed: it leaves
-    /// the set only when the set without it pays over it. With `shapes`
+    /// shape that the whole curve supports ([`start_shape`]: the viscous
+    /// rise or the Stribeck curve, the simplest whose small-sample Akaike
+    /// criterion on all the training points ([`super::trial::aicc`]) is
+    /// within [`AICC_SUPPORT`] of the lowest), and that shape is presumed
+    /// with its viscous rise ([`presumed_terms`]; how it may leave:
+    /// `removal::holds_rise`, `removal::presumed_gives_way`). With `shapes`
     /// empty (a time series) the start is the base.
     pub(super) fn presume(
         &self,
@@ -81,6 +112,7 @@ impl Ctx<'_> {
             tried.push(t.tried.clone());
             sets.push(t);
         }
+        let aiccs: Vec<f64> = sets.iter().map(|s| s.aicc).collect();
         let text: Vec<String> = sets
             .iter()
             .map(|s| {
@@ -91,14 +123,12 @@ impl Ctx<'_> {
                 )
             })
             .collect();
-        // The simplest shape within AICC_SUPPORT of the lowest: the data
-        // do not prefer a richer one over it (Burnham & Anderson 2002).
-        let lowest = sets.iter().map(|s| s.aicc).fold(f64::INFINITY, f64::min);
         let best = sets
             .into_iter()
-            .find(|s| s.aicc <= lowest + AICC_SUPPORT)
-            .expect("the lowest is within its own support");
-        let _ = self.presumed.set(best.tried.terms.clone());
+            .nth(start_shape(&aiccs, shapes.contains(&VISCOUS)))
+            .expect("start_shape is an index of the sets");
+        let presumed = presumed_terms(&best.tried.terms, shapes);
+        let _ = self.presumed.set(presumed);
         if !shapes.is_empty() {
             let shape = best
                 .tried
@@ -106,8 +136,15 @@ impl Ctx<'_> {
                 .first()
                 .copied()
                 .unwrap_or("the base alone");
+            let stays = if shape == VISCOUS {
+                "it stays unless its key ends at zero"
+            } else if shape == STRIBECK {
+                "it stays unless it gives way to its viscous rise (which pays over it, or, its keys flagged, predicts the folds no worse within 10 of its Akaike criterion); the rise stays unless its key ends at zero"
+            } else {
+                "it stays unless the set without it pays over it"
+            };
             let why = format!(
-                "the selection starts from {shape}, the classic shape the whole steady curve supports (small-sample Akaike criterion on all the training points: {}); it stays unless the set without it pays over it",
+                "the selection starts from {shape}, the classic shape the whole steady curve supports (small-sample Akaike criterion on all the training points: {}); {stays}",
                 text.join(", ")
             );
             say(&format!("auto: {why}"));
@@ -120,6 +157,32 @@ impl Ctx<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_steady_curve_starts_from_the_simplest_rising_shape_its_criterion_supports() {
+        // The base alone lowest: a rise all the same, the viscous rise.
+        assert_eq!(start_shape(&[-226.1, -226.0, -223.5], true), 1);
+        // The Stribeck curve 5.7 below the viscous rise: the curve.
+        assert_eq!(start_shape(&[-63.3, -164.3, -170.0], true), 2);
+        // 1.6 below: within the support, the simpler viscous rise.
+        assert_eq!(start_shape(&[-186.2, -201.6, -203.2], true), 1);
+        // No viscous rise among the candidates: the base may be the start.
+        assert_eq!(start_shape(&[-226.1, -223.5], false), 0);
+        assert_eq!(start_shape(&[-10.0], false), 0);
+        // A shape that could not be fitted (+inf) is never the start.
+        assert_eq!(start_shape(&[-50.0, f64::INFINITY, -40.0], true), 2);
+    }
+
+    #[test]
+    fn the_presumption_of_a_curve_covers_its_viscous_rise() {
+        let shapes = [VISCOUS, STRIBECK];
+        assert_eq!(
+            presumed_terms(&[STRIBECK], &shapes),
+            vec![STRIBECK, VISCOUS]
+        );
+        assert_eq!(presumed_terms(&[VISCOUS], &shapes), vec![VISCOUS]);
+        assert!(presumed_terms(&[], &shapes).is_empty());
+    }
 
     #[test]
     fn a_viscous_rise_beside_the_stribeck_curve_is_named_once_and_its_presumption_passes_to_the_curve(

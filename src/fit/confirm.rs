@@ -27,7 +27,7 @@
 use super::candidates::is_part;
 use super::cross_validate::cv_rms;
 use super::prepared::Prepared;
-use super::removal::{change_text, flagged, keeps_part, lighter, pays};
+use super::removal::{change_text, flagged, goes_of_pair, holds_rise, keeps_part, lighter, pays};
 use super::select::{fitted_keys, Selection};
 use super::trial::{set_final_model, KeyFlag, Scored, Tried};
 use super::unknowns::ParamSpec;
@@ -74,7 +74,9 @@ pub fn unconfirmed(s: &Selection, final_mse: &[f64], units: super::Units) -> Opt
     // pays over it; any other term must pay.
     let part = is_part(term);
     let presumed = s.presumed.contains(&term);
-    let stays = if part {
+    let stays = if holds_rise(term, &s.presumed) {
+        true
+    } else if part {
         keeps_part(&fewer.tried, &at_final)
     } else if presumed {
         !pays(&at_final, &fewer.tried).0
@@ -148,8 +150,15 @@ pub(super) fn confounded_at_final(
             None => passed.push(f.term),
         }
     };
-    let mut options = lighter(&s.chosen, f.term, Some(f.key));
-    options.extend(lighter(&s.chosen, other, Some(other_key)));
+    let presumed = |t: &str| s.presumed.contains(&t);
+    let (may_go, other_may_go) = goes_of_pair(f.term, f.confounded, presumed);
+    let mut options = Vec::new();
+    if may_go {
+        options = lighter(&s.chosen, f.term, Some(f.key));
+    }
+    if other_may_go {
+        options.extend(lighter(&s.chosen, other, Some(other_key)));
+    }
     let (t, form, set) = options
         .iter()
         .filter_map(|(t, form, terms)| {
@@ -157,7 +166,9 @@ pub(super) fn confounded_at_final(
                 .scored
                 .iter()
                 .find(|x| same_terms(&x.tried.terms, terms))?;
-            let may = !s.presumed.contains(t) || pays(&at_final, &set.tried).0;
+            let may = !s.presumed.contains(t)
+                || ((form.is_some() || !holds_rise(t, &s.presumed))
+                    && pays(&at_final, &set.tried).0);
             may.then_some((*t, *form, set))
         })
         .min_by(|a, b| a.2.tried.cv_rms.total_cmp(&b.2.tried.cv_rms))?;

@@ -9,10 +9,12 @@
 //! change pays is [`pays`], the one yardstick of the selection and of its
 //! confirmation (`confirm.rs`).
 
-use super::candidates::{is_part, lighter_forms, needs, needs_unheld, one_element, CANDIDATES};
+use super::candidates::{
+    is_part, lighter_forms, needs, needs_unheld, one_element, CANDIDATES, VISCOUS,
+};
 use super::cross_validate::{paired, TERM_COST};
 use super::prepared::Prepared;
-use super::trial::{Ctx, Scored, Tried};
+use super::trial::{Ctx, Scored, Tried, AICC_DECISIVE};
 use super::FitError;
 use rayon::prelude::*;
 
@@ -41,14 +43,74 @@ pub(super) fn keeps_part(without: &Tried, with: &Tried) -> bool {
     gain.is_finite() && gain >= 0.0
 }
 
+/// Whether a flagged presumed shape (rule 7) leaves the set `current`
+/// for `next`. Removed, only when the set without it pays over it.
+/// Reduced to its lighter classic shape (the Stribeck curve to its viscous
+/// rise), also when that predicts the folds no worse and the whole curve's
+/// Akaike criterion does not rule the lighter shape out (a difference
+/// below [`AICC_DECISIVE`]): the flag, the folds and the criterion then all
+/// leave the richer shape's extra keys in doubt, and its extrapolation
+/// rests on them.
+pub(super) fn presumed_gives_way(current: &Scored, next: &Scored, reduced: bool) -> bool {
+    pays(&current.tried, &next.tried).0
+        || (reduced
+            && keeps_part(&current.tried, &next.tried)
+            && next.aicc - current.aicc < AICC_DECISIVE)
+}
+
+/// Whether `t` is a presumed shape (rule 7, among `presumed`) of a curve
+/// presumed to rise, or a term that holds the presumed rise's key: the
+/// viscous rise, or the Stribeck curve above it. Such
+/// a term is never removed outright for the flat base, whatever the folds
+/// say: it gives way only to its lighter shape (the curve to its rise), and
+/// the rise goes only when its key ends at zero. A lubricated drive's
+/// friction rises with speed, and past the data the rise is what counts:
+/// the folds' short reach, a quarter of the speeds, cannot weigh a rise
+/// within the noise there (on random joints a Coulomb + viscous curve
+/// dropped to the flat base predicted 25–90 deg/s up to 3.1× worse), nor
+/// tell it from the boundary rate's logarithmic rise, which fits the folds
+/// as well and falls behind past the data (in its place: 9.9× worse).
+pub(super) fn holds_rise(t: &str, presumed: &[&'static str]) -> bool {
+    // A term that fits the rise's key (the Stribeck curve added beside a
+    // presumed rise) holds the rise as well.
+    let keys = |name: &str| CANDIDATES.iter().find(|c| c.name == name).map(|c| c.keys);
+    let fits_the_rise = || {
+        keys(t)
+            .zip(keys(VISCOUS))
+            .is_some_and(|(theirs, rise)| rise.iter().all(|k| theirs.contains(k)))
+    };
+    presumed.contains(&VISCOUS) && (presumed.contains(&t) || fits_the_rise())
+}
+
+/// Which of a flagged term `t` and the term it is confounded with (if
+/// any) may go: both, unless exactly one of them is presumed (rule 7,
+/// `presumed`): where the data cannot tell the two apart, the shape the
+/// whole curve supports stays.
+pub(super) fn goes_of_pair(
+    t: &str,
+    confounded: Option<(&'static str, &'static str)>,
+    presumed: impl Fn(&str) -> bool,
+) -> (bool, bool) {
+    match confounded {
+        Some((o, _)) => match (presumed(t), presumed(o)) {
+            (true, false) => (false, true),
+            (false, true) => (true, false),
+            _ => (true, true),
+        },
+        None => (true, false),
+    }
+}
+
 impl Ctx<'_> {
     /// Whether term `t` may leave the set `with` it for the set `without`
     /// it (or its lighter form): a part of a chosen term when the folds
     /// predict worse with it; a presumed term (rule 7) when the set
     /// without it pays over the set with it; any other term when it does
     /// not pay over the set without it.
-    pub(super) fn may_leave(&self, t: &str, without: &Tried, with: &Tried) -> bool {
-        if is_part(t) {
+    pub(super) fn may_leave(&self, t: &str, reduced: bool, without: &Tried, with: &Tried) -> bool {
+        if self.holds_rise(t) && !reduced {
+            false
+        } else if is_part(t) {
             !keeps_part(without, with)
         } else if self.is_presumed(t) {
             pays(with, without).0
@@ -60,6 +122,12 @@ impl Ctx<'_> {
     /// Whether `t` is a presumed term (`select.rs`, rule 7).
     pub(super) fn is_presumed(&self, t: &str) -> bool {
         self.presumed.get().is_some_and(|p| p.contains(&t))
+    }
+
+    /// Whether `t` is a presumed shape of a curve presumed to rise
+    /// ([`holds_rise`]).
+    pub(super) fn holds_rise(&self, t: &str) -> bool {
+        holds_rise(t, self.presumed.get().map_or(&[], Vec::as_slice))
     }
 
     /// Remove, one at a time, each chosen term (but `newest`) that does not
@@ -98,7 +166,7 @@ impl Ctx<'_> {
             // does not pay over it (a part: if the set predicts worse with it).
             let Some((t, form, lighter)) = scored
                 .into_iter()
-                .filter(|(t, _, s)| self.may_leave(t, &s.tried, &current.tried))
+                .filter(|(t, form, s)| self.may_leave(t, form.is_some(), &s.tried, &current.tried))
                 .min_by(|a, b| a.2.tried.cv_rms.total_cmp(&b.2.tried.cv_rms))
             else {
                 return Ok(current);
@@ -138,8 +206,21 @@ impl Ctx<'_> {
             };
             // Its lighter forms without the flagged key, then the set
             // without it; when confounded, the same for the other term.
-            let mut options = lighter(&current.tried.terms, f.term, Some(f.key));
-            if let Some((other, other_key)) = f.confounded {
+            // A presumed shape's lighter classic shape is tried whichever
+            // key is flagged: the curve's extra keys are what the data
+            // cannot separate from the others (a Stribeck curve's viscous
+            // key correlated with the level is its dip trading against them).
+            let key = (!self.is_presumed(f.term)).then_some(f.key);
+            // Of a presumed shape and a term confounded with it, the term
+            // goes: where the data cannot tell the two apart, the shape the
+            // whole curve supports stands.
+            let presumed = |t: &str| self.is_presumed(t);
+            let (may_go, other_may_go) = goes_of_pair(f.term, f.confounded, presumed);
+            let mut options = Vec::new();
+            if may_go {
+                options = lighter(&current.tried.terms, f.term, key);
+            }
+            if let Some((other, other_key)) = f.confounded.filter(|_| other_may_go) {
                 options.extend(lighter(&current.tried.terms, other, Some(other_key)));
             }
             let scored: Vec<(&'static str, Option<&'static str>, Scored)> = options
@@ -149,11 +230,13 @@ impl Ctx<'_> {
             tried.extend(scored.iter().map(|(_, _, s)| s.tried.clone()));
             let best = scored
                 .into_iter()
-                .filter(|(t, _, s)| {
-                    if self.is_presumed(t) {
-                        // Confounded or flagged, a presumed shape leaves
-                        // only when the set without it pays over it.
-                        pays(&current.tried, &s.tried).0
+                .filter(|(t, form, s)| {
+                    if self.holds_rise(t) && form.is_none() {
+                        // Removed outright, only the rise, when it ended
+                        // at zero.
+                        *t == VISCOUS && f.edge && f.term == *t
+                    } else if self.is_presumed(t) {
+                        presumed_gives_way(&current, s, form.is_some())
                     } else {
                         f.confounded.is_some() || !pays(&s.tried, &current.tried).0
                     }
@@ -190,6 +273,8 @@ impl Ctx<'_> {
 pub(super) struct Flagged {
     pub(super) term: &'static str,
     pub(super) key: &'static str,
+    /// The key ended at zero or at a bound (not a correlation).
+    pub(super) edge: bool,
     pub(super) why: String,
     /// The other term and its key, when the flag is a correlation with a
     /// key of another chosen term (not the base's, not a given name's).
@@ -211,6 +296,7 @@ pub(super) fn flagged(s: &Scored, kept: &[&'static str]) -> Option<Flagged> {
                     return Some(Flagged {
                         term: t,
                         key: k,
+                        edge: true,
                         why: format!("{k} ended at zero or at a bound"),
                         confounded: None,
                     });
@@ -236,6 +322,7 @@ pub(super) fn flagged(s: &Scored, kept: &[&'static str]) -> Option<Flagged> {
                 Some(Flagged {
                     term: t,
                     key: k,
+                    edge: false,
                     why,
                     confounded,
                 })
@@ -404,6 +491,76 @@ mod tests {
         // Removing the stiffness takes the damping with it (it requires it).
         let without = lighter(&set, "pre-sliding", Some(k0));
         assert_eq!(without.last().unwrap().2, vec!["drivetrain Stribeck"]);
+    }
+
+    fn scored_cv(terms: &[&'static str], fold_mse: &[f64], aicc: f64) -> Scored {
+        let mut s = scored(terms);
+        s.tried.fold_mse = fold_mse.to_vec();
+        s.tried.cv_rms = (fold_mse.iter().sum::<f64>() / fold_mse.len() as f64).sqrt();
+        s.aicc = aicc;
+        s
+    }
+
+    #[test]
+    fn a_flagged_presumed_curve_gives_way_to_its_lighter_shape_only_where_the_criterion_leaves_it_in_doubt(
+    ) {
+        // The folds of joint 7 of random family 5 (RMS² per fold): the
+        // viscous rise predicts them no worse than the Stribeck curve, but
+        // not by more than the folds' spread (it does not pay).
+        let stribeck = scored_cv(
+            &["drivetrain Stribeck"],
+            &[2.36e-4, 1.32e-4, 1.65e-4, 3.20e-3],
+            -170.0,
+        );
+        let viscous = |aicc| {
+            scored_cv(
+                &["drivetrain viscous"],
+                &[7.37e-5, 2.60e-4, 3.92e-4, 9.89e-4],
+                aicc,
+            )
+        };
+        assert!(!pays(&stribeck.tried, &viscous(-164.3).tried).0);
+        // AICc 5.7 apart: the lighter shape keeps support; reduced.
+        assert!(presumed_gives_way(&stribeck, &viscous(-164.3), true));
+        // 16.6 apart: the data rule the viscous rise out; kept.
+        assert!(!presumed_gives_way(&stribeck, &viscous(-153.4), true));
+        // Removed outright (no lighter shape in its place): only by paying.
+        assert!(!presumed_gives_way(&stribeck, &viscous(-164.3), false));
+        // A lighter shape that predicts worse never takes its place.
+        let worse = scored_cv(&["drivetrain viscous"], &[3e-4, 3e-4, 3e-4, 4e-3], -169.0);
+        assert!(!presumed_gives_way(&stribeck, &worse, true));
+    }
+
+    #[test]
+    fn a_curve_presumed_to_rise_is_never_removed_for_the_flat_base() {
+        let stribeck = ["drivetrain Stribeck", "drivetrain viscous"];
+        assert!(holds_rise("drivetrain Stribeck", &stribeck));
+        assert!(holds_rise("drivetrain viscous", &stribeck));
+        assert!(holds_rise("drivetrain viscous", &["drivetrain viscous"]));
+        // The Stribeck curve added beside a presumed rise holds its key.
+        assert!(holds_rise("drivetrain Stribeck", &["drivetrain viscous"]));
+        // Not presumed, or no rise presumed (a time series): the folds decide.
+        assert!(!holds_rise("boundary rate", &stribeck));
+        assert!(!holds_rise("drivetrain quadratic", &["drivetrain viscous"]));
+        assert!(!holds_rise("drivetrain Stribeck", &["drivetrain Stribeck"]));
+        assert!(!holds_rise("drivetrain viscous", &[]));
+    }
+
+    #[test]
+    fn of_a_presumed_shape_and_a_term_confounded_with_it_the_term_goes() {
+        let presumed = |t: &str| t == "drivetrain Stribeck";
+        let film = Some(("film", "lubricant.viscosity_pa_s"));
+        assert_eq!(
+            goes_of_pair("drivetrain Stribeck", film, presumed),
+            (false, true)
+        );
+        let stribeck = Some(("drivetrain Stribeck", "drivetrain.stribeck_n"));
+        assert_eq!(goes_of_pair("film", stribeck, presumed), (true, false));
+        // Neither presumed: either may go (the folds choose).
+        let rate = Some(("boundary rate", "contact.boundary_friction_rate"));
+        assert_eq!(goes_of_pair("film", rate, presumed), (true, true));
+        // Not confounded: only the flagged term is in question.
+        assert_eq!(goes_of_pair("film", None, presumed), (true, false));
     }
 
     #[test]

@@ -44,6 +44,15 @@ pub(super) struct Scored {
     pub(super) aicc: f64,
 }
 
+/// The Akaike difference past which a presumed shape's lighter classic
+/// shape has essentially no support (Burnham & Anderson 2002, §2.6: above
+/// 10, an evidence ratio e^5 ≈ 150 against it). Below it, a presumed
+/// shape whose keys the data cannot separate (rule 4's flag) gives way to
+/// its lighter shape when that predicts the folds no worse
+/// (`removal.rs`): the flag, the folds and the criterion all leave the
+/// richer shape's extra keys in doubt.
+pub const AICC_DECISIVE: f64 = 10.0;
+
 /// The small-sample Akaike information criterion (Hurvich & Tsai 1989) of
 /// a least-squares fit of `k` parameters to `n` samples with residual
 /// sum of squares n·rms²: n ln(rms²) + 2k + 2k(k+1)/(n−k−1). `k` counts
