@@ -29,7 +29,7 @@ impl Source {
     }
 
     /// `--holdout FRACTION`: the table cut in two before anything reads it,
-    /// the training rows and the held-out rows ([`held_out_rows`]), each a
+    /// the training rows and the held-out rows (`held_out_rows`), each a
     /// source of its own with `mapping`, the held-out part named
     /// `NAME (held out)`. Nothing of the held-out rows reaches the training
     /// part (its `ddt()` is taken within it). A time series' held-out part
