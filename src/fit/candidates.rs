@@ -191,7 +191,7 @@ pub fn set_specs(given: &[ParamSpec], keys: &[&str]) -> Vec<ParamSpec> {
 
 /// The keys of a set of candidates, the base key first, each once (two
 /// candidates may share one: the Stribeck curve's viscous rise).
-pub(super) fn set_keys(terms: &[&'static str]) -> Vec<&'static str> {
+pub(super) fn set_keys(terms: &[&str]) -> Vec<&'static str> {
     let mut keys = vec![BASE_KEY];
     for t in terms {
         if let Some(c) = CANDIDATES.iter().find(|c| c.name == *t) {
@@ -208,7 +208,7 @@ pub(super) fn set_keys(terms: &[&'static str]) -> Vec<&'static str> {
 
 /// Whether `terms` fit every key of candidate `r` (hold it): `r` itself,
 /// or a term whose keys include its own.
-pub(super) fn holds(terms: &[&'static str], r: &str) -> bool {
+pub(super) fn holds(terms: &[&str], r: &str) -> bool {
     let fitted = set_keys(terms);
     CANDIDATES
         .iter()

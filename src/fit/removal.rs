@@ -10,7 +10,7 @@
 //! confirmation (`confirm.rs`).
 
 use super::candidates::{
-    is_part, lighter_forms, needs, needs_unheld, one_element, CANDIDATES, VISCOUS,
+    holds, is_part, lighter_forms, needs, needs_unheld, one_element, CANDIDATES, VISCOUS,
 };
 use super::cross_validate::{paired, TERM_COST};
 use super::prepared::Prepared;
@@ -73,13 +73,7 @@ pub(super) fn presumed_gives_way(current: &Scored, next: &Scored, reduced: bool)
 pub(super) fn holds_rise(t: &str, presumed: &[&'static str]) -> bool {
     // A term that fits the rise's key (the Stribeck curve added beside a
     // presumed rise) holds the rise as well.
-    let keys = |name: &str| CANDIDATES.iter().find(|c| c.name == name).map(|c| c.keys);
-    let fits_the_rise = || {
-        keys(t)
-            .zip(keys(VISCOUS))
-            .is_some_and(|(theirs, rise)| rise.iter().all(|k| theirs.contains(k)))
-    };
-    presumed.contains(&VISCOUS) && (presumed.contains(&t) || fits_the_rise())
+    presumed.contains(&VISCOUS) && (presumed.contains(&t) || holds(&[t], VISCOUS))
 }
 
 /// Which of a flagged term `t` and the term it is confounded with (if
