@@ -413,6 +413,68 @@ fn friction_whose_sign_opposes_the_velocity_is_refused_naming_the_sign_not_fitte
 }
 
 #[test]
+fn a_steady_curve_whose_friction_opposes_the_velocity_or_is_its_magnitude_is_refused_though_it_has_only_a_few_points(
+) {
+    // Eight steady points one way, as a lead screw's curve is measured:
+    // each point a steady state, so eight that all oppose the velocity are
+    // a sign convention (the drivetrain asymmetry would otherwise carry
+    // the flipped level and the fit say "converged").
+    let d = dir("sign-steady");
+    // `backward`: each speed also taken backward with friction `backward`
+    // times the forward one (-1 friction, +1 its magnitude).
+    let write_both = |name: &str, sign: f64, backward: Option<f64>| {
+        let mut text = String::from("velocity_rad_s,friction_nm\n");
+        for k in 1..=8 {
+            let w = 2.0 * k as f64;
+            let f = sign * (2.6e-3 + 1e-5 * w);
+            text += &format!("{w},{f}\n");
+            if let Some(b) = backward {
+                text += &format!("{},{}\n", -w, b * f);
+            }
+        }
+        let path = d.join(name);
+        std::fs::write(&path, text).unwrap();
+        path
+    };
+    let write = |name: &str, sign: f64| write_both(name, sign, None);
+    let fit = |csv: &Path| {
+        run(&[
+            "fit",
+            csv.to_str().unwrap(),
+            "--rotary",
+            "--fit",
+            "auto",
+            "--out",
+            d.join("f.yaml").to_str().unwrap(),
+        ])
+    };
+    let (code, _, err) = fit(&write("negated.csv", -1.0));
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("its sign opposes the velocity's in 100.0 % of the sliding samples (8 of 8"),
+        "{err}"
+    );
+    assert!(!d.join("f.yaml").exists());
+    // Its magnitude both ways, as a tribometer reports μ: one sign, no
+    // change with the direction of motion.
+    let (code, _, err) = fit(&write_both("magnitude.csv", 1.0, Some(1.0)));
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("one sign in both directions")
+            && err.contains("--friction 'if(VELOCITY < 0, -(EXPR), EXPR)'"),
+        "{err}"
+    );
+    assert!(!d.join("f.yaml").exists());
+    let (code, _, err) = fit(&write("own-sign.csv", 1.0));
+    assert!(code == 0 || code == 4, "{err}");
+    assert!(d.join("f.yaml").exists());
+    std::fs::remove_file(d.join("f.yaml")).unwrap();
+    let (code, _, err) = fit(&write_both("both-ways.csv", 1.0, Some(-1.0)));
+    assert!(code == 0 || code == 4, "{err}");
+    assert!(d.join("f.yaml").exists());
+}
+
+#[test]
 fn a_fast_joint_is_asked_whether_its_velocity_is_in_degrees_per_second() {
     let d = dir("deg-s");
     // 0.5 rad/s written as deg/s: 28.6 "rad/s".

@@ -58,6 +58,7 @@
 //! | `contact_scale.rs` | the contact's gain and load chosen from the data (a joint's lever, a linear axis's gain); a key's value as it acts on the joint |
 //! | `unknowns.rs` | the fitted parameters: bounds, scales, configuration keys; the data's scales |
 //! | `reversals.rs` | velocity reversals in the data and the stiffness through them (pre-sliding starts) |
+//! | `sign_convention.rs` | friction's sign against the velocity's: a logged reaction or a magnitude refused, with the fix |
 //! | `inputs.rs` | what is read: the data files, held out and validation files, their mapping, a bag's topics; one file into a table |
 //! | `bag_input.rs` | topics of a bag → a table |
 //! | `held_out.rs` | `--holdout`: the rows held out, the table cut in two before anything reads it, a later part scored after the motion before it |
@@ -106,6 +107,7 @@ pub mod reversals;
 pub mod select;
 pub mod separable;
 pub mod series;
+pub mod sign_convention;
 pub mod stats;
 pub mod synthetic;
 pub mod trial;

@@ -41,7 +41,7 @@ pub fn data_scale(
             message: "the velocity is zero in every sample: there is no sliding to fit".into(),
         });
     }
-    check_sign(&all, v)?;
+    super::sign_convention::check_sign(&all, v)?;
     let scale = DataScale {
         friction_n: f,
         velocity_m_s: v,
@@ -49,39 +49,6 @@ pub fn data_scale(
         reversal_stiffness_n_m: super::reversals::stiffness(&all).stiffness_n_m,
     };
     Ok((scale, sum_abs / n.max(1) as f64, lmax > 1.01 * lmin))
-}
-
-/// The share of sliding samples whose friction opposes the velocity above
-/// which the data are refused: friction is the force the motion loses, with
-/// the velocity's sign (a share near 1 is a sign convention, not friction).
-pub const OPPOSED_SHARE_REFUSED: f64 = 0.9;
-
-/// Refuse data whose friction has the opposite sign to the velocity in
-/// more than [`OPPOSED_SHARE_REFUSED`] of the sliding samples (|v| above a
-/// tenth of the top speed `v_top`; at least 10 of them).
-fn check_sign(all: &[super::Series], v_top: f64) -> Result<(), FitError> {
-    let (mut sliding, mut opposed) = (0usize, 0usize);
-    for se in all {
-        for (v, f) in se.velocity.iter().zip(&se.friction) {
-            if v.abs() > 0.1 * v_top && *f != 0.0 {
-                sliding += 1;
-                if v.signum() != f.signum() {
-                    opposed += 1;
-                }
-            }
-        }
-    }
-    let share = opposed as f64 / sliding.max(1) as f64;
-    if sliding >= 10 && share > OPPOSED_SHARE_REFUSED {
-        return Err(FitError::Data {
-            what: "friction".into(),
-            message: format!(
-                "its sign opposes the velocity's in {:.1} % of the sliding samples ({opposed} of {sliding} faster than a tenth of the top speed): friction is the force the motion loses and has the velocity's sign; if the recording's convention is the other one, fit its negative (--friction '-(EXPR)')",
-                100.0 * share
-            ),
-        });
-    }
-    Ok(())
 }
 
 /// The configuration our model runs on, the contact's scale (see
