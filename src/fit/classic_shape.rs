@@ -64,10 +64,16 @@ pub(super) fn classic_shapes(candidates: &[&'static Candidate]) -> Vec<&'static 
 /// (Burnham & Anderson 2002). Where the viscous rise is a candidate
 /// (`rises`), the flat base is not one of the shapes: a lubricated drive's
 /// friction rises with speed, and the fit decides by how much (its
-/// viscous key bounded at zero).
+/// viscous key bounded at zero). Where no rising shape could be fitted
+/// (its criterion infinite: a curve at one speed, or with no more points
+/// than the shape has keys and one), the data cannot show a rise, and the
+/// start is the base.
 pub(super) fn start_shape(aiccs: &[f64], rises: bool) -> usize {
     let from = usize::from(rises).min(aiccs.len().saturating_sub(1));
     let lowest = aiccs[from..].iter().copied().fold(f64::INFINITY, f64::min);
+    if !lowest.is_finite() && lowest > 0.0 {
+        return 0;
+    }
     (from..aiccs.len())
         .find(|&k| aiccs[k] <= lowest + AICC_SUPPORT)
         .unwrap_or(from)
@@ -143,10 +149,16 @@ impl Ctx<'_> {
             } else {
                 "it stays unless the set without it pays over it"
             };
-            let why = format!(
-                "the selection starts from {shape}, the classic shape the whole steady curve supports (small-sample Akaike criterion on all the training points: {}); {stays}",
-                text.join(", ")
-            );
+            let list = text.join(", ");
+            let why = if best.tried.terms.is_empty() {
+                format!(
+                    "the selection starts from the base alone: no rising classic shape could be fitted to these points (small-sample Akaike criterion on all the training points: {list})"
+                )
+            } else {
+                format!(
+                    "the selection starts from {shape}, the classic shape the whole steady curve supports (small-sample Akaike criterion on all the training points: {list}); {stays}"
+                )
+            };
             say(&format!("auto: {why}"));
             *start = why;
         }
@@ -171,6 +183,9 @@ mod tests {
         assert_eq!(start_shape(&[-10.0], false), 0);
         // A shape that could not be fitted (+inf) is never the start.
         assert_eq!(start_shape(&[-50.0, f64::INFINITY, -40.0], true), 2);
+        // None could (a curve at one speed): the base, not a rise the
+        // data cannot show.
+        assert_eq!(start_shape(&[-20.3, f64::INFINITY, f64::INFINITY], true), 0);
     }
 
     #[test]

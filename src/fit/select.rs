@@ -311,6 +311,11 @@ fn open_candidates<'c>(
 
 /// Why the selection stopped: the best next term does not pay.
 fn does_not_pay(name: &str, gain: f64, se: f64, share: f64) -> String {
+    if !(gain.is_finite() && se.is_finite()) {
+        return format!(
+            "the best next term, {name}, cannot be scored on these folds (a fold too small for the keys it adds, or a refit that failed), so it is not added"
+        );
+    }
     format!(
         "the best next term, {name}, lowers the folds' mean squared error by {} ± {} (standard error), {:.2} % of it: a term must lower it by more than its standard error and by more than {:.0} % (the cost of a term), so it does not pay for itself",
         crate::text::Num::sig(gain, 5),
@@ -476,6 +481,18 @@ mod tests {
     use super::super::candidates::CANDIDATES;
     use super::super::cross_validate::paired;
     use super::*;
+
+    #[test]
+    fn a_term_the_folds_cannot_score_is_said_to_be_unscored_not_to_gain_nan() {
+        let text = does_not_pay("film", f64::NAN, f64::NAN, f64::NAN);
+        assert!(text.contains("cannot be scored on these folds"), "{text}");
+        assert!(!text.contains("NaN"), "{text}");
+        let text = does_not_pay("film", 1e-9, 2e-9, 0.5);
+        assert!(
+            text.contains("lowers the folds' mean squared error by 1e-9 ± 2e-9"),
+            "{text}"
+        );
+    }
 
     fn scored(terms: &[&'static str], fold_mse: &[f64]) -> Scored {
         let n = fold_mse.len() as f64;
