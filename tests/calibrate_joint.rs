@@ -465,6 +465,26 @@ fn a_steady_curve_whose_friction_opposes_the_velocity_or_is_its_magnitude_is_ref
         "{err}"
     );
     assert!(!d.join("f.yaml").exists());
+    // A held-out file in the other convention: refused by its name, not
+    // scored against a model with the right one.
+    let negated = write("negated-validation.csv", -1.0);
+    let (code, _, err) = run(&[
+        "fit",
+        write("own-sign.csv", 1.0).to_str().unwrap(),
+        "--validate",
+        negated.to_str().unwrap(),
+        "--rotary",
+        "--fit",
+        "auto",
+        "--out",
+        d.join("f.yaml").to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("the friction of --validate") && err.contains("negated-validation.csv"),
+        "{err}"
+    );
+    assert!(!d.join("f.yaml").exists());
     let (code, _, err) = fit(&write("own-sign.csv", 1.0));
     assert!(code == 0 || code == 4, "{err}");
     assert!(d.join("f.yaml").exists());

@@ -224,6 +224,9 @@ pub fn prepare(
     let map_values: Vec<f64> = mapping.coefficients.iter().map(|c| c.1).collect();
     let load_n = config.contact.load_n;
     let (scale, mean_abs_n, loads_vary) = data_scale(&train, &map_values, load_n)?;
+    for v in &validate {
+        super::sign_convention::check_validation(&v.series(&map_values)?)?;
+    }
     let load_given = train
         .iter()
         .map(|s| s.series(&map_values).map(|se| se.load.is_some()))

@@ -142,6 +142,25 @@ pub fn check_sign(all: &[Series], v_top: f64) -> Result<(), FitError> {
     Ok(())
 }
 
+/// [`check_sign`] on one `--validate` file, `se` through the maps' start
+/// values, over its own top speed: a held-out file in the other convention
+/// would otherwise be scored against a model with the right one, and every
+/// model's held-out error would be the convention's. The error names the
+/// file.
+pub fn check_validation(se: &Series) -> Result<(), FitError> {
+    let top = se.velocity.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    if top == 0.0 {
+        return Ok(());
+    }
+    check_sign(std::slice::from_ref(se), top).map_err(|e| match e {
+        FitError::Data { message, .. } => FitError::Data {
+            what: format!("the friction of --validate {}", se.name),
+            message,
+        },
+        other => other,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -200,6 +219,15 @@ mod tests {
             5.0
         )
         .is_ok());
+    }
+
+    #[test]
+    fn a_validation_file_in_the_other_convention_is_refused_by_its_name() {
+        let mut se = mirrored(|v| -v.signum());
+        se.name = "fast.csv".into();
+        let e = check_validation(&se).unwrap_err().to_string();
+        assert!(e.contains("--validate fast.csv"), "{e}");
+        assert!(check_validation(&mirrored(f64::signum)).is_ok());
     }
 
     #[test]
