@@ -437,17 +437,17 @@ fn a_steady_curve_whose_friction_opposes_the_velocity_or_is_its_magnitude_is_ref
         path
     };
     let write = |name: &str, sign: f64| write_both(name, sign, None);
-    let fit = |csv: &Path| {
-        run(&[
-            "fit",
-            csv.to_str().unwrap(),
-            "--rotary",
-            "--fit",
-            "auto",
-            "--out",
-            d.join("f.yaml").to_str().unwrap(),
-        ])
+    let out = d.join("f.yaml");
+    // `fit` with `--validate` files besides.
+    let fit_validated = |csv: &Path, validate: &[&Path]| {
+        let mut args = vec!["fit", csv.to_str().unwrap()];
+        for v in validate {
+            args.extend(["--validate", v.to_str().unwrap()]);
+        }
+        args.extend(["--rotary", "--fit", "auto", "--out", out.to_str().unwrap()]);
+        run(&args)
     };
+    let fit = |csv: &Path| fit_validated(csv, &[]);
     let (code, _, err) = fit(&write("negated.csv", -1.0));
     assert_eq!(code, 2, "{err}");
     assert!(
@@ -468,17 +468,7 @@ fn a_steady_curve_whose_friction_opposes_the_velocity_or_is_its_magnitude_is_ref
     // A held-out file in the other convention: refused by its name, not
     // scored against a model with the right one.
     let negated = write("negated-validation.csv", -1.0);
-    let (code, _, err) = run(&[
-        "fit",
-        write("own-sign.csv", 1.0).to_str().unwrap(),
-        "--validate",
-        negated.to_str().unwrap(),
-        "--rotary",
-        "--fit",
-        "auto",
-        "--out",
-        d.join("f.yaml").to_str().unwrap(),
-    ]);
+    let (code, _, err) = fit_validated(&write("own-sign.csv", 1.0), &[&negated]);
     assert_eq!(code, 2, "{err}");
     assert!(
         err.contains("the friction of --validate") && err.contains("negated-validation.csv"),
