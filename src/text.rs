@@ -18,7 +18,16 @@ impl Num {
         }
         let e = v.abs().log10().floor() as i32 - (digits as i32 - 1);
         let m = 10f64.powi(-e);
-        Self((v * m).round() / m)
+        let rounded = (v * m).round() / m;
+        // `rounded` is within an ulp of the decimal (10^k is not always a
+        // double: 6.5933000000000005e-25); the nearest double to the
+        // decimal itself shows as that decimal.
+        let digits = digits.clamp(1, 17) as usize;
+        Self(
+            format!("{:.*e}", digits - 1, rounded)
+                .parse()
+                .unwrap_or(rounded),
+        )
     }
 
     /// Scientific notation with `decimals` digits after the point
@@ -56,6 +65,10 @@ mod tests {
         assert_eq!(Num::sig(7_290.123, 5).to_string(), "7290.1");
         assert_eq!(Num::sig(14_734.2, 4).to_string(), "14730");
         assert_eq!(Num::sig(0.0, 5).to_string(), "0");
+        // Tiny and huge magnitudes, whose scale 10^k is not a double.
+        assert_eq!(Num::sig(6.593_299_9e-25, 5).to_string(), "6.5933e-25");
+        assert_eq!(Num::sig(-1.234_567e-31, 3).to_string(), "-1.23e-31");
+        assert_eq!(Num::sig(9.999_96e22, 5).to_string(), "1e23");
         assert_eq!(Num::sig(f64::NAN, 5).to_string(), "NaN");
         assert_eq!(Num(1.23456e-3).sci(4), "1.2346e-3");
         assert_eq!(Num(f64::INFINITY).sci(4), "inf");
