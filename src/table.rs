@@ -78,6 +78,20 @@ pub struct Table {
     pub has_header: bool,
 }
 
+/// A hint when `cell` reads as a number written with a decimal comma
+/// (`0,01`, `-1,5e-3`), which this reader does not take; else nothing.
+fn decimal_comma_hint(cell: &str) -> &'static str {
+    let t = cell.trim();
+    let looks = t.matches(',').count() == 1
+        && !t.contains('.')
+        && t.replacen(',', ".", 1).parse::<f64>().is_ok();
+    if looks {
+        " (a decimal comma? numbers are read with a decimal point: convert the file's decimal commas to points, e.g. `sed 's/,/./g'` on a semicolon- or tab-separated file)"
+    } else {
+        ""
+    }
+}
+
 impl Table {
     /// Data rows.
     pub fn rows(&self) -> usize {
@@ -143,7 +157,11 @@ impl Table {
                 return TableError::Cell {
                     path: self.source.clone(),
                     line: cell.line,
-                    message: format!("`{}` in column `{name}` is not a number", cell.text),
+                    message: format!(
+                        "`{}` in column `{name}` is not a number{}",
+                        cell.text,
+                        decimal_comma_hint(&cell.text)
+                    ),
                 }
             }
             None => format!(
@@ -431,6 +449,18 @@ mod tests {
         assert!(e.to_string().contains("3 columns"));
         let e = Table::parse("", p, Delimiter::Auto, None, 0).unwrap_err();
         assert!(e.to_string().contains("no data rows"));
+    }
+
+    #[test]
+    fn a_number_written_with_a_decimal_comma_is_named_as_such() {
+        let p = Path::new("euro.csv");
+        let t = Table::parse("v;f\n0,01;1,5\n", p, Delimiter::Auto, None, 0).unwrap();
+        let m = t.column_error("v").to_string();
+        assert!(m.contains("`0,01`") && m.contains("decimal comma"), "{m}");
+        // Text that is not a comma-decimal number gets no such hint.
+        let t = Table::parse("v;f\n1,2,3;x\n", p, Delimiter::Auto, None, 0).unwrap();
+        assert!(!t.column_error("v").to_string().contains("decimal comma"));
+        assert!(!t.column_error("f").to_string().contains("decimal comma"));
     }
 
     #[test]

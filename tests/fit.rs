@@ -354,6 +354,12 @@ fn bad_data_keys_and_bounds_get_a_clear_message_and_nothing_is_written() {
         &["--fit", "k", "--map", "k=1", "--load", "k * p"],
         "`p` is neither a column",
     );
+    // A header with units in it: the error says how to name the columns.
+    expect_error(
+        "velocity (m/s),friction (N)\n0.1,5\n0.2,6\n0.3,7\n",
+        &["--fit", "contact.boundary_friction"],
+        "(`velocity (m/s)`) is named for expressions with --columns NAME,...",
+    );
     expect_error(
         good,
         &[

@@ -146,11 +146,22 @@ pub(super) fn compile(
             || derived.iter().any(|d| d.id == id)
             || coefficients.iter().any(|(c, _)| c == id);
         if !known {
+            // A header such as `velocity (m/s)` cannot be written in an
+            // expression: say how to name its columns.
+            let rename = table
+                .names
+                .iter()
+                .find(|n| !is_identifier(n))
+                .map_or_else(String::new, |n| {
+                    format!(
+                        "; a column whose name is not an identifier (`{n}`) is named for expressions with --columns NAME,... (one name per column, replacing the header's)"
+                    )
+                });
             return Err(FitError::Expression {
                 what: what.into(),
                 text: text.into(),
                 message: format!(
-                    "`{id}` is neither a column of {} ({}) nor a map coefficient (--map NAME=VALUE)",
+                    "`{id}` is neither a column of {} ({}) nor a map coefficient (--map NAME=VALUE){rename}",
                     table.source.display(),
                     table.names.join(", ")
                 ),
@@ -164,6 +175,15 @@ pub(super) fn compile(
         fixed: None,
         affine: None,
     })
+}
+
+/// Whether an expression can name `name` as it is: a letter or `_`, then
+/// letters, digits and `_`.
+fn is_identifier(name: &str) -> bool {
+    let mut c = name.chars();
+    c.next()
+        .is_some_and(|f| f.is_ascii_alphabetic() || f == '_')
+        && c.all(|x| x.is_ascii_alphanumeric() || x == '_')
 }
 
 /// `text` with each `ddt(NAME)` and `smooth(NAME)` replaced by its
