@@ -445,6 +445,46 @@ fn a_missing_validation_file_is_named_once_with_its_reason() {
     assert!(stderr.contains("nope.csv"), "{stderr}");
 }
 
+/// A steady curve with a temperature column `celsius(k)` °C at row k.
+fn steady_with_temperature(d: &Path, celsius: impl Fn(usize) -> f64) -> std::path::PathBuf {
+    let mut csv = String::from("velocity_m_s,friction_n,temperature_c\n");
+    for k in 0..12 {
+        let v = 0.01 * 1.5f64.powi(k as i32);
+        for s in [1.0, -1.0] {
+            csv += &format!("{},{},{}\n", s * v, s * (0.5 + 0.1 * v), celsius(k));
+        }
+    }
+    let path = d.join("steady.csv");
+    std::fs::write(&path, csv).unwrap();
+    path
+}
+
+#[test]
+fn a_temperature_column_that_reads_as_kelvin_is_warned_of_and_celsius_is_not() {
+    let d = dir("kelvin");
+    let fit = |data: &Path| {
+        let out = d.join("fitted.yaml");
+        let (code, _, stderr) = run(&[
+            "fit",
+            data.to_str().unwrap(),
+            "--fit",
+            "contact.boundary_friction",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(code == 0 || code == 4, "{stderr}");
+        stderr
+    };
+    let kelvin = fit(&steady_with_temperature(&d, |k| 293.15 + k as f64));
+    assert!(
+        kelvin.contains("between 293.15 and 304.15 °C in every training sample")
+            && kelvin.contains("--temperature 'NAME - 273.15'"),
+        "{kelvin}"
+    );
+    let celsius = fit(&steady_with_temperature(&d, |k| 20.0 + k as f64));
+    assert!(!celsius.contains("where kelvin lies"), "{celsius}");
+}
+
 #[test]
 fn a_simulate_run_is_fit_data_as_written_its_text_columns_skipped() {
     let d = dir("from-simulate");

@@ -232,8 +232,8 @@ pub fn choose(
             what: "data".into(),
             message: format!(
                 "no contact scale fits the node's limits: the level {} {fu} at {} {su} needs a gain above {} or a load below node.min_load_n ({} N); raise node.max_abs_velocity_m_s or lower node.min_load_n",
-                crate::text::Num(level),
-                crate::text::Num(top),
+                crate::text::Num::sig(level, 5),
+                crate::text::Num::sig(top, 5),
                 crate::text::Num(limits.gain),
                 crate::text::Num(limits.load.0)
             ),
@@ -243,10 +243,10 @@ pub fn choose(
     let how = format!(
         "chosen from the data: the boundary friction {} gives the sliding level {} {fu}, and the film's transition ({} m/s at this load and viscosity) lies {}× above the contact's top speed {} m/s{}",
         crate::text::Num(mu),
-        crate::text::Num(level),
-        crate::text::Num(v_t),
+        crate::text::Num::sig(level, 5),
+        crate::text::Num::sig(v_t, 5),
         crate::text::Num((v_t / (gain * top)).round()),
-        crate::text::Num(gain * top),
+        crate::text::Num::sig(gain * top, 5),
         if at_limit.is_empty() {
             String::new()
         } else {
@@ -455,7 +455,7 @@ fn level_within_bounds(
                         "{lo}:{hi} excludes {mu}, the boundary friction on which the chosen scale rests (load {} N and gain {} give the data's sliding level {} {} with it): widen the bounds, or set contact.boundary_friction inside them in the configuration (the load is then chosen from that value)",
                         crate::text::Num(scale.load_n),
                         crate::text::Num(scale.gain),
-                        crate::text::Num(level),
+                        crate::text::Num::sig(level, 5),
                         units.force()
                     ),
                 });

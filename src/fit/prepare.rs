@@ -71,14 +71,14 @@ fn model_setup(
         return Ok((c, None, scale));
     };
     notes.push(format!(
-        "the contact's scale: gain {} {}, contact load {} N ({})",
-        crate::text::Num(l.gain),
+        "the contact's scale: gain {}{}, contact load {} N ({})",
+        crate::text::Num::sig(l.gain, 5),
         if units == super::Units::Rotary {
-            "m"
+            " m"
         } else {
             ""
         },
-        crate::text::Num(l.load_n),
+        crate::text::Num::sig(l.load_n, 5),
         l.how
     ));
     let load_min = load_range(train, map_values, c.contact.load_n)?.0;
@@ -201,11 +201,39 @@ fn data_warnings(req: &DataRequest, scale: &DataScale, key_specs: &[ParamSpec]) 
     if req.rotary && scale.velocity_m_s > FAST_JOINT_RAD_S {
         notes.push(format!(
             "warning: --rotary: the top speed is {} rad/s ({} deg/s); a robot joint rarely turns faster than {FAST_JOINT_RAD_S} rad/s. If the velocity is in deg/s, convert it: --velocity 'NAME * 3.14159265 / 180' (a motor shaft's speed in rad/s is fine as it is)",
-            crate::text::Num(scale.velocity_m_s),
+            crate::text::Num::sig(scale.velocity_m_s, 5),
             crate::text::Num(scale.velocity_m_s.to_degrees().round())
         ));
     }
     notes
+}
+
+/// Every training temperature, if each lies where kelvin does and a
+/// lubricant does not work: [`KELVIN_LOOKALIKE_C`].
+const KELVIN_LOOKALIKE_C: (f64, f64) = (230.0, 400.0);
+
+/// A warning when every training temperature reads as kelvin in °C
+/// (a room at 293, not 20): a viscosity law then sees a lubricant above
+/// 230 °C.
+fn kelvin_warning(train: &[Source], map_values: &[f64]) -> Result<Option<String>, FitError> {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for s in train {
+        let Some(t) = s.series(map_values)?.temperature else {
+            return Ok(None);
+        };
+        for x in t {
+            lo = lo.min(x);
+            hi = hi.max(x);
+        }
+    }
+    let (a, b) = KELVIN_LOOKALIKE_C;
+    Ok((lo.is_finite() && a <= lo && hi <= b).then(|| {
+        format!(
+            "warning: the temperature lies between {} and {} °C in every training sample, where kelvin lies and a lubricant does not work: if it is in kelvin, convert it: --temperature 'NAME - 273.15'",
+            crate::text::Num::sig(lo, 5),
+            crate::text::Num::sig(hi, 5)
+        )
+    }))
 }
 
 /// Read the data and set up the parameters (everything checked before any
@@ -235,6 +263,7 @@ pub fn prepare(
         .any(|g| g);
     let (key_specs, map_fit) = split_specs(params, &map_names, &map_values)?;
     notes.extend(data_warnings(req, &scale, &key_specs));
+    notes.extend(kelvin_warning(&train, &map_values)?);
     // The scale is chosen for a joint's data, and under --fit auto for
     // data that do not give the load when the configuration does not
     // either: a `contact.load_n` other than the default is the user's
