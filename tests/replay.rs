@@ -699,6 +699,60 @@ fn a_fit_on_an_sqlite3_bag_recovers_boundary_friction_and_viscosity() {
 }
 
 #[test]
+fn a_fit_on_the_nodes_own_lockstep_recording_recovers_its_boundary_friction_though_its_load_topic_is_empty(
+) {
+    // The node ran without a load input: its bag has the topic
+    // `/friction_node/normal_load` with no message. The load is then the
+    // configuration's, as it was in the node (before: the empty topic was
+    // taken by default and the fit refused it, "no message could be read").
+    let d = dir("own-bag-fit");
+    let out = d.join("fitted.yaml");
+    let (code, stdout, stderr) = run(&[
+        "fit",
+        NODE_BAG,
+        "--velocity-topic",
+        "/friction_node/cmd_velocity",
+        "--friction-topic",
+        "/friction_node/friction_force",
+        "--fit",
+        "contact.boundary_friction",
+        "--start",
+        "contact.boundary_friction=0.2",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stdout}\n{stderr}");
+    assert!(
+        stderr.contains("load from the configuration (contact.load_n), temperature none"),
+        "{stderr}"
+    );
+    let fitted = friction_node::config::Config::load(Some(&out), &[]).unwrap();
+    approx::assert_relative_eq!(fitted.contact.boundary_friction, 0.3, max_relative = 1e-4);
+}
+
+#[test]
+fn a_fit_on_a_bag_without_its_topics_named_lists_the_bags_topics() {
+    let d = dir("rosbags-fit-untold");
+    let out = d.join("fitted.yaml");
+    let (code, _, stderr) = run(&[
+        "fit",
+        ROSBAGS_MCAP,
+        "--fit",
+        "contact.boundary_friction",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains("needs --velocity-topic and --friction-topic; the bag has:")
+            && stderr.contains("/joint_states  [sensor_msgs/msg/JointState]")
+            && stderr.contains("/slider/friction"),
+        "{stderr}"
+    );
+    assert!(!out.exists(), "nothing written");
+}
+
+#[test]
 fn a_truncated_sqlite3_bag_is_refused_or_replayed_up_to_the_damage_never_a_panic() {
     let d = dir("db3-damaged");
     let bytes = std::fs::read(format!("{ROSBAGS_SQLITE3}/rosbags_sqlite3.db3")).unwrap();

@@ -63,23 +63,29 @@ impl SampleKind {
 }
 
 /// The load topic used when none is named: the first valid
-/// `std_msgs/msg/Float64` topic whose name ends in `normal_load`.
+/// `std_msgs/msg/Float64` topic whose name ends in `normal_load` and that
+/// holds a message (a node run without a load input records the topic
+/// empty: the configuration's load is then the load).
 pub fn default_load_topic(scan: &super::BagScan) -> Option<String> {
     scan.channels
         .iter()
         .find(|c| {
-            c.topic.ends_with("normal_load") && TopicDecoder::new(c, SampleKind::Float64).is_ok()
+            c.topic.ends_with("normal_load")
+                && c.messages > 0
+                && TopicDecoder::new(c, SampleKind::Float64).is_ok()
         })
         .map(|c| c.topic.clone())
 }
 
 /// The temperature topic used when none is named: the first valid
-/// `sensor_msgs/msg/Temperature` topic whose name ends in `temperature`.
+/// `sensor_msgs/msg/Temperature` topic whose name ends in `temperature`
+/// and that holds a message.
 pub fn default_temperature_topic(scan: &super::BagScan) -> Option<String> {
     scan.channels
         .iter()
         .find(|c| {
             c.topic.ends_with("temperature")
+                && c.messages > 0
                 && TopicDecoder::new(c, SampleKind::Temperature).is_ok()
         })
         .map(|c| c.topic.clone())

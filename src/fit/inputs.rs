@@ -117,9 +117,18 @@ impl DataRequest {
     fn bag_table(&self, path: &Path) -> Result<(Table, Option<String>), FitError> {
         let (Some(velocity), Some(friction)) = (&self.topics.velocity, &self.topics.friction)
         else {
+            // Name the topics there are to choose from (a bag that cannot
+            // be scanned fails again, with its own error, once they are
+            // given).
+            let has = crate::bag::Bag::open(path)
+                .and_then(|b| b.scan())
+                .map_or_else(
+                    |_| String::new(),
+                    |scan| format!("; the bag has:\n{}", crate::bag::listing(&scan.listing())),
+                );
             return Err(FitError::Data {
                 what: path.display().to_string(),
-                message: "bag data needs --velocity-topic and --friction-topic".into(),
+                message: format!("bag data needs --velocity-topic and --friction-topic{has}"),
             });
         };
         let topics = super::bag_input::BagTopics {
