@@ -40,8 +40,9 @@ pub enum TableError {
         /// Why.
         cause: std::io::Error,
     },
-    /// A cell or line that does not parse; `line` 0: the file as a whole.
-    #[error("{}:{line}: {message}", path.display())]
+    /// A cell or line that does not parse; `line` 0: the file as a whole
+    /// (shown without a line).
+    #[error("{}{}: {message}", path.display(), at_line(*line))]
     Cell {
         /// The file.
         path: PathBuf,
@@ -50,6 +51,15 @@ pub enum TableError {
         /// What is wrong.
         message: String,
     },
+}
+
+/// `:LINE`, or nothing for line 0 (the file as a whole).
+fn at_line(line: usize) -> String {
+    if line == 0 {
+        String::new()
+    } else {
+        format!(":{line}")
+    }
 }
 
 /// The first cell of a column that is not a number.
@@ -440,7 +450,7 @@ mod tests {
         );
         let m = t.column_error("w").to_string();
         assert!(
-            m.contains("no column named `w`") && m.contains("t_s, v"),
+            m.starts_with("bad.csv: no column named `w`") && m.contains("t_s, v"),
             "{m}"
         );
         let e = Table::parse("t_s,v\n0,nan\n", p, Delimiter::Auto, None, 0).unwrap_err();
