@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import json
 import os
+import tempfile
 from typing import Any, Dict, Iterable, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -380,15 +381,69 @@ class FitResult:
         return f"FitResult({vals}; train RMS {self.train_rms_n:.4g} N, converged={self.converged})"
 
 
+Table = Mapping[str, Any]
+"""Columns in memory: a dict of equal-length 1-D arrays (as ``Model.run``
+returns) or a pandas DataFrame, named as a CSV file's header would be."""
+
+
+def _is_table(x: Any) -> bool:
+    return isinstance(x, Mapping) or (hasattr(x, "columns") and hasattr(x, "items"))
+
+
+def _write_table(table: Table, path: str, what: str) -> None:
+    """``table``'s columns as CSV at ``path``: numbers in the shortest form
+    that reads back to the same double, text columns as they are."""
+    cols = [(str(k), np.asarray(v)) for k, v in table.items()]
+    if not cols:
+        raise ValueError(f"{what}: a table without columns")
+    n = None
+    for name, c in cols:
+        if not name or any(ch in name for ch in ",\n\r\""):
+            raise ValueError(f"{what}: column name {name!r} must be non-empty, without commas, quotes or line breaks")
+        if c.ndim != 1:
+            raise ValueError(f"{what}: column {name!r} has shape {c.shape}; a column is one-dimensional")
+        if n is not None and len(c) != n:
+            raise ValueError(f"{what}: column {name!r} has {len(c)} rows, column {cols[0][0]!r} has {n}")
+        n = len(c)
+    text = []
+    for name, c in cols:
+        if c.dtype.kind in "biuf":
+            text.append([repr(float(x)) for x in c])
+        else:
+            cells = [str(x) for x in c]
+            bad = next((x for x in cells if any(ch in x for ch in ",\n\r\"")), None)
+            if bad is not None:
+                raise ValueError(f"{what}: column {name!r} holds {bad!r}: a cell without commas, quotes or line breaks")
+            text.append(cells)
+    with open(path, "w", encoding="utf-8") as f:
+        f.write(",".join(name for name, _ in cols) + "\n")
+        for row in zip(*text):
+            f.write(",".join(row) + "\n")
+
+
+def _as_files(items: Sequence[Any], tmp: str, stem: str) -> list:
+    """Paths as they are; each table in memory written to ``tmp`` as
+    ``STEM-K.csv`` (the name the report gives it)."""
+    out = []
+    for k, d in enumerate(items, start=1):
+        if _is_table(d):
+            path = os.path.join(tmp, f"{stem}-{k}.csv")
+            _write_table(d, path, f"{stem} {k}")
+            out.append(path)
+        else:
+            out.append(os.fspath(d))
+    return out
+
+
 def fit(
-    data: Union[PathLike, Sequence[PathLike]],
+    data: Union[PathLike, Table, Sequence[Union[PathLike, Table]]],
     fit: Union[str, Sequence[str]],
     config: Optional[PathLike] = None,
     overrides: Optional[Mapping[str, Any]] = None,
     bounds: Optional[Mapping[str, Tuple[float, float]]] = None,
     start: Optional[Mapping[str, float]] = None,
     holdout: float = 0.0,
-    validate: Iterable[PathLike] = (),
+    validate: Iterable[Union[PathLike, Table]] = (),
     baselines: bool = False,
     starts: int = 3,
     global_points: int = 16,
@@ -420,7 +475,11 @@ def fit(
 ) -> FitResult:
     """Calibrate configuration keys (and input-map coefficients) to
     recorded friction, as ``friction-node fit`` does (same arguments, same
-    defaults, same messages): ``data`` CSV files or bags, ``fit`` the keys
+    defaults, same messages): ``data`` CSV files or bags, or tables in
+    memory (a dict of equal-length arrays, as ``Model.run`` returns, or a
+    pandas DataFrame, named as a CSV header: ``t_s``, ``velocity_m_s``,
+    ``friction_n``...; the report calls them ``data-1.csv``...; so does
+    ``validate``, ``validate-1.csv``...), ``fit`` the keys
     (e.g. ``["roughness.sigma_m", "contact.boundary_friction"]``), ``bounds``
     ``{key: (lo, hi)}``, ``start`` ``{key: value}``. ``out`` writes the
     fitted parameter file, ``report`` the summary, tables and plots.
@@ -433,46 +492,50 @@ def fit(
     (``"profiled"`` or ``"searched"``) choose how the search runs, as
     ``--jacobian``, ``--later-runs``, ``--linear-keys`` and ``--cheap-keys``
     do."""
-    if isinstance(data, (str, os.PathLike)):
+    if isinstance(data, (str, os.PathLike)) or _is_table(data):
         data = [data]
+    if isinstance(validate, (str, os.PathLike)) or _is_table(validate):
+        validate = [validate]
     if isinstance(fit, str):
         fit = [k for k in fit.split(",") if k.strip()]
-    raw = _core.fit(
-        [os.fspath(d) for d in data],
-        list(fit),
-        config_path=_path(config),
-        overrides=_overrides(overrides, {}),
-        bounds=[(k, float(lo), float(hi)) for k, (lo, hi) in (bounds or {}).items()],
-        starts_at=[(k, float(v)) for k, v in (start or {}).items()],
-        holdout=float(holdout),
-        validate=[os.fspath(v) for v in validate],
-        baselines=bool(baselines),
-        starts=int(starts),
-        global_points=int(global_points),
-        seed=int(seed),
-        max_evaluations=int(max_evaluations),
-        columns=None if columns is None else list(columns),
-        skip=int(skip),
-        delimiter=delimiter,
-        time=time,
-        velocity=velocity,
-        friction=friction,
-        load=load,
-        temperature=temperature,
-        smooth=float(smooth),
-        map=[(k, float(v)) for k, v in (map or {}).items()],
-        velocity_topic=velocity_topic,
-        friction_topic=friction_topic,
-        joint=joint,
-        load_topic=load_topic,
-        temperature_topic=temperature_topic,
-        out=_path(out),
-        report_dir=_path(report),
-        progress=bool(progress),
-        rotary=bool(rotary),
-        jacobian=jacobian,
-        later_runs=later_runs,
-        linear_keys=linear_keys,
-        cheap_keys=cheap_keys,
-    )
+    # Tables in memory are written for the fit and removed after it.
+    with tempfile.TemporaryDirectory(prefix="friction-node-fit-") as tmp:
+        raw = _core.fit(
+            _as_files(list(data), tmp, "data"),
+            list(fit),
+            config_path=_path(config),
+            overrides=_overrides(overrides, {}),
+            bounds=[(k, float(lo), float(hi)) for k, (lo, hi) in (bounds or {}).items()],
+            starts_at=[(k, float(v)) for k, v in (start or {}).items()],
+            holdout=float(holdout),
+            validate=_as_files(list(validate), tmp, "validate"),
+            baselines=bool(baselines),
+            starts=int(starts),
+            global_points=int(global_points),
+            seed=int(seed),
+            max_evaluations=int(max_evaluations),
+            columns=None if columns is None else list(columns),
+            skip=int(skip),
+            delimiter=delimiter,
+            time=time,
+            velocity=velocity,
+            friction=friction,
+            load=load,
+            temperature=temperature,
+            smooth=float(smooth),
+            map=[(k, float(v)) for k, v in (map or {}).items()],
+            velocity_topic=velocity_topic,
+            friction_topic=friction_topic,
+            joint=joint,
+            load_topic=load_topic,
+            temperature_topic=temperature_topic,
+            out=_path(out),
+            report_dir=_path(report),
+            progress=bool(progress),
+            rotary=bool(rotary),
+            jacobian=jacobian,
+            later_runs=later_runs,
+            linear_keys=linear_keys,
+            cheap_keys=cheap_keys,
+        )
     return FitResult(raw)

@@ -143,6 +143,38 @@ def test_fit_recovers_boundary_friction_and_equals_the_cli(cli, tmp_path):
 
 
 
+def test_fit_takes_tables_in_memory_and_equals_the_fit_of_the_same_csv(tmp_path):
+    truth = fn.Model(**{"solver.cells": 32, "contact.boundary_friction": 0.22})
+    t = np.arange(2001) * truth.dt
+    run = truth.run(t, np.sin(2 * np.pi * t))
+    train = {"t_s": t[:1500], "velocity_m_s": run["velocity_m_s"][:1500], "friction_n": run["friction_n"][:1500]}
+    held = {k: v for k, v in run.items() if k in ("t_s", "velocity_m_s", "friction_n")}
+    data, validate = tmp_path / "train.csv", tmp_path / "validate.csv"
+    for path, table in ((data, train), (validate, held)):
+        np.savetxt(path, np.column_stack([table["t_s"], table["velocity_m_s"], table["friction_n"]]),
+                   delimiter=",", header="t_s,velocity_m_s,friction_n", comments="", fmt="%.17g")
+    args = dict(fit=["contact.boundary_friction"], overrides={"solver.cells": 32}, starts=1, global_points=0)
+    from_files = fn.fit(data, validate=[validate], **args)
+    # A dict of arrays (and Model.run's own dict, its extra columns unread).
+    from_tables = fn.fit(train, validate=run, **args)
+    assert from_tables.value("contact.boundary_friction") == from_files.value("contact.boundary_friction")
+    assert from_tables.train_rms_n == from_files.train_rms_n
+    assert from_tables.held_out_rms_n == from_files.held_out_rms_n
+    assert from_tables.value("contact.boundary_friction") == pytest.approx(0.22, rel=1e-3)
+
+
+@pytest.mark.parametrize("table, words", [
+    ({"velocity_m_s": [0.1, 0.2], "friction_n": [1.0]}, "'friction_n' has 1 rows"),
+    ({"velocity_m_s": np.zeros((2, 2)), "friction_n": [1.0, 2.0]}, "shape (2, 2)"),
+    ({"velocity, m/s": [0.1], "friction_n": [1.0]}, "column name 'velocity, m/s'"),
+    ({}, "a table without columns"),
+])
+def test_a_table_in_memory_that_cannot_be_a_csv_is_a_value_error_naming_it(table, words):
+    with pytest.raises(ValueError) as e:
+        fn.fit(table, ["contact.boundary_friction"])
+    assert words in str(e.value) and "data 1" in str(e.value)
+
+
 def test_the_search_rules_are_the_clis_and_a_bad_rule_is_named(cli, tmp_path):
     truth = fn.Model(**{"solver.cells": 32, "contact.boundary_friction": 0.22})
     t = np.arange(1001) * truth.dt
