@@ -93,7 +93,7 @@ fn the_fitted_file_carries_the_training_range_and_the_report_splits_the_validati
         .unwrap();
     assert!(share > 50.0 && share < 100.0, "{row}");
     assert!(
-        cells[5].contains("speed") && cells[5].contains("past its edge"),
+        cells[5].contains("speed") && cells[5].contains("× its top"),
         "{row}"
     );
     assert!(cells[6] != "—" && cells[7] != "—", "{row}");

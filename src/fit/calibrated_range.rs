@@ -128,28 +128,63 @@ pub struct Placement {
     pub samples: usize,
     /// See `samples`.
     pub outside: usize,
-    /// The furthest excursion: the input, its value and the edge it left
-    /// (axis units for a speed), as a factor beyond the edge.
-    pub furthest: Option<(&'static str, f64, f64)>,
+    /// The furthest excursion (axis units for a speed).
+    pub furthest: Option<Excursion>,
     /// RMS error inside and outside the range (None: no sample there).
     pub rms_inside: Option<f64>,
     /// See `rms_inside`.
     pub rms_outside: Option<f64>,
 }
 
-/// How far beyond its range `value` lies, as a factor (> 1 beyond the
-/// top, value/lo < 1 below the bottom is given as lo/value).
-fn factor(value: f64, lo: f64, hi: f64) -> f64 {
-    if value > hi {
-        if hi > 0.0 {
-            value / hi
+/// A sample outside the range: which input left it, by how much, and on
+/// which side.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Excursion {
+    /// The input (`speed forward`, `load`…).
+    pub input: &'static str,
+    /// Its value.
+    pub value: f64,
+    /// The edge it left: the range's top (above) or bottom (below).
+    pub edge: f64,
+    /// Whether above the top.
+    pub above: bool,
+    /// How far: value/top above, bottom/value below (∞ at or below zero
+    /// under a positive bottom, or above a zero top).
+    pub factor: f64,
+}
+
+impl Excursion {
+    /// `value` of `input` against its range [`lo`, `hi`], which it left.
+    fn new(input: &'static str, value: f64, lo: f64, hi: f64) -> Self {
+        let above = value > hi;
+        let (edge, factor) = if above {
+            (hi, if hi > 0.0 { value / hi } else { f64::INFINITY })
         } else {
-            f64::INFINITY
+            (
+                lo,
+                if value > 0.0 {
+                    lo / value
+                } else {
+                    f64::INFINITY
+                },
+            )
+        };
+        Self {
+            input,
+            value,
+            edge,
+            above,
+            factor,
         }
-    } else if value > 0.0 {
-        lo / value
-    } else {
-        f64::INFINITY
+    }
+
+    /// Whether it lies further out than `other`: above the top before
+    /// below the bottom (a faster motion, a heavier load is what a
+    /// calibration is stretched to; a time series' reversal passes every
+    /// speed down to zero, below any steady curve's slowest point), then by
+    /// factor.
+    fn beyond(&self, other: &Self) -> bool {
+        (self.above, self.factor) > (other.above, other.factor)
     }
 }
 
@@ -160,7 +195,7 @@ pub fn place(fits: &[SeriesFit], range: &CalibratedRange) -> Vec<Placement> {
             let se = &s.series;
             let (mut n, mut out) = (0usize, 0usize);
             let (mut ss_in, mut n_in, mut ss_out, mut n_out) = (0.0, 0usize, 0.0, 0usize);
-            let mut furthest: Option<(&'static str, f64, f64)> = None;
+            let mut furthest: Option<Excursion> = None;
             for k in 0..se.len() {
                 let r = s.predicted[k] - se.friction[k];
                 if !r.is_finite() {
@@ -184,9 +219,9 @@ pub fn place(fits: &[SeriesFit], range: &CalibratedRange) -> Vec<Placement> {
                         out += 1;
                         ss_out += r * r;
                         n_out += 1;
-                        let f = factor(value, lo, hi);
-                        if furthest.is_none_or(|(_, _, g)| f > g) {
-                            furthest = Some((input, value, f));
+                        let e = Excursion::new(input, value, lo, hi);
+                        if furthest.is_none_or(|g| e.beyond(&g)) {
+                            furthest = Some(e);
                         }
                     }
                 }
@@ -264,20 +299,22 @@ pub fn section(o: &FitOutcome, range: &CalibratedRange) -> String {
     );
     let cell = |x: Option<f64>| x.map_or("—".to_string(), |v| Num::sig(v, 5).to_string());
     for (role, p) in &placed {
-        let furthest = p.furthest.map_or("—".to_string(), |(input, value, f)| {
-            let unit = match input {
+        let furthest = p.furthest.map_or("—".to_string(), |e| {
+            let unit = match e.input {
                 "load" => " N".to_string(),
                 "temperature" => " °C".to_string(),
                 _ => format!(" {}", units.speed()),
             };
-            if f.is_finite() {
-                format!(
-                    "{input} {}{unit} ({}× past its edge)",
-                    Num::sig(value, 4),
-                    Num::sig(f, 3)
-                )
+            let (input, value) = (e.input, Num::sig(e.value, 4));
+            if !e.factor.is_finite() && e.above {
+                format!("{input} {value}{unit} (never trained)")
+            } else if e.above {
+                format!("{input} {value}{unit} ({}× its top)", Num::sig(e.factor, 3))
             } else {
-                format!("{input} {}{unit} (never trained)", Num::sig(value, 4))
+                format!(
+                    "{input} {value}{unit} (below its bottom, {}{unit})",
+                    Num::sig(e.edge, 4)
+                )
             }
         });
         let _ = writeln!(
@@ -369,9 +406,24 @@ mod tests {
         assert_eq!((p.samples, p.outside), (4, 2));
         approx::assert_relative_eq!(p.rms_inside.unwrap(), 0.1, max_relative = 1e-9);
         approx::assert_relative_eq!(p.rms_outside.unwrap(), 2.0, max_relative = 1e-9);
-        let (input, value, f) = p.furthest.unwrap();
-        assert_eq!(input, "speed forward");
-        approx::assert_relative_eq!(value, 2.5, max_relative = 1e-9);
-        approx::assert_relative_eq!(f, 5.0, max_relative = 1e-9);
+        let e = p.furthest.unwrap();
+        assert_eq!(e.input, "speed forward");
+        assert!(e.above);
+        approx::assert_relative_eq!(e.value, 2.5, max_relative = 1e-9);
+        approx::assert_relative_eq!(e.factor, 5.0, max_relative = 1e-9);
+        // A sample far below the slowest trained speed (a reversal of a
+        // time series against a steady curve) does not outrank one above
+        // the top, however large its ratio.
+        let val = fit(
+            "val",
+            &[1e-15, 0.6, -0.25],
+            &[1.0, 1.0, -1.0],
+            &[1.1, 1.1, -1.1],
+        );
+        let curve_place = &place(&[val], &curve)[0];
+        assert_eq!(curve_place.outside, 2);
+        let e = curve_place.furthest.unwrap();
+        assert!(e.above && e.input == "speed forward", "{e:?}");
+        approx::assert_relative_eq!(e.value, 0.6, max_relative = 1e-9);
     }
 }
