@@ -486,6 +486,60 @@ fn a_temperature_column_that_reads_as_kelvin_is_warned_of_and_celsius_is_not() {
 }
 
 #[test]
+fn a_measured_force_that_still_holds_the_inertia_is_warned_of_with_its_mass() {
+    // The model's friction plus 500 kg times the acceleration, as a drive
+    // force logged without its inertia removed.
+    let d = dir("inertia");
+    // Each amplitude and load for a whole period of the 1 Hz sine.
+    let m = motion(4.0, 1e-3);
+    let f = model_friction(&coarse(), &m).unwrap();
+    let mut csv = String::from("t_s,velocity_m_s,friction_n,load_n\n");
+    for k in 0..m.len() {
+        let (i, j) = (k.saturating_sub(1), (k + 1).min(m.len() - 1));
+        let a = (m[j].1 - m[i].1) / (m[j].0 - m[i].0);
+        csv += &format!("{},{},{},{}\n", m[k].0, m[k].1, f[k] + 500.0 * a, m[k].2);
+    }
+    let data = d.join("drive.csv");
+    std::fs::write(&data, csv).unwrap();
+    let out = d.join("fitted.yaml");
+    let fit = |extra: &[&str]| {
+        let mut args = vec![
+            "--set",
+            "solver.cells=32",
+            "fit",
+            data.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let (code, _, stderr) = run(&args);
+        assert!(code == 0 || code == 4, "{stderr}");
+        stderr
+    };
+    let err = fit(&["--fit", "contact.boundary_friction"]);
+    let mass: f64 = err
+        .split("a mass of ")
+        .nth(1)
+        .and_then(|r| r.split(' ').next())
+        .and_then(|m| m.parse().ok())
+        .unwrap_or_else(|| panic!("no mass in: {err}"));
+    approx::assert_relative_eq!(mass, 500.0, max_relative = 0.02);
+    assert!(err.contains("--map m="), "{err}");
+    // With the inertia subtracted through a fitted mass, no warning.
+    let err = fit(&[
+        "--friction",
+        "friction_n - m * ddt(velocity_m_s)",
+        "--map",
+        "m=400",
+        "--bounds",
+        "m=0:1000",
+        "--fit",
+        "contact.boundary_friction,m",
+    ]);
+    assert!(!err.contains("follows the acceleration"), "{err}");
+}
+
+#[test]
 fn a_simulate_run_is_fit_data_as_written_its_text_columns_skipped() {
     let d = dir("from-simulate");
     let data = d.join("run.csv");

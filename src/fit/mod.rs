@@ -39,6 +39,7 @@
 //! | `report_plots.rs` | a report's plots: fit and residuals per series, every model's residual against velocity |
 //! | `by_direction.rs` | the residual by direction of motion: level and offset errors |
 //! | `calibrated_range.rs` | the calibrated range from the training samples (into the fitted file); where held-out data lie against it, the error inside and outside |
+//! | `inertia_check.rs` | whether a fit's residual follows the acceleration (a drive force that still holds m·a): the mass it points to, a warning |
 //! | `cross_validate.rs` | cross-validation by what a calibration is used for: the folds (files, time blocks, speed ranges) and each fold's refit |
 //! | `prepared.rs` | what `prepare` makes: the data and our model for them; our model for another set of keys |
 //! | `driver.rs` | one model's whole fit: global phase, local runs, statistics, predictions |
@@ -88,6 +89,7 @@ pub mod error;
 mod expr;
 mod film_run;
 mod held_out;
+pub mod inertia_check;
 pub mod inputs;
 pub mod local_run;
 pub mod models_table;

@@ -144,6 +144,19 @@ impl FitRequest {
         let gain = p.contact_scale.as_ref().map_or(1.0, |s| s.gain);
         let section = super::calibrated_range::attach(&mut ours.config, &ours.outcome, gain);
         extra_md.insert_str(0, &section);
+        if let Some(w) = super::inertia_check::inertia_warning(&ours.outcome) {
+            say(&w);
+            extra_md.insert_str(
+                0,
+                &format!(
+                    "## The residual and the acceleration
+
+{w}
+
+"
+                ),
+            );
+        }
         let yaml = super::report::fitted_yaml(&ours.config, &ours.outcome, &p.names, &ours.map);
         if let Some(o) = &outputs.fitted {
             crate::output::write_file(o, yaml.as_bytes())?;
