@@ -16,8 +16,9 @@
 //! acceleration). A warning when s > [`INERTIA_SHARE`]: a quarter of the
 //! residual's sum of squares is inertia. Where the fit already subtracts
 //! a fitted mass, s is zero at its optimum (the residual is orthogonal to
-//! its slope); on the real recordings (`data/`) s is at most 0.035,
-//! on EMPS fitted without its mass 0.985 (m̂ 97 kg; the benchmark's is 95).
+//! its slope). On the real recordings as `docs/real-data-benchmarks.sh`
+//! fits them, s is 0.003 (seal) and 1e-7 (EMPS, its mass fitted); on EMPS
+//! fitted without its mass 0.985 (m̂ 97 kg; the benchmark's is 95).
 
 use super::driver::FitOutcome;
 use super::Units;
