@@ -482,7 +482,7 @@ fn a_temperature_column_that_reads_as_kelvin_is_warned_of_and_celsius_is_not() {
         "{kelvin}"
     );
     let celsius = fit(&steady_with_temperature(&d, |k| 20.0 + k as f64));
-    assert!(!celsius.contains("where kelvin lies"), "{celsius}");
+    assert!(!celsius.contains("where kelvin readings lie"), "{celsius}");
 }
 
 #[test]

@@ -408,6 +408,9 @@ def _write_table(table: Table, path: str, what: str) -> None:
     text = []
     for name, c in cols:
         if c.dtype.kind in "biuf":
+            bad = np.flatnonzero(~np.isfinite(c.astype(float)))
+            if bad.size:
+                raise ValueError(f"{what}: column {name!r} is {c[bad[0]]} at row {bad[0]} (counting from 0): every sample must be finite")
             text.append([repr(float(x)) for x in c])
         else:
             cells = [str(x) for x in c]

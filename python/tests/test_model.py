@@ -168,6 +168,7 @@ def test_fit_takes_tables_in_memory_and_equals_the_fit_of_the_same_csv(tmp_path)
     ({"velocity_m_s": np.zeros((2, 2)), "friction_n": [1.0, 2.0]}, "shape (2, 2)"),
     ({"velocity, m/s": [0.1], "friction_n": [1.0]}, "column name 'velocity, m/s'"),
     ({}, "a table without columns"),
+    ({"velocity_m_s": [0.1, 0.2, 0.3], "friction_n": [1.0, 2.0, np.nan]}, "'friction_n' is nan at row 2 (counting from 0)"),
 ])
 def test_a_table_in_memory_that_cannot_be_a_csv_is_a_value_error_naming_it(table, words):
     with pytest.raises(ValueError) as e:

@@ -208,8 +208,9 @@ fn data_warnings(req: &DataRequest, scale: &DataScale, key_specs: &[ParamSpec]) 
     notes
 }
 
-/// Every training temperature, if each lies where kelvin does and a
-/// lubricant does not work: [`KELVIN_LOOKALIKE_C`].
+/// Temperatures, °C, where a machine's kelvin readings lie (−43 to
+/// 127 °C) and few lubricants work: training data all inside are warned
+/// of.
 const KELVIN_LOOKALIKE_C: (f64, f64) = (230.0, 400.0);
 
 /// A warning when every training temperature reads as kelvin in °C
@@ -229,7 +230,7 @@ fn kelvin_warning(train: &[Source], map_values: &[f64]) -> Result<Option<String>
     let (a, b) = KELVIN_LOOKALIKE_C;
     Ok((lo.is_finite() && a <= lo && hi <= b).then(|| {
         format!(
-            "warning: the temperature lies between {} and {} °C in every training sample, where kelvin lies and a lubricant does not work: if it is in kelvin, convert it: --temperature 'NAME - 273.15'",
+            "warning: the temperature lies between {} and {} °C in every training sample, where kelvin readings lie and few lubricants work: if it is in kelvin, convert it: --temperature 'NAME - 273.15'",
             crate::text::Num::sig(lo, 5),
             crate::text::Num::sig(hi, 5)
         )
