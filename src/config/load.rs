@@ -152,6 +152,7 @@ impl Config {
             let message = e.inner().to_string();
             let message = enum_choice_error(&params, &key, &message).unwrap_or(message);
             if message.starts_with("unknown field") {
+                let message = nearest_first(&message);
                 ConfigError::UnknownKey { key, message }
             } else {
                 ConfigError::InvalidValue { key, message }
@@ -159,6 +160,30 @@ impl Config {
         })?;
         cfg.validate()?;
         Ok(cfg)
+    }
+}
+
+/// serde's "unknown field `x`, expected one of `a`, `b`…" led by the
+/// expected name nearest to `x`, when one is near enough to be a typo
+/// (`lenght_m` → `length_m`: at most a third of its letters edited).
+fn nearest_first(message: &str) -> String {
+    let Some((field, tail)) = message
+        .strip_prefix("unknown field `")
+        .and_then(|r| r.split_once('`'))
+    else {
+        return message.to_string();
+    };
+    let nearest = tail
+        .split('`')
+        .skip(1)
+        .step_by(2)
+        .map(|n| (strsim::damerau_levenshtein(field, n), n))
+        .min();
+    match nearest {
+        Some((d, n)) if d <= (field.chars().count() / 3).max(1) => {
+            format!("did you mean `{n}`? {message}")
+        }
+        _ => message.to_string(),
     }
 }
 

@@ -48,9 +48,17 @@ fn unknown_key_is_named_with_its_full_path() {
         "{e}"
     );
     assert!(
-        e.to_string().contains("length_m"),
-        "suggests the valid keys: {e}"
+        e.to_string().contains("did you mean `length_m`?"),
+        "suggests the nearest valid key: {e}"
     );
+    // A name near none of them gets the list alone.
+    let e = load(
+        "friction_node:\n  ros__parameters:\n    contact:\n      colour: 1\n",
+        &[],
+    )
+    .unwrap_err();
+    let m = e.to_string();
+    assert!(!m.contains("did you mean") && m.contains("length_m"), "{m}");
 }
 
 #[test]
