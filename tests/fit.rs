@@ -325,7 +325,12 @@ fn bad_data_keys_and_bounds_get_a_clear_message_and_nothing_is_written() {
     expect_error(
         good,
         &["--fit", "roughness.sigma"],
-        "not a key of the configuration",
+        "not a key of the configuration (see launch-config/default.yaml): did you mean `roughness.sigma_m`?",
+    );
+    expect_error(
+        good,
+        &["--fit", "contact.boundary_fricton"],
+        "did you mean `contact.boundary_friction`?",
     );
     expect_error(good, &["--fit", "contact.profile"], "not numeric");
     expect_error(good, &["--fit", "solver.cells"], "integer");

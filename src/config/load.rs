@@ -164,8 +164,7 @@ impl Config {
 }
 
 /// serde's "unknown field `x`, expected one of `a`, `b`…" led by the
-/// expected name nearest to `x`, when one is near enough to be a typo
-/// (`lenght_m` → `length_m`: at most a third of its letters edited).
+/// expected name `x` most likely meant ([`super::nearest_key`]).
 fn nearest_first(message: &str) -> String {
     let Some((field, tail)) = message
         .strip_prefix("unknown field `")
@@ -173,17 +172,9 @@ fn nearest_first(message: &str) -> String {
     else {
         return message.to_string();
     };
-    let nearest = tail
-        .split('`')
-        .skip(1)
-        .step_by(2)
-        .map(|n| (strsim::damerau_levenshtein(field, n), n))
-        .min();
-    match nearest {
-        Some((d, n)) if d <= (field.chars().count() / 3).max(1) => {
-            format!("did you mean `{n}`? {message}")
-        }
-        _ => message.to_string(),
+    match super::nearest_key::nearest(field, tail.split('`').skip(1).step_by(2)) {
+        Some(n) => format!("did you mean `{n}`? {message}"),
+        None => message.to_string(),
     }
 }
 

@@ -30,6 +30,7 @@
 //! | `contacts.rs` | `contacts.*`: several contacts, each overriding the top-level sections |
 //! | `calibrated_range.rs` | where a fitted file was calibrated ([`CalibratedRange`]): speeds by direction, loads, temperatures, the training error |
 //! | `error.rs` | [`ConfigError`] and the [`Origin`] of a configuration |
+//! | `nearest_key.rs` | the valid name a misspelt or unit-less key most likely meant |
 //! | `envelope.rs` | the inputs every entry point accepts: velocity, load, temperature ([`Envelope`]) |
 //! | `parameters.rs` | the live-parameter catalogue (declared keys, types, ranges, writability) and [`parameters::apply_set`] |
 //! | `topics.rs` | the node's ROS 2 topic names resolved from the configuration (namespace, `~/`, remappings) |
@@ -42,6 +43,7 @@ mod envelope;
 mod error;
 mod load;
 mod model;
+pub mod nearest_key;
 mod node_sections;
 pub mod parameters;
 pub mod ros_args;

@@ -192,6 +192,27 @@ fn lookup_mut<'a>(tree: &'a mut Value, key: &str) -> Option<&'a mut Value> {
     })
 }
 
+/// The dotted names of every real-valued key under `tree` (prefixed by
+/// `prefix`), into `out`.
+fn numeric_keys(tree: &Value, prefix: &str, out: &mut Vec<String>) {
+    match tree {
+        Value::Mapping(m) => {
+            for (k, v) in m {
+                if let Some(k) = k.as_str() {
+                    let name = if prefix.is_empty() {
+                        k.to_string()
+                    } else {
+                        format!("{prefix}.{k}")
+                    };
+                    numeric_keys(v, &name, out);
+                }
+            }
+        }
+        Value::Number(n) if n.is_f64() => out.push(prefix.to_string()),
+        _ => {}
+    }
+}
+
 impl ConfigKeys {
     /// The key tree of `config`.
     pub fn new(config: &Config) -> Self {
@@ -207,9 +228,16 @@ impl ConfigKeys {
             message,
         };
         match lookup(&self.tree, key) {
-            None => Err(err(
-                "is not a key of the configuration (see launch-config/default.yaml)".into(),
-            )),
+            None => {
+                let mut keys = Vec::new();
+                numeric_keys(&self.tree, "", &mut keys);
+                let hint =
+                    crate::config::nearest_key::nearest(key, keys.iter().map(String::as_str))
+                        .map_or_else(String::new, |k| format!(": did you mean `{k}`?"));
+                Err(err(format!(
+                    "is not a key of the configuration (see launch-config/default.yaml){hint}"
+                )))
+            }
             Some(Value::Number(n)) if n.is_f64() => Ok(n.as_f64().expect("f64")),
             Some(Value::Number(n)) => Err(err(format!(
                 "is an integer setting ({n}), not a continuous parameter"
