@@ -233,6 +233,7 @@ mod tests {
             start: String::new(),
             tried: scored.iter().map(|t| t.tried.clone()).collect(),
             excluded: Vec::new(),
+            not_admitted: Vec::new(),
             removed: Vec::new(),
             added: Vec::new(),
             folds: String::new(),
