@@ -187,7 +187,9 @@ pub struct Selection {
 /// and beyond [`TERM_COST`]) — in which case the smallest such (the
 /// lowest CV error among equals). So a superset (the Stribeck curve
 /// around a viscous rise) is not chosen for what the smaller term does
-/// alone.
+/// alone. A set that could not be scored (its fit failed, or rule 9 did
+/// not admit it: CV error infinite) does not predict as well: the test
+/// that it does not pay cannot tell.
 fn simplest_that_predicts_as_well(step: Vec<Scored>) -> Scored {
     let lowest = step
         .iter()
@@ -196,7 +198,10 @@ fn simplest_that_predicts_as_well(step: Vec<Scored>) -> Scored {
         .expect("a candidate was open");
     let keys = |t: &Tried| set_keys(&t.terms).len();
     step.into_iter()
-        .filter(|t| t.tried.cv_rms == lowest.cv_rms || !pays(&t.tried, &lowest).0)
+        .filter(|t| {
+            t.tried.cv_rms == lowest.cv_rms
+                || (t.tried.cv_rms.is_finite() && !pays(&t.tried, &lowest).0)
+        })
         .min_by(|a, b| {
             keys(&a.tried)
                 .cmp(&keys(&b.tried))
@@ -607,6 +612,28 @@ mod tests {
         assert_eq!(
             simplest_that_predicts_as_well(step).tried.terms,
             ["drivetrain Stribeck"]
+        );
+    }
+
+    #[test]
+    fn a_set_that_could_not_be_scored_is_never_the_step_choice() {
+        // A lighter set with no score (its fit failed, or rule 9 did not
+        // admit it) is not one that predicts as well (before: chosen for
+        // its fewer keys, and the selection stopped at 'cannot be scored').
+        let inf = f64::INFINITY;
+        let step = vec![
+            scored(
+                &["drivetrain Stribeck", "boundary rate"],
+                &[2.0, 2.1, 1.9, 2.0],
+            ),
+            scored(
+                &["drivetrain Stribeck", "drivetrain quadratic"],
+                &[inf, inf, inf, inf],
+            ),
+        ];
+        assert_eq!(
+            simplest_that_predicts_as_well(step).tried.terms,
+            ["drivetrain Stribeck", "boundary rate"]
         );
     }
 
