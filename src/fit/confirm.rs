@@ -74,7 +74,7 @@ pub fn unconfirmed(s: &Selection, final_mse: &[f64], units: super::Units) -> Opt
     // pays over it; any other term must pay.
     let part = is_part(term);
     let presumed = s.presumed.contains(&term);
-    let stays = if holds_rise(term, &s.presumed) {
+    let stays = if holds_rise(term, &s.presumed) || !super::removal::is_scored(&fewer.tried) {
         true
     } else if part {
         keeps_part(&fewer.tried, &at_final)
@@ -166,9 +166,10 @@ pub(super) fn confounded_at_final(
                 .scored
                 .iter()
                 .find(|x| same_terms(&x.tried.terms, terms))?;
-            let may = !s.presumed.contains(t)
-                || ((form.is_some() || !holds_rise(t, &s.presumed))
-                    && pays(&at_final, &set.tried).0);
+            let may = super::removal::is_scored(&set.tried)
+                && (!s.presumed.contains(t)
+                    || ((form.is_some() || !holds_rise(t, &s.presumed))
+                        && pays(&at_final, &set.tried).0));
             may.then_some((*t, *form, set))
         })
         .min_by(|a, b| a.2.tried.cv_rms.total_cmp(&b.2.tried.cv_rms))?;

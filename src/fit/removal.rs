@@ -33,6 +33,14 @@ pub(super) fn pays(from: &Tried, to: &Tried) -> (bool, f64, f64, f64) {
     )
 }
 
+/// Whether the set `t` was scored: its CV error is finite. A set whose
+/// fit failed, or that rule 9 did not admit, is never one a selection
+/// moves to: the tests that a term does not pay or that the folds predict
+/// no worse cannot tell against an infinite error, and read "true".
+pub(super) fn is_scored(t: &Tried) -> bool {
+    t.cv_rms.is_finite()
+}
+
 /// Whether a part of a chosen term ([`super::candidates::is_part`]) stays:
 /// the set `with` it predicts the folds no worse than the set `without`
 /// it (the folds' mean squared error not raised on average). A part is
@@ -52,6 +60,9 @@ pub(super) fn keeps_part(without: &Tried, with: &Tried) -> bool {
 /// leave the richer shape's extra keys in doubt, and its extrapolation
 /// rests on them.
 pub(super) fn presumed_gives_way(current: &Scored, next: &Scored, reduced: bool) -> bool {
+    if !is_scored(&next.tried) {
+        return false;
+    }
     pays(&current.tried, &next.tried).0
         || (reduced
             && keeps_part(&current.tried, &next.tried)
@@ -102,7 +113,7 @@ impl Ctx<'_> {
     /// without it pays over the set with it; any other term when it does
     /// not pay over the set without it.
     pub(super) fn may_leave(&self, t: &str, reduced: bool, without: &Tried, with: &Tried) -> bool {
-        if self.holds_rise(t) && !reduced {
+        if (self.holds_rise(t) && !reduced) || !is_scored(without) {
             false
         } else if is_part(t) {
             !keeps_part(without, with)
@@ -232,7 +243,8 @@ impl Ctx<'_> {
                     } else if self.is_presumed(t) {
                         presumed_gives_way(&current, s, form.is_some())
                     } else {
-                        f.confounded.is_some() || !pays(&s.tried, &current.tried).0
+                        is_scored(&s.tried)
+                            && (f.confounded.is_some() || !pays(&s.tried, &current.tried).0)
                     }
                 })
                 .min_by(|a, b| a.2.tried.cv_rms.total_cmp(&b.2.tried.cv_rms));
@@ -493,6 +505,20 @@ mod tests {
         s.tried.cv_rms = (fold_mse.iter().sum::<f64>() / fold_mse.len() as f64).sqrt();
         s.aicc = aicc;
         s
+    }
+
+    #[test]
+    fn no_set_gives_way_to_one_that_could_not_be_scored() {
+        // An unscored set (its fit failed, or rule 9 did not admit it):
+        // infinite fold errors, which every "does not pay" test reads as
+        // true. A time-series joint (draw d57) lost its pre-sliding so and
+        // predicted its faster motion 8.3× worse.
+        let current = scored_cv(&["drivetrain Stribeck"], &[1.0, 1.1, 0.9, 1.0], -100.0);
+        let inf = f64::INFINITY;
+        let unscored = scored_cv(&["drivetrain viscous"], &[inf, inf, inf, inf], inf);
+        assert!(!is_scored(&unscored.tried) && is_scored(&current.tried));
+        assert!(!presumed_gives_way(&current, &unscored, true));
+        assert!(!presumed_gives_way(&current, &unscored, false));
     }
 
     #[test]

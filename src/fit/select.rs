@@ -200,7 +200,7 @@ fn simplest_that_predicts_as_well(step: Vec<Scored>) -> Scored {
     step.into_iter()
         .filter(|t| {
             t.tried.cv_rms == lowest.cv_rms
-                || (t.tried.cv_rms.is_finite() && !pays(&t.tried, &lowest).0)
+                || (super::removal::is_scored(&t.tried) && !pays(&t.tried, &lowest).0)
         })
         .min_by(|a, b| {
             keys(&a.tried)
