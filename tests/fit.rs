@@ -464,22 +464,26 @@ fn steady_with_temperature(d: &Path, celsius: impl Fn(usize) -> f64) -> std::pat
     path
 }
 
+/// `fit DATA --out D/fitted.yaml ARGS…`, which must end with a fitted file
+/// (exit 0, or 4: not converged); its standard error.
+fn fit_stderr(d: &Path, data: &Path, args: &[&str]) -> String {
+    let out = d.join("fitted.yaml");
+    let mut all = vec![
+        "fit",
+        data.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    all.extend_from_slice(args);
+    let (code, _, stderr) = run(&all);
+    assert!(code == 0 || code == 4, "{stderr}");
+    stderr
+}
+
 #[test]
 fn a_temperature_column_that_reads_as_kelvin_is_warned_of_and_celsius_is_not() {
     let d = dir("kelvin");
-    let fit = |data: &Path| {
-        let out = d.join("fitted.yaml");
-        let (code, _, stderr) = run(&[
-            "fit",
-            data.to_str().unwrap(),
-            "--fit",
-            "contact.boundary_friction",
-            "--out",
-            out.to_str().unwrap(),
-        ]);
-        assert!(code == 0 || code == 4, "{stderr}");
-        stderr
-    };
+    let fit = |data: &Path| fit_stderr(&d, data, &["--fit", "contact.boundary_friction"]);
     let kelvin = fit(&steady_with_temperature(&d, |k| 293.15 + k as f64));
     assert!(
         kelvin.contains("between 293.15 and 304.15 °C in every training sample")
@@ -506,20 +510,10 @@ fn a_measured_force_that_still_holds_the_inertia_is_warned_of_with_its_mass() {
     }
     let data = d.join("drive.csv");
     std::fs::write(&data, csv).unwrap();
-    let out = d.join("fitted.yaml");
     let fit = |extra: &[&str]| {
-        let mut args = vec![
-            "--set",
-            "solver.cells=32",
-            "fit",
-            data.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ];
+        let mut args = vec!["--set", "solver.cells=32"];
         args.extend_from_slice(extra);
-        let (code, _, stderr) = run(&args);
-        assert!(code == 0 || code == 4, "{stderr}");
-        stderr
+        fit_stderr(&d, &data, &args)
     };
     let err = fit(&["--fit", "contact.boundary_friction"]);
     let mass: f64 = err
