@@ -30,6 +30,7 @@
 //! | `confirm.rs` | `--fit auto`'s choice confirmed at the final fit's optimum: scored on the same folds, it falls back to the best set with one term fewer when it no longer pays over it, or to the lighter set of two chosen terms that are confounded at that optimum |
 //! | `select.rs` | `--fit auto`'s rule: stepwise with removal on cross-validation, terms that pay, dead terms dropped; its report |
 //! | `classic_shape.rs` | `--fit auto`'s rule 7: a steady curve starts from the classic shape its points support (AICc), which is presumed |
+//! | `curve_support.rs` | `--fit auto`'s rule 10: on a steady curve a term enters only where the whole curve's AICc is lowered too |
 //! | `removal.rs` | terms taken away during the selection: one that no longer pays, one flagged dead, one of two confounded terms; the lighter forms; whether a change pays |
 //! | `trial.rs` | one set of terms tried: fitted on the training data, scored by cross-validation |
 //! | `candidates.rs` | the candidate terms, the keys of a set, which candidates the data allow, the keys `--fit auto` starts from |
@@ -82,6 +83,7 @@ pub mod compare;
 pub mod confirm;
 pub mod contact_scale;
 pub mod cross_validate;
+mod curve_support;
 pub mod data;
 pub mod driver;
 pub mod earlier_optima;

@@ -125,6 +125,13 @@
 //!    fresh random joint (seed 41, joint 23) the quadratic paid on the
 //!    folds (CV 0.0209 → 0.0124 N·m) at 0.82 ± 0.65 N·m·s²/rad² and
 //!    predicted 90 deg/s 35× worse than the Stribeck curve.
+//! 10. On a steady curve a term enters only where the whole curve supports
+//!    it as well as the folds (`curve_support.rs`): its set's small-sample
+//!    Akaike criterion on all the training points is below the current
+//!    set's. Four folds of a few points each give rule 3's standard error
+//!    three degrees of freedom, and a chance gain on one fold passes it;
+//!    the criterion weighs every point at once. A time series, whose
+//!    samples are correlated and whose blocks are long, does not use it.
 //!
 //! The report lists every set tried with its CV error per fold, the set
 //! chosen and why the selection stopped.
@@ -132,6 +139,7 @@
 use super::candidates::{candidates_here, holds, parts_to_add, set_keys, Candidate};
 use super::classic_shape::{classic_shapes, without_subsumed};
 use super::cross_validate::paired;
+use super::curve_support::{supported, why_unsupported};
 use super::options::SearchSettings;
 use super::prepared::Prepared;
 use super::removal::{cv, keeps_part, pays};
@@ -272,6 +280,26 @@ pub fn select(
         }
         let step = ctx.step(&current, &open, say)?;
         tried.extend(step.iter().map(|t| t.tried.clone()));
+        // Rule 10: on a steady curve a set whose whole-curve criterion is
+        // not below the current set's is not a step's choice.
+        let (step, unsupported): (Vec<Scored>, Vec<Scored>) = step
+            .into_iter()
+            .partition(|t| !steady || supported(&current, t));
+        for t in unsupported
+            .iter()
+            .filter(|t| pays(&current.tried, &t.tried).0)
+        {
+            let name = t.tried.terms.last().copied().unwrap_or_default();
+            let why = why_unsupported(&current, t, name);
+            say(&format!("auto: not supported by the whole curve: {why}"));
+            ctx.not_admitted
+                .lock()
+                .unwrap_or_else(|p| p.into_inner())
+                .push(why);
+        }
+        if step.is_empty() {
+            break not_supported(&current, &unsupported);
+        }
         let best = simplest_that_predicts_as_well(step);
         let (ok, gain, se, share) = pays(&current.tried, &best.tried);
         let name = best.tried.terms.last().copied().unwrap_or_default();
@@ -352,6 +380,26 @@ fn does_not_pay(name: &str, gain: f64, se: f64, share: f64) -> String {
         crate::text::Num::sig(se, 5),
         100.0 * share,
         100.0 * TERM_COST
+    )
+}
+
+/// Why the selection stopped when no set of the step is supported by the
+/// whole curve (rule 10): the best of them on the folds, and its criterion.
+fn not_supported(current: &Scored, unsupported: &[Scored]) -> String {
+    let Some(best) = unsupported
+        .iter()
+        .filter(|t| super::removal::is_scored(&t.tried))
+        .min_by(|a, b| a.tried.cv_rms.total_cmp(&b.tried.cv_rms))
+    else {
+        return "no next term could be scored on these folds".to_string();
+    };
+    let name = best.tried.terms.last().copied().unwrap_or_default();
+    format!(
+        "the best next term on the folds, {name} (CV {} against {}), does not lower the whole curve's small-sample Akaike criterion ({:.1} with it against {:.1}), nor does any other (rule 10), so none is added",
+        crate::text::Num::sig(best.tried.cv_rms, 5),
+        crate::text::Num::sig(current.tried.cv_rms, 5),
+        best.aicc,
+        current.aicc
     )
 }
 
@@ -442,7 +490,7 @@ impl Ctx<'_> {
 pub fn report(s: &Selection, units: super::Units) -> String {
     let u = units.force();
     let mut md = format!(
-        "## Terms chosen by the data (`--fit auto`)\n\nRule: stepwise selection on cross-validation of the training data ({}; each fold predicted by the set refitted without it); each step takes the candidate with the lowest CV error, unless one with fewer keys predicts as well (the best does not pay for its extra keys over it); a term is added only if it lowers the folds' mean squared error by more than the standard error of that lowering and by more than {:.0} % of it (the cost of a term), and a term chosen earlier goes, or gives way to a lighter form of it (the Stribeck curve to its viscous rise), when it no longer pays beside a later one; a part of a chosen term (the pre-sliding bristle's damping, LuGre's σ1 beside its stiffness σ0) comes with it unless the folds predict worse with it; a term that ends at zero or at a bound, or that the data cannot tell from another parameter (|ρ| > 0.95), is dropped or reduced and the set fitted again unless that predicts worse, and of two chosen terms that the data cannot tell apart (a key of one correlated so with a key of the other; a part and its own term are one element, not two) one goes, whichever the folds miss least; the chosen set's final fit is scored on the same folds, and gives way to the best set with one term fewer when it no longer pays over it; a steady curve starts from its rising classic shape (the viscous rise or the Stribeck curve: the simplest whose small-sample Akaike criterion on all the training points is within 2 of the lowest), presumed with its viscous rise: it is never removed for the flat base (the curve gives way to its rise when that pays over it or, the curve's keys flagged, predicts the folds no worse within 10 of its Akaike criterion; the rise goes only when its key ends at zero), and of it and a term confounded with it the term goes; the quadratic rise comes only on top of a viscous rise and only where the fit tells its coefficient from zero (its 95 % interval excludes zero), and a Stribeck speed lies within the data's speeds. Neither --validate nor --holdout data are used.\n\n| set (boundary friction +) | CV RMS ({u}) | RMS per fold ({u}) | film solves |\n|---|---|---|---|\n",
+        "## Terms chosen by the data (`--fit auto`)\n\nRule: stepwise selection on cross-validation of the training data ({}; each fold predicted by the set refitted without it); each step takes the candidate with the lowest CV error, unless one with fewer keys predicts as well (the best does not pay for its extra keys over it); a term is added only if it lowers the folds' mean squared error by more than the standard error of that lowering and by more than {:.0} % of it (the cost of a term), and a term chosen earlier goes, or gives way to a lighter form of it (the Stribeck curve to its viscous rise), when it no longer pays beside a later one; a part of a chosen term (the pre-sliding bristle's damping, LuGre's σ1 beside its stiffness σ0) comes with it unless the folds predict worse with it; a term that ends at zero or at a bound, or that the data cannot tell from another parameter (|ρ| > 0.95), is dropped or reduced and the set fitted again unless that predicts worse, and of two chosen terms that the data cannot tell apart (a key of one correlated so with a key of the other; a part and its own term are one element, not two) one goes, whichever the folds miss least; the chosen set's final fit is scored on the same folds, and gives way to the best set with one term fewer when it no longer pays over it; a steady curve starts from its rising classic shape (the viscous rise or the Stribeck curve: the simplest whose small-sample Akaike criterion on all the training points is within 2 of the lowest), presumed with its viscous rise: it is never removed for the flat base (the curve gives way to its rise when that pays over it or, the curve's keys flagged, predicts the folds no worse within 10 of its Akaike criterion; the rise goes only when its key ends at zero), and of it and a term confounded with it the term goes; the quadratic rise comes only on top of a viscous rise and only where the fit tells its coefficient from zero (its 95 % interval excludes zero), and a Stribeck speed lies within the data's speeds; on a steady curve a term enters only where its set's small-sample Akaike criterion on all the training points is also below the current set's. Neither --validate nor --holdout data are used.\n\n| set (boundary friction +) | CV RMS ({u}) | RMS per fold ({u}) | film solves |\n|---|---|---|---|\n",
         s.folds,
         100.0 * TERM_COST
     );
