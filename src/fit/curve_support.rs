@@ -29,7 +29,7 @@ use super::trial::Scored;
 /// set's. A criterion that is not a number (a set scored without one)
 /// does not block.
 pub(super) fn supported(current: &Scored, next: &Scored) -> bool {
-    !(next.aicc >= current.aicc)
+    next.aicc < current.aicc || next.aicc.is_nan() || current.aicc.is_nan()
 }
 
 /// Why `next` was not added beside `current` (rule 10), for the report.

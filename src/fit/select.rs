@@ -126,12 +126,12 @@
 //!    folds (CV 0.0209 → 0.0124 N·m) at 0.82 ± 0.65 N·m·s²/rad² and
 //!    predicted 90 deg/s 35× worse than the Stribeck curve.
 //! 10. On a steady curve a term enters only where the whole curve supports
-//!    it as well as the folds (`curve_support.rs`): its set's small-sample
-//!    Akaike criterion on all the training points is below the current
-//!    set's. Four folds of a few points each give rule 3's standard error
-//!    three degrees of freedom, and a chance gain on one fold passes it;
-//!    the criterion weighs every point at once. A time series, whose
-//!    samples are correlated and whose blocks are long, does not use it.
+//!     it as well as the folds (`curve_support.rs`): its set's small-sample
+//!     Akaike criterion on all the training points is below the current
+//!     set's. Four folds of a few points each give rule 3's standard error
+//!     three degrees of freedom, and a chance gain on one fold passes it;
+//!     the criterion weighs every point at once. A time series, whose
+//!     samples are correlated and whose blocks are long, does not use it.
 //!
 //! The report lists every set tried with its CV error per fold, the set
 //! chosen and why the selection stopped.
