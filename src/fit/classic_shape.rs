@@ -6,7 +6,7 @@
 //! goes only when its key ends at zero (`removal.rs`, `confirm.rs`).
 
 use super::candidates::{lighter_forms, set_keys, Candidate, STRIBECK, VISCOUS};
-use super::trial::{Ctx, Scored, Tried};
+use super::trial::{Ctx, Scored, Tried, AICC_SUPPORT};
 use super::FitError;
 
 /// The chosen `terms` without those whose keys another chosen term fits
@@ -40,13 +40,6 @@ pub(super) fn without_subsumed(
     }
     (chosen, kept)
 }
-
-/// How much lower (better) a richer classic shape's small-sample Akaike
-/// criterion must be to be preferred to a simpler one (rule 7): a
-/// difference below 2 is one the data do not resolve (Burnham & Anderson
-/// 2002, *Model Selection and Multimodel Inference*, §2.6), and the
-/// simpler shape is taken.
-pub const AICC_SUPPORT: f64 = 2.0;
 
 /// The classic shapes of a steady curve that are candidates here (rule
 /// 7): the viscous rise (with the base, Coulomb + viscous) and the

@@ -81,7 +81,7 @@
 //!    starts from the simplest rising shape whose small-sample Akaike
 //!    criterion (`trial::aicc`, asymptotically leave-one-out
 //!    cross-validation) is within
-//!    [`AICC_SUPPORT`](super::classic_shape::AICC_SUPPORT) of the lowest
+//!    [`AICC_SUPPORT`](super::trial::AICC_SUPPORT) of the lowest
 //!    (`classic_shape::start_shape`): the viscous rise or the Stribeck
 //!    curve, not the flat base — a lubricated drive's friction rises with
 //!    speed, and the fit decides by how much (the viscous key is bounded
@@ -128,10 +128,12 @@
 //! 10. On a steady curve a term enters only where the whole curve supports
 //!     it as well as the folds (`curve_support.rs`): its set's small-sample
 //!     Akaike criterion on all the training points is below the current
-//!     set's. Four folds of a few points each give rule 3's standard error
-//!     three degrees of freedom, and a chance gain on one fold passes it;
-//!     the criterion weighs every point at once. A time series, whose
-//!     samples are correlated and whose blocks are long, does not use it.
+//!     set's by more than [`AICC_SUPPORT`](super::trial::AICC_SUPPORT) (2),
+//!     a difference the data resolve, as rule 7 asks of a richer shape.
+//!     Four folds of a few points each give rule 3's standard error three
+//!     degrees of freedom, and a chance gain on one fold passes it; the
+//!     criterion weighs every point at once. A time series, whose samples
+//!     are correlated and whose blocks are long, does not use it.
 //!
 //! The report lists every set tried with its CV error per fold, the set
 //! chosen and why the selection stopped.
@@ -281,7 +283,7 @@ pub fn select(
         let step = ctx.step(&current, &open, say)?;
         tried.extend(step.iter().map(|t| t.tried.clone()));
         // Rule 10: on a steady curve a set whose whole-curve criterion is
-        // not below the current set's is not a step's choice.
+        // not more than 2 below the current set's is not a step's choice.
         let (step, unsupported): (Vec<Scored>, Vec<Scored>) = step
             .into_iter()
             .partition(|t| !steady || supported(&current, t));
@@ -395,9 +397,10 @@ fn not_supported(current: &Scored, unsupported: &[Scored]) -> String {
     };
     let name = best.tried.terms.last().copied().unwrap_or_default();
     format!(
-        "the best next term on the folds, {name} (CV {} against {}), does not lower the whole curve's small-sample Akaike criterion ({:.1} with it against {:.1}), nor does any other (rule 10), so none is added",
+        "the best next term on the folds, {name} (CV {} against {}), does not lower the whole curve's small-sample Akaike criterion by more than {} ({:.1} with it against {:.1}), nor does any other (rule 10), so none is added",
         crate::text::Num::sig(best.tried.cv_rms, 5),
         crate::text::Num::sig(current.tried.cv_rms, 5),
+        super::trial::AICC_SUPPORT,
         best.aicc,
         current.aicc
     )
@@ -490,7 +493,7 @@ impl Ctx<'_> {
 pub fn report(s: &Selection, units: super::Units) -> String {
     let u = units.force();
     let mut md = format!(
-        "## Terms chosen by the data (`--fit auto`)\n\nRule: stepwise selection on cross-validation of the training data ({}; each fold predicted by the set refitted without it); each step takes the candidate with the lowest CV error, unless one with fewer keys predicts as well (the best does not pay for its extra keys over it); a term is added only if it lowers the folds' mean squared error by more than the standard error of that lowering and by more than {:.0} % of it (the cost of a term), and a term chosen earlier goes, or gives way to a lighter form of it (the Stribeck curve to its viscous rise), when it no longer pays beside a later one; a part of a chosen term (the pre-sliding bristle's damping, LuGre's σ1 beside its stiffness σ0) comes with it unless the folds predict worse with it; a term that ends at zero or at a bound, or that the data cannot tell from another parameter (|ρ| > 0.95), is dropped or reduced and the set fitted again unless that predicts worse, and of two chosen terms that the data cannot tell apart (a key of one correlated so with a key of the other; a part and its own term are one element, not two) one goes, whichever the folds miss least; the chosen set's final fit is scored on the same folds, and gives way to the best set with one term fewer when it no longer pays over it; a steady curve starts from its rising classic shape (the viscous rise or the Stribeck curve: the simplest whose small-sample Akaike criterion on all the training points is within 2 of the lowest), presumed with its viscous rise: it is never removed for the flat base (the curve gives way to its rise when that pays over it or, the curve's keys flagged, predicts the folds no worse within 10 of its Akaike criterion; the rise goes only when its key ends at zero), and of it and a term confounded with it the term goes; the quadratic rise comes only on top of a viscous rise and only where the fit tells its coefficient from zero (its 95 % interval excludes zero), and a Stribeck speed lies within the data's speeds; on a steady curve a term enters only where its set's small-sample Akaike criterion on all the training points is also below the current set's. Neither --validate nor --holdout data are used.\n\n| set (boundary friction +) | CV RMS ({u}) | RMS per fold ({u}) | film solves |\n|---|---|---|---|\n",
+        "## Terms chosen by the data (`--fit auto`)\n\nRule: stepwise selection on cross-validation of the training data ({}; each fold predicted by the set refitted without it); each step takes the candidate with the lowest CV error, unless one with fewer keys predicts as well (the best does not pay for its extra keys over it); a term is added only if it lowers the folds' mean squared error by more than the standard error of that lowering and by more than {:.0} % of it (the cost of a term), and a term chosen earlier goes, or gives way to a lighter form of it (the Stribeck curve to its viscous rise), when it no longer pays beside a later one; a part of a chosen term (the pre-sliding bristle's damping, LuGre's σ1 beside its stiffness σ0) comes with it unless the folds predict worse with it; a term that ends at zero or at a bound, or that the data cannot tell from another parameter (|ρ| > 0.95), is dropped or reduced and the set fitted again unless that predicts worse, and of two chosen terms that the data cannot tell apart (a key of one correlated so with a key of the other; a part and its own term are one element, not two) one goes, whichever the folds miss least; the chosen set's final fit is scored on the same folds, and gives way to the best set with one term fewer when it no longer pays over it; a steady curve starts from its rising classic shape (the viscous rise or the Stribeck curve: the simplest whose small-sample Akaike criterion on all the training points is within 2 of the lowest), presumed with its viscous rise: it is never removed for the flat base (the curve gives way to its rise when that pays over it or, the curve's keys flagged, predicts the folds no worse within 10 of its Akaike criterion; the rise goes only when its key ends at zero), and of it and a term confounded with it the term goes; the quadratic rise comes only on top of a viscous rise and only where the fit tells its coefficient from zero (its 95 % interval excludes zero), and a Stribeck speed lies within the data's speeds; on a steady curve a term enters only where its set's small-sample Akaike criterion on all the training points is also more than 2 below the current set's. Neither --validate nor --holdout data are used.\n\n| set (boundary friction +) | CV RMS ({u}) | RMS per fold ({u}) | film solves |\n|---|---|---|---|\n",
         s.folds,
         100.0 * TERM_COST
     );

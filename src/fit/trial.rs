@@ -44,6 +44,14 @@ pub(super) struct Scored {
     pub(super) aicc: f64,
 }
 
+/// How much lower (better) a richer set's small-sample Akaike criterion
+/// must be for the whole curve to support it over a simpler one: a
+/// difference below 2 is one the data do not resolve (Burnham & Anderson
+/// 2002, *Model Selection and Multimodel Inference*, §2.6), and the
+/// simpler set is taken (rule 7's start, `classic_shape.rs`; rule 10's
+/// terms, `curve_support.rs`).
+pub const AICC_SUPPORT: f64 = 2.0;
+
 /// The Akaike difference past which a presumed shape's lighter classic
 /// shape has essentially no support (Burnham & Anderson 2002, §2.6: above
 /// 10, an evidence ratio e^5 ≈ 150 against it). Below it, a presumed
