@@ -293,7 +293,6 @@ pub fn select(
         {
             let name = t.tried.terms.last().copied().unwrap_or_default();
             let why = why_unsupported(&current, t, name);
-            say(&format!("auto: not supported by the whole curve: {why}"));
             ctx.not_admitted
                 .lock()
                 .unwrap_or_else(|p| p.into_inner())
@@ -330,7 +329,9 @@ pub fn select(
         .not_admitted
         .into_inner()
         .unwrap_or_else(|p| p.into_inner());
-    not_admitted.dedup();
+    // Each once: a set come back to is refused again with the same words.
+    let mut seen = std::collections::HashSet::new();
+    not_admitted.retain(|n| seen.insert(n.clone()));
     for n in &not_admitted {
         say(&format!("auto: not admitted: {n}"));
     }
