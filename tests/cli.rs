@@ -217,6 +217,17 @@ fn stribeck_and_profile_write_their_columns() {
 }
 
 #[test]
+fn a_missing_required_argument_is_named_on_the_errors_one_line() {
+    let (ok, _, stderr) = run(&["fit", "data.csv", "--fit", "auto"]);
+    assert!(!ok);
+    assert!(
+        stderr.contains("the following required arguments were not provided: --out <FILE>"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains(":;"), "{stderr}");
+}
+
+#[test]
 fn an_unknown_study_lists_the_valid_ones() {
     let (ok, _, stderr) = run(&["study", "frequency", "--out", "/tmp/never"]);
     assert!(!ok);

@@ -589,7 +589,15 @@ pub fn one_line_error(e: &clap::Error) -> String {
         }
         parts.push(l.trim_start_matches("error: ").to_string());
     }
-    let mut msg = parts.join("; ");
+    // A line that ends in a colon introduces the next ("not provided:"
+    // then the argument): joined by a space, the others by "; ".
+    let mut msg = String::new();
+    for p in &parts {
+        if !msg.is_empty() {
+            msg.push_str(if msg.ends_with(':') { " " } else { "; " });
+        }
+        msg.push_str(p);
+    }
     if let Some(ContextValue::Strings(valid)) = e.get(ContextKind::ValidValue) {
         if !msg.contains("possible values") {
             msg.push_str(&format!("; allowed values: {}", valid.join(", ")));
