@@ -387,7 +387,9 @@ fn does_not_pay(name: &str, gain: f64, se: f64, share: f64) -> String {
 }
 
 /// Why the selection stopped when no set of the step is supported by the
-/// whole curve (rule 10): the best of them on the folds, and its criterion.
+/// whole curve (rule 10): the best of them on the folds, and why it is not
+/// added — it does not pay there (rule 3), or it does and the criterion
+/// refuses it.
 fn not_supported(current: &Scored, unsupported: &[Scored]) -> String {
     let Some(best) = unsupported
         .iter()
@@ -397,8 +399,13 @@ fn not_supported(current: &Scored, unsupported: &[Scored]) -> String {
         return "no next term could be scored on these folds".to_string();
     };
     let name = best.tried.terms.last().copied().unwrap_or_default();
+    let (ok, gain, se, share) = pays(&current.tried, &best.tried);
+    if !ok {
+        // It does not pay on the folds either: rule 3 is the reason.
+        return does_not_pay(name, gain, se, share);
+    }
     format!(
-        "the best next term on the folds, {name} (CV {} against {}), does not lower the whole curve's small-sample Akaike criterion by more than {} ({:.1} with it against {:.1}), nor does any other (rule 10), so none is added",
+        "the best next term on the folds, {name} (CV {} against {}), pays there but does not lower the whole curve's small-sample Akaike criterion by more than {} ({:.1} with it against {:.1}), nor does any other (rule 10), so none is added",
         crate::text::Num::sig(best.tried.cv_rms, 5),
         crate::text::Num::sig(current.tried.cv_rms, 5),
         super::trial::AICC_SUPPORT,
@@ -728,6 +735,39 @@ mod tests {
             &[1.1, 1.0, 1.3, 1.1],
         );
         assert!(!keeps_part(&without.tried, &higher.tried));
+    }
+
+    #[test]
+    fn a_stop_by_rule_10_names_rule_3_when_the_best_refused_term_does_not_pay_on_the_folds_either()
+    {
+        let with_aicc = |mut s: Scored, aicc| {
+            s.aicc = aicc;
+            s
+        };
+        let current = with_aicc(
+            scored(&["drivetrain Stribeck"], &[1.0, 1.0, 1.0, 1.0]),
+            -169.2,
+        );
+        // Lower on average but within the folds' spread: rule 3's reason.
+        let noisy = with_aicc(
+            scored(
+                &["drivetrain Stribeck", "drivetrain quadratic"],
+                &[0.2, 1.9, 0.3, 1.4],
+            ),
+            -166.4,
+        );
+        let why = not_supported(&current, std::slice::from_ref(&noisy));
+        assert!(why.contains("does not pay for itself"), "{why}");
+        // Lower on every fold: it pays there, and rule 10 refuses it.
+        let paying = with_aicc(
+            scored(&["drivetrain Stribeck", "film"], &[0.5, 0.5, 0.6, 0.5]),
+            -168.0,
+        );
+        let why = not_supported(&current, &[noisy, paying]);
+        assert!(
+            why.starts_with("the best next term on the folds, film") && why.contains("(rule 10)"),
+            "{why}"
+        );
     }
 
     #[test]
