@@ -23,7 +23,8 @@
 //! steeper viscous rise beneath the dip predicted 25–90 deg/s 3.0× worse
 //! than Coulomb + viscous.
 
-use super::trial::{Scored, AICC_SUPPORT};
+use super::removal::pays;
+use super::trial::{Ctx, Scored, AICC_SUPPORT};
 
 /// Whether the set `next` is supported by the whole curve beside
 /// `current`: its small-sample Akaike criterion is below the current
@@ -48,6 +49,31 @@ pub(super) fn why_unsupported(current: &Scored, next: &Scored, name: &str) -> St
         next.aicc,
         current.aicc
     )
+}
+
+impl Ctx<'_> {
+    /// Rule 10: the sets of a step that the whole curve supports beside
+    /// `current` (every one on a time series, `steady` false), and those
+    /// it refuses. A refused set that pays on the folds is recorded as not
+    /// admitted, with why.
+    pub(super) fn split_by_support(
+        &self,
+        current: &Scored,
+        step: Vec<Scored>,
+        steady: bool,
+    ) -> (Vec<Scored>, Vec<Scored>) {
+        let (kept, refused): (Vec<Scored>, Vec<Scored>) = step
+            .into_iter()
+            .partition(|t| !steady || supported(current, t));
+        for t in refused.iter().filter(|t| pays(&current.tried, &t.tried).0) {
+            let name = t.tried.terms.last().copied().unwrap_or_default();
+            self.not_admitted
+                .lock()
+                .unwrap_or_else(|p| p.into_inner())
+                .push(why_unsupported(current, t, name));
+        }
+        (kept, refused)
+    }
 }
 
 #[cfg(test)]

@@ -141,7 +141,6 @@
 use super::candidates::{candidates_here, holds, parts_to_add, set_keys, Candidate};
 use super::classic_shape::{classic_shapes, without_subsumed};
 use super::cross_validate::paired;
-use super::curve_support::{supported, why_unsupported};
 use super::options::SearchSettings;
 use super::prepared::Prepared;
 use super::removal::{cv, keeps_part, pays};
@@ -274,44 +273,9 @@ pub fn select(
         Vec::new()
     };
     let mut start = String::new();
-    let mut current = ctx.presume(base, &shapes, &mut tried, &mut start, say)?;
-    let why = loop {
-        let open = open_candidates(&candidates, &current.tried.terms);
-        if open.is_empty() {
-            break "every candidate was chosen".to_string();
-        }
-        let step = ctx.step(&current, &open, say)?;
-        tried.extend(step.iter().map(|t| t.tried.clone()));
-        // Rule 10: on a steady curve a set whose whole-curve criterion is
-        // not more than 2 below the current set's is not a step's choice.
-        let (step, unsupported): (Vec<Scored>, Vec<Scored>) = step
-            .into_iter()
-            .partition(|t| !steady || supported(&current, t));
-        for t in unsupported
-            .iter()
-            .filter(|t| pays(&current.tried, &t.tried).0)
-        {
-            let name = t.tried.terms.last().copied().unwrap_or_default();
-            let why = why_unsupported(&current, t, name);
-            ctx.not_admitted
-                .lock()
-                .unwrap_or_else(|p| p.into_inner())
-                .push(why);
-        }
-        if step.is_empty() {
-            break not_supported(&current, &unsupported);
-        }
-        let best = simplest_that_predicts_as_well(step);
-        let (ok, gain, se, share) = pays(&current.tried, &best.tried);
-        let name = best.tried.terms.last().copied().unwrap_or_default();
-        if !ok {
-            break does_not_pay(name, gain, se, share);
-        }
-        current = best;
-        // Removal: a term chosen earlier that no longer pays beside the
-        // new one goes (the first choice does not block a better pair).
-        current = ctx.prune(current, name, &mut tried, &mut removed, say)?;
-    };
+    let current = ctx.presume(base, &shapes, &mut tried, &mut start, say)?;
+    let (current, why) =
+        ctx.stepwise(current, &candidates, steady, &mut tried, &mut removed, say)?;
     // A part of a chosen term comes with it unless the folds predict worse
     // with it (rule 4b).
     let mut added: Vec<String> = Vec::new();
@@ -475,6 +439,42 @@ impl Ctx<'_> {
 
     /// One step: each open candidate added to `current`, fitted and
     /// scored side by side.
+    /// Rules 2, 3 and 10: from `current`, add the candidate each step
+    /// chooses while it pays, removing a term chosen earlier that no longer
+    /// pays beside the new one. Returns the set and why the steps stopped.
+    fn stepwise(
+        &self,
+        mut current: Scored,
+        candidates: &[&'static Candidate],
+        steady: bool,
+        tried: &mut Vec<Tried>,
+        removed: &mut Vec<String>,
+        say: &(dyn Fn(&str) + Sync),
+    ) -> Result<(Scored, String), FitError> {
+        loop {
+            let open = open_candidates(candidates, &current.tried.terms);
+            if open.is_empty() {
+                return Ok((current, "every candidate was chosen".to_string()));
+            }
+            let step = self.step(&current, &open, say)?;
+            tried.extend(step.iter().map(|t| t.tried.clone()));
+            let (step, unsupported) = self.split_by_support(&current, step, steady);
+            if step.is_empty() {
+                let why = not_supported(&current, &unsupported);
+                return Ok((current, why));
+            }
+            let best = simplest_that_predicts_as_well(step);
+            let (ok, gain, se, share) = pays(&current.tried, &best.tried);
+            let name = best.tried.terms.last().copied().unwrap_or_default();
+            if !ok {
+                return Ok((current, does_not_pay(name, gain, se, share)));
+            }
+            // Removal: a term chosen earlier that no longer pays beside the
+            // new one goes (the first choice does not block a better pair).
+            current = self.prune(best, name, tried, removed, say)?;
+        }
+    }
+
     fn step(
         &self,
         current: &Scored,
