@@ -28,6 +28,7 @@
 //! | `request.rs` | a calibration as data ([`request::FitRequest`]) and its one flow, `run`, for the command line and Python: prepare → select → fit ours → the fitted file → the classic models → the report |
 //! | `prepare.rs` | data → our model: the sources (the held-out part cut off first), scales, keys, maps, the contact's scale |
 //! | `confirm.rs` | `--fit auto`'s choice confirmed at the final fit's optimum: scored on the same folds, it falls back to the best set with one term fewer when it no longer pays over it, or to the lighter set of two chosen terms that are confounded at that optimum |
+//! | `selection_report.rs` | `--fit auto`'s report: the rule in words, every set tried with its error per fold, what was left out, not admitted, added and removed, the choice and why it stopped |
 //! | `select.rs` | `--fit auto`'s rule: stepwise with removal on cross-validation, terms that pay, dead terms dropped; its report |
 //! | `classic_shape.rs` | `--fit auto`'s rule 7: a steady curve starts from the classic shape its points support (AICc), which is presumed |
 //! | `curve_support.rs` | `--fit auto`'s rule 10: on a steady curve a term enters only where the whole curve's AICc is lowered too |
@@ -109,6 +110,7 @@ pub mod report_plots;
 pub mod request;
 pub mod reversals;
 pub mod select;
+pub mod selection_report;
 pub mod separable;
 pub mod series;
 pub mod sign_convention;

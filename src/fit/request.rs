@@ -137,9 +137,9 @@ impl FitRequest {
         };
         let mut ours =
             self.fit_confirmed(&mut p, &given, selection.as_mut(), progress, stop, &say)?;
-        let mut extra_md = selection
-            .as_ref()
-            .map_or(String::new(), |s| super::select::report(s, p.data.units));
+        let mut extra_md = selection.as_ref().map_or(String::new(), |s| {
+            super::selection_report::report(s, p.data.units)
+        });
         // The range the calibration saw, into the fitted file and the report.
         let gain = p.contact_scale.as_ref().map_or(1.0, |s| s.gain);
         let section = super::calibrated_range::attach(&mut ours.config, &ours.outcome, gain);

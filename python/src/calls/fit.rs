@@ -239,7 +239,10 @@ fn calibration_dict<'py>(
     let mut notes = c.prepared.notes.clone();
     notes.extend(c.skipped.iter().cloned());
     if let Some(s) = &c.selection {
-        notes.push(friction_node::fit::select::report(s, c.prepared.data.units));
+        notes.push(friction_node::fit::selection_report::report(
+            s,
+            c.prepared.data.units,
+        ));
     }
     d.set_item("notes", notes)?;
     d.set_item("summary_md", c.summary_md())?;

@@ -1,0 +1,64 @@
+//! The report of `--fit auto`'s selection (`select.rs`): its rule in
+//! words, every set tried with its error per fold, the candidates left
+//! out, the sets not admitted, the start, the terms added and removed,
+//! the set chosen and why the steps stopped.
+
+use super::cross_validate::TERM_COST;
+use super::select::Selection;
+use std::fmt::Write as _;
+
+/// The selection as a markdown section.
+pub fn report(s: &Selection, units: super::Units) -> String {
+    let u = units.force();
+    let mut md = format!(
+        "## Terms chosen by the data (`--fit auto`)\n\nRule: stepwise selection on cross-validation of the training data ({}; each fold predicted by the set refitted without it); each step takes the candidate with the lowest CV error, unless one with fewer keys predicts as well (the best does not pay for its extra keys over it); a term is added only if it lowers the folds' mean squared error by more than the standard error of that lowering and by more than {:.0} % of it (the cost of a term), and a term chosen earlier goes, or gives way to a lighter form of it (the Stribeck curve to its viscous rise), when it no longer pays beside a later one; a part of a chosen term (the pre-sliding bristle's damping, LuGre's σ1 beside its stiffness σ0) comes with it unless the folds predict worse with it; a term that ends at zero or at a bound, or that the data cannot tell from another parameter (|ρ| > 0.95), is dropped or reduced and the set fitted again unless that predicts worse, and of two chosen terms that the data cannot tell apart (a key of one correlated so with a key of the other; a part and its own term are one element, not two) one goes, whichever the folds miss least; the chosen set's final fit is scored on the same folds, and gives way to the best set with one term fewer when it no longer pays over it; a steady curve starts from its rising classic shape (the viscous rise or the Stribeck curve: the simplest whose small-sample Akaike criterion on all the training points is within 2 of the lowest), presumed with its viscous rise: it is never removed for the flat base (the curve gives way to its rise when that pays over it or, the curve's keys flagged, predicts the folds no worse within 10 of its Akaike criterion; the rise goes only when its key ends at zero), and of it and a term confounded with it the term goes; the quadratic rise comes only on top of a viscous rise and only where the fit tells its coefficient from zero (its 95 % interval excludes zero), and a Stribeck speed lies within the data's speeds; on a steady curve a term enters only where its set's small-sample Akaike criterion on all the training points is also more than 2 below the current set's. Neither --validate nor --holdout data are used.\n\n| set (boundary friction +) | CV RMS ({u}) | RMS per fold ({u}) | film solves |\n|---|---|---|---|\n",
+        s.folds,
+        100.0 * TERM_COST
+    );
+    for t in &s.tried {
+        let folds: Vec<String> = t
+            .fold_mse
+            .iter()
+            .map(|m| crate::text::Num::sig(m.sqrt(), 5).to_string())
+            .collect();
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} | {} |",
+            if t.terms.is_empty() {
+                "—".to_string()
+            } else {
+                t.terms.join(", ")
+            },
+            crate::text::Num::sig(t.cv_rms, 5),
+            folds.join(" / "),
+            t.simulations
+        );
+    }
+    for e in &s.excluded {
+        let _ = writeln!(md, "\nNot a candidate on these data: {e}");
+    }
+    for e in &s.not_admitted {
+        let _ = writeln!(md, "\nNot admitted: {e}");
+    }
+    if !s.start.is_empty() {
+        let _ = writeln!(md, "\nStart: {}", s.start);
+    }
+    for a in &s.added {
+        let _ = writeln!(md, "\nAdded: {a}");
+    }
+    for r in &s.removed {
+        let _ = writeln!(md, "\nRemoved: {r}");
+    }
+    let _ = write!(
+        md,
+        "\nChosen: boundary friction{}. Stopped: {}. Keys fitted: {}. Selection took {:.1} s.\n",
+        s.chosen
+            .iter()
+            .map(|c| format!(", {c}"))
+            .collect::<String>(),
+        s.why,
+        s.keys.join(", "),
+        s.wall_s
+    );
+    md
+}
