@@ -279,10 +279,8 @@ fn fit_writes_a_complete_parameter_file_that_the_node_accepts_and_a_report() {
     }
 }
 
-fn expect_error(csv: &str, args: &[&str], needle: &str) {
-    let d = dir(&format!("bad-{}", needle.len() + csv.len()));
-    let data = d.join("data.csv");
-    std::fs::write(&data, csv).unwrap();
+/// `fit DATA --out D/fitted.yaml ARGS…`: its exit code and standard error.
+fn fit_into(d: &Path, data: &Path, args: &[&str]) -> (i32, String) {
     let out = d.join("fitted.yaml");
     let mut all = vec![
         "fit",
@@ -292,10 +290,21 @@ fn expect_error(csv: &str, args: &[&str], needle: &str) {
     ];
     all.extend_from_slice(args);
     let (code, _, stderr) = run(&all);
+    (code, stderr)
+}
+
+fn expect_error(csv: &str, args: &[&str], needle: &str) {
+    let d = dir(&format!("bad-{}", needle.len() + csv.len()));
+    let data = d.join("data.csv");
+    std::fs::write(&data, csv).unwrap();
+    let (code, stderr) = fit_into(&d, &data, args);
     assert_eq!(code, 2, "{needle}: {stderr}");
     assert!(stderr.contains(needle), "expected `{needle}` in: {stderr}");
     assert!(!stderr.contains("panicked"), "{stderr}");
-    assert!(!out.exists(), "nothing is written on bad input");
+    assert!(
+        !d.join("fitted.yaml").exists(),
+        "nothing is written on bad input"
+    );
 }
 
 #[test]
@@ -467,15 +476,7 @@ fn steady_with_temperature(d: &Path, celsius: impl Fn(usize) -> f64) -> std::pat
 /// `fit DATA --out D/fitted.yaml ARGS…`, which must end with a fitted file
 /// (exit 0, or 4: not converged); its standard error.
 fn fit_stderr(d: &Path, data: &Path, args: &[&str]) -> String {
-    let out = d.join("fitted.yaml");
-    let mut all = vec![
-        "fit",
-        data.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ];
-    all.extend_from_slice(args);
-    let (code, _, stderr) = run(&all);
+    let (code, stderr) = fit_into(d, data, args);
     assert!(code == 0 || code == 4, "{stderr}");
     stderr
 }

@@ -135,6 +135,15 @@ fn assert_ours_contains(md: &str, classic: &str) {
 }
 
 /// Ours' held-out RMS is at most `factor` × the classic's (`label`).
+/// The selection's "Chosen:" line starts with `prefix`.
+fn assert_chosen(md: &str, prefix: &str) {
+    let chosen = md
+        .lines()
+        .find(|l| l.starts_with("Chosen:"))
+        .unwrap_or_else(|| panic!("no Chosen line\n{md}"));
+    assert!(chosen.starts_with(prefix), "{chosen}");
+}
+
 fn assert_held_out_within(md: &str, label: &str, factor: f64) {
     let (_, ours) = row(md, "friction-node");
     let (_, classic) = row(md, label);
@@ -151,11 +160,7 @@ fn on_a_coulomb_plus_viscous_record_ours_chooses_the_viscous_rise_and_predicts_a
     stribeck_record(&data, 200.0, 200.0, 0.01, 2000.0);
     let md = fit_auto(&data);
     assert_ours_contains(&md, "Coulomb + viscous");
-    let chosen = md.lines().find(|l| l.starts_with("Chosen:")).unwrap();
-    assert!(
-        chosen.starts_with("Chosen: boundary friction, drivetrain viscous."),
-        "{chosen}"
-    );
+    assert_chosen(&md, "Chosen: boundary friction, drivetrain viscous.");
 }
 
 #[test]
@@ -290,11 +295,7 @@ fn on_the_lead_screws_faster_speeds_the_film_scored_by_refitted_folds_does_not_p
         with_film >= stribeck,
         "the film beside the Stribeck curve: CV {with_film}, the curve alone {stribeck}\n{md}"
     );
-    let chosen = md.lines().find(|l| l.starts_with("Chosen:")).unwrap();
-    assert!(
-        chosen.starts_with("Chosen: boundary friction, drivetrain Stribeck."),
-        "{chosen}"
-    );
+    assert_chosen(&md, "Chosen: boundary friction, drivetrain Stribeck.");
     assert_held_out_within(&md, "Stribeck", 1.0 + 1e-4);
 }
 
@@ -314,11 +315,7 @@ fn a_film_placed_inside_a_joints_data_by_its_trial_is_not_shipped_there() {
     // curve.
     let md = fit_joint_fixture("joint-peak");
     assert_held_out_within(&md, "Stribeck", 1.05);
-    let chosen = md.lines().find(|l| l.starts_with("Chosen:")).unwrap();
-    assert!(
-        chosen.starts_with("Chosen: boundary friction, drivetrain Stribeck."),
-        "{chosen}"
-    );
+    assert_chosen(&md, "Chosen: boundary friction, drivetrain Stribeck.");
     assert!(
         md.lines().any(|l| l
             .starts_with("Not admitted: film beside drivetrain Stribeck: it pays on the folds")),
@@ -341,11 +338,7 @@ fn a_quadratic_rise_whose_coefficient_the_data_cannot_tell_from_zero_is_not_admi
     // viscous key, ρ 0.987; on a fresh joint where the two correlated
     // 0.909 it stayed and predicted 35× worse.)
     let md = fit_joint_fixture("joint-peak-draw5");
-    let chosen = md.lines().find(|l| l.starts_with("Chosen:")).unwrap();
-    assert!(
-        chosen.starts_with("Chosen: boundary friction, drivetrain Stribeck."),
-        "{chosen}"
-    );
+    assert_chosen(&md, "Chosen: boundary friction, drivetrain Stribeck.");
     assert!(
         md.lines().any(|l| l
             .starts_with("Not admitted: drivetrain quadratic beside drivetrain Stribeck: ")
@@ -368,11 +361,7 @@ fn a_noise_dip_that_pays_on_the_folds_but_not_on_the_whole_curve_is_not_added() 
     // the dip predicted 25–90 deg/s 3.0× worse than Coulomb + viscous.
     // Rule 10: a term enters a steady curve only where both support it.
     let md = fit_joint_fixture("joint-cv-noise-dip");
-    let chosen = md.lines().find(|l| l.starts_with("Chosen:")).unwrap();
-    assert!(
-        chosen.starts_with("Chosen: boundary friction, drivetrain viscous."),
-        "{chosen}"
-    );
+    assert_chosen(&md, "Chosen: boundary friction, drivetrain viscous.");
     assert!(
         md.lines().any(|l| l.starts_with(
             "Not admitted: drivetrain Stribeck beside drivetrain viscous: it pays on the folds"
