@@ -99,40 +99,79 @@ fn load_range(sources: &[Source], map: &[f64], load_n: f64) -> Result<(f64, f64)
     Ok((lo, hi))
 }
 
-/// The column names a joint's table may use for the velocity and the
-/// friction when `--velocity` / `--friction` keep their defaults.
-const ROTARY_VELOCITY_COLUMNS: &[&str] = &["velocity_rad_s"];
-/// See [`ROTARY_VELOCITY_COLUMNS`].
+/// The column names a joint's table may use for the velocity when
+/// `--velocity` keeps its default, each with its factor to rad/s.
+const ROTARY_VELOCITY_COLUMNS: &[(&str, f64)] = &[
+    ("velocity_rad_s", 1.0),
+    ("velocity_deg_s", std::f64::consts::PI / 180.0),
+    ("velocity_rpm", std::f64::consts::PI / 30.0),
+];
+/// The column names a joint's table may use for the friction when
+/// `--friction` keeps its default, N·m.
 const ROTARY_FRICTION_COLUMNS: &[&str] =
     &["friction_nm", "friction_n_m", "torque_nm", "torque_n_m"];
 
 /// `--rotary` with the default column names: a table without
 /// `velocity_m_s` / `friction_n` but with a joint's names (`velocity_rad_s`,
-/// `friction_nm`, `torque_nm`, …) is read through those.
-fn rotary_columns(mapping: &super::Mapping, table: &super::Table) -> super::Mapping {
+/// `velocity_deg_s`, `velocity_rpm`, `friction_nm`, `torque_nm`, …) is read
+/// through those, a velocity in deg/s or rpm converted to rad/s (said in
+/// `notes`). A table with none of them is an error that names them.
+fn rotary_columns(
+    mapping: &super::Mapping,
+    table: &super::Table,
+    notes: &mut Vec<String>,
+) -> Result<super::Mapping, FitError> {
     let defaults = super::Mapping::default();
-    let pick = |given: &str, default: &str, joint: &[&str]| -> String {
-        if given != default || table.column(given).is_some() {
-            return given.to_string();
-        }
-        joint
-            .iter()
-            .find(|c| table.column(c).is_some())
-            .map_or(given.to_string(), |c| c.to_string())
-    };
-    super::Mapping {
-        velocity: pick(
-            &mapping.velocity,
-            &defaults.velocity,
-            ROTARY_VELOCITY_COLUMNS,
+    let has = |c: &str| table.column(c).is_some();
+    let keeps = |given: &str, default: &str| given != default || has(given);
+    let unknown = |what: &str, names: &[&str], hint: &str| {
+        FitError::Data {
+        what: table.source.display().to_string(),
+        message: format!(
+            "no {what} column: under --rotary it is read from `{}` when --{what} is not given, and the table has {}; name it with --{what} EXPR, {hint}",
+            names.join("`, `"),
+            table.names.join(", "),
         ),
-        friction: pick(
-            &mapping.friction,
-            &defaults.friction,
-            ROTARY_FRICTION_COLUMNS,
-        ),
-        ..mapping.clone()
     }
+    };
+    let velocity = if keeps(&mapping.velocity, &defaults.velocity) {
+        mapping.velocity.clone()
+    } else {
+        let &(name, to_rad_s) = ROTARY_VELOCITY_COLUMNS
+            .iter()
+            .find(|(c, _)| has(c))
+            .ok_or_else(|| {
+                let names: Vec<&str> = ROTARY_VELOCITY_COLUMNS.iter().map(|(c, _)| *c).collect();
+                unknown(
+                    "velocity",
+                    &names,
+                    "in rad/s (a column in deg/s: `--velocity 'COLUMN * 0.017453292519943295'`)",
+                )
+            })?;
+        if to_rad_s == 1.0 {
+            name.to_string()
+        } else {
+            notes.push(format!(
+                "{}: the velocity is `{name}`, read as rad/s: `{name} * {to_rad_s:e}`",
+                table.source.display()
+            ));
+            format!("{name} * {to_rad_s:e}")
+        }
+    };
+    let friction = if keeps(&mapping.friction, &defaults.friction) {
+        mapping.friction.clone()
+    } else {
+        ROTARY_FRICTION_COLUMNS
+            .iter()
+            .find(|c| has(c))
+            .ok_or_else(|| unknown("friction", ROTARY_FRICTION_COLUMNS, "in N·m"))?
+            .to_string()
+    };
+    Ok(super::Mapping {
+        velocity,
+        friction,
+        ..mapping.clone()
+    })
 }
 
 /// A joint turning faster than this, rad/s, is unusual enough to ask
@@ -153,7 +192,7 @@ fn read_sources(req: &DataRequest, notes: &mut Vec<String>) -> Result<Sources, F
         let (table, note) = req.table(p)?;
         notes.extend(note);
         let mapping = if req.rotary {
-            rotary_columns(&req.mapping, &table)
+            rotary_columns(&req.mapping, &table, notes)?
         } else {
             req.mapping.clone()
         };
@@ -306,4 +345,68 @@ pub fn prepare(
         load_given,
         notes,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::table::{Delimiter, Table};
+    use std::path::Path;
+
+    fn joint_table(header: &str, speeds: &[f64]) -> Table {
+        let mut text = format!("{header}\n");
+        for v in speeds {
+            text += &format!("{v},{}\n", 0.3 + 0.05 * v);
+        }
+        Table::parse(&text, Path::new("j.csv"), Delimiter::Auto, None, 0).unwrap()
+    }
+
+    fn rotary_velocity(header: &str, speeds: &[f64]) -> (Vec<f64>, Vec<String>) {
+        let mut notes = Vec::new();
+        let table = joint_table(header, speeds);
+        let mapping = rotary_columns(&crate::fit::Mapping::default(), &table, &mut notes).unwrap();
+        let series = Source::new(table, &mapping).unwrap().series(&[]).unwrap();
+        (series.velocity, notes)
+    }
+
+    #[test]
+    fn a_joints_velocity_in_deg_s_or_rpm_is_read_in_rad_s_and_said() {
+        let (rad, notes) = rotary_velocity("velocity_rad_s,torque_nm", &[0.5, 2.0]);
+        assert_eq!(rad, vec![0.5, 2.0]);
+        assert!(notes.is_empty(), "{notes:?}");
+        let (deg, notes) = rotary_velocity("velocity_deg_s,friction_nm", &[90.0, 180.0]);
+        approx::assert_relative_eq!(deg[0], std::f64::consts::FRAC_PI_2, epsilon = 1e-12);
+        approx::assert_relative_eq!(deg[1], std::f64::consts::PI, epsilon = 1e-12);
+        assert!(
+            notes[0].contains("`velocity_deg_s`, read as rad/s"),
+            "{notes:?}"
+        );
+        let (rpm, notes) = rotary_velocity("velocity_rpm,friction_nm", &[60.0, 30.0]);
+        approx::assert_relative_eq!(rpm[0], 2.0 * std::f64::consts::PI, epsilon = 1e-12);
+        approx::assert_relative_eq!(rpm[1], std::f64::consts::PI, epsilon = 1e-12);
+        assert!(notes[0].contains("`velocity_rpm`"), "{notes:?}");
+    }
+
+    #[test]
+    fn a_joint_table_without_a_known_column_is_an_error_naming_the_columns_it_has() {
+        let table = joint_table("omega,tau", &[1.0]);
+        let err = rotary_columns(&crate::fit::Mapping::default(), &table, &mut Vec::new())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("no velocity column")
+                && err.contains("`velocity_deg_s`")
+                && err.contains("the table has omega, tau")
+                && err.contains("--velocity EXPR"),
+            "{err}"
+        );
+        let table = joint_table("velocity_rad_s,tau", &[1.0]);
+        let err = rotary_columns(&crate::fit::Mapping::default(), &table, &mut Vec::new())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("no friction column") && err.contains("`torque_nm`"),
+            "{err}"
+        );
+    }
 }
