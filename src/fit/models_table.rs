@@ -161,17 +161,27 @@ pub fn models_table(rows: &[ModelRow], scale_n: f64) -> String {
 /// RMS of the measured friction on held-out samples (validation data, else
 /// the held-out parts), N: the scale of the held-out error.
 pub fn held_out_scale(o: &FitOutcome) -> f64 {
-    let fits = if o.validate.is_empty() {
+    friction_rms(if o.validate.is_empty() {
         &o.held_out
     } else {
         &o.validate
-    };
+    })
+}
+
+/// The RMS of the measured friction over `fits`.
+fn friction_rms(fits: &[super::problem::SeriesFit]) -> f64 {
     let (ss, n) = fits
         .iter()
         .flat_map(|sf| sf.series.friction.iter())
         .fold((0.0, 0usize), |(ss, n), f| (ss + f * f, n + 1));
     (ss / n.max(1) as f64).sqrt()
 }
+
+/// An error below this fraction of the measured friction's RMS is at the
+/// resolution of a model's own arithmetic (a record a model made without
+/// noise), not of a measurement: no force sensor resolves a millionth of
+/// the friction it measures, so below it the verdict compares nothing.
+pub const EXACT_FRACTION: f64 = 1e-6;
 
 /// How ours stands against the best classic model on the verdict's
 /// yardstick.
@@ -311,6 +321,18 @@ pub fn verdict(ours: &FitOutcome, classic: &[FitOutcome]) -> String {
         return String::new();
     };
     let (m, t) = (Num::sig(mine, 5), Num::sig(theirs, 5));
+    let scale = if held {
+        held_out_scale(ours)
+    } else {
+        friction_rms(&ours.train)
+    };
+    if mine.max(theirs) <= EXACT_FRACTION * scale {
+        return format!(
+            "**Verdict: ours and {} both reproduce these data exactly** ({what} RMS {m} {u} against {t} {u}, both below {EXACT_FRACTION:e} of the measured friction's RMS {} {u}, the resolution of the models' own arithmetic). Data without noise, a model's own output, cannot tell the models apart: judge them on a measured record, or on a synthetic one with a measurement's noise.",
+            b.label,
+            Num::sig(scale, 5)
+        );
+    }
     let apart = 100.0 * (mine / theirs - 1.0);
     match standing(&paired(ours), &paired(b)) {
         Standing::Level => format!(
