@@ -180,3 +180,52 @@ def test_on_the_oring_seal_every_baseline_reaches_an_independent_optimum():
     assert "LuGre" in table.splitlines()[0], table
     rows = [l for l in table.splitlines() if l.startswith("| O-ring257_")]
     assert [l.split("|")[2].strip() for l in rows] == ["fit", "fit"], table
+
+
+LEAD = REPO / "data" / "lead-screw"
+EMPS = REPO / "data" / "emps-ball-screw"
+
+
+def _lead_screw_split(tmp_path, name, train):
+    """The lead screw's drive-1 steady curve (motor speed, rad/s; torque,
+    N·m) as docs/real-data-benchmarks.sh splits it: the training part."""
+    import csv
+
+    rows = [r for r in csv.DictReader(open(LEAD / "steady_state_summary.csv"))
+            if r["drive"] == "1" and not r["file_label"].startswith("n")]
+    rows.sort(key=lambda r: float(r["motor_speed_rad_s"]))
+    p = tmp_path / f"lead-{name}-train.csv"
+    with open(p, "w") as f:
+        f.write("velocity_rad_s,friction_nm\n")
+        for r in rows:
+            if train(int(r["file_label"])):
+                f.write(f"{r['motor_speed_rad_s']},{float(r['motor_torque_mNm']) / 1000}\n")
+    return p
+
+
+@pytest.mark.parametrize("name,train", [
+    ("a", lambda rpm: rpm in (2, 20, 40, 60, 80, 100, 140, 180)),
+    ("b", lambda rpm: rpm <= 100),
+])
+def test_on_the_lead_screw_every_baseline_reaches_an_independent_optimum(tmp_path, name, train):
+    data = _lead_screw_split(tmp_path, name, train)
+    r = fn.fit(str(data), ["contact.boundary_friction"], baselines=True, rotary=True,
+               global_points=0, starts=1)
+    check_every_baseline(r)
+
+
+def test_on_emps_coulomb_viscous_and_stribeck_reach_an_independent_optimum():
+    # The input maps held at the benchmark's identified mass and offset;
+    # LuGre is left out here: its bristle integrated in Python over the
+    # record's 24 800 samples at every evaluation would take minutes.
+    r = fn.fit(
+        str(EMPS / "DATA_EMPS.csv"), ["contact.boundary_friction"], baselines=True,
+        time="t", velocity="ddt(qm)", smooth=0.01,
+        friction="35.15 * smooth(smooth(vir)) - 95.1 * ddt(ddt(qm)) + 3.2",
+        global_points=0, starts=1,
+    )
+    models = [m for m in r.raw["models"] if m["label"] in ("Coulomb + viscous", "Stribeck")]
+    assert len(models) == 2, [m["label"] for m in r.raw["models"]]
+    for m in models:
+        ours, theirs = m["cost_n2"], independent_cost(m, random_starts=1)
+        assert ours <= 1.01 * theirs, f"{m['label']}: cost {ours:.6g} against SciPy's {theirs:.6g}"
