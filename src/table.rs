@@ -159,6 +159,16 @@ impl Table {
         self.names.iter().position(|n| n == name)
     }
 
+    /// A hint for text on the first data row under a header, which is
+    /// often a row of units (`s, rad/s, N·m`): `--skip 1` drops it.
+    fn units_row_hint(&self, line: usize) -> &'static str {
+        if self.has_header && self.lines.first() == Some(&line) {
+            " (a row of units under the header? --skip 1 drops the first data row)"
+        } else {
+            ""
+        }
+    }
+
     /// Why column `name` cannot be read as numbers: missing (with the
     /// columns there are) or holding text (with its first text cell).
     pub fn column_error(&self, name: &str) -> TableError {
@@ -168,9 +178,10 @@ impl Table {
                     path: self.source.clone(),
                     line: cell.line,
                     message: format!(
-                        "`{}` in column `{name}` is not a number{}",
+                        "`{}` in column `{name}` is not a number{}{}",
                         cell.text,
-                        decimal_comma_hint(&cell.text)
+                        decimal_comma_hint(&cell.text),
+                        self.units_row_hint(cell.line)
                     ),
                 }
             }
@@ -471,6 +482,19 @@ mod tests {
         let t = Table::parse("v;f\n1,2,3;x\n", p, Delimiter::Auto, None, 0).unwrap();
         assert!(!t.column_error("v").to_string().contains("decimal comma"));
         assert!(!t.column_error("f").to_string().contains("decimal comma"));
+    }
+
+    #[test]
+    fn text_on_the_first_row_under_a_header_is_named_as_a_possible_row_of_units() {
+        let p = Path::new("units.csv");
+        let t = Table::parse("v,f\nrad/s,Nm\n1,2\n2,3\n", p, Delimiter::Auto, None, 0).unwrap();
+        let m = t.column_error("v").to_string();
+        assert!(m.contains("units.csv:2") && m.contains("--skip 1"), "{m}");
+        let t = Table::parse("v,f\nrad/s,Nm\n1,2\n2,3\n", p, Delimiter::Auto, None, 1).unwrap();
+        assert_eq!(t.column("v"), Some(&[1.0, 2.0][..]));
+        // Text further down is no row of units.
+        let t = Table::parse("v,f\n1,2\nx,3\n", p, Delimiter::Auto, None, 0).unwrap();
+        assert!(!t.column_error("v").to_string().contains("--skip"));
     }
 
     #[test]

@@ -122,7 +122,9 @@ fn rotary_columns(
     notes: &mut Vec<String>,
 ) -> Result<super::Mapping, FitError> {
     let defaults = super::Mapping::default();
-    let has = |c: &str| table.column(c).is_some();
+    // A column by name, numeric or not (a text column is named by the
+    // expression that reads it).
+    let has = |c: &str| table.index(c).is_some();
     let keeps = |given: &str, default: &str| given != default || has(given);
     let unknown = |what: &str, names: &[&str], hint: &str| {
         FitError::Data {
@@ -398,6 +400,27 @@ mod tests {
                 && err.contains("`velocity_deg_s`")
                 && err.contains("the table has omega, tau")
                 && err.contains("--velocity EXPR"),
+            "{err}"
+        );
+        // A joint's column that holds text (a row of units) is named, and
+        // reading it says so, not that there is no such column.
+        let table = Table::parse(
+            "velocity_rad_s,torque_nm\nrad/s,Nm\n1,0.3\n2,0.4\n",
+            Path::new("u.csv"),
+            Delimiter::Auto,
+            None,
+            0,
+        )
+        .unwrap();
+        let mapping =
+            rotary_columns(&crate::fit::Mapping::default(), &table, &mut Vec::new()).unwrap();
+        assert_eq!(mapping.velocity, "velocity_rad_s");
+        let Err(err) = Source::new(table, &mapping) else {
+            panic!("a column of text was read");
+        };
+        let err = err.to_string();
+        assert!(
+            err.contains("holds text") && err.contains("--skip 1"),
             "{err}"
         );
         let table = joint_table("velocity_rad_s,tau", &[1.0]);
