@@ -176,6 +176,28 @@ fn rotary_columns(
     })
 }
 
+/// Without `--rotary` and with the default `--velocity`: a table that
+/// has no `velocity_m_s` but a joint's velocity column is an error that
+/// points at `--rotary`, not one that says `velocity_m_s` is missing.
+fn refuse_joint_columns(mapping: &super::Mapping, table: &super::Table) -> Result<(), FitError> {
+    let defaults = super::Mapping::default();
+    if mapping.velocity != defaults.velocity || table.index(&mapping.velocity).is_some() {
+        return Ok(());
+    }
+    match ROTARY_VELOCITY_COLUMNS
+        .iter()
+        .find(|(c, _)| table.index(c).is_some())
+    {
+        Some((joint, _)) => Err(FitError::Data {
+            what: table.source.display().to_string(),
+            message: format!(
+                "the table has a joint's velocity `{joint}` and no `velocity_m_s`: fit a joint with --rotary (velocity in rad/s, deg/s or rpm, friction in N·m; the lever arm is chosen from the data), or name a linear axis's columns with --velocity and --friction"
+            ),
+        }),
+        None => Ok(()),
+    }
+}
+
 /// A joint turning faster than this, rad/s, is unusual enough to ask
 /// whether its velocity is in deg/s.
 const FAST_JOINT_RAD_S: f64 = 20.0;
@@ -196,6 +218,7 @@ fn read_sources(req: &DataRequest, notes: &mut Vec<String>) -> Result<Sources, F
         let mapping = if req.rotary {
             rotary_columns(&req.mapping, &table, notes)?
         } else {
+            refuse_joint_columns(&req.mapping, &table)?;
             req.mapping.clone()
         };
         Ok((Source::new(table, &mapping)?, mapping))
@@ -387,6 +410,29 @@ mod tests {
         approx::assert_relative_eq!(rpm[0], 2.0 * std::f64::consts::PI, epsilon = 1e-12);
         approx::assert_relative_eq!(rpm[1], std::f64::consts::PI, epsilon = 1e-12);
         assert!(notes[0].contains("`velocity_rpm`"), "{notes:?}");
+    }
+
+    #[test]
+    fn a_joints_table_without_rotary_is_an_error_that_points_at_rotary() {
+        let mapping = crate::fit::Mapping::default();
+        let err = refuse_joint_columns(&mapping, &joint_table("velocity_deg_s,torque_nm", &[1.0]))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("`velocity_deg_s`") && err.contains("--rotary"),
+            "{err}"
+        );
+        // A linear axis's table, or a joint's named by --velocity, is read.
+        assert!(
+            refuse_joint_columns(&mapping, &joint_table("velocity_m_s,friction_n", &[1.0])).is_ok()
+        );
+        let named = crate::fit::Mapping {
+            velocity: "velocity_rad_s * 0.02".into(),
+            ..mapping
+        };
+        assert!(
+            refuse_joint_columns(&named, &joint_table("velocity_rad_s,torque_nm", &[1.0])).is_ok()
+        );
     }
 
     #[test]
