@@ -46,6 +46,7 @@
 //! | `prepared.rs` | what `prepare` makes: the data and our model for them; our model for another set of keys |
 //! | `driver.rs` | one model's whole fit: global phase, local runs, statistics, predictions |
 //! | `multistart.rs` | the global phase, then local runs from the best distinct starts; the distinct optima |
+//! | `bound_polish.rs` | a local run that spent its budget beside a bound: those parameters held on it and the others fitted, kept where the bound is active |
 //! | `local_run.rs` | one Levenberg–Marquardt run: secant or difference Jacobians, the partial refresh, the polish, what was still moving |
 //! | `earlier_optima.rs` | the optima earlier runs found: a later run's stop inside one's confidence region or, opt-in, in its valley |
 //! | `separable.rs` | the parameters the residuals are linear in, solved exactly in their bounds at every point; the local runs' variables (the others) |
@@ -75,6 +76,7 @@
 #[cfg(feature = "mcap")]
 pub mod bag_input;
 pub mod baselines;
+pub mod bound_polish;
 mod box_qp;
 pub mod by_direction;
 pub mod calibrated_range;

@@ -173,12 +173,19 @@ fn local_runs(
         ));
     };
     let run_from = |x: &Vec<f64>, earlier: &[Found]| {
-        local_run(
+        let run = local_run(
             (problem, separable),
             x,
             options.max_evaluations,
             options.jacobian,
             earlier,
+            options.later_runs,
+            (options.ftol, options.xtol),
+        );
+        super::bound_polish::settle(
+            (problem, separable),
+            run,
+            options.max_evaluations,
             options.later_runs,
             (options.ftol, options.xtol),
         )

@@ -241,6 +241,26 @@ impl<'p, 'a> Variables<'p, 'a> {
         })
     }
 
+    /// These variables with the parameters `held` (indices of the whole
+    /// point) no longer searched: held at their values in the whole point
+    /// `x`, which becomes the reference.
+    pub(super) fn holding(&self, held: &[usize], x: &[f64]) -> Self {
+        let keep = |v: &Vec<usize>| v.iter().copied().filter(|i| !held.contains(i)).collect();
+        Self {
+            problem: self.problem,
+            separable: self.separable,
+            reference: x.to_vec(),
+            searched: keep(&self.searched),
+            profiled: keep(&self.profiled),
+        }
+    }
+
+    /// The indices (in the whole point) of the parameters searched,
+    /// profiled ones included.
+    pub(super) fn varied(&self) -> impl Iterator<Item = usize> + '_ {
+        self.searched.iter().chain(&self.profiled).copied()
+    }
+
     /// The problem.
     pub fn problem(&self) -> &'p Problem<'a> {
         self.problem
