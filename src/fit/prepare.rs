@@ -126,16 +126,6 @@ fn rotary_columns(
     // expression that reads it).
     let has = |c: &str| table.index(c).is_some();
     let keeps = |given: &str, default: &str| given != default || has(given);
-    let unknown = |what: &str, names: &[&str], hint: &str| {
-        FitError::Data {
-        what: table.source.display().to_string(),
-        message: format!(
-            "no {what} column: under --rotary it is read from `{}` when --{what} is not given, and the table has {}; name it with --{what} EXPR, {hint}",
-            names.join("`, `"),
-            table.names.join(", "),
-        ),
-    }
-    };
     let velocity = if keeps(&mapping.velocity, &defaults.velocity) {
         mapping.velocity.clone()
     } else {
@@ -144,7 +134,8 @@ fn rotary_columns(
             .find(|(c, _)| has(c))
             .ok_or_else(|| {
                 let names: Vec<&str> = ROTARY_VELOCITY_COLUMNS.iter().map(|(c, _)| *c).collect();
-                unknown(
+                unknown_column(
+                    table,
                     "velocity",
                     &names,
                     "in rad/s (a column in deg/s: `--velocity 'COLUMN * 0.017453292519943295'`)",
@@ -166,7 +157,7 @@ fn rotary_columns(
         ROTARY_FRICTION_COLUMNS
             .iter()
             .find(|c| has(c))
-            .ok_or_else(|| unknown("friction", ROTARY_FRICTION_COLUMNS, "in N·m"))?
+            .ok_or_else(|| unknown_column(table, "friction", ROTARY_FRICTION_COLUMNS, "in N·m"))?
             .to_string()
     };
     Ok(super::Mapping {
@@ -174,6 +165,19 @@ fn rotary_columns(
         friction,
         ..mapping.clone()
     })
+}
+
+/// Under `--rotary`, no `what` column of the joint's `names` in `table`:
+/// the error lists the table's columns and how to name one (`hint`).
+fn unknown_column(table: &super::Table, what: &str, names: &[&str], hint: &str) -> FitError {
+    FitError::Data {
+        what: table.source.display().to_string(),
+        message: format!(
+            "no {what} column: under --rotary it is read from `{}` when --{what} is not given, and the table has {}; name it with --{what} EXPR, {hint}",
+            names.join("`, `"),
+            table.names.join(", "),
+        ),
+    }
 }
 
 /// Without `--rotary` and with the default `--velocity`: a table that
