@@ -489,7 +489,10 @@ def fit(
     ``fit=["auto", ...]`` lets the data choose the physical terms (the
     names after ``auto`` are fitted as well); ``rotary=True`` takes a
     joint's velocity in rad/s and friction in N·m (the lever arm and the
-    contact's load are chosen from the data). ``jacobian`` (``"secant"`` or
+    contact's load are chosen from the data); with ``velocity`` and
+    ``friction`` left at their defaults it reads a joint's columns by name
+    (``velocity_rad_s``, or ``velocity_deg_s`` / ``velocity_rpm`` converted
+    to rad/s; ``friction_nm``, ``torque_nm``...). ``jacobian`` (``"secant"`` or
     ``"differences"``), ``later_runs`` (``"full"`` or ``"valley"``),
     ``linear_keys`` (``"solved"`` or ``"searched"``) and ``cheap_keys``
     (``"profiled"`` or ``"searched"``) choose how the search runs, as
