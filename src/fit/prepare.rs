@@ -167,6 +167,60 @@ fn rotary_columns(
     })
 }
 
+/// Time columns named with their unit, read in seconds when `--time` is
+/// not given and the table has no `t_s`: (name, divisor to seconds).
+const TIME_COLUMNS: &[(&str, f64)] = &[
+    ("time_s", 1.0),
+    ("t_ms", 1e3),
+    ("time_ms", 1e3),
+    ("t_us", 1e6),
+    ("time_us", 1e6),
+    ("t_ns", 1e9),
+    ("time_ns", 1e9),
+    ("stamp_ns", 1e9),
+];
+/// Time columns without a unit: a table with one of these and no `t_s`
+/// is refused rather than read as a steady curve.
+const UNITLESS_TIME_COLUMNS: &[&str] = &["t", "time", "timestamp"];
+
+/// `--time` left unset on a table without `t_s`: a steady curve, unless
+/// the table has a time column by another name. One named with its unit
+/// (`t_ms`, `time_ns`, …) is read in seconds and said in `notes`; one
+/// without (`t`, `time`, `timestamp`) is an error that asks for its unit,
+/// since a time series fitted as a steady curve would lose its dynamics
+/// (pre-sliding, the film's memory) without a word.
+fn time_column(
+    mapping: super::Mapping,
+    table: &super::Table,
+    notes: &mut Vec<String>,
+) -> Result<super::Mapping, FitError> {
+    if mapping.time.is_some() || table.index("t_s").is_some() {
+        return Ok(mapping);
+    }
+    let file = table.source.display().to_string();
+    if let Some(&(name, per_s)) = TIME_COLUMNS.iter().find(|(c, _)| table.index(c).is_some()) {
+        let time = if per_s == 1.0 {
+            name.to_string()
+        } else {
+            format!("{name} / {per_s:e}")
+        };
+        notes.push(format!("{file}: the time is `{name}`, read in s: `{time}`"));
+        return Ok(super::Mapping {
+            time: Some(time),
+            ..mapping
+        });
+    }
+    match UNITLESS_TIME_COLUMNS.iter().find(|c| table.index(c).is_some()) {
+        Some(name) => Err(FitError::Data {
+            what: file,
+            message: format!(
+                "the table has a time column `{name}` without a unit and no `t_s`: give its unit with --time EXPR in s (`--time {name}` in s, `--time '{name} / 1000'` in ms); a table without a time column is read as a steady curve, each row a steady state (to fit it so, rename the column with --columns)"
+            ),
+        }),
+        None => Ok(mapping),
+    }
+}
+
 /// Under `--rotary`, no `what` column of the joint's `names` in `table`:
 /// the error lists the table's columns and how to name one (`hint`).
 fn unknown_column(table: &super::Table, what: &str, names: &[&str], hint: &str) -> FitError {
@@ -225,6 +279,7 @@ fn read_sources(req: &DataRequest, notes: &mut Vec<String>) -> Result<Sources, F
             refuse_joint_columns(&req.mapping, &table)?;
             req.mapping.clone()
         };
+        let mapping = time_column(mapping, &table, notes)?;
         Ok((Source::new(table, &mapping)?, mapping))
     };
     let given = req
@@ -414,6 +469,52 @@ mod tests {
         approx::assert_relative_eq!(rpm[0], 2.0 * std::f64::consts::PI, epsilon = 1e-12);
         approx::assert_relative_eq!(rpm[1], std::f64::consts::PI, epsilon = 1e-12);
         assert!(notes[0].contains("`velocity_rpm`"), "{notes:?}");
+    }
+
+    fn time_of(header: &str) -> Result<(Option<String>, Vec<String>), FitError> {
+        let mut notes = Vec::new();
+        let mut text = format!("{header}\n");
+        for k in 0..4 {
+            text += &format!("{k},{},1\n", 0.1 * k as f64);
+        }
+        let table = Table::parse(&text, Path::new("s.csv"), Delimiter::Auto, None, 0).unwrap();
+        let m = time_column(crate::fit::Mapping::default(), &table, &mut notes)?;
+        Ok((m.time, notes))
+    }
+
+    #[test]
+    fn a_time_column_named_with_its_unit_is_read_in_seconds_and_said() {
+        let (time, notes) = time_of("t_ms,velocity_m_s,friction_n").unwrap();
+        assert_eq!(time.as_deref(), Some("t_ms / 1e3"));
+        assert!(
+            notes[0].contains("the time is `t_ms`, read in s"),
+            "{notes:?}"
+        );
+        let (time, _) = time_of("stamp_ns,velocity_m_s,friction_n").unwrap();
+        assert_eq!(time.as_deref(), Some("stamp_ns / 1e9"));
+        // `t_s` is the time as it is; no time column is a steady curve.
+        assert_eq!(
+            time_of("t_s,velocity_m_s,friction_n").unwrap(),
+            (None, vec![])
+        );
+        assert_eq!(
+            time_of("n,velocity_m_s,friction_n").unwrap(),
+            (None, vec![])
+        );
+    }
+
+    #[test]
+    fn a_time_column_without_a_unit_is_refused_not_read_as_a_steady_curve() {
+        let err = time_of("time,velocity_m_s,friction_n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("time column `time` without a unit")
+                && err.contains("--time 'time / 1000'")
+                && err.contains("steady curve"),
+            "{err}"
+        );
+        assert!(time_of("t,velocity_m_s,friction_n").is_err());
     }
 
     #[test]
