@@ -27,6 +27,7 @@
 //! |---|---|
 //! | `request.rs` | a calibration as data ([`request::FitRequest`]) and its one flow, `run`, for the command line and Python: prepare → select → fit ours → the fitted file → the classic models → the report |
 //! | `prepare.rs` | data → our model: the sources (the held-out part cut off first), scales, keys, maps, the contact's scale |
+//! | `table_columns.rs` | a table's columns as a fit's inputs: a joint's columns under `--rotary` (deg/s, rpm converted), a time column named with its unit, what was meant when a default column is missing, the columns not read |
 //! | `confirm.rs` | `--fit auto`'s choice confirmed at the final fit's optimum: scored on the same folds, it falls back to the best set with one term fewer when it no longer pays over it, or to the lighter set of two chosen terms that are confounded at that optimum |
 //! | `selection_report.rs` | `--fit auto`'s report: the rule in words, every set tried with its error per fold, what was left out, not admitted, added and removed, the choice and why it stopped |
 //! | `select.rs` | `--fit auto`'s rule: stepwise with removal on cross-validation, terms that pay, dead terms dropped; its report |
@@ -118,6 +119,7 @@ pub mod series;
 pub mod sign_convention;
 pub mod stats;
 pub mod synthetic;
+pub mod table_columns;
 pub mod trial;
 pub mod units;
 pub mod unknowns;

@@ -1,0 +1,382 @@
+//! How a table's columns become a fit's inputs when `--velocity`,
+//! `--friction` and `--time` keep their defaults: a joint's columns under
+//! `--rotary` (rad/s, deg/s or rpm; N·m), a time column named with its
+//! unit, the errors that point at what was meant (a joint's table without
+//! `--rotary`, a time column without a unit), and the columns a fit does
+//! not read, said.
+
+use super::FitError;
+
+/// The column names a joint's table may use for the velocity when
+/// `--velocity` keeps its default, each with its factor to rad/s.
+const ROTARY_VELOCITY_COLUMNS: &[(&str, f64)] = &[
+    ("velocity_rad_s", 1.0),
+    ("velocity_deg_s", std::f64::consts::PI / 180.0),
+    ("velocity_rpm", std::f64::consts::PI / 30.0),
+];
+/// The column names a joint's table may use for the friction when
+/// `--friction` keeps its default, N·m.
+const ROTARY_FRICTION_COLUMNS: &[&str] =
+    &["friction_nm", "friction_n_m", "torque_nm", "torque_n_m"];
+
+/// `--rotary` with the default column names: a table without
+/// `velocity_m_s` / `friction_n` but with a joint's names (`velocity_rad_s`,
+/// `velocity_deg_s`, `velocity_rpm`, `friction_nm`, `torque_nm`, …) is read
+/// through those, a velocity in deg/s or rpm converted to rad/s (said in
+/// `notes`). A table with none of them is an error that names them.
+pub fn rotary_columns(
+    mapping: &super::Mapping,
+    table: &super::Table,
+    notes: &mut Vec<String>,
+) -> Result<super::Mapping, FitError> {
+    let defaults = super::Mapping::default();
+    // A column by name, numeric or not (a text column is named by the
+    // expression that reads it).
+    let has = |c: &str| table.index(c).is_some();
+    let keeps = |given: &str, default: &str| given != default || has(given);
+    let velocity = if keeps(&mapping.velocity, &defaults.velocity) {
+        mapping.velocity.clone()
+    } else {
+        let &(name, to_rad_s) = ROTARY_VELOCITY_COLUMNS
+            .iter()
+            .find(|(c, _)| has(c))
+            .ok_or_else(|| {
+                let names: Vec<&str> = ROTARY_VELOCITY_COLUMNS.iter().map(|(c, _)| *c).collect();
+                unknown_column(
+                    table,
+                    "velocity",
+                    &names,
+                    "in rad/s (a column in deg/s: `--velocity 'COLUMN * 0.017453292519943295'`)",
+                )
+            })?;
+        if to_rad_s == 1.0 {
+            name.to_string()
+        } else {
+            notes.push(format!(
+                "{}: the velocity is `{name}`, read as rad/s: `{name} * {to_rad_s:e}`",
+                table.source.display()
+            ));
+            format!("{name} * {to_rad_s:e}")
+        }
+    };
+    let friction = if keeps(&mapping.friction, &defaults.friction) {
+        mapping.friction.clone()
+    } else {
+        ROTARY_FRICTION_COLUMNS
+            .iter()
+            .find(|c| has(c))
+            .ok_or_else(|| unknown_column(table, "friction", ROTARY_FRICTION_COLUMNS, "in N·m"))?
+            .to_string()
+    };
+    Ok(super::Mapping {
+        velocity,
+        friction,
+        ..mapping.clone()
+    })
+}
+
+/// Time columns named with their unit, read in seconds when `--time` is
+/// not given and the table has no `t_s`: (name, divisor to seconds).
+const TIME_COLUMNS: &[(&str, f64)] = &[
+    ("time_s", 1.0),
+    ("t_ms", 1e3),
+    ("time_ms", 1e3),
+    ("t_us", 1e6),
+    ("time_us", 1e6),
+    ("t_ns", 1e9),
+    ("time_ns", 1e9),
+    ("stamp_ns", 1e9),
+];
+/// Time columns without a unit: a table with one of these and no `t_s`
+/// is refused rather than read as a steady curve.
+const UNITLESS_TIME_COLUMNS: &[&str] = &["t", "time", "timestamp"];
+
+/// `--time` left unset on a table without `t_s`: a steady curve, unless
+/// the table has a time column by another name. One named with its unit
+/// (`t_ms`, `time_ns`, …) is read in seconds and said in `notes`; one
+/// without (`t`, `time`, `timestamp`) is an error that asks for its unit,
+/// since a time series fitted as a steady curve would lose its dynamics
+/// (pre-sliding, the film's memory) without a word.
+pub fn time_column(
+    mapping: super::Mapping,
+    table: &super::Table,
+    notes: &mut Vec<String>,
+) -> Result<super::Mapping, FitError> {
+    if mapping.time.is_some() || table.index("t_s").is_some() {
+        return Ok(mapping);
+    }
+    let file = table.source.display().to_string();
+    if let Some(&(name, per_s)) = TIME_COLUMNS.iter().find(|(c, _)| table.index(c).is_some()) {
+        let time = if per_s == 1.0 {
+            name.to_string()
+        } else {
+            format!("{name} / {per_s:e}")
+        };
+        notes.push(format!("{file}: the time is `{name}`, read in s: `{time}`"));
+        return Ok(super::Mapping {
+            time: Some(time),
+            ..mapping
+        });
+    }
+    match UNITLESS_TIME_COLUMNS.iter().find(|c| table.index(c).is_some()) {
+        Some(name) => Err(FitError::Data {
+            what: file,
+            message: format!(
+                "the table has a time column `{name}` without a unit and no `t_s`: give its unit with --time EXPR in s (`--time {name}` in s, `--time '{name} / 1000'` in ms); a table without a time column is read as a steady curve, each row a steady state (to fit it so, rename the column with --columns)"
+            ),
+        }),
+        None => Ok(mapping),
+    }
+}
+
+/// Under `--rotary`, no `what` column of the joint's `names` in `table`:
+/// the error lists the table's columns and how to name one (`hint`).
+fn unknown_column(table: &super::Table, what: &str, names: &[&str], hint: &str) -> FitError {
+    FitError::Data {
+        what: table.source.display().to_string(),
+        message: format!(
+            "no {what} column: under --rotary it is read from `{}` when --{what} is not given, and the table has {}; name it with --{what} EXPR, {hint}",
+            names.join("`, `"),
+            table.names.join(", "),
+        ),
+    }
+}
+
+/// Without `--rotary` and with the default `--velocity`: a table that
+/// has no `velocity_m_s` but a joint's velocity column is an error that
+/// points at `--rotary`, not one that says `velocity_m_s` is missing.
+pub fn refuse_joint_columns(
+    mapping: &super::Mapping,
+    table: &super::Table,
+) -> Result<(), FitError> {
+    let defaults = super::Mapping::default();
+    if mapping.velocity != defaults.velocity || table.index(&mapping.velocity).is_some() {
+        return Ok(());
+    }
+    match ROTARY_VELOCITY_COLUMNS
+        .iter()
+        .find(|(c, _)| table.index(c).is_some())
+    {
+        Some((joint, _)) => Err(FitError::Data {
+            what: table.source.display().to_string(),
+            message: format!(
+                "the table has a joint's velocity `{joint}` and no `velocity_m_s`: fit a joint with --rotary (velocity in rad/s, deg/s or rpm, friction in N·m; the lever arm is chosen from the data), or name a linear axis's columns with --velocity and --friction"
+            ),
+        }),
+        None => Ok(()),
+    }
+}
+
+/// Column names a fit reads without being told: a load, temperature or
+/// time column by another name is not read.
+const DEFAULT_INPUTS: [&str; 3] = ["t_s", "load_n", "temperature_c"];
+
+/// The numeric columns of `table` that no input of `mapping` reads, said
+/// in a note: a load, temperature or time column by another name than its
+/// default (`load_n`, `temperature_c`, `t_s`) would otherwise be left out
+/// without a word.
+pub fn unread_columns(mapping: &super::Mapping, table: &super::Table) -> Option<String> {
+    let given = [
+        mapping.time.as_deref(),
+        Some(mapping.velocity.as_str()),
+        Some(mapping.friction.as_str()),
+        mapping.load.as_deref(),
+        mapping.temperature.as_deref(),
+    ];
+    let read = |name: &str| {
+        DEFAULT_INPUTS.contains(&name)
+            || given.iter().flatten().any(|e| {
+                e.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+                    .any(|id| id == name)
+            })
+    };
+    let unread: Vec<&str> = table
+        .names
+        .iter()
+        .map(String::as_str)
+        .filter(|n| table.column(n).is_some() && !read(n))
+        .collect();
+    (!unread.is_empty()).then(|| {
+        format!(
+            "{}: not read: {} (a load, temperature or time column is read under its default name, `load_n`, `temperature_c`, `t_s`, or named with --load, --temperature, --time)",
+            table.source.display(),
+            unread.join(", ")
+        )
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fit::Source;
+    use crate::table::{Delimiter, Table};
+    use std::path::Path;
+
+    fn joint_table(header: &str, speeds: &[f64]) -> Table {
+        let mut text = format!("{header}\n");
+        for v in speeds {
+            text += &format!("{v},{}\n", 0.3 + 0.05 * v);
+        }
+        Table::parse(&text, Path::new("j.csv"), Delimiter::Auto, None, 0).unwrap()
+    }
+
+    fn rotary_velocity(header: &str, speeds: &[f64]) -> (Vec<f64>, Vec<String>) {
+        let mut notes = Vec::new();
+        let table = joint_table(header, speeds);
+        let mapping = rotary_columns(&crate::fit::Mapping::default(), &table, &mut notes).unwrap();
+        let series = Source::new(table, &mapping).unwrap().series(&[]).unwrap();
+        (series.velocity, notes)
+    }
+
+    #[test]
+    fn a_joints_velocity_in_deg_s_or_rpm_is_read_in_rad_s_and_said() {
+        let (rad, notes) = rotary_velocity("velocity_rad_s,torque_nm", &[0.5, 2.0]);
+        assert_eq!(rad, vec![0.5, 2.0]);
+        assert!(notes.is_empty(), "{notes:?}");
+        let (deg, notes) = rotary_velocity("velocity_deg_s,friction_nm", &[90.0, 180.0]);
+        approx::assert_relative_eq!(deg[0], std::f64::consts::FRAC_PI_2, epsilon = 1e-12);
+        approx::assert_relative_eq!(deg[1], std::f64::consts::PI, epsilon = 1e-12);
+        assert!(
+            notes[0].contains("`velocity_deg_s`, read as rad/s"),
+            "{notes:?}"
+        );
+        let (rpm, notes) = rotary_velocity("velocity_rpm,friction_nm", &[60.0, 30.0]);
+        approx::assert_relative_eq!(rpm[0], 2.0 * std::f64::consts::PI, epsilon = 1e-12);
+        approx::assert_relative_eq!(rpm[1], std::f64::consts::PI, epsilon = 1e-12);
+        assert!(notes[0].contains("`velocity_rpm`"), "{notes:?}");
+    }
+
+    fn time_of(header: &str) -> Result<(Option<String>, Vec<String>), FitError> {
+        let mut notes = Vec::new();
+        let mut text = format!("{header}\n");
+        for k in 0..4 {
+            text += &format!("{k},{},1\n", 0.1 * k as f64);
+        }
+        let table = Table::parse(&text, Path::new("s.csv"), Delimiter::Auto, None, 0).unwrap();
+        let m = time_column(crate::fit::Mapping::default(), &table, &mut notes)?;
+        Ok((m.time, notes))
+    }
+
+    #[test]
+    fn a_time_column_named_with_its_unit_is_read_in_seconds_and_said() {
+        let (time, notes) = time_of("t_ms,velocity_m_s,friction_n").unwrap();
+        assert_eq!(time.as_deref(), Some("t_ms / 1e3"));
+        assert!(
+            notes[0].contains("the time is `t_ms`, read in s"),
+            "{notes:?}"
+        );
+        let (time, _) = time_of("stamp_ns,velocity_m_s,friction_n").unwrap();
+        assert_eq!(time.as_deref(), Some("stamp_ns / 1e9"));
+        // `t_s` is the time as it is; no time column is a steady curve.
+        assert_eq!(
+            time_of("t_s,velocity_m_s,friction_n").unwrap(),
+            (None, vec![])
+        );
+        assert_eq!(
+            time_of("n,velocity_m_s,friction_n").unwrap(),
+            (None, vec![])
+        );
+    }
+
+    #[test]
+    fn a_time_column_without_a_unit_is_refused_not_read_as_a_steady_curve() {
+        let err = time_of("time,velocity_m_s,friction_n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("time column `time` without a unit")
+                && err.contains("--time 'time / 1000'")
+                && err.contains("steady curve"),
+            "{err}"
+        );
+        assert!(time_of("t,velocity_m_s,friction_n").is_err());
+    }
+
+    #[test]
+    fn the_columns_a_fit_does_not_read_are_said() {
+        let table = Table::parse(
+            "velocity_m_s,friction_n,normal_force_n,load_n,note\n0.1,1,5,5,a\n0.2,1,5,5,b\n",
+            Path::new("x.csv"),
+            Delimiter::Auto,
+            None,
+            0,
+        )
+        .unwrap();
+        let mut mapping = crate::fit::Mapping::default();
+        let note = unread_columns(&mapping, &table).unwrap();
+        // The unread numeric column, not the default load nor a text one.
+        assert!(
+            note.starts_with("x.csv: not read: normal_force_n ("),
+            "{note}"
+        );
+        mapping.load = Some("2 * normal_force_n".into());
+        assert_eq!(unread_columns(&mapping, &table), None);
+    }
+
+    #[test]
+    fn a_joints_table_without_rotary_is_an_error_that_points_at_rotary() {
+        let mapping = crate::fit::Mapping::default();
+        let err = refuse_joint_columns(&mapping, &joint_table("velocity_deg_s,torque_nm", &[1.0]))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("`velocity_deg_s`") && err.contains("--rotary"),
+            "{err}"
+        );
+        // A linear axis's table, or a joint's named by --velocity, is read.
+        assert!(
+            refuse_joint_columns(&mapping, &joint_table("velocity_m_s,friction_n", &[1.0])).is_ok()
+        );
+        let named = crate::fit::Mapping {
+            velocity: "velocity_rad_s * 0.02".into(),
+            ..mapping
+        };
+        assert!(
+            refuse_joint_columns(&named, &joint_table("velocity_rad_s,torque_nm", &[1.0])).is_ok()
+        );
+    }
+
+    #[test]
+    fn a_joint_table_without_a_known_column_is_an_error_naming_the_columns_it_has() {
+        let table = joint_table("omega,tau", &[1.0]);
+        let err = rotary_columns(&crate::fit::Mapping::default(), &table, &mut Vec::new())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("no velocity column")
+                && err.contains("`velocity_deg_s`")
+                && err.contains("the table has omega, tau")
+                && err.contains("--velocity EXPR"),
+            "{err}"
+        );
+        // A joint's column that holds text (a row of units) is named, and
+        // reading it says so, not that there is no such column.
+        let table = Table::parse(
+            "velocity_rad_s,torque_nm\nrad/s,Nm\n1,0.3\n2,0.4\n",
+            Path::new("u.csv"),
+            Delimiter::Auto,
+            None,
+            0,
+        )
+        .unwrap();
+        let mapping =
+            rotary_columns(&crate::fit::Mapping::default(), &table, &mut Vec::new()).unwrap();
+        assert_eq!(mapping.velocity, "velocity_rad_s");
+        let Err(err) = Source::new(table, &mapping) else {
+            panic!("a column of text was read");
+        };
+        let err = err.to_string();
+        assert!(
+            err.contains("holds text") && err.contains("--skip 1"),
+            "{err}"
+        );
+        let table = joint_table("velocity_rad_s,tau", &[1.0]);
+        let err = rotary_columns(&crate::fit::Mapping::default(), &table, &mut Vec::new())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("no friction column") && err.contains("`torque_nm`"),
+            "{err}"
+        );
+    }
+}
