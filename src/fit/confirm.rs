@@ -62,6 +62,7 @@ pub fn unconfirmed(s: &Selection, final_mse: &[f64], units: super::Units) -> Opt
         fold_mse: final_mse.to_vec(),
         cv_rms: cv_rms(final_mse),
         simulations: 0,
+        unscored: None,
     };
     let term = chosen
         .iter()
@@ -132,6 +133,7 @@ pub(super) fn confounded_at_final(
         fold_mse: final_mse.to_vec(),
         cv_rms: cv_rms(final_mse),
         simulations: 0,
+        unscored: None,
     };
     let shipped = Scored {
         tried: at_final.clone(),
@@ -221,6 +223,7 @@ mod tests {
                 fold_mse: fold_mse.to_vec(),
                 cv_rms: cv_rms(fold_mse),
                 simulations: 0,
+                unscored: None,
             },
             optimum: vec![("contact.boundary_friction".into(), 0.2)],
             flags: Vec::new(),

@@ -88,6 +88,7 @@ mod tests {
                 fold_mse: vec![cv * cv; 4],
                 cv_rms: cv,
                 simulations: 0,
+                unscored: None,
             },
             optimum: Vec::new(),
             flags: Vec::new(),

@@ -121,7 +121,7 @@ fn read_sources(req: &DataRequest, notes: &mut Vec<String>) -> Result<Sources, F
             table_columns::rotary_columns(&req.mapping, &table, notes)?
         } else {
             table_columns::refuse_joint_columns(&req.mapping, &table)?;
-            req.mapping.clone()
+            table_columns::linear_columns(&req.mapping, &table, notes)
         };
         let mapping = table_columns::time_column(mapping, &table, notes)?;
         notes.extend(table_columns::unread_columns(&mapping, &table));

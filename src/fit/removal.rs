@@ -397,6 +397,7 @@ mod tests {
                 fold_mse: vec![1.0],
                 cv_rms: 1.0,
                 simulations: 0,
+                unscored: None,
             },
             optimum: Vec::new(),
             flags: Vec::new(),

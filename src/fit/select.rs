@@ -537,6 +537,7 @@ mod tests {
                 fold_mse: fold_mse.to_vec(),
                 cv_rms: (fold_mse.iter().sum::<f64>() / n).sqrt(),
                 simulations: 0,
+                unscored: None,
             },
             optimum: Vec::new(),
             flags: Vec::new(),

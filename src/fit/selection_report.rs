@@ -16,21 +16,25 @@ pub fn report(s: &Selection, units: super::Units) -> String {
         100.0 * TERM_COST
     );
     for t in &s.tried {
-        let folds: Vec<String> = t
-            .fold_mse
-            .iter()
-            .map(|m| crate::text::Num::sig(m.sqrt(), 5).to_string())
-            .collect();
+        let (cv, folds) = match t.unscored {
+            Some(why) => ("—".to_string(), why.to_string()),
+            None => (
+                crate::text::Num::sig(t.cv_rms, 5).to_string(),
+                t.fold_mse
+                    .iter()
+                    .map(|m| crate::text::Num::sig(m.sqrt(), 5).to_string())
+                    .collect::<Vec<_>>()
+                    .join(" / "),
+            ),
+        };
         let _ = writeln!(
             md,
-            "| {} | {} | {} | {} |",
+            "| {} | {cv} | {folds} | {} |",
             if t.terms.is_empty() {
                 "—".to_string()
             } else {
                 t.terms.join(", ")
             },
-            crate::text::Num::sig(t.cv_rms, 5),
-            folds.join(" / "),
             t.simulations
         );
     }

@@ -1,6 +1,7 @@
 //! How a table's columns become a fit's inputs when `--velocity`,
 //! `--friction` and `--time` keep their defaults: a joint's columns under
-//! `--rotary` (rad/s, deg/s or rpm; N·m), a time column named with its
+//! `--rotary` (rad/s, deg/s or rpm; N·m), a linear axis's velocity named
+//! with another unit (mm/s, m/min, mm/min), a time column named with its
 //! unit, the errors that point at what was meant (a joint's table without
 //! `--rotary`, a time column without a unit), and the columns a fit does
 //! not read, said.
@@ -37,27 +38,15 @@ pub fn rotary_columns(
     let velocity = if keeps(&mapping.velocity, &defaults.velocity) {
         mapping.velocity.clone()
     } else {
-        let &(name, to_rad_s) = ROTARY_VELOCITY_COLUMNS
-            .iter()
-            .find(|(c, _)| has(c))
-            .ok_or_else(|| {
-                let names: Vec<&str> = ROTARY_VELOCITY_COLUMNS.iter().map(|(c, _)| *c).collect();
-                unknown_column(
-                    table,
-                    "velocity",
-                    &names,
-                    "in rad/s (a column in deg/s: `--velocity 'COLUMN * 0.017453292519943295'`)",
-                )
-            })?;
-        if to_rad_s == 1.0 {
-            name.to_string()
-        } else {
-            notes.push(format!(
-                "{}: the velocity is `{name}`, read as rad/s: `{name} * {to_rad_s:e}`",
-                table.source.display()
-            ));
-            format!("{name} * {to_rad_s:e}")
-        }
+        velocity_by_unit(table, ROTARY_VELOCITY_COLUMNS, "rad/s", notes).ok_or_else(|| {
+            let names: Vec<&str> = ROTARY_VELOCITY_COLUMNS.iter().map(|(c, _)| *c).collect();
+            unknown_column(
+                table,
+                "velocity",
+                &names,
+                "in rad/s (a column in deg/s: `--velocity 'COLUMN * 0.017453292519943295'`)",
+            )
+        })?
     };
     let friction = if keeps(&mapping.friction, &defaults.friction) {
         mapping.friction.clone()
@@ -73,6 +62,57 @@ pub fn rotary_columns(
         friction,
         ..mapping.clone()
     })
+}
+
+/// The first of `columns` (name, factor to `unit`) that `table` has, as the
+/// expression that reads it in `unit`; a factor other than 1 is said in
+/// `notes`.
+fn velocity_by_unit(
+    table: &super::Table,
+    columns: &[(&str, f64)],
+    unit: &str,
+    notes: &mut Vec<String>,
+) -> Option<String> {
+    let &(name, factor) = columns.iter().find(|(c, _)| table.index(c).is_some())?;
+    if factor == 1.0 {
+        return Some(name.to_string());
+    }
+    notes.push(format!(
+        "{}: the velocity is `{name}`, read as {unit}: `{name} * {factor:e}`",
+        table.source.display()
+    ));
+    Some(format!("{name} * {factor:e}"))
+}
+
+/// A linear axis's velocity columns named with a unit other than m/s,
+/// read when `--velocity` keeps its default and the table has no
+/// `velocity_m_s`, each with its factor to m/s.
+const LINEAR_VELOCITY_COLUMNS: &[(&str, f64)] = &[
+    ("velocity_mm_s", 1e-3),
+    ("velocity_m_min", 1.0 / 60.0),
+    ("velocity_mm_min", 1.0 / 60_000.0),
+];
+
+/// Without `--rotary`, with the default `--velocity` and no `velocity_m_s`
+/// in `table`: a linear axis's velocity named with another unit
+/// (`velocity_mm_s`, `velocity_m_min`, `velocity_mm_min`) is read in m/s
+/// and said in `notes`. Otherwise `mapping` is kept as it is.
+pub fn linear_columns(
+    mapping: &super::Mapping,
+    table: &super::Table,
+    notes: &mut Vec<String>,
+) -> super::Mapping {
+    let defaults = super::Mapping::default();
+    if mapping.velocity != defaults.velocity || table.index(&mapping.velocity).is_some() {
+        return mapping.clone();
+    }
+    match velocity_by_unit(table, LINEAR_VELOCITY_COLUMNS, "m/s", notes) {
+        Some(velocity) => super::Mapping {
+            velocity,
+            ..mapping.clone()
+        },
+        None => mapping.clone(),
+    }
 }
 
 /// Time columns named with their unit, read in seconds when `--time` is
@@ -244,6 +284,40 @@ mod tests {
         approx::assert_relative_eq!(rpm[0], 2.0 * std::f64::consts::PI, epsilon = 1e-12);
         approx::assert_relative_eq!(rpm[1], std::f64::consts::PI, epsilon = 1e-12);
         assert!(notes[0].contains("`velocity_rpm`"), "{notes:?}");
+    }
+
+    #[test]
+    fn a_linear_axis_velocity_in_mm_s_or_m_min_is_read_in_m_s_and_said() {
+        let read = |header: &str, speeds: &[f64]| {
+            let mut notes = Vec::new();
+            let table = joint_table(header, speeds);
+            let mapping = linear_columns(&crate::fit::Mapping::default(), &table, &mut notes);
+            let series = Source::new(table, &mapping).unwrap().series(&[]).unwrap();
+            (series.velocity, notes)
+        };
+        let (mm, notes) = read("velocity_mm_s,friction_n", &[5.0, 250.0]);
+        approx::assert_relative_eq!(mm[0], 5e-3, epsilon = 1e-15);
+        approx::assert_relative_eq!(mm[1], 0.25, epsilon = 1e-15);
+        assert!(
+            notes[0].contains("`velocity_mm_s`, read as m/s"),
+            "{notes:?}"
+        );
+        let (m_min, _) = read("velocity_m_min,friction_n", &[6.0, 12.0]);
+        approx::assert_relative_eq!(m_min[0], 0.1, epsilon = 1e-15);
+        let (mm_min, _) = read("velocity_mm_min,friction_n", &[600.0, 1200.0]);
+        approx::assert_relative_eq!(mm_min[0], 0.01, epsilon = 1e-15);
+        // `velocity_m_s` is read as it is, beside any other.
+        let table = Table::parse(
+            "velocity_m_s,velocity_mm_s,friction_n\n0.5,500,1\n",
+            Path::new("b.csv"),
+            Delimiter::Auto,
+            None,
+            0,
+        )
+        .unwrap();
+        let mut notes = Vec::new();
+        let mapping = linear_columns(&crate::fit::Mapping::default(), &table, &mut notes);
+        assert_eq!((mapping.velocity.as_str(), notes), ("velocity_m_s", vec![]));
     }
 
     fn time_of(header: &str) -> Result<(Option<String>, Vec<String>), FitError> {

@@ -26,6 +26,9 @@ pub struct Tried {
     pub cv_rms: f64,
     /// Model evaluations it took.
     pub simulations: usize,
+    /// Why the set was not scored (its errors then infinite): not
+    /// admitted, or its fit failed.
+    pub unscored: Option<&'static str>,
 }
 
 /// A candidate set's fit, for warm starts and the report.
@@ -280,13 +283,14 @@ impl Ctx<'_> {
     }
 
     /// A set the fit could not fit: scored as predicting nothing.
-    fn unfitted(&self, terms: &[&'static str]) -> Scored {
+    fn unfitted(&self, terms: &[&'static str], why: &'static str) -> Scored {
         Scored {
             tried: Tried {
                 terms: terms.to_vec(),
                 fold_mse: vec![f64::INFINITY; self.folds.count()],
                 cv_rms: f64::INFINITY,
                 simulations: 0,
+                unscored: Some(why),
             },
             optimum: Vec::new(),
             flags: Vec::new(),
@@ -316,14 +320,14 @@ impl Ctx<'_> {
         let fitted = match fit(&model, &self.data, map_fit.clone(), &options) {
             Ok(o) => o,
             Err(FitError::Interrupted(i)) => return Err(FitError::Interrupted(i)),
-            Err(_) => return Ok(self.unfitted(terms)),
+            Err(_) => return Ok(self.unfitted(terms, "its fit failed")),
         };
         if let Some(why) = unshown(terms, &fitted) {
             self.not_admitted
                 .lock()
                 .unwrap_or_else(|p| p.into_inner())
                 .push(why);
-            return Ok(self.unfitted(terms));
+            return Ok(self.unfitted(terms, "not admitted (below)"));
         }
         let fold_mse = cross_validate(
             &model,
@@ -347,6 +351,7 @@ impl Ctx<'_> {
                 fold_mse,
                 cv_rms,
                 simulations: model.film_solves(),
+                unscored: None,
             },
             optimum: fitted
                 .params
