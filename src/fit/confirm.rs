@@ -218,16 +218,8 @@ mod tests {
 
     fn scored(terms: &[&'static str], fold_mse: &[f64]) -> Scored {
         Scored {
-            tried: Tried {
-                terms: terms.to_vec(),
-                fold_mse: fold_mse.to_vec(),
-                cv_rms: cv_rms(fold_mse),
-                simulations: 0,
-                unscored: None,
-            },
             optimum: vec![("contact.boundary_friction".into(), 0.2)],
-            flags: Vec::new(),
-            aicc: f64::NAN,
+            ..Scored::with_folds(terms, fold_mse, f64::NAN)
         }
     }
 

@@ -79,21 +79,9 @@ impl Ctx<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fit::trial::Tried;
 
     fn scored(terms: &[&'static str], cv: f64, aicc: f64) -> Scored {
-        Scored {
-            tried: Tried {
-                terms: terms.to_vec(),
-                fold_mse: vec![cv * cv; 4],
-                cv_rms: cv,
-                simulations: 0,
-                unscored: None,
-            },
-            optimum: Vec::new(),
-            flags: Vec::new(),
-            aicc,
-        }
+        Scored::with_folds(terms, &[cv * cv; 4], aicc)
     }
 
     #[test]

@@ -391,18 +391,7 @@ mod tests {
     use super::*;
 
     fn scored(terms: &[&'static str]) -> Scored {
-        Scored {
-            tried: Tried {
-                terms: terms.to_vec(),
-                fold_mse: vec![1.0],
-                cv_rms: 1.0,
-                simulations: 0,
-                unscored: None,
-            },
-            optimum: Vec::new(),
-            flags: Vec::new(),
-            aicc: f64::NAN,
-        }
+        Scored::with_folds(terms, &[1.0], f64::NAN)
     }
 
     fn with_flag(terms: &[&'static str], key: &str, rho: f64, partner: &str) -> Scored {
@@ -501,11 +490,7 @@ mod tests {
     }
 
     fn scored_cv(terms: &[&'static str], fold_mse: &[f64], aicc: f64) -> Scored {
-        let mut s = scored(terms);
-        s.tried.fold_mse = fold_mse.to_vec();
-        s.tried.cv_rms = (fold_mse.iter().sum::<f64>() / fold_mse.len() as f64).sqrt();
-        s.aicc = aicc;
-        s
+        Scored::with_folds(terms, fold_mse, aicc)
     }
 
     #[test]

@@ -144,6 +144,7 @@ use super::cross_validate::paired;
 use super::options::SearchSettings;
 use super::prepared::Prepared;
 use super::removal::{cv, keeps_part, pays};
+use super::stop_reason::{does_not_pay, not_supported};
 use super::trial::{Ctx, Scored, Tried};
 use super::unknowns::ParamSpec;
 use super::FitError;
@@ -333,50 +334,6 @@ fn open_candidates<'c>(
         .collect()
 }
 
-/// Why the selection stopped: the best next term does not pay.
-fn does_not_pay(name: &str, gain: f64, se: f64, share: f64) -> String {
-    if !(gain.is_finite() && se.is_finite()) {
-        return format!(
-            "the best next term, {name}, cannot be scored on these folds (a fold too small for the keys it adds, or a refit that failed), so it is not added"
-        );
-    }
-    format!(
-        "the best next term, {name}, lowers the folds' mean squared error by {} ± {} (standard error), {:.2} % of it: a term must lower it by more than its standard error and by more than {:.0} % (the cost of a term), so it does not pay for itself",
-        crate::text::Num::sig(gain, 5),
-        crate::text::Num::sig(se, 5),
-        100.0 * share,
-        100.0 * TERM_COST
-    )
-}
-
-/// Why the selection stopped when no set of the step is supported by the
-/// whole curve (rule 10): the best of them on the folds, and why it is not
-/// added — it does not pay there (rule 3), or it does and the criterion
-/// refuses it.
-fn not_supported(current: &Scored, unsupported: &[Scored]) -> String {
-    let Some(best) = unsupported
-        .iter()
-        .filter(|t| super::removal::is_scored(&t.tried))
-        .min_by(|a, b| a.tried.cv_rms.total_cmp(&b.tried.cv_rms))
-    else {
-        return "no next term could be scored on these folds".to_string();
-    };
-    let name = best.tried.terms.last().copied().unwrap_or_default();
-    let (ok, gain, se, share) = pays(&current.tried, &best.tried);
-    if !ok {
-        // It does not pay on the folds either: rule 3 is the reason.
-        return does_not_pay(name, gain, se, share);
-    }
-    format!(
-        "the best next term on the folds, {name} (CV {} against {}), pays there but does not lower the whole curve's small-sample Akaike criterion by more than {} ({:.1} with it against {:.1}), nor does any other (rule 10), so none is added",
-        crate::text::Num::sig(best.tried.cv_rms, 5),
-        crate::text::Num::sig(current.tried.cv_rms, 5),
-        super::trial::AICC_SUPPORT,
-        best.aicc,
-        current.aicc
-    )
-}
-
 /// The keys the chosen set fits: its terms' keys, then the names given
 /// after `auto` that are not tied to a term's choice, each once.
 pub(super) fn fitted_keys(terms: &[&'static str], given: &[ParamSpec]) -> Vec<String> {
@@ -517,32 +474,8 @@ mod tests {
     use super::super::cross_validate::paired;
     use super::*;
 
-    #[test]
-    fn a_term_the_folds_cannot_score_is_said_to_be_unscored_not_to_gain_nan() {
-        let text = does_not_pay("film", f64::NAN, f64::NAN, f64::NAN);
-        assert!(text.contains("cannot be scored on these folds"), "{text}");
-        assert!(!text.contains("NaN"), "{text}");
-        let text = does_not_pay("film", 1e-9, 2e-9, 0.5);
-        assert!(
-            text.contains("lowers the folds' mean squared error by 1e-9 ± 2e-9"),
-            "{text}"
-        );
-    }
-
     fn scored(terms: &[&'static str], fold_mse: &[f64]) -> Scored {
-        let n = fold_mse.len() as f64;
-        Scored {
-            tried: Tried {
-                terms: terms.to_vec(),
-                fold_mse: fold_mse.to_vec(),
-                cv_rms: (fold_mse.iter().sum::<f64>() / n).sqrt(),
-                simulations: 0,
-                unscored: None,
-            },
-            optimum: Vec::new(),
-            flags: Vec::new(),
-            aicc: f64::NAN,
-        }
+        Scored::with_folds(terms, fold_mse, f64::NAN)
     }
 
     #[test]
@@ -679,39 +612,6 @@ mod tests {
             &[1.1, 1.0, 1.3, 1.1],
         );
         assert!(!keeps_part(&without.tried, &higher.tried));
-    }
-
-    #[test]
-    fn a_stop_by_rule_10_names_rule_3_when_the_best_refused_term_does_not_pay_on_the_folds_either()
-    {
-        let with_aicc = |mut s: Scored, aicc| {
-            s.aicc = aicc;
-            s
-        };
-        let current = with_aicc(
-            scored(&["drivetrain Stribeck"], &[1.0, 1.0, 1.0, 1.0]),
-            -169.2,
-        );
-        // Lower on average but within the folds' spread: rule 3's reason.
-        let noisy = with_aicc(
-            scored(
-                &["drivetrain Stribeck", "drivetrain quadratic"],
-                &[0.2, 1.9, 0.3, 1.4],
-            ),
-            -166.4,
-        );
-        let why = not_supported(&current, std::slice::from_ref(&noisy));
-        assert!(why.contains("does not pay for itself"), "{why}");
-        // Lower on every fold: it pays there, and rule 10 refuses it.
-        let paying = with_aicc(
-            scored(&["drivetrain Stribeck", "film"], &[0.5, 0.5, 0.6, 0.5]),
-            -168.0,
-        );
-        let why = not_supported(&current, &[noisy, paying]);
-        assert!(
-            why.starts_with("the best next term on the folds, film") && why.contains("(rule 10)"),
-            "{why}"
-        );
     }
 
     #[test]

@@ -47,6 +47,26 @@ pub(super) struct Scored {
     pub(super) aicc: f64,
 }
 
+#[cfg(test)]
+impl Scored {
+    /// A set scored with these fold errors and criterion, for tests of
+    /// the rules that read them.
+    pub(super) fn with_folds(terms: &[&'static str], fold_mse: &[f64], aicc: f64) -> Self {
+        Scored {
+            tried: Tried {
+                terms: terms.to_vec(),
+                fold_mse: fold_mse.to_vec(),
+                cv_rms: super::cross_validate::cv_rms(fold_mse),
+                simulations: 0,
+                unscored: None,
+            },
+            optimum: Vec::new(),
+            flags: Vec::new(),
+            aicc,
+        }
+    }
+}
+
 /// How much lower (better) a richer set's small-sample Akaike criterion
 /// must be for the whole curve to support it over a simpler one: a
 /// difference below 2 is one the data do not resolve (Burnham & Anderson
