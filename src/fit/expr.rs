@@ -157,11 +157,19 @@ pub(super) fn compile(
                         "; a column whose name is not an identifier (`{n}`) is named for expressions with --columns NAME,... (one name per column, replacing the header's)"
                     )
                 });
+            // Names are case-sensitive: `Velocity_m_s` is not `velocity_m_s`.
+            let case = table
+                .names
+                .iter()
+                .find(|n| n.eq_ignore_ascii_case(id))
+                .map_or_else(String::new, |n| {
+                    format!("; column names are case-sensitive: the table has `{n}`")
+                });
             return Err(FitError::Expression {
                 what: what.into(),
                 text: text.into(),
                 message: format!(
-                    "`{id}` is neither a column of {} ({}) nor a map coefficient (--map NAME=VALUE){rename}",
+                    "`{id}` is neither a column of {} ({}) nor a map coefficient (--map NAME=VALUE){case}{rename}",
                     table.source.display(),
                     table.names.join(", ")
                 ),
@@ -405,5 +413,34 @@ impl Columns<'_> {
                 }
             })
             .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::table::Delimiter;
+    use std::path::Path;
+
+    #[test]
+    fn a_column_named_in_another_case_is_pointed_at() {
+        let table = Table::parse(
+            "Velocity_m_s,Friction_N\n0.1,1\n0.2,2\n",
+            Path::new("c.csv"),
+            Delimiter::Auto,
+            None,
+            0,
+        )
+        .unwrap();
+        let Err(err) = compile("--velocity", "velocity_m_s", &table, &mut Vec::new(), &[]) else {
+            panic!("a column was read under another case");
+        };
+        let err = err.to_string();
+        assert!(
+            err.contains("is neither a column of c.csv")
+                && err.contains("case-sensitive: the table has `Velocity_m_s`"),
+            "{err}"
+        );
+        assert!(compile("--velocity", "Velocity_m_s", &table, &mut Vec::new(), &[]).is_ok());
     }
 }
