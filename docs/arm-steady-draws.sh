@@ -16,6 +16,11 @@
 # the viscous part at 90 deg/s is 0.05–3 × f_c (log-uniform); each is
 # compared with the best classic's held-out RMS.
 #
+# OFFSET=x (with CURVES=random) adds to each random joint a level that
+# differs by direction, a constant c drawn uniform in ±x·f_c from its own
+# generator (a torque sensor's offset: τ + c both ways); the curves and
+# noise are those of OFFSET=0.
+#
 # Usage: docs/arm-steady-draws.sh [OUT_DIR] [BIN]   (default: out/arm-steady-draws)
 # DRAWS=20 sets the draws per curve.
 set -euo pipefail
@@ -25,13 +30,16 @@ BIN=${2:-target/release/friction-node}
 DRAWS=${DRAWS:-20}
 CURVES=${CURVES:-peak rise}
 SEED=${SEED:-2026}
+OFFSET=${OFFSET:-0}
 mkdir -p "$OUT"
 [ -x "$BIN" ] || cargo build --release --quiet
 . docs/bench-lib.sh
 
-python3 - "$OUT" "$DRAWS" "$CURVES" "$SEED" <<'PY'
+python3 - "$OUT" "$DRAWS" "$CURVES" "$SEED" "$OFFSET" <<'PY'
 import math, random, sys
 out, draws, names, family = sys.argv[1], int(sys.argv[2]), sys.argv[3].split(), int(sys.argv[4])
+offset = float(sys.argv[5])
+offsets = {}
 train = [0.5, 1.0, 2.0, 3.0, 5.0, 7.0, 10.0, 13.0, 16.0, 20.0]
 validate = [25.0, 35.0, 45.0, 60.0, 75.0, 90.0]
 curves = {"peak": (1.2, 1.8, 0.05, 2.0), "rise": (1.2, 0.6, 0.1, 1.0)}
@@ -44,12 +52,18 @@ if names == ["random"]:
         ratio = rng.uniform(0.4, 2.0)
         curves[f"random{k}"] = (fc, fc * (1.0 if k % 3 == 0 else ratio), logu(0.005, 0.5),
                                 logu(0.05, 3.0) * fc / math.radians(90.0))
+    if offset > 0.0:
+        orng = random.Random(f"{family} offset")
+        offsets = {n: orng.uniform(-offset, offset) * p[0] for n, p in curves.items()}
+        with open(f"{out}/random-offsets.txt", "w") as f:
+            for n, c in offsets.items():
+                f.write(f"{n} {c:.4g}\n")
     with open(f"{out}/random-curves.txt", "w") as f:
         for n, (fc, fs, ws, b) in curves.items():
             f.write(f"{n} {fc:.4g} {fs:.4g} {ws:.4g} {b:.4g}\n")
 else:
     curves = {n: curves[n] for n in names}
-def write(path, speeds, p, seed):
+def write(path, speeds, p, seed, c=0.0):
     fc, fs, ws, b = p
     rng = random.Random(seed)
     with open(path, "w") as f:
@@ -57,15 +71,16 @@ def write(path, speeds, p, seed):
         for deg in speeds:
             for sign in (1.0, -1.0):
                 w = sign * math.radians(deg)
-                tau = sign * (fc + (fs - fc) * math.exp(-(w / ws) ** 2)) + b * w
+                tau = sign * (fc + (fs - fc) * math.exp(-(w / ws) ** 2)) + b * w + c
                 f.write(f"{w},{tau * (1 + rng.gauss(0, 0.01))}\n")
 for name, p in curves.items():
     for seed in (range(1, draws + 1) if not name.startswith("random") else [1]):
         # Each random joint gets its own noise (until stop 70 every one of
         # them drew seed 1's, so the family's noise was one draw repeated).
         noise = seed if not name.startswith("random") else 1000 * family + int(name[6:])
-        write(f"{out}/{name}-{seed}-train.csv", train, p, noise)
-        write(f"{out}/{name}-{seed}-validate.csv", validate, p, 100000 + noise if name.startswith("random") else 100 + seed)
+        c = offsets.get(name, 0.0)
+        write(f"{out}/{name}-{seed}-train.csv", train, p, noise, c)
+        write(f"{out}/{name}-{seed}-validate.csv", validate, p, 100000 + noise if name.startswith("random") else 100 + seed, c)
 PY
 
 if [ "$CURVES" = random ]; then

@@ -104,7 +104,7 @@ pub const CANDIDATES: &[Candidate] = &[
         part_of_requirement: false,
     },
     Candidate {
-        name: "drivetrain asymmetry",
+        name: ASYMMETRY,
         keys: &["drivetrain.coulomb_asymmetry_n"],
         requires: None,
         needs_varying_load: false,
@@ -348,6 +348,10 @@ pub(super) const STRIBECK: &str = "drivetrain Stribeck";
 /// The drivetrain's viscous rise (Coulomb + viscous with the base), the
 /// other classic shape of rule 7.
 pub(super) const VISCOUS: &str = "drivetrain viscous";
+/// The drivetrain's direction asymmetry (a level higher one way than the
+/// other: an offset of the moving friction), which rule 7 also compares
+/// the classic shapes beside.
+pub(super) const ASYMMETRY: &str = "drivetrain asymmetry";
 /// See [`FILM`].
 pub(super) const FILM_KEY: &str = "lubricant.viscosity_pa_s";
 

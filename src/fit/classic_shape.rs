@@ -4,8 +4,10 @@
 //! within [`AICC_SUPPORT`] of the lowest — and that shape is presumed with
 //! its viscous rise: the curve gives way only to its rise, and the rise
 //! goes only when its key ends at zero (`removal.rs`, `confirm.rs`).
+//! Rule 7b: where the direction asymmetry lowers the criterion by more
+//! than [`AICC_SUPPORT`], the shapes are compared beside it.
 
-use super::candidates::{lighter_forms, set_keys, Candidate, STRIBECK, VISCOUS};
+use super::candidates::{lighter_forms, set_keys, Candidate, ASYMMETRY, STRIBECK, VISCOUS};
 use super::trial::{Ctx, Scored, Tried, AICC_SUPPORT};
 use super::FitError;
 
@@ -72,6 +74,19 @@ pub(super) fn start_shape(aiccs: &[f64], rises: bool) -> usize {
         .unwrap_or(from)
 }
 
+/// Rule 7b: whether the classic shapes are compared beside the direction
+/// asymmetry — the criteria `offset` of each set with it, against `plain`
+/// without it. A curve whose level differs by direction (a torque
+/// sensor's offset, a load lifted one way) leaves that offset in every
+/// shape's residuals, and beside it the shapes' criteria differ by noise;
+/// where the asymmetry lowers the lowest criterion by more than
+/// [`AICC_SUPPORT`], the data resolve it, and the shapes are compared
+/// with it.
+pub(super) fn beside_offset(plain: &[f64], offset: &[f64]) -> bool {
+    let lowest = |a: &[f64]| a.iter().copied().fold(f64::INFINITY, f64::min);
+    lowest(offset) < lowest(plain) - AICC_SUPPORT
+}
+
 /// The terms presumed from the start `terms`: those, and each one's
 /// lighter classic shape among `shapes` (the Stribeck curve's viscous
 /// rise), so that a curve that gives way to it (rule 4) leaves a rise, not
@@ -101,6 +116,7 @@ impl Ctx<'_> {
         &self,
         base: Scored,
         shapes: &[&'static str],
+        offset: bool,
         tried: &mut Vec<Tried>,
         start: &mut String,
         say: &(dyn Fn(&str) + Sync),
@@ -112,19 +128,47 @@ impl Ctx<'_> {
             sets.push(t);
         }
         let aiccs: Vec<f64> = sets.iter().map(|s| s.aicc).collect();
-        let text: Vec<String> = sets
-            .iter()
-            .map(|s| {
-                format!(
-                    "{} {:.1}",
-                    s.tried.terms.first().copied().unwrap_or("the base alone"),
-                    s.aicc
-                )
-            })
-            .collect();
+        let criteria = |sets: &[Scored]| -> String {
+            sets.iter()
+                .map(|s| {
+                    let name = match s.tried.terms.first().copied() {
+                        Some(ASYMMETRY) | None => "the base alone",
+                        Some(t) => t,
+                    };
+                    format!("{name} {:.1}", s.aicc)
+                })
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        let mut list = criteria(&sets);
+        // Rule 7b: each set beside the direction asymmetry too.
+        let mut compared = aiccs.clone();
+        if offset && !shapes.is_empty() {
+            // Each warm from the one before (the base's offset, then the
+            // rise beside it, then the curve, whose keys hold the rise's),
+            // not from its own fit without the offset, which the offset
+            // distorted.
+            let mut with: Vec<Scored> = Vec::with_capacity(sets.len());
+            for s in &sets {
+                let terms: Vec<&'static str> =
+                    s.tried.terms.iter().copied().chain([ASYMMETRY]).collect();
+                let warm = with.last().map_or(&s.optimum, |w| &w.optimum);
+                let t = self.try_set(&terms, warm)?;
+                tried.push(t.tried.clone());
+                with.push(t);
+            }
+            let offset_aiccs: Vec<f64> = with.iter().map(|s| s.aicc).collect();
+            if beside_offset(&aiccs, &offset_aiccs) {
+                list = format!(
+                    "{list}; beside the direction asymmetry, which the criterion resolves (its lowest more than {AICC_SUPPORT} lower with it), and by which the shapes are compared: {}",
+                    criteria(&with)
+                );
+                compared = offset_aiccs;
+            }
+        }
         let best = sets
             .into_iter()
-            .nth(start_shape(&aiccs, shapes.contains(&VISCOUS)))
+            .nth(start_shape(&compared, shapes.contains(&VISCOUS)))
             .expect("start_shape is an index of the sets");
         let presumed = presumed_terms(&best.tried.terms, shapes);
         let _ = self.presumed.set(presumed);
@@ -142,7 +186,6 @@ impl Ctx<'_> {
             } else {
                 "it stays unless the set without it pays over it"
             };
-            let list = text.join(", ");
             let why = if best.tried.terms.is_empty() {
                 format!(
                     "the selection starts from the base alone: no rising classic shape could be fitted to these points (small-sample Akaike criterion on all the training points: {list})"
@@ -162,6 +205,22 @@ impl Ctx<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_shapes_are_compared_beside_the_direction_asymmetry_only_where_it_is_resolved() {
+        // An offset of 0.3 N·m on a 2 N·m rise (tests/fit_direction_offset.rs).
+        assert!(beside_offset(
+            &[-36.5, -43.6, -37.7],
+            &[-53.1, -132.1, -153.5]
+        ));
+        // A symmetric curve: the asymmetry's key costs more than it gains.
+        assert!(!beside_offset(
+            &[-36.5, -163.6, -170.0],
+            &[-34.3, -161.4, -171.9]
+        ));
+        // A curve driven one way: the asymmetry is the level's twin.
+        assert!(!beside_offset(&[-80.0, -120.0], &[-77.8, -117.8]));
+    }
 
     #[test]
     fn a_steady_curve_starts_from_the_simplest_rising_shape_its_criterion_supports() {

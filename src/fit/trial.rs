@@ -160,10 +160,40 @@ fn film_placements(p: &Prepared) -> Vec<f64> {
         .collect()
 }
 
+/// The drivetrain Stribeck curve's keys: its speed and its amplitude.
+const STRIBECK_SPEED_KEY: &str = "drivetrain.stribeck_speed_m_s";
+const STRIBECK_AMPLITUDE_KEY: &str = "drivetrain.stribeck_n";
+/// The direction asymmetry's key.
+const ASYMMETRY_KEY: &str = "drivetrain.coulomb_asymmetry_n";
+
+/// The best Stribeck curves on the training data by variable projection
+/// ([`super::baselines::stribeck_curve_by_grid`]: a log grid of speeds,
+/// the curve's levels and slope solved at each), without and with a level
+/// that differs by direction, in the data's units. A start of our
+/// Stribeck term at one of them (its speed and amplitude) is in the basin
+/// of a curve that a start at zero amplitude cannot see, whose speed then
+/// has no gradient: a rise that saturates inside the data beside an
+/// offset (seed 197 joint 22 of `OFFSET=0.2 docs/arm-steady-draws.sh`,
+/// where the three placements at zero amplitude found a straight line,
+/// training RMS 0.0149 against the curve's 0.0033 N·m).
+fn stribeck_curves(p: &Prepared) -> Vec<super::baselines::GridCurve> {
+    let series: Vec<_> = p
+        .data
+        .train
+        .iter()
+        .filter_map(|s| s.series(&p.data.map_values).ok())
+        .collect();
+    [false, true]
+        .into_iter()
+        .filter_map(|offset| super::baselines::stribeck_curve_by_grid(&series, offset))
+        .collect()
+}
+
 /// Where a new term's speed-like key starts besides its own start: the
 /// film's viscosity at [`film_placements`]; a Stribeck speed or a boundary
 /// film's activation speed at the data's slowest sliding speed, its top
-/// speed and between (contact units). A term that bends the curve at a
+/// speed and between (contact units), a Stribeck speed also where the
+/// best Stribeck curves on the data bend ([`stribeck_speeds`]). A term that bends the curve at a
 /// speed has as many optima as the data have places to bend it: one start
 /// finds one of them.
 fn placements(p: &Prepared, key: &str) -> Vec<f64> {
@@ -296,6 +326,43 @@ impl Ctx<'_> {
             for v in values {
                 let mut x = start.clone();
                 x[i] = v.clamp(q.lo, q.hi);
+                out.push(x);
+            }
+        }
+        if new_keys.contains(&STRIBECK_SPEED_KEY) {
+            out.extend(self.stribeck_starts(model, &start));
+        }
+        out
+    }
+
+    /// Starts of a set whose Stribeck curve is new: `start` with the
+    /// curve's speed and amplitude (and the direction asymmetry, where the
+    /// set fits it) at each of [`stribeck_curves`], in contact units.
+    fn stribeck_starts(
+        &self,
+        model: &super::physics_model::PhysicsModel,
+        start: &[f64],
+    ) -> Vec<Vec<f64>> {
+        let gain = self.p.contact_scale.as_ref().map_or(1.0, |s| s.gain);
+        let params = model.parameters();
+        let at = |key: &str| params.iter().position(|q| q.name == key);
+        let (Some(speed), Some(amplitude)) = (at(STRIBECK_SPEED_KEY), at(STRIBECK_AMPLITUDE_KEY))
+        else {
+            return Vec::new();
+        };
+        let mut out: Vec<Vec<f64>> = Vec::new();
+        for x in stribeck_curves(self.p).into_iter().map(|c| {
+            let mut x = start.to_vec();
+            let mut set = |i: usize, v: f64| x[i] = v.clamp(params[i].lo, params[i].hi);
+            set(speed, c.speed * gain);
+            set(amplitude, c.amplitude / gain);
+            if let Some(i) = at(ASYMMETRY_KEY) {
+                set(i, c.offset / gain);
+            }
+            x
+        }) {
+            // On speeds taken both ways the two curves are one.
+            if !out.contains(&x) {
                 out.push(x);
             }
         }
