@@ -59,6 +59,7 @@
 //! | `physics_model.rs` | our model as a predictor: its keys, its film reused when only the terms after it change, its linear keys |
 //! | `film_run.rs` | our model's film along a series (transient and steady solves), the trace it keeps, the friction recomposed along it |
 //! | `baselines.rs` | Coulomb + viscous, Stribeck, LuGre |
+//! | `classic_regression.rs` | the classic curves by linear least squares on the training samples (Stribeck on a grid of speeds): the classics' starts and our Stribeck term's |
 //! | `problem.rs` | the problem: a model, the data and its map coefficients, residuals, predictions |
 //! | `data.rs` | the data of a fit: training, held-out and validation sources by role, with the maps' coefficients |
 //! | `contact_scale.rs` | the contact's gain and load chosen from the data (a joint's lever, a linear axis's gain); a key's value as it acts on the joint |
@@ -83,6 +84,7 @@ mod box_qp;
 pub mod by_direction;
 pub mod calibrated_range;
 pub mod candidates;
+pub mod classic_regression;
 pub mod classic_shape;
 pub mod compare;
 pub mod confirm;
@@ -128,7 +130,8 @@ pub mod unknowns;
 mod windowed;
 
 pub use crate::table::{Delimiter, Table, TableError};
-pub use baselines::{Baseline, BaselineKind, LoadForm};
+pub use baselines::{Baseline, BaselineKind};
+pub use classic_regression::LoadForm;
 pub use data::Data;
 pub use driver::FitOutcome;
 pub use error::{FitError, PredictError};

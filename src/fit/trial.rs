@@ -167,7 +167,7 @@ const STRIBECK_AMPLITUDE_KEY: &str = "drivetrain.stribeck_n";
 const ASYMMETRY_KEY: &str = "drivetrain.coulomb_asymmetry_n";
 
 /// The best Stribeck curves on the training data by variable projection
-/// ([`super::baselines::stribeck_curve_by_grid`]: a log grid of speeds,
+/// ([`super::classic_regression::stribeck_curve_by_grid`]: a log grid of speeds,
 /// the curve's levels and slope solved at each), without and with a level
 /// that differs by direction, in the data's units. A start of our
 /// Stribeck term at one of them (its speed and amplitude) is in the basin
@@ -176,7 +176,7 @@ const ASYMMETRY_KEY: &str = "drivetrain.coulomb_asymmetry_n";
 /// offset (seed 197 joint 22 of `OFFSET=0.2 docs/arm-steady-draws.sh`,
 /// where the three placements at zero amplitude found a straight line,
 /// training RMS 0.0149 against the curve's 0.0033 N·m).
-fn stribeck_curves(p: &Prepared) -> Vec<super::baselines::GridCurve> {
+fn stribeck_curves(p: &Prepared) -> Vec<super::classic_regression::GridCurve> {
     let series: Vec<_> = p
         .data
         .train
@@ -185,7 +185,7 @@ fn stribeck_curves(p: &Prepared) -> Vec<super::baselines::GridCurve> {
         .collect();
     [false, true]
         .into_iter()
-        .filter_map(|offset| super::baselines::stribeck_curve_by_grid(&series, offset))
+        .filter_map(|offset| super::classic_regression::stribeck_curve_by_grid(&series, offset))
         .collect()
 }
 
