@@ -159,7 +159,7 @@ pub struct GridCurve {
 
 /// Where a term that bends a curve at a speed (our drivetrain Stribeck
 /// curve) is best started on the training samples of `series`: the best
-/// curve of [`stribeck_grid`] over the data's speeds, its levels and
+/// curve of `stribeck_grid` (a log grid of 49 speeds) over the data's speeds, its levels and
 /// slope solved at each speed, with a constant beside them when `offset`
 /// (a level that differs by direction, which otherwise moves the best
 /// speed). None: too few samples.
