@@ -89,5 +89,8 @@ fn a_rise_that_saturates_inside_the_data_is_found_beside_its_offset() {
     );
     let ours = held_out(&stdout, "friction-node");
     let stribeck = held_out(&stdout, "Stribeck");
-    assert!(ours < 0.5 * stribeck, "ours {ours} against Stribeck {stribeck}");
+    assert!(
+        ours < 0.5 * stribeck,
+        "ours {ours} against Stribeck {stribeck}"
+    );
 }
