@@ -212,6 +212,14 @@ impl Table {
         Self::parse(&text, path, delimiter, names, skip)
     }
 
+    /// A table parsed from CSV `text` as the file `name` (delimiter
+    /// detected, no rows skipped), for tests.
+    #[cfg(test)]
+    pub fn of_csv(text: &str, name: &str) -> Table {
+        Table::parse(text, std::path::Path::new(name), Delimiter::Auto, None, 0)
+            .expect("a test table parses")
+    }
+
     /// Parse table text (see [`Table::read`]).
     pub fn parse(
         text: &str,

@@ -9,28 +9,11 @@
 //! the rest and checks that the bound is active.
 
 mod common;
-use common::cli::run;
-
-use std::path::Path;
 
 #[test]
 fn a_stribeck_speed_on_its_bound_ends_the_fit_converged_there() {
-    let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures");
-    let d = common::cli::fresh_dir("at-a-bound", "speed");
-    let train = d.join("train.csv");
-    std::fs::copy(fixtures.join("joint-speed-at-bound-train.csv"), &train).unwrap();
-    let validate = fixtures.join("joint-speed-at-bound-validate.csv");
-    let (code, stdout, err) = run(&[
-        "fit",
-        train.to_str().unwrap(),
-        "--validate",
-        validate.to_str().unwrap(),
-        "--rotary",
-        "--fit",
-        "auto",
-        "--out",
-        d.join("f.yaml").to_str().unwrap(),
-    ]);
+    let (code, stdout, err) =
+        common::cli::fit_joint_fixture("at-a-bound", "joint-speed-at-bound", &[]);
     assert_eq!(code, 0, "{err}");
     assert!(
         stdout.starts_with("# Fit of friction-node: converged"),

@@ -19,13 +19,10 @@
 //! term at zero amplitude, where its speed has no gradient, ended on a
 //! straight line (training RMS 0.0149 N·m, 10.6× the Stribeck classic held
 //! out); started also at the best curves of a grid of speeds
-//! (`baselines::stribeck_curve_by_grid`, as the classic is started) it
+//! (`classic_regression::stribeck_curve_by_grid`, as the classic is started) it
 //! finds the curve (0.0033 N·m).
 
 mod common;
-use common::cli::run;
-
-use std::path::Path;
 
 /// The held-out RMS of `model`'s row in the models table.
 fn held_out(stdout: &str, model: &str) -> f64 {
@@ -36,26 +33,25 @@ fn held_out(stdout: &str, model: &str) -> f64 {
     row.split('|').nth(7).unwrap().trim().parse().unwrap()
 }
 
-/// `fit --rotary --fit auto --baselines` of the fixture `name`: its
-/// exit code, stdout and stderr.
+/// `fit --rotary --fit auto --baselines` of the fixture `name`.
 fn fit_fixture(name: &str) -> (i32, String, String) {
-    let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures");
-    let d = common::cli::fresh_dir("direction-offset", name);
-    let train = d.join("train.csv");
-    std::fs::copy(fixtures.join(format!("{name}-train.csv")), &train).unwrap();
-    let validate = fixtures.join(format!("{name}-validate.csv"));
-    run(&[
-        "fit",
-        train.to_str().unwrap(),
-        "--validate",
-        validate.to_str().unwrap(),
-        "--rotary",
-        "--fit",
-        "auto",
-        "--baselines",
-        "--out",
-        d.join("f.yaml").to_str().unwrap(),
-    ])
+    common::cli::fit_joint_fixture("direction-offset", name, &["--baselines"])
+}
+
+/// The curve beside the offset is chosen, and ours predicts below
+/// `share` × the Stribeck classic's held-out error (the offset is ours
+/// alone).
+fn assert_curve_beside_offset(stdout: &str, share: f64) {
+    assert!(
+        stdout.contains("Chosen: boundary friction, drivetrain Stribeck, drivetrain asymmetry."),
+        "{stdout}"
+    );
+    let ours = held_out(stdout, "friction-node");
+    let stribeck = held_out(stdout, "Stribeck");
+    assert!(
+        ours < share * stribeck,
+        "ours {ours} against Stribeck {stribeck}"
+    );
 }
 
 #[test]
@@ -66,31 +62,12 @@ fn a_rise_with_a_direction_offset_is_fitted_as_the_curve_beside_the_offset() {
         stdout.contains("beside the direction asymmetry, which the criterion resolves"),
         "{stdout}"
     );
-    assert!(
-        stdout.contains("Chosen: boundary friction, drivetrain Stribeck, drivetrain asymmetry."),
-        "{stdout}"
-    );
-    // The offset is ours alone: below the classics' held-out error.
-    let ours = held_out(&stdout, "friction-node");
-    let stribeck = held_out(&stdout, "Stribeck");
-    assert!(
-        ours < 0.8 * stribeck,
-        "ours {ours} against Stribeck {stribeck}"
-    );
+    assert_curve_beside_offset(&stdout, 0.8);
 }
 
 #[test]
 fn a_rise_that_saturates_inside_the_data_is_found_beside_its_offset() {
     let (code, stdout, err) = fit_fixture("joint-offset-saturating");
     assert_eq!(code, 0, "{err}");
-    assert!(
-        stdout.contains("Chosen: boundary friction, drivetrain Stribeck, drivetrain asymmetry."),
-        "{stdout}"
-    );
-    let ours = held_out(&stdout, "friction-node");
-    let stribeck = held_out(&stdout, "Stribeck");
-    assert!(
-        ours < 0.5 * stribeck,
-        "ours {ours} against Stribeck {stribeck}"
-    );
+    assert_curve_beside_offset(&stdout, 0.5);
 }

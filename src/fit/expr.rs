@@ -419,19 +419,10 @@ impl Columns<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::table::Delimiter;
-    use std::path::Path;
 
     #[test]
     fn a_column_named_in_another_case_is_pointed_at() {
-        let table = Table::parse(
-            "Velocity_m_s,Friction_N\n0.1,1\n0.2,2\n",
-            Path::new("c.csv"),
-            Delimiter::Auto,
-            None,
-            0,
-        )
-        .unwrap();
+        let table = Table::of_csv("Velocity_m_s,Friction_N\n0.1,1\n0.2,2\n", "c.csv");
         let Err(err) = compile("--velocity", "velocity_m_s", &table, &mut Vec::new(), &[]) else {
             panic!("a column was read under another case");
         };

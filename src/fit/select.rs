@@ -269,6 +269,7 @@ pub fn select(
         stop,
         given,
         presumed: std::sync::OnceLock::new(),
+        stribeck_curves: std::sync::OnceLock::new(),
         scored: std::sync::Mutex::new(Vec::new()),
         not_admitted: std::sync::Mutex::new(Vec::new()),
     };

@@ -458,11 +458,9 @@ impl Source {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::table::Delimiter;
-    use std::path::Path;
 
     fn table(text: &str) -> Table {
-        Table::parse(text, Path::new("m.csv"), Delimiter::Auto, None, 0).unwrap()
+        Table::of_csv(text, "m.csv")
     }
 
     #[test]

@@ -249,15 +249,14 @@ pub fn unread_columns(mapping: &super::Mapping, table: &super::Table) -> Option<
 mod tests {
     use super::*;
     use crate::fit::Source;
-    use crate::table::{Delimiter, Table};
-    use std::path::Path;
+    use crate::table::Table;
 
     fn joint_table(header: &str, speeds: &[f64]) -> Table {
         let mut text = format!("{header}\n");
         for v in speeds {
             text += &format!("{v},{}\n", 0.3 + 0.05 * v);
         }
-        Table::parse(&text, Path::new("j.csv"), Delimiter::Auto, None, 0).unwrap()
+        Table::of_csv(&text, "j.csv")
     }
 
     fn rotary_velocity(header: &str, speeds: &[f64]) -> (Vec<f64>, Vec<String>) {
@@ -307,14 +306,10 @@ mod tests {
         let (mm_min, _) = read("velocity_mm_min,friction_n", &[600.0, 1200.0]);
         approx::assert_relative_eq!(mm_min[0], 0.01, epsilon = 1e-15);
         // `velocity_m_s` is read as it is, beside any other.
-        let table = Table::parse(
+        let table = Table::of_csv(
             "velocity_m_s,velocity_mm_s,friction_n\n0.5,500,1\n",
-            Path::new("b.csv"),
-            Delimiter::Auto,
-            None,
-            0,
-        )
-        .unwrap();
+            "b.csv",
+        );
         let mut notes = Vec::new();
         let mapping = linear_columns(&crate::fit::Mapping::default(), &table, &mut notes);
         assert_eq!((mapping.velocity.as_str(), notes), ("velocity_m_s", vec![]));
@@ -326,7 +321,7 @@ mod tests {
         for k in 0..4 {
             text += &format!("{k},{},1\n", 0.1 * k as f64);
         }
-        let table = Table::parse(&text, Path::new("s.csv"), Delimiter::Auto, None, 0).unwrap();
+        let table = Table::of_csv(&text, "s.csv");
         let m = time_column(crate::fit::Mapping::default(), &table, &mut notes)?;
         Ok((m.time, notes))
     }
@@ -368,14 +363,10 @@ mod tests {
 
     #[test]
     fn the_columns_a_fit_does_not_read_are_said() {
-        let table = Table::parse(
+        let table = Table::of_csv(
             "velocity_m_s,friction_n,normal_force_n,load_n,note\n0.1,1,5,5,a\n0.2,1,5,5,b\n",
-            Path::new("x.csv"),
-            Delimiter::Auto,
-            None,
-            0,
-        )
-        .unwrap();
+            "x.csv",
+        );
         let mut mapping = crate::fit::Mapping::default();
         let note = unread_columns(&mapping, &table).unwrap();
         // The unread numeric column, not the default load nor a text one.
@@ -425,14 +416,10 @@ mod tests {
         );
         // A joint's column that holds text (a row of units) is named, and
         // reading it says so, not that there is no such column.
-        let table = Table::parse(
+        let table = Table::of_csv(
             "velocity_rad_s,torque_nm\nrad/s,Nm\n1,0.3\n2,0.4\n",
-            Path::new("u.csv"),
-            Delimiter::Auto,
-            None,
-            0,
-        )
-        .unwrap();
+            "u.csv",
+        );
         let mapping =
             rotary_columns(&crate::fit::Mapping::default(), &table, &mut Vec::new()).unwrap();
         assert_eq!(mapping.velocity, "velocity_rad_s");

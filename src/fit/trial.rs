@@ -133,6 +133,9 @@ pub(super) struct Ctx<'a> {
     /// when the set without them predicts the folds better, by the rule a
     /// term must meet to enter.
     pub(super) presumed: std::sync::OnceLock<Vec<&'static str>>,
+    /// The best Stribeck curves on the training data ([`stribeck_curves`]),
+    /// made once, when the first set with a new Stribeck term is tried.
+    pub(super) stribeck_curves: std::sync::OnceLock<Vec<super::classic_regression::GridCurve>>,
     /// Every set scored so far, by its terms in catalogue order: a set
     /// that the removal or the flag checks come back to is the same
     /// problem on the same folds, and is not fitted again.
@@ -351,7 +354,8 @@ impl Ctx<'_> {
             return Vec::new();
         };
         let mut out: Vec<Vec<f64>> = Vec::new();
-        for x in stribeck_curves(self.p).into_iter().map(|c| {
+        let curves = self.stribeck_curves.get_or_init(|| stribeck_curves(self.p));
+        for x in curves.iter().map(|c| {
             let mut x = start.to_vec();
             let mut set = |i: usize, v: f64| x[i] = v.clamp(params[i].lo, params[i].hi);
             set(speed, c.speed * gain);

@@ -54,3 +54,29 @@ pub fn run(args: &[&str]) -> (i32, String, String) {
         String::from_utf8_lossy(&o.stderr).into_owned(),
     )
 }
+
+/// `fit --rotary --fit auto` of the joint fixture `name`
+/// (`tests/fixtures/{name}-train.csv`, copied into a fresh directory of
+/// `suite`, validated on `{name}-validate.csv`), with `extra` arguments:
+/// (exit code, stdout, stderr).
+pub fn fit_joint_fixture(suite: &str, name: &str, extra: &[&str]) -> (i32, String, String) {
+    let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures");
+    let d = fresh_dir(suite, name);
+    let train = d.join("train.csv");
+    std::fs::copy(fixtures.join(format!("{name}-train.csv")), &train).unwrap();
+    let validate = fixtures.join(format!("{name}-validate.csv"));
+    let out = d.join("f.yaml");
+    let mut args = vec![
+        "fit",
+        train.to_str().unwrap(),
+        "--validate",
+        validate.to_str().unwrap(),
+        "--rotary",
+        "--fit",
+        "auto",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    run(&args)
+}
