@@ -103,7 +103,44 @@ pub(super) fn presumed_terms(terms: &[&'static str], shapes: &[&'static str]) ->
     presumed
 }
 
+/// Each shape's criterion in words ("drivetrain viscous −43.6, …"), a
+/// set beside the asymmetry named by its shape.
+fn criteria(sets: &[Scored]) -> String {
+    sets.iter()
+        .map(|s| {
+            let name = match s.tried.terms.first().copied() {
+                Some(ASYMMETRY) | None => "the base alone",
+                Some(t) => t,
+            };
+            format!("{name} {:.1}", s.aicc)
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
 impl Ctx<'_> {
+    /// Rule 7b: each of `sets` (the base, then each shape) fitted beside
+    /// the direction asymmetry, each warm from the one before (the base's
+    /// offset, then the rise beside it, then the curve, whose keys hold the
+    /// rise's), not from its own fit without the offset, which the offset
+    /// distorted.
+    fn beside_asymmetry(
+        &self,
+        sets: &[Scored],
+        tried: &mut Vec<Tried>,
+    ) -> Result<Vec<Scored>, FitError> {
+        let mut with: Vec<Scored> = Vec::with_capacity(sets.len());
+        for s in sets {
+            let terms: Vec<&'static str> =
+                s.tried.terms.iter().copied().chain([ASYMMETRY]).collect();
+            let warm = with.last().map_or(&s.optimum, |w| &w.optimum);
+            let t = self.try_set(&terms, warm)?;
+            tried.push(t.tried.clone());
+            with.push(t);
+        }
+        Ok(with)
+    }
+
     /// Rule 7: on a steady curve the selection starts from the classic
     /// shape that the whole curve supports ([`start_shape`]: the viscous
     /// rise or the Stribeck curve, the simplest whose small-sample Akaike
@@ -128,37 +165,12 @@ impl Ctx<'_> {
             sets.push(t);
         }
         let aiccs: Vec<f64> = sets.iter().map(|s| s.aicc).collect();
-        let criteria = |sets: &[Scored]| -> String {
-            sets.iter()
-                .map(|s| {
-                    let name = match s.tried.terms.first().copied() {
-                        Some(ASYMMETRY) | None => "the base alone",
-                        Some(t) => t,
-                    };
-                    format!("{name} {:.1}", s.aicc)
-                })
-                .collect::<Vec<_>>()
-                .join(", ")
-        };
         let mut list = criteria(&sets);
-        // Rule 7b: each set beside the direction asymmetry too.
-        let mut compared = aiccs.clone();
+        let mut compared = aiccs;
         if offset && !shapes.is_empty() {
-            // Each warm from the one before (the base's offset, then the
-            // rise beside it, then the curve, whose keys hold the rise's),
-            // not from its own fit without the offset, which the offset
-            // distorted.
-            let mut with: Vec<Scored> = Vec::with_capacity(sets.len());
-            for s in &sets {
-                let terms: Vec<&'static str> =
-                    s.tried.terms.iter().copied().chain([ASYMMETRY]).collect();
-                let warm = with.last().map_or(&s.optimum, |w| &w.optimum);
-                let t = self.try_set(&terms, warm)?;
-                tried.push(t.tried.clone());
-                with.push(t);
-            }
+            let with = self.beside_asymmetry(&sets, tried)?;
             let offset_aiccs: Vec<f64> = with.iter().map(|s| s.aicc).collect();
-            if beside_offset(&aiccs, &offset_aiccs) {
+            if beside_offset(&compared, &offset_aiccs) {
                 list = format!(
                     "{list}; beside the direction asymmetry, which the criterion resolves (its lowest more than {AICC_SUPPORT} lower with it), and by which the shapes are compared: {}",
                     criteria(&with)
