@@ -177,12 +177,18 @@ impl Table {
                 return TableError::Cell {
                     path: self.source.clone(),
                     line: cell.line,
-                    message: format!(
-                        "`{}` in column `{name}` is not a number{}{}",
-                        cell.text,
-                        decimal_comma_hint(&cell.text),
-                        self.units_row_hint(cell.line)
-                    ),
+                    message: if cell.text.trim().is_empty() {
+                        format!(
+                            "the cell in column `{name}` is empty: every row needs a number in each column read (drop the row, or fill it)"
+                        )
+                    } else {
+                        format!(
+                            "`{}` in column `{name}` is not a number{}{}",
+                            cell.text,
+                            decimal_comma_hint(&cell.text),
+                            self.units_row_hint(cell.line)
+                        )
+                    },
                 }
             }
             None => format!(
@@ -490,6 +496,18 @@ mod tests {
         let t = Table::parse("v;f\n1,2,3;x\n", p, Delimiter::Auto, None, 0).unwrap();
         assert!(!t.column_error("v").to_string().contains("decimal comma"));
         assert!(!t.column_error("f").to_string().contains("decimal comma"));
+    }
+
+    #[test]
+    fn an_empty_cell_is_named_as_empty_with_its_line() {
+        let p = Path::new("gap.csv");
+        let t = Table::parse("v,f\n1,2\n2,\n3,4\n", p, Delimiter::Auto, None, 0).unwrap();
+        let m = t.column_error("f").to_string();
+        assert!(
+            m.contains("gap.csv:3") && m.contains("the cell in column `f` is empty"),
+            "{m}"
+        );
+        assert!(!m.contains("``"), "{m}");
     }
 
     #[test]

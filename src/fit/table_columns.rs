@@ -1,7 +1,8 @@
 //! How a table's columns become a fit's inputs when `--velocity`,
 //! `--friction` and `--time` keep their defaults: a joint's columns under
-//! `--rotary` (rad/s, deg/s or rpm; N·m), a linear axis's velocity named
-//! with another unit (mm/s, m/min, mm/min), a time column named with its
+//! `--rotary` (rad/s, deg/s or rpm; N·m or N·mm), a linear axis's velocity
+//! and friction named with another unit (mm/s, m/min, mm/min; mN, kN, or
+//! `force_n`), a time column named with its
 //! unit, the errors that point at what was meant (a joint's table without
 //! `--rotary`, a time column without a unit), and the columns a fit does
 //! not read, said.
@@ -16,15 +17,24 @@ const ROTARY_VELOCITY_COLUMNS: &[(&str, f64)] = &[
     ("velocity_rpm", std::f64::consts::PI / 30.0),
 ];
 /// The column names a joint's table may use for the friction when
-/// `--friction` keeps its default, N·m.
-const ROTARY_FRICTION_COLUMNS: &[&str] =
-    &["friction_nm", "friction_n_m", "torque_nm", "torque_n_m"];
+/// `--friction` keeps its default, each with its factor to N·m.
+const ROTARY_FRICTION_COLUMNS: &[(&str, f64)] = &[
+    ("friction_nm", 1.0),
+    ("friction_n_m", 1.0),
+    ("torque_nm", 1.0),
+    ("torque_n_m", 1.0),
+    ("friction_nmm", 1e-3),
+    ("friction_n_mm", 1e-3),
+    ("torque_nmm", 1e-3),
+    ("torque_n_mm", 1e-3),
+];
 
 /// `--rotary` with the default column names: a table without
 /// `velocity_m_s` / `friction_n` but with a joint's names (`velocity_rad_s`,
-/// `velocity_deg_s`, `velocity_rpm`, `friction_nm`, `torque_nm`, …) is read
-/// through those, a velocity in deg/s or rpm converted to rad/s (said in
-/// `notes`). A table with none of them is an error that names them.
+/// `velocity_deg_s`, `velocity_rpm`, `friction_nm`, `torque_nm`,
+/// `torque_nmm`, …) is read through those, a velocity in deg/s or rpm
+/// converted to rad/s and a torque in N·mm to N·m (said in `notes`). A
+/// table with none of them is an error that names them.
 pub fn rotary_columns(
     mapping: &super::Mapping,
     table: &super::Table,
@@ -38,24 +48,22 @@ pub fn rotary_columns(
     let velocity = if keeps(&mapping.velocity, &defaults.velocity) {
         mapping.velocity.clone()
     } else {
-        velocity_by_unit(table, ROTARY_VELOCITY_COLUMNS, "rad/s", notes).ok_or_else(|| {
-            let names: Vec<&str> = ROTARY_VELOCITY_COLUMNS.iter().map(|(c, _)| *c).collect();
-            unknown_column(
-                table,
-                "velocity",
-                &names,
-                "in rad/s (a column in deg/s: `--velocity 'COLUMN * 0.017453292519943295'`)",
-            )
-        })?
+        column_by_unit(table, ROTARY_VELOCITY_COLUMNS, "velocity", "rad/s", notes).ok_or_else(
+            || {
+                unknown_column(
+                    table,
+                    "velocity",
+                    ROTARY_VELOCITY_COLUMNS,
+                    "in rad/s (a column in deg/s: `--velocity 'COLUMN * 0.017453292519943295'`)",
+                )
+            },
+        )?
     };
     let friction = if keeps(&mapping.friction, &defaults.friction) {
         mapping.friction.clone()
     } else {
-        ROTARY_FRICTION_COLUMNS
-            .iter()
-            .find(|c| has(c))
+        column_by_unit(table, ROTARY_FRICTION_COLUMNS, "friction", "N·m", notes)
             .ok_or_else(|| unknown_column(table, "friction", ROTARY_FRICTION_COLUMNS, "in N·m"))?
-            .to_string()
     };
     Ok(super::Mapping {
         velocity,
@@ -66,10 +74,11 @@ pub fn rotary_columns(
 
 /// The first of `columns` (name, factor to `unit`) that `table` has, as the
 /// expression that reads it in `unit`; a factor other than 1 is said in
-/// `notes`.
-fn velocity_by_unit(
+/// `notes` (`what`: the velocity, the friction).
+fn column_by_unit(
     table: &super::Table,
     columns: &[(&str, f64)],
+    what: &str,
     unit: &str,
     notes: &mut Vec<String>,
 ) -> Option<String> {
@@ -78,7 +87,7 @@ fn velocity_by_unit(
         return Some(name.to_string());
     }
     notes.push(format!(
-        "{}: the velocity is `{name}`, read as {unit}: `{name} * {factor:e}`",
+        "{}: the {what} is `{name}`, read as {unit}: `{name} * {factor:e}`",
         table.source.display()
     ));
     Some(format!("{name} * {factor:e}"))
@@ -93,26 +102,43 @@ const LINEAR_VELOCITY_COLUMNS: &[(&str, f64)] = &[
     ("velocity_mm_min", 1.0 / 60_000.0),
 ];
 
-/// Without `--rotary`, with the default `--velocity` and no `velocity_m_s`
-/// in `table`: a linear axis's velocity named with another unit
-/// (`velocity_mm_s`, `velocity_m_min`, `velocity_mm_min`) is read in m/s
-/// and said in `notes`. Otherwise `mapping` is kept as it is.
+/// A linear axis's friction columns named otherwise than `friction_n`,
+/// read when `--friction` keeps its default and the table has no
+/// `friction_n`, each with its factor to N.
+const LINEAR_FRICTION_COLUMNS: &[(&str, f64)] = &[
+    ("force_n", 1.0),
+    ("friction_mn", 1e-3),
+    ("force_mn", 1e-3),
+    ("friction_kn", 1e3),
+    ("force_kn", 1e3),
+];
+
+/// Without `--rotary`: with the default `--velocity` and no `velocity_m_s`
+/// in `table`, a linear axis's velocity named with another unit
+/// (`velocity_mm_s`, `velocity_m_min`, `velocity_mm_min`) is read in m/s;
+/// with the default `--friction` and no `friction_n`, a friction named
+/// `force_n`, or with another unit (`friction_mn`, `friction_kn`, …), is
+/// read in N; a factor is said in `notes`. Otherwise the column is kept as
+/// `mapping` names it.
 pub fn linear_columns(
     mapping: &super::Mapping,
     table: &super::Table,
     notes: &mut Vec<String>,
 ) -> super::Mapping {
     let defaults = super::Mapping::default();
-    if mapping.velocity != defaults.velocity || table.index(&mapping.velocity).is_some() {
-        return mapping.clone();
+    let by_default = |given: &str, default: &str| given == default && table.index(given).is_none();
+    let mut out = mapping.clone();
+    if by_default(&mapping.velocity, &defaults.velocity) {
+        if let Some(v) = column_by_unit(table, LINEAR_VELOCITY_COLUMNS, "velocity", "m/s", notes) {
+            out.velocity = v;
+        }
     }
-    match velocity_by_unit(table, LINEAR_VELOCITY_COLUMNS, "m/s", notes) {
-        Some(velocity) => super::Mapping {
-            velocity,
-            ..mapping.clone()
-        },
-        None => mapping.clone(),
+    if by_default(&mapping.friction, &defaults.friction) {
+        if let Some(f) = column_by_unit(table, LINEAR_FRICTION_COLUMNS, "friction", "N", notes) {
+            out.friction = f;
+        }
     }
+    out
 }
 
 /// Time columns named with their unit, read in seconds when `--time` is
@@ -171,7 +197,8 @@ pub fn time_column(
 
 /// Under `--rotary`, no `what` column of the joint's `names` in `table`:
 /// the error lists the table's columns and how to name one (`hint`).
-fn unknown_column(table: &super::Table, what: &str, names: &[&str], hint: &str) -> FitError {
+fn unknown_column(table: &super::Table, what: &str, names: &[(&str, f64)], hint: &str) -> FitError {
+    let names: Vec<&str> = names.iter().map(|(c, _)| *c).collect();
     FitError::Data {
         what: table.source.display().to_string(),
         message: format!(
@@ -313,6 +340,41 @@ mod tests {
         let mut notes = Vec::new();
         let mapping = linear_columns(&crate::fit::Mapping::default(), &table, &mut notes);
         assert_eq!((mapping.velocity.as_str(), notes), ("velocity_m_s", vec![]));
+    }
+
+    #[test]
+    fn a_friction_in_mn_kn_or_n_mm_is_read_in_n_or_n_m_and_said() {
+        let read = |header: &str, rotary: bool| {
+            let mut notes = Vec::new();
+            let table = joint_table(header, &[1.0, 2.0]);
+            let defaults = crate::fit::Mapping::default();
+            let mapping = if rotary {
+                rotary_columns(&defaults, &table, &mut notes).unwrap()
+            } else {
+                linear_columns(&defaults, &table, &mut notes)
+            };
+            let series = Source::new(table, &mapping).unwrap().series(&[]).unwrap();
+            (series.friction, notes)
+        };
+        // joint_table writes 0.3 + 0.05 v in the friction column.
+        let (mn, notes) = read("velocity_m_s,friction_mn", false);
+        approx::assert_relative_eq!(mn[1], 0.4e-3, epsilon = 1e-15);
+        assert!(
+            notes[0].contains("the friction is `friction_mn`, read as N"),
+            "{notes:?}"
+        );
+        let (kn, _) = read("velocity_mm_s,force_kn", false);
+        approx::assert_relative_eq!(kn[0], 350.0, epsilon = 1e-9);
+        let (n, notes) = read("velocity_m_s,force_n", false);
+        assert_eq!((n[0], notes.len()), (0.35, 0));
+        let (nmm, notes) = read("velocity_rad_s,torque_nmm", true);
+        approx::assert_relative_eq!(nmm[1], 0.4e-3, epsilon = 1e-15);
+        assert!(notes[0].contains("`torque_nmm`, read as N·m"), "{notes:?}");
+        // `friction_n` is read as it is, beside any other.
+        let table = Table::of_csv("velocity_m_s,friction_n,friction_mn\n0.5,1,1000\n", "b.csv");
+        let mut notes = Vec::new();
+        let mapping = linear_columns(&crate::fit::Mapping::default(), &table, &mut notes);
+        assert_eq!((mapping.friction.as_str(), notes), ("friction_n", vec![]));
     }
 
     fn time_of(header: &str) -> Result<(Option<String>, Vec<String>), FitError> {
