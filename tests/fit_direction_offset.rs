@@ -71,3 +71,39 @@ fn a_rise_that_saturates_inside_the_data_is_found_beside_its_offset() {
     assert_eq!(code, 0, "{err}");
     assert_curve_beside_offset(&stdout, 0.5);
 }
+
+#[test]
+fn a_curve_taken_one_way_only_has_no_direction_asymmetry_to_choose() {
+    // The rise's forward half: a level that differs by direction is the
+    // level itself here, so it is not a candidate, and says why.
+    let fixtures = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures");
+    let text = std::fs::read_to_string(fixtures.join("joint-offset-rise-train.csv")).unwrap();
+    let mut lines = text.lines();
+    let mut forward = format!("{}\n", lines.next().unwrap());
+    for l in lines.filter(|l| !l.starts_with('-')) {
+        forward += &format!("{l}\n");
+    }
+    let d = common::cli::fresh_dir("direction-offset", "one-way");
+    let train = d.join("forward.csv");
+    std::fs::write(&train, forward).unwrap();
+    let out = d.join("f.yaml");
+    let (code, stdout, err) = common::cli::run(&[
+        "fit",
+        train.to_str().unwrap(),
+        "--rotary",
+        "--fit",
+        "auto",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        stdout.contains(
+            "Not a candidate on these data: drivetrain asymmetry: the training data slide one way only"
+        ),
+        "{stdout}"
+    );
+    assert!(
+        !stdout.contains("Chosen: boundary friction, drivetrain Stribeck, drivetrain asymmetry")
+    );
+}

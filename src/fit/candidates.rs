@@ -312,6 +312,7 @@ pub(super) fn candidates_here(
     let mut excluded: Vec<String> = Vec::new();
     let mut candidates = Vec::new();
     let no_reversal = p.scale.reversal_stiffness_n_m.is_none();
+    let one_way = moves_one_way(p);
     for c in CANDIDATES {
         if c.needs_varying_load && !p.loads_vary {
             continue;
@@ -320,6 +321,13 @@ pub(super) fn candidates_here(
         // case it is chosen does not).
         let fitted = |k: &&str| given.iter().any(|g| g.name == *k && !g.if_chosen);
         if c.keys.iter().any(fitted) {
+            continue;
+        }
+        if one_way && c.name == ASYMMETRY {
+            excluded.push(format!(
+                "{}: the training data slide one way only, and a level that differs by direction shows only where they slide both ways (it would be the level itself)",
+                c.name
+            ));
             continue;
         }
         if no_reversal && c.keys.iter().any(|k| k.contains("presliding_")) {
@@ -338,6 +346,22 @@ pub(super) fn candidates_here(
         }
     }
     (candidates, excluded)
+}
+
+/// Whether `p`'s training data slide one way only: no sample faster than
+/// [`SLIDING_FRACTION`](super::by_direction::SLIDING_FRACTION) of the top
+/// speed in one of the two directions.
+fn moves_one_way(p: &Prepared) -> bool {
+    let slow = super::by_direction::SLIDING_FRACTION * p.scale.velocity_m_s;
+    let (mut forward, mut backward) = (false, false);
+    for s in &p.data.train {
+        let Ok(se) = s.series(&p.data.map_values) else {
+            return false;
+        };
+        forward |= se.velocity.iter().any(|&v| v >= slow);
+        backward |= se.velocity.iter().any(|&v| v <= -slow);
+    }
+    !(forward && backward)
 }
 
 /// The candidate named `film` (the viscosity), and its key.
