@@ -492,9 +492,11 @@ def fit(
     contact's load are chosen from the data); with ``velocity`` and
     ``friction`` left at their defaults it reads a joint's columns by name
     (``velocity_rad_s``, or ``velocity_deg_s`` / ``velocity_rpm`` converted
-    to rad/s; ``friction_nm``, ``torque_nm``...); without it, a table
-    with no ``velocity_m_s`` but ``velocity_mm_s``, ``velocity_m_min`` or
-    ``velocity_mm_min`` is read in m/s. ``jacobian`` (``"secant"`` or
+    to rad/s; ``friction_nm``, ``torque_nm``..., or ``torque_nmm`` in
+    N·mm converted to N·m); without it, a table with no ``velocity_m_s``
+    but ``velocity_mm_s``, ``velocity_m_min`` or ``velocity_mm_min`` is
+    read in m/s, and one with no ``friction_n`` but ``force_n``,
+    ``friction_mn`` or ``friction_kn`` is read in N. ``jacobian`` (``"secant"`` or
     ``"differences"``), ``later_runs`` (``"full"`` or ``"valley"``),
     ``linear_keys`` (``"solved"`` or ``"searched"``) and ``cheap_keys``
     (``"profiled"`` or ``"searched"``) choose how the search runs, as
