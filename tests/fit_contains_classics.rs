@@ -476,3 +476,24 @@ fn a_stribeck_dip_the_noise_made_gives_way_to_the_viscous_rise_beneath_it() {
     );
     assert_held_out_within(&md, "Coulomb + viscous", 1.05);
 }
+
+#[test]
+fn a_path_of_removals_that_ends_on_a_set_its_start_beats_goes_back_to_the_start() {
+    // Random joint 14 of seed 241 (drawn after rule 10): a Stribeck dip,
+    // f_c 0.630, f_s 1.110 N·m, ω_s 0.222 rad/s, b 0.350 N·m·s/rad. The
+    // curve gave way to its rise beside the film, the film went as
+    // confounded with the rise, the rise ended at zero: the base alone
+    // (criterion −83.3 against the curve's −174.6, CV 0.154 against
+    // 0.043 N·m) predicted 25–90 deg/s 1.9× worse than Stribeck.
+    let md = fit_joint_fixture("joint-dip-path");
+    let chosen = chosen(&md);
+    assert!(
+        chosen.starts_with("Chosen: boundary friction, drivetrain Stribeck."),
+        "{chosen}"
+    );
+    assert!(
+        md.contains("the base alone → drivetrain Stribeck: the selection's path ended there"),
+        "rule 11 says why"
+    );
+    assert_held_out_within(&md, "Stribeck", 1.05);
+}

@@ -178,7 +178,7 @@ impl Ctx<'_> {
             };
             let change = change_text(t, form);
             say(&format!(
-                "auto: {change}: no longer pays beside {newest} (CV RMS {})",
+                "auto: {change}: no longer pays beside {newest} ({})",
                 cv(&lighter.tried, self.p)
             ));
             removed.push(format!(
@@ -263,7 +263,7 @@ impl Ctx<'_> {
                 "and that set predicts as well"
             };
             say(&format!(
-                "auto: {change}: {}, {outcome} (CV RMS {})",
+                "auto: {change}: {}, {outcome} ({})",
                 f.why,
                 cv(&next.tried, self.p)
             ));
@@ -377,12 +377,17 @@ pub(super) fn change_text(t: &str, form: Option<&str>) -> String {
     }
 }
 
+/// A set's cross-validated error for the progress lines, "CV RMS 0.35 N",
+/// or why the set has none ("not admitted (below)", "its fit failed").
 pub(super) fn cv(t: &Tried, p: &Prepared) -> String {
-    format!(
-        "{} {}",
-        crate::text::Num::sig(t.cv_rms, 5),
-        p.data.units.force()
-    )
+    match t.unscored {
+        Some(why) => why.to_string(),
+        None => format!(
+            "CV RMS {} {}",
+            crate::text::Num::sig(t.cv_rms, 5),
+            p.data.units.force()
+        ),
+    }
 }
 
 #[cfg(test)]
