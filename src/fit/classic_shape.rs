@@ -200,7 +200,7 @@ impl Ctx<'_> {
             };
             let why = if best.tried.terms.is_empty() {
                 format!(
-                    "the selection starts from the base alone: no rising classic shape could be fitted to these points (small-sample Akaike criterion on all the training points: {list})"
+                    "the selection starts from the base alone: no rising classic shape could be fitted and scored on these points (a shape's criterion needs more points than its keys + 1; small-sample Akaike criterion on all the training points: {list})"
                 )
             } else {
                 format!(

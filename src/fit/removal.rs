@@ -378,10 +378,15 @@ pub(super) fn change_text(t: &str, form: Option<&str>) -> String {
 }
 
 /// A set's cross-validated error for the progress lines, "CV RMS 0.35 N",
-/// or why the set has none ("not admitted (below)", "its fit failed").
+/// or why the set has none ("not admitted (below)", "its fit failed",
+/// "cannot be scored on these folds").
 pub(super) fn cv(t: &Tried, p: &Prepared) -> String {
     match t.unscored {
         Some(why) => why.to_string(),
+        None if !is_scored(t) => {
+            "cannot be scored on these folds (a fold too small for its keys, or a refit that failed)"
+                .to_string()
+        }
         None => format!(
             "CV RMS {} {}",
             crate::text::Num::sig(t.cv_rms, 5),
