@@ -40,8 +40,26 @@ pub(super) fn start_beats(start: &Scored, end: &Scored) -> bool {
     pays(&end.tried, &start.tried).0 && start.aicc < end.aicc - AICC_SUPPORT
 }
 
+/// Rule 11 applied: `end`, or, on a steady curve whose `start` beats it
+/// ([`start_beats`]), the start, with why said and recorded in `removed`.
+pub(super) fn back_to_start(
+    start: Scored,
+    end: Scored,
+    steady: bool,
+    removed: &mut Vec<String>,
+    say: &(dyn Fn(&str) + Sync),
+) -> Scored {
+    if !(steady && start_beats(&start, &end)) {
+        return end;
+    }
+    let why = why_back_to_start(&start, &end);
+    say(&format!("auto: {why}"));
+    removed.push(why);
+    start
+}
+
 /// Why the selection went back to its start (rule 11), for the report.
-pub(super) fn why_back_to_start(start: &Scored, end: &Scored) -> String {
+fn why_back_to_start(start: &Scored, end: &Scored) -> String {
     let name = |s: &Scored| {
         if s.tried.terms.is_empty() {
             "the base alone".to_string()

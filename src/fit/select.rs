@@ -164,7 +164,7 @@
 use super::candidates::{candidates_here, holds, parts_to_add, set_keys, Candidate, ASYMMETRY};
 use super::classic_shape::{classic_shapes, without_subsumed};
 use super::cross_validate::paired;
-use super::curve_support::{start_beats, why_back_to_start};
+use super::curve_support::back_to_start;
 use super::options::SearchSettings;
 use super::prepared::Prepared;
 use super::removal::{cv, keeps_part, pays};
@@ -270,21 +270,8 @@ pub fn select(
     for e in &excluded {
         say(&format!("auto: not a candidate on these data: {e}"));
     }
-    let data = p.data.training_only();
-    let folds = super::cross_validate::folds_for(&data);
     let steady = p.data.train.iter().all(|s| s.is_steady());
-    let ctx = Ctx {
-        p,
-        data,
-        folds,
-        search,
-        stop,
-        given,
-        presumed: std::sync::OnceLock::new(),
-        stribeck_curves: std::sync::OnceLock::new(),
-        scored: std::sync::Mutex::new(Vec::new()),
-        not_admitted: std::sync::Mutex::new(Vec::new()),
-    };
+    let ctx = Ctx::new(p, search, given, stop);
     let base = ctx.try_set(&[], &Vec::new())?;
     say(&format!(
         "auto: base (boundary friction): {}",
@@ -309,28 +296,22 @@ pub fn select(
     let current = ctx.add_parts(current, &candidates, &mut tried, &mut added, say)?;
     // A term that ends at zero or at a bound, or that the data cannot tell
     // from another, is dropped and the set fitted again.
-    let mut current = ctx.drop_flagged(current, &mut tried, &mut removed, say)?;
+    let current = ctx.drop_flagged(current, &mut tried, &mut removed, say)?;
     // Rule 11: a path that ends on a set its start beats on both the folds
     // and the whole curve's criterion goes back to the start.
-    if steady && start_beats(&start_set, &current) {
-        let why = why_back_to_start(&start_set, &current);
-        say(&format!("auto: {why}"));
-        removed.push(why);
-        current = start_set;
-    }
+    let current = back_to_start(start_set, current, steady, &mut removed, say);
     listed_once(&mut tried);
     let (chosen, presumed) = without_subsumed(
         &current.tried.terms,
         &ctx.presumed.get().cloned().unwrap_or_default(),
     );
     let keys = fitted_keys(&chosen, given);
-    let mut not_admitted = ctx
-        .not_admitted
-        .into_inner()
-        .unwrap_or_else(|p| p.into_inner());
     // Each once: a set come back to is refused again with the same words.
-    let mut seen = std::collections::HashSet::new();
-    not_admitted.retain(|n| seen.insert(n.clone()));
+    let not_admitted = once_each(
+        ctx.not_admitted
+            .into_inner()
+            .unwrap_or_else(|p| p.into_inner()),
+    );
     for n in &not_admitted {
         say(&format!("auto: not admitted: {n}"));
     }
@@ -345,11 +326,18 @@ pub fn select(
         presumed,
         start,
         keys,
-        folds: super::cross_validate::describe(folds, p.data.train.iter().all(|s| s.is_steady())),
+        folds: super::cross_validate::describe(ctx.folds, steady),
         why,
         wall_s: wall.elapsed().as_secs_f64(),
         scored: ctx.scored.into_inner().unwrap_or_else(|p| p.into_inner()),
     })
+}
+
+/// `lines` with each line once, in the order first said.
+fn once_each(mut lines: Vec<String>) -> Vec<String> {
+    let mut seen = std::collections::HashSet::new();
+    lines.retain(|n| seen.insert(n.clone()));
+    lines
 }
 
 /// The candidates a step tries beside `terms`: not chosen yet, their

@@ -145,6 +145,32 @@ pub(super) struct Ctx<'a> {
     pub(super) not_admitted: std::sync::Mutex<Vec<String>>,
 }
 
+impl<'a> Ctx<'a> {
+    /// A selection's shared state on `p`'s training data, cut into the
+    /// folds that suit them (`cross_validate::folds_for`).
+    pub(super) fn new(
+        p: &'a Prepared,
+        search: &'a SearchSettings,
+        given: &'a [ParamSpec],
+        stop: &'a crate::interrupt::Stop,
+    ) -> Self {
+        let data = p.data.training_only();
+        let folds = super::cross_validate::folds_for(&data);
+        Ctx {
+            p,
+            data,
+            folds,
+            search,
+            stop,
+            given,
+            presumed: std::sync::OnceLock::new(),
+            stribeck_curves: std::sync::OnceLock::new(),
+            scored: std::sync::Mutex::new(Vec::new()),
+            not_admitted: std::sync::Mutex::new(Vec::new()),
+        }
+    }
+}
+
 /// The viscosities that put the film's transition inside the data, when
 /// the contact's scale put it far above them (`contact_scale.rs`): at the
 /// top speed, the slowest sliding speed and between (the transition speed
