@@ -153,8 +153,10 @@ pub(super) fn compile(
                 .iter()
                 .find(|n| !is_identifier(n))
                 .map_or_else(String::new, |n| {
+                    let example = identifiers_for(&table.names)
+                        .map_or_else(String::new, |c| format!(", here `--columns {c}`"));
                     format!(
-                        "; a column whose name is not an identifier (`{n}`) is named for expressions with --columns NAME,... (one name per column, replacing the header's)"
+                        "; a column whose name is not an identifier (`{n}`) is named for expressions with --columns NAME,... (one name per column, replacing the header's){example}"
                     )
                 });
             // Names are case-sensitive: `Velocity_m_s` is not `velocity_m_s`.
@@ -192,6 +194,40 @@ fn is_identifier(name: &str) -> bool {
     c.next()
         .is_some_and(|f| f.is_ascii_alphabetic() || f == '_')
         && c.all(|x| x.is_ascii_alphanumeric() || x == '_')
+}
+
+/// The header `names` as identifiers an expression can name, the unit
+/// kept as the default columns write it (`velocity (m/s)` →
+/// `velocity_m_s`, `Torque [N·m]` → `torque_nm`, `Force [N]` →
+/// `force_n`), comma-separated for `--columns`; None when two would be
+/// the same or one would be empty.
+fn identifiers_for(names: &[String]) -> Option<String> {
+    let mut out: Vec<String> = Vec::with_capacity(names.len());
+    for n in names {
+        let mut id = String::new();
+        let chars: Vec<char> = n.trim().to_lowercase().chars().collect();
+        for (i, &c) in chars.iter().enumerate() {
+            // A product of units (N·m, N.m, N*m) is written together.
+            let joins = matches!(c, '·' | '.' | '*' | '⋅')
+                && i > 0
+                && chars[i - 1].is_ascii_alphabetic()
+                && chars.get(i + 1).is_some_and(|x| x.is_ascii_alphabetic());
+            if c.is_ascii_alphanumeric() {
+                id.push(c);
+            } else if !joins && !id.ends_with('_') {
+                id.push('_');
+            }
+        }
+        let mut id = id.trim_matches('_').to_string();
+        if id.starts_with(|c: char| c.is_ascii_digit()) {
+            id.insert(0, '_');
+        }
+        if id.is_empty() || out.contains(&id) {
+            return None;
+        }
+        out.push(id);
+    }
+    Some(out.join(","))
 }
 
 /// `text` with each `ddt(NAME)` and `smooth(NAME)` replaced by its
@@ -433,5 +469,36 @@ mod tests {
             "{err}"
         );
         assert!(compile("--velocity", "Velocity_m_s", &table, &mut Vec::new(), &[]).is_ok());
+    }
+
+    #[test]
+    fn headers_with_units_in_brackets_get_a_columns_line_that_names_them_as_the_defaults() {
+        let names =
+            |h: &[&str]| identifiers_for(&h.iter().map(|s| s.to_string()).collect::<Vec<_>>());
+        assert_eq!(
+            names(&["velocity (m/s)", "friction (N)"]).as_deref(),
+            Some("velocity_m_s,friction_n")
+        );
+        assert_eq!(
+            names(&["Time [ms]", "Velocity [mm/s]", "Force [N]"]).as_deref(),
+            Some("time_ms,velocity_mm_s,force_n")
+        );
+        assert_eq!(
+            names(&["velocity (rad/s)", "torque (N·m)", "torque (N.mm)"]).as_deref(),
+            Some("velocity_rad_s,torque_nm,torque_nmm")
+        );
+        assert_eq!(names(&["2nd", "x"]).as_deref(), Some("_2nd,x"));
+        // Two that would be one name, or one that would be empty: none.
+        assert_eq!(names(&["v (m/s)", "v [m/s]"]), None);
+        assert_eq!(names(&["v", "(-)"]), None);
+        let table = Table::of_csv("velocity (m/s),friction (N)\n0.1,1\n0.2,2\n", "u.csv");
+        let Err(err) = compile("--velocity", "velocity_m_s", &table, &mut Vec::new(), &[]) else {
+            panic!("a column was read that the table does not have");
+        };
+        assert!(
+            err.to_string()
+                .ends_with("here `--columns velocity_m_s,friction_n`"),
+            "{err}"
+        );
     }
 }
