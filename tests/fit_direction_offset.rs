@@ -74,28 +74,10 @@ fn a_rise_that_saturates_inside_the_data_is_found_beside_its_offset() {
 
 #[test]
 fn a_curve_taken_one_way_only_has_no_direction_asymmetry_to_choose() {
-    // The rise's forward half: a level that differs by direction is the
-    // level itself here, so it is not a candidate, and says why.
-    let fixtures = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures");
-    let text = std::fs::read_to_string(fixtures.join("joint-offset-rise-train.csv")).unwrap();
-    let mut lines = text.lines();
-    let mut forward = format!("{}\n", lines.next().unwrap());
-    for l in lines.filter(|l| !l.starts_with('-')) {
-        forward += &format!("{l}\n");
-    }
-    let d = common::cli::fresh_dir("direction-offset", "one-way");
-    let train = d.join("forward.csv");
-    std::fs::write(&train, forward).unwrap();
-    let out = d.join("f.yaml");
-    let (code, stdout, err) = common::cli::run(&[
-        "fit",
-        train.to_str().unwrap(),
-        "--rotary",
-        "--fit",
-        "auto",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    // The rise's forward half (`joint-offset-rise-forward-*`): a level that
+    // differs by direction is the level itself here, so it is not a
+    // candidate, and the report says why.
+    let (code, stdout, err) = fit_fixture("joint-offset-rise-forward");
     assert_eq!(code, 0, "{err}");
     assert!(
         stdout.contains(
