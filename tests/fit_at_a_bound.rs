@@ -2,7 +2,7 @@
 //! `tests/fixtures/joint-speed-at-bound-*.csv` (a random steady joint of
 //! `docs/arm-steady-draws.sh`, seed 107 joint 16: a Stribeck peak of
 //! f_s 3.22 against f_c 2.15 N·m at ω_s 0.373 rad/s, above the data's top
-//! speed 0.349) puts the Stribeck curve's speed on rule 9's bound, the
+//! speed 0.349) puts the Stribeck curve's speed on rule 8's bound, the
 //! data's top speed. Under the sine transform Levenberg–Marquardt crawled
 //! toward it until its budget ended: "NOT converged", exit 4, on 16 of 768
 //! random joints. `fit/bound_polish.rs` holds the speed on its bound, fits

@@ -9,7 +9,7 @@
 //! bound until its budget ends ("not converged: evaluation limit
 //! reached"). On the random steady joints of `docs/arm-steady-draws.sh`
 //! that was the end of 16 of 768 fits, each with its Stribeck speed on the
-//! data's top speed (rule 9's bound).
+//! data's top speed (rule 8's bound).
 //!
 //! The step here: the searched parameters within [`NEAR`] of a bound
 //! (a fraction of their scaled range) are set on it and held, the others
