@@ -18,7 +18,7 @@
 # Run from anywhere: bash bags/regenerate.sh
 # Needs: cargo, python3 with
 #   pip install "mcap==1.*" "mcap-ros2-support==0.*" "rosbags==0.11.*" numpy
-# Regenerate after a deliberate change to the solver's numbers: tests/replay.rs
+# Regenerate after a deliberate change to the solver's numbers: tests/replay/fidelity.rs
 # checks that the node bag replays within 1e-6 of what was recorded.
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -1,7 +1,7 @@
 //! The real-time loop on simulated time (exact step counts: no test here
 //! depends on how busy the machine is): deadlines, catch-up, clock jumps,
 //! command validation and accounting, timeouts, statistics. Recording is
-//! tested in `tests/recording.rs`.
+//! tested in `tests/recording/`.
 
 mod common;
 use common::{drain, timer_config};

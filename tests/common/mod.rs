@@ -1,5 +1,5 @@
 //! Helpers shared by the integration tests: the loop's (`tests/node.rs`,
-//! `tests/recording.rs`) and running the binary (`cli`). Each test file
+//! `tests/recording/`) and running the binary (`cli`). Each test file
 //! uses some of them.
 #![allow(dead_code)]
 
