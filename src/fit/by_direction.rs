@@ -97,6 +97,9 @@ pub struct SourceResidual {
     pub backward: GroupResidual,
     /// The slower samples, around reversals and rest.
     pub reversal: GroupResidual,
+    /// Whether the source is a steady curve: its slower samples are then
+    /// its slowest steady points, not a passage through reversal.
+    pub steady: bool,
 }
 
 impl SourceResidual {
@@ -167,6 +170,7 @@ pub fn source_residuals(
                             forward: GroupResidual::default(),
                             backward: GroupResidual::default(),
                             reversal: GroupResidual::default(),
+                            steady: s.steady,
                         });
                         out.len() - 1
                     }
@@ -212,10 +216,11 @@ pub fn direction_table(o: &FitOutcome) -> String {
         "| source | role | motion | samples | mean speed ({speed_unit}) | measured mean ({f}) | model mean ({f}) | bias ({f}) | RMS ({f}) |\n|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in source_residuals(&o.train, &o.held_out, &o.validate) {
+        let slow = if r.steady { "slow" } else { "reversal" };
         for (motion, g) in [
             ("forward", &r.forward),
             ("backward", &r.backward),
-            ("reversal", &r.reversal),
+            (slow, &r.reversal),
         ] {
             if g.samples == 0 {
                 continue;
@@ -236,7 +241,8 @@ pub fn direction_table(o: &FitOutcome) -> String {
     }
     let _ = writeln!(
         s,
-        "\nforward / backward: sliding faster than {:.0} % of the source's top speed; reversal: the rest. \
+        "\nforward / backward: sliding faster than {:.0} % of the source's top speed; reversal: the rest \
+         (slow on a steady curve, which passes through no reversal). \
          Bias = mean(model − measured).",
         100.0 * SLIDING_FRACTION
     );
@@ -403,5 +409,18 @@ mod tests {
             v.reversal.samples
         );
         assert!(v.forward.mean_speed_m_s().unwrap() > 0.005);
+    }
+
+    #[test]
+    fn a_steady_curves_slowest_points_are_called_slow_not_a_reversal() {
+        let mut curve = source(0.0, 0.0);
+        let mut series = (*curve.series).clone();
+        series.steady = true;
+        curve.series = std::sync::Arc::new(series);
+        let table = direction_table(&crate::fit::driver::tests_outcome(vec![curve]));
+        assert!(table.contains("| fit | slow |"), "{table}");
+        assert!(!table.contains("| reversal |"), "{table}");
+        let series = direction_table(&crate::fit::driver::tests_outcome(vec![source(0.0, 0.0)]));
+        assert!(series.contains("| fit | reversal |"), "{series}");
     }
 }
