@@ -26,7 +26,7 @@
 //! `Solver`'s fields this file uses: `d`, `settings`, `p`, `h0`, `hist`, `w`.
 
 use super::work::Work;
-use super::{Ctx, Disc, H0Mode, Outcome, Solver};
+use super::{Ctx, Disc, H0Mode, Level, Outcome, Solver};
 use crate::physics::estimate::Status;
 
 impl Solver {
@@ -101,55 +101,21 @@ impl Solver {
     /// residual ΔF (N), the iterations used and whether it converged.
     fn picard(&mut self, h0: f64, ctx: &Ctx) -> (f64, u32, bool) {
         let rs = self.settings.reference;
-        let d = &self.d;
-        let w = &mut self.w;
-        let n = d.grid.n;
-        let dx = d.grid.dx;
-        let (coef, inv_dt) = match ctx.time {
-            Some((c, dt)) => (Some(c), 1.0 / dt),
-            None => (None, 0.0),
-        };
-        let w0 = ctx.w0();
+        let n = self.d.grid.n;
         let half_v = 0.5 * ctx.v;
         let mut converged = false;
         let mut iters = 0;
-        let mut omega = rs.fluid_relaxation;
-        let mut last_change = f64::INFINITY;
-        let mut shrinking = 0u32;
+        let mut omega = Relaxation::new(rs.fluid_relaxation, rs.fluid_relaxation_min);
         for it in 1..=rs.max_fluid_iterations {
             iters = it;
+            let (d, w) = (&self.d, &mut self.w);
             for i in 0..n {
                 let s = d.eos.eval(self.p[i]);
                 w.cells.rho[i] = s.rho;
                 w.cells.gr[i] = s.rho / s.mu;
             }
             faces(d, w, h0, half_v);
-            for i in 0..n {
-                let (kl, kr) = (w.faces.dql[i], w.faces.dql[i + 1]);
-                let mut rhs = -w0 * (w.faces.q[i + 1] - w.faces.q[i]);
-                if let Some(c) = coef {
-                    let hc = h0 + d.grid.g_cell[i];
-                    rhs -= dx
-                        * inv_dt
-                        * (c.a[0] * w.cells.rho[i] * hc
-                            + c.a[1] * self.hist[0].rho_h[i]
-                            + c.a[2] * self.hist[1].rho_h[i]);
-                    rhs -= c.w[1] * self.hist[0].div[i] + c.w[2] * self.hist[1].div[i];
-                }
-                if w.has_source {
-                    rhs += w.source[i];
-                }
-                if i == 0 {
-                    rhs += w0 * kl * d.p_amb;
-                }
-                if i + 1 == n {
-                    rhs += w0 * kr * d.p_amb;
-                }
-                w.rows.a[i] = if i == 0 { 0.0 } else { -w0 * kl };
-                w.rows.b[i] = w0 * (kl + kr);
-                w.rows.c[i] = if i + 1 == n { 0.0 } else { -w0 * kr };
-                w.rows.r[i] = rhs;
-            }
+            linear_rows(d, &self.hist, w, h0, ctx);
             thomas(w, n);
             let mut pmax = d.p_amb;
             let mut change: f64 = 0.0;
@@ -158,19 +124,9 @@ impl Solver {
                 change = change.max(dp.abs());
                 pmax = pmax.max(self.p[i].abs());
             }
-            if change > last_change {
-                omega = (0.5 * omega).max(rs.fluid_relaxation_min);
-                shrinking = 0;
-            } else {
-                shrinking += 1;
-                if shrinking >= 20 {
-                    omega = (1.25 * omega).min(rs.fluid_relaxation);
-                    shrinking = 0;
-                }
-            }
-            last_change = change;
+            let om = omega.after(change);
             for i in 0..n {
-                self.p[i] += omega * (w.tmp[i].max(0.0) - self.p[i]);
+                self.p[i] += om * (w.tmp[i].max(0.0) - self.p[i]);
             }
             if !change.is_finite() {
                 return (f64::NAN, iters, false);
@@ -204,6 +160,81 @@ impl Solver {
             }
             None => f_net,
         }
+    }
+}
+
+/// The adaptive ω_fluid of the module doc: halved (down to its minimum)
+/// whenever the update grows, regrown by 25 % (up to its start) after 20
+/// shrinking updates.
+struct Relaxation {
+    omega: f64,
+    start: f64,
+    min: f64,
+    last_change: f64,
+    shrinking: u32,
+}
+
+impl Relaxation {
+    fn new(start: f64, min: f64) -> Self {
+        Self {
+            omega: start,
+            start,
+            min,
+            last_change: f64::INFINITY,
+            shrinking: 0,
+        }
+    }
+
+    /// ω for the update whose largest change is `change`.
+    fn after(&mut self, change: f64) -> f64 {
+        if change > self.last_change {
+            self.omega = (0.5 * self.omega).max(self.min);
+            self.shrinking = 0;
+        } else {
+            self.shrinking += 1;
+            if self.shrinking >= 20 {
+                self.omega = (1.25 * self.omega).min(self.start);
+                self.shrinking = 0;
+            }
+        }
+        self.last_change = change;
+        self.omega
+    }
+}
+
+/// The tridiagonal rows (`w.rows`) of the Reynolds equation linearised at
+/// the frozen density: flux divergence, storage against the history levels
+/// and the source, with ambient pressure at both edges.
+fn linear_rows(d: &Disc, hist: &[Level; 2], w: &mut Work, h0: f64, ctx: &Ctx) {
+    let n = d.grid.n;
+    let dx = d.grid.dx;
+    let w0 = ctx.w0();
+    for i in 0..n {
+        let (kl, kr) = (w.faces.dql[i], w.faces.dql[i + 1]);
+        let mut rhs = -w0 * (w.faces.q[i + 1] - w.faces.q[i]);
+        if let Some((c, dt)) = ctx.time {
+            let hc = h0 + d.grid.g_cell[i];
+            let inv_dt = 1.0 / dt;
+            rhs -= dx
+                * inv_dt
+                * (c.a[0] * w.cells.rho[i] * hc
+                    + c.a[1] * hist[0].rho_h[i]
+                    + c.a[2] * hist[1].rho_h[i]);
+            rhs -= c.w[1] * hist[0].div[i] + c.w[2] * hist[1].div[i];
+        }
+        if w.has_source {
+            rhs += w.source[i];
+        }
+        if i == 0 {
+            rhs += w0 * kl * d.p_amb;
+        }
+        if i + 1 == n {
+            rhs += w0 * kr * d.p_amb;
+        }
+        w.rows.a[i] = if i == 0 { 0.0 } else { -w0 * kl };
+        w.rows.b[i] = w0 * (kl + kr);
+        w.rows.c[i] = if i + 1 == n { 0.0 } else { -w0 * kr };
+        w.rows.r[i] = rhs;
     }
 }
 
