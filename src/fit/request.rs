@@ -140,23 +140,7 @@ impl FitRequest {
         let mut extra_md = selection.as_ref().map_or(String::new(), |s| {
             super::selection_report::report(s, p.data.units)
         });
-        // The range the calibration saw, into the fitted file and the report.
-        let gain = p.contact_scale.as_ref().map_or(1.0, |s| s.gain);
-        let section = super::calibrated_range::attach(&mut ours.config, &ours.outcome, gain);
-        extra_md.insert_str(0, &section);
-        if let Some(w) = super::inertia_check::inertia_warning(&ours.outcome) {
-            say(&w);
-            extra_md.insert_str(
-                0,
-                &format!(
-                    "## The residual and the acceleration
-
-{w}
-
-"
-                ),
-            );
-        }
+        extra_md.insert_str(0, &range_and_inertia(&p, &mut ours, &say));
         let yaml = super::report::fitted_yaml(&ours.config, &ours.outcome, &p.names, &ours.map);
         if let Some(o) = &outputs.fitted {
             crate::output::write_file(o, yaml.as_bytes())?;
@@ -184,6 +168,22 @@ impl FitRequest {
             report_files,
         })
     }
+}
+
+/// The report's first sections: the range the calibration saw (also
+/// attached to the fitted file) and, when the residual follows the
+/// acceleration, that warning (also said).
+fn range_and_inertia(p: &Prepared, ours: &mut OursFitted, say: &dyn Fn(&str)) -> String {
+    let gain = p.contact_scale.as_ref().map_or(1.0, |s| s.gain);
+    let mut md = super::calibrated_range::attach(&mut ours.config, &ours.outcome, gain);
+    if let Some(w) = super::inertia_check::inertia_warning(&ours.outcome) {
+        say(&w);
+        md.insert_str(
+            0,
+            &format!("## The residual and the acceleration\n\n{w}\n\n"),
+        );
+    }
+    md
 }
 
 impl FitRequest {
