@@ -1,5 +1,6 @@
-//! A local run that spent its budget beside a bound: the parameters there
-//! held on it and the others fitted (an active-set step).
+//! A local run that spent its budget beside a bound, or that crawled
+//! toward one: the parameters there held on it and the others fitted (an
+//! active-set step).
 //!
 //! The sine transform s = lo + (hi − lo)(1 + sin u)/2 is stationary at a
 //! bound: where the bounded problem's optimum lies on a bound (the cost
@@ -20,6 +21,20 @@
 //! (the bound is active: the first-order condition of the bounded
 //! problem, by one-sided differences); else the crawl's end stands as it
 //! was.
+//!
+//! A run does not wait for its budget's end where it sees the crawl: a
+//! searched parameter within 5 % of its range of a bound that comes nearer
+//! at each of 10 accepted steps ends it (`local_run`'s doc), and the step
+//! here holds that parameter too. Where that bound does not hold it (the
+//! held fit costs more than the crawl's end, or the cost falls inward) the
+//! run is made again from its start without the watch: its path and end
+//! are what they were, and the watch has cost the evaluations up to the
+//! crawl and the held fit. A fresh run from the crawl's end was tried
+//! first and lost optima: its path differs from the one it replaces
+//! (stop 80). On EMPS's LuGre fit the
+//! given start crawled for 2008 evaluations (+ 11 278 for its Jacobians)
+//! to the optimum `fc = 0`; it ends now after 247 (+ 1062) at the same
+//! cost.
 
 use super::local_run::{one_run, LocalRun};
 use super::options::{JacobianRule, LaterRuns};
@@ -32,12 +47,16 @@ use super::separable::{Separable, Variables};
 pub const NEAR: f64 = 1e-3;
 
 /// `run`, or, when it did not converge with searched parameters within
-/// [`NEAR`] of a bound, the fit with those held on their bounds if the
-/// bound is active there (see the module's doc). `max_evaluations` is the
-/// held fit's budget.
+/// [`NEAR`] of a bound or crawling toward one, the fit with those held on
+/// their bounds if the bound is active there (see the module's doc). A run
+/// that ended crawling toward a bound that does not hold it is replaced by
+/// `unwatched`, the same run without the watch (its path as it was, its
+/// end settled the same way), the evaluations of both counted.
+/// `max_evaluations` is the held fit's budget.
 pub fn settle(
     (problem, separable): (&Problem<'_>, Option<&Separable>),
     run: LocalRun,
+    unwatched: impl FnOnce() -> LocalRun,
     max_evaluations: usize,
     later: LaterRuns,
     tolerance: (f64, f64),
@@ -45,6 +64,37 @@ pub fn settle(
     if run.converged || problem.stop.requested() {
         return run;
     }
+    let held = |run: &LocalRun| {
+        held_on_bounds((problem, separable), run, max_evaluations, later, tolerance)
+    };
+    if let Some(fitted) = held(&run) {
+        return fitted;
+    }
+    if run.crawling.is_empty() {
+        return run;
+    }
+    let again = unwatched();
+    let again = LocalRun {
+        evaluations: run.evaluations + again.evaluations,
+        jacobian_evaluations: run.jacobian_evaluations + again.jacobian_evaluations,
+        ..again
+    };
+    if again.converged || problem.stop.requested() {
+        return again;
+    }
+    held(&again).unwrap_or(again)
+}
+
+/// The fit with `run`'s searched parameters within [`NEAR`] of a bound,
+/// and those it crawled toward one with, held on it, when it converged no higher than `run` and the bound is
+/// active there.
+fn held_on_bounds(
+    (problem, separable): (&Problem<'_>, Option<&Separable>),
+    run: &LocalRun,
+    max_evaluations: usize,
+    later: LaterRuns,
+    tolerance: (f64, f64),
+) -> Option<LocalRun> {
     let vars = Variables::new(problem, separable, &run.x);
     let mut at_bound = run.x.clone();
     let held: Vec<usize> = vars
@@ -52,9 +102,10 @@ pub fn settle(
         .filter(|&i| {
             let p = &problem.params[i];
             let f = p.fraction(run.x[i]);
-            let side = if f < NEAR {
+            let crawled = run.crawling.contains(&i);
+            let side = if f < NEAR || (crawled && f < 0.5) {
                 0.0
-            } else if f > 1.0 - NEAR {
+            } else if f > 1.0 - NEAR || crawled {
                 1.0
             } else {
                 return false;
@@ -64,7 +115,7 @@ pub fn settle(
         })
         .collect();
     if held.is_empty() {
-        return run;
+        return None;
     }
     let rest = vars.holding(&held, &at_bound);
     let u0 = rest.to_internal(&at_bound);
@@ -75,15 +126,16 @@ pub fn settle(
         (JacobianRule::Differences, later),
         &[],
         tolerance,
+        false,
     );
     if !fitted.converged || fitted.cost > run.cost || !active(&vars, &held, &fitted) {
-        return run;
+        return None;
     }
     let names: Vec<&str> = held
         .iter()
         .map(|&i| problem.params[i].name.as_str())
         .collect();
-    LocalRun {
+    Some(LocalRun {
         termination: format!(
             "{} with {} held on its bound (the cost rises inward: the bound is active)",
             fitted.termination,
@@ -95,7 +147,7 @@ pub fn settle(
         // stopped inside this optimum's region, they run to their end.
         curvature: None,
         ..fitted
-    }
+    })
 }
 
 /// Whether the cost at `fitted` rises when each `held` parameter alone is
@@ -119,6 +171,7 @@ fn active(vars: &Variables<'_, '_>, held: &[usize], fitted: &LocalRun) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fit::local_run::local_run;
     use crate::fit::problem::{tests_data, Model};
     use crate::fit::series::{Mapping, Series};
     use crate::fit::unknowns::FittedParameter;
@@ -156,6 +209,27 @@ mod tests {
         (PastTheBound(params, target), data)
     }
 
+    /// Residuals k·(a + b − 4) and b − 6 over a ∈ [0, 10], b ∈ [−10, 10]:
+    /// a valley along a + b = 4 whose lowest point (a = −2) lies past the
+    /// bound a = 0.
+    struct Valley(Vec<FittedParameter>, f64);
+
+    impl Model for Valley {
+        fn label(&self) -> String {
+            "valley".into()
+        }
+        fn parameters(&self) -> &[FittedParameter] {
+            &self.0
+        }
+        fn predict(&self, x: &[f64], s: &Series) -> Result<Vec<f64>, crate::fit::PredictError> {
+            let (a, b) = (x[0], x[1]);
+            let mut out = s.friction.clone();
+            out[0] -= self.1 * (a + b - 4.0);
+            out[1] -= b - 6.0;
+            Ok(out)
+        }
+    }
+
     fn crawl(x: Vec<f64>, cost: f64) -> LocalRun {
         LocalRun {
             x,
@@ -165,6 +239,7 @@ mod tests {
             evaluations: 200,
             jacobian_evaluations: 0,
             curvature: None,
+            crawling: Vec::new(),
         }
     }
 
@@ -174,7 +249,14 @@ mod tests {
         let problem = Problem::new(&m, &data, vec![]).unwrap();
         let x = vec![1.9999, 0.5];
         let run = crawl(x.clone(), problem.cost(&x));
-        let settled = settle((&problem, None), run, 200, LaterRuns::Full, (1e-10, 1e-8));
+        let settled = settle(
+            (&problem, None),
+            run,
+            not_again,
+            200,
+            LaterRuns::Full,
+            (1e-10, 1e-8),
+        );
         assert!(settled.converged, "{}", settled.termination);
         assert!(
             settled.termination.contains("a held on its bound"),
@@ -198,10 +280,100 @@ mod tests {
         let settled = settle(
             (&problem, None),
             run.clone(),
+            not_again,
             200,
             LaterRuns::Full,
             (1e-10, 1e-8),
         );
         assert_eq!(settled, run);
+    }
+
+    #[test]
+    fn a_run_crawling_along_a_valley_toward_an_active_bound_ends_early_and_settles_on_it() {
+        let k = 300.0;
+        let (_, data) = model(5.0);
+        let m = Valley(
+            vec![
+                FittedParameter::new("a", 5.0, 0.0, 10.0),
+                FittedParameter::new("b", -1.0, -10.0, 10.0),
+            ],
+            k,
+        );
+        let problem = Problem::new(&m, &data, vec![]).unwrap();
+        let start = [5.0, -1.0];
+        let tolerance = (1e-10, 1e-8);
+        let run = local_run(
+            (&problem, None),
+            &start,
+            200,
+            JacobianRule::Differences,
+            &[],
+            LaterRuns::Full,
+            tolerance,
+            true,
+        );
+        assert_eq!(run.crawling, vec![0], "{}", run.termination);
+        assert!(run.termination.contains("crawling toward a bound (a"));
+        // Unwatched, the same run walks on to the bound.
+        let vars = Variables::new(&problem, None, &start);
+        let u0 = vars.to_internal(&start);
+        let rules = (JacobianRule::Differences, LaterRuns::Full);
+        let (walked, _) = one_run(vars, &u0, 200, rules, &[], tolerance, false);
+        let settled = settle(
+            (&problem, None),
+            run,
+            not_again,
+            200,
+            LaterRuns::Full,
+            tolerance,
+        );
+        assert!(settled.converged, "{}", settled.termination);
+        assert!(settled.termination.contains("a held on its bound"));
+        assert_eq!(settled.x[0], 0.0);
+        // At a = 0: k²(b − 4) + (b − 6) = 0.
+        let b = (4.0 * k * k + 6.0) / (k * k + 1.0);
+        approx::assert_relative_eq!(settled.x[1], b, epsilon = 1e-9);
+        assert!(
+            settled.evaluations < walked.evaluations,
+            "{} evaluations settled, {} walked",
+            settled.evaluations,
+            walked.evaluations
+        );
+    }
+
+    #[test]
+    fn a_run_that_crawled_toward_a_bound_that_does_not_hold_it_is_made_again_without_the_watch() {
+        // The optimum a = 1.99 lies inside: held at 2 the cost falls inward,
+        // so the run is replaced by the same run unwatched (here a stand-in
+        // that ended at the optimum), the evaluations of both counted.
+        let (m, data) = model(1.99);
+        let problem = Problem::new(&m, &data, vec![]).unwrap();
+        let x = vec![1.9, 0.5];
+        let mut run = crawl(x.clone(), problem.cost(&x));
+        run.evaluations = 20;
+        run.crawling = vec![0];
+        let optimum = vec![1.99, (-1.0 + (1.0f64 + 1.2 * 0.995).sqrt()) / 0.6];
+        let unwatched = LocalRun {
+            converged: true,
+            termination: "converged (cost)".into(),
+            evaluations: 30,
+            ..crawl(optimum.clone(), problem.cost(&optimum))
+        };
+        let settled = settle(
+            (&problem, None),
+            run,
+            || unwatched.clone(),
+            200,
+            LaterRuns::Full,
+            (1e-10, 1e-8),
+        );
+        assert_eq!(settled.x, optimum);
+        assert!(settled.converged, "{}", settled.termination);
+        assert_eq!(settled.evaluations, 50);
+    }
+
+    /// A run that must not be made again.
+    fn not_again() -> LocalRun {
+        panic!("a run that did not crawl is not made again")
     }
 }

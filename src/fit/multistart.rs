@@ -77,6 +77,7 @@ pub fn search(
             evaluations: 1,
             jacobian_evaluations: 0,
             curvature: None,
+            crawling: Vec::new(),
         });
     }
     distinct
@@ -173,18 +174,22 @@ fn local_runs(
         ));
     };
     let run_from = |x: &Vec<f64>, earlier: &[Found]| {
-        let run = local_run(
-            (problem, separable),
-            x,
-            options.max_evaluations,
-            options.jacobian,
-            earlier,
-            options.later_runs,
-            (options.ftol, options.xtol),
-        );
+        let run = |watch_crawl: bool| {
+            local_run(
+                (problem, separable),
+                x,
+                options.max_evaluations,
+                options.jacobian,
+                earlier,
+                options.later_runs,
+                (options.ftol, options.xtol),
+                watch_crawl,
+            )
+        };
         super::bound_polish::settle(
             (problem, separable),
-            run,
+            run(true),
+            || run(false),
             options.max_evaluations,
             options.later_runs,
             (options.ftol, options.xtol),

@@ -366,6 +366,7 @@ mod tests {
             &[],
             LaterRuns::Full,
             (1e-10, 1e-8),
+            true,
         );
         assert!(run.converged, "{}", run.termination);
         (run.x, model.solves())

@@ -255,6 +255,12 @@ impl<'p, 'a> Variables<'p, 'a> {
         }
     }
 
+    /// The indices (in the whole point) of the parameters the optimiser
+    /// searches (through the sine transform), profiled ones excluded.
+    pub(super) fn searched(&self) -> &[usize] {
+        &self.searched
+    }
+
     /// The indices (in the whole point) of the parameters searched,
     /// profiled ones included.
     pub(super) fn varied(&self) -> impl Iterator<Item = usize> + '_ {
