@@ -13,14 +13,15 @@
 //! secant Jacobians is polished by a run on differences from its end
 //! point, so the convergence test and the optimum are the exact method's.
 //!
-//! A searched parameter within [`CRAWL_ZONE`] of a bound whose distance to
-//! it fell at each of [`CRAWL_STEPS`] accepted steps in a row is crawling
-//! toward it: the sine transform is stationary at a bound, so where the
-//! cost still falls past it each step moves it a fixed fraction of the way
-//! left, to the end of the budget (on EMPS's LuGre fit, 3 % of the range
-//! to 0.1 % in 800 evaluations). The run ends there, and
-//! `bound_polish::settle` holds the parameter on the bound or, where the
-//! bound is not active, resumes the run.
+//! A searched parameter within `CRAWL_ZONE` (5 % of its range) of a bound
+//! whose distance to it fell at each of `CRAWL_STEPS` (10) accepted steps
+//! in a row is crawling toward it: the sine transform is stationary at a
+//! bound, so where the cost still falls past it each step moves it a fixed
+//! fraction of the way left, to the end of the budget (on EMPS's LuGre
+//! fit, 3 % of the range to 0.1 % in 800 evaluations). The run ends there,
+//! and `bound_polish::settle` holds the parameter on the bound or, where
+//! the bound does not hold it, makes the run again without the watch.
+
 use super::earlier_optima::{EarlierOptima, Found, Joined, VALLEY_POINTS};
 use super::options::{JacobianRule, LaterRuns};
 use super::problem::Problem;
