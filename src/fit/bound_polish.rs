@@ -176,28 +176,33 @@ mod tests {
     use crate::fit::series::{Mapping, Series};
     use crate::fit::unknowns::FittedParameter;
 
-    /// Residuals a − target and b − a/2 + c·b² over a ∈ [0.1, 2] (log
-    /// scaled), b ∈ [−3, 3]: with `target` 5 the optimum lies past the
-    /// bound a = 2, at b solving b − 1 + c·b² = 0.
-    struct PastTheBound(Vec<FittedParameter>, f64);
+    /// A model of two residuals, functions of the two parameters (a, b):
+    /// the first two samples' friction less `residuals(a, b)`.
+    struct TwoResiduals {
+        params: Vec<FittedParameter>,
+        residuals: Box<dyn Fn(f64, f64) -> [f64; 2] + Sync>,
+    }
 
-    impl Model for PastTheBound {
+    impl Model for TwoResiduals {
         fn label(&self) -> String {
-            "past the bound".into()
+            "two residuals".into()
         }
         fn parameters(&self) -> &[FittedParameter] {
-            &self.0
+            &self.params
         }
         fn predict(&self, x: &[f64], s: &Series) -> Result<Vec<f64>, crate::fit::PredictError> {
-            let (a, b) = (x[0], x[1]);
+            let r = (self.residuals)(x[0], x[1]);
             let mut out = s.friction.clone();
-            out[0] -= a - self.1;
-            out[1] -= b - a / 2.0 + 0.3 * b * b;
+            out[0] -= r[0];
+            out[1] -= r[1];
             Ok(out)
         }
     }
 
-    fn model(target: f64) -> (PastTheBound, crate::fit::data::Data) {
+    /// Residuals a − target and b − a/2 + c·b² over a ∈ [0.1, 2] (log
+    /// scaled), b ∈ [−3, 3]: with `target` 5 the optimum lies past the
+    /// bound a = 2, at b solving b − 1 + c·b² = 0.
+    fn model(target: f64) -> (TwoResiduals, crate::fit::data::Data) {
         let mut text = String::from("t_s,velocity_m_s,friction_n\n");
         for k in 0..2 {
             text += &format!("{},0.1,1\n", k as f64 * 0.01);
@@ -206,27 +211,20 @@ mod tests {
         let mut a = FittedParameter::new("a", 1.0, 0.1, 2.0);
         a.log = true;
         let params = vec![a, FittedParameter::new("b", 0.0, -3.0, 3.0)];
-        (PastTheBound(params, target), data)
+        let residuals = Box::new(move |a, b| [a - target, b - a / 2.0 + 0.3 * b * b]);
+        (TwoResiduals { params, residuals }, data)
     }
 
     /// Residuals k·(a + b − 4) and b − 6 over a ∈ [0, 10], b ∈ [−10, 10]:
     /// a valley along a + b = 4 whose lowest point (a = −2) lies past the
     /// bound a = 0.
-    struct Valley(Vec<FittedParameter>, f64);
-
-    impl Model for Valley {
-        fn label(&self) -> String {
-            "valley".into()
-        }
-        fn parameters(&self) -> &[FittedParameter] {
-            &self.0
-        }
-        fn predict(&self, x: &[f64], s: &Series) -> Result<Vec<f64>, crate::fit::PredictError> {
-            let (a, b) = (x[0], x[1]);
-            let mut out = s.friction.clone();
-            out[0] -= self.1 * (a + b - 4.0);
-            out[1] -= b - 6.0;
-            Ok(out)
+    fn valley(k: f64) -> TwoResiduals {
+        TwoResiduals {
+            params: vec![
+                FittedParameter::new("a", 5.0, 0.0, 10.0),
+                FittedParameter::new("b", -1.0, -10.0, 10.0),
+            ],
+            residuals: Box::new(move |a, b| [k * (a + b - 4.0), b - 6.0]),
         }
     }
 
@@ -292,13 +290,7 @@ mod tests {
     fn a_run_crawling_along_a_valley_toward_an_active_bound_ends_early_and_settles_on_it() {
         let k = 300.0;
         let (_, data) = model(5.0);
-        let m = Valley(
-            vec![
-                FittedParameter::new("a", 5.0, 0.0, 10.0),
-                FittedParameter::new("b", -1.0, -10.0, 10.0),
-            ],
-            k,
-        );
+        let m = valley(k);
         let problem = Problem::new(&m, &data, vec![]).unwrap();
         let start = [5.0, -1.0];
         let tolerance = (1e-10, 1e-8);
