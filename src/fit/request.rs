@@ -14,6 +14,7 @@
 
 use super::candidates::initial_specs;
 use super::compare::{fit_baselines, fit_ours, OursFitted};
+use super::confirm::Fallback;
 use super::driver::FitOutcome;
 use super::inputs::DataRequest;
 use super::options::{LabelledProgress, SearchSettings};
@@ -203,6 +204,8 @@ impl FitRequest {
         say: &dyn Fn(&str),
     ) -> Result<OursFitted, FitError> {
         let cross_validated = self.baselines || selection.is_some();
+        // The last fallback taken: the larger set's fit and selection.
+        let mut last: Option<(OursFitted, Selection, Fallback)> = None;
         loop {
             say(&format!(
                 "{} parameter(s) on {} file(s) ({} validation), {} local run(s), {} global points",
@@ -216,19 +219,85 @@ impl FitRequest {
             let Some(s) = selection.as_deref_mut() else {
                 return Ok(ours);
             };
-            let fallback = ours.outcome.fold_mse.as_deref().and_then(|m| {
-                super::confirm::unconfirmed(s, m, p.data.units).or_else(|| {
-                    let flags = super::trial::flags_of(&ours.outcome);
-                    super::confirm::confounded_at_final(s, m, flags, p.data.units)
-                })
-            });
+            let units = p.data.units;
+            let (ours, fallback) = match last.take() {
+                Some((larger, before, f)) => {
+                    match kept_larger(p, given, s, larger, ours, before, &f, say)? {
+                        // The larger set again: only a flag may still move it.
+                        Weighed::Larger(larger) => {
+                            let f = larger.outcome.fold_mse.as_deref().and_then(|m| {
+                                let flags = super::trial::flags_of(&larger.outcome);
+                                super::confirm::confounded_at_final(s, m, flags, units)
+                            });
+                            (larger, f)
+                        }
+                        Weighed::Smaller(ours) => {
+                            let f = fallback_of(s, &ours, units);
+                            (ours, f)
+                        }
+                    }
+                }
+                None => {
+                    let f = fallback_of(s, &ours, units);
+                    (ours, f)
+                }
+            };
             let Some(f) = fallback else {
                 return Ok(ours);
             };
             say(&format!("auto: not confirmed: {}", f.why));
-            super::confirm::fall_back(p, given, s, f)?;
+            let before = s.clone();
+            super::confirm::fall_back(p, given, s, f.clone())?;
+            last = Some((ours, before, f));
         }
     }
+}
+
+/// The set a final fit `ours` of `s.chosen` falls back to, if any
+/// (`confirm.rs`): the folds' verdict first, then a flag.
+fn fallback_of(s: &Selection, ours: &OursFitted, units: super::Units) -> Option<Fallback> {
+    let m = ours.outcome.fold_mse.as_deref()?;
+    super::confirm::unconfirmed(s, m, units).or_else(|| {
+        let flags = super::trial::flags_of(&ours.outcome);
+        super::confirm::confounded_at_final(s, m, flags, units)
+    })
+}
+
+/// Which of two final fits a fallback leaves.
+enum Weighed {
+    /// The fallback was overturned: the larger set stays.
+    Larger(OursFitted),
+    /// The fallback stands.
+    Smaller(OursFitted),
+}
+
+/// After the fallback `f` from the set of `before` (fitted as `larger`)
+/// was fitted as `smaller`: which stays. When the fallback is overturned
+/// (`Fallback::overturned`), `s` and `p`'s model are the larger set's again.
+#[allow(clippy::too_many_arguments)] // the confirmation's state, handed on once
+fn kept_larger(
+    p: &mut Prepared,
+    given: &[ParamSpec],
+    s: &mut Selection,
+    larger: OursFitted,
+    smaller: OursFitted,
+    before: Selection,
+    f: &Fallback,
+    say: &dyn Fn(&str),
+) -> Result<Weighed, FitError> {
+    let folds = (&larger.outcome.fold_mse, &smaller.outcome.fold_mse);
+    let (Some(l), Some(m)) = folds else {
+        return Ok(Weighed::Smaller(smaller));
+    };
+    let Some(why) = f.overturned(&before, l, m, p.data.units) else {
+        return Ok(Weighed::Smaller(smaller));
+    };
+    say(&format!("auto: kept: {why}"));
+    let o = &larger.outcome;
+    let optimum = o.params.iter().map(|q| q.name.clone());
+    let optimum = optimum.zip(o.best.iter().copied()).collect();
+    super::confirm::keep_larger(p, given, s, before, &optimum, why)?;
+    Ok(Weighed::Larger(larger))
 }
 
 /// What follows our fit: the classic models, the verdict, the report's files.

@@ -187,6 +187,9 @@ pub struct Selection {
     pub not_admitted: Vec<String>,
     /// Terms chosen and then removed, each with why.
     pub removed: Vec<String>,
+    /// Terms the final fit kept where the best set without them, fitted
+    /// in its turn, predicted the folds worse (`confirm.rs`), each with why.
+    pub kept: Vec<String>,
     /// Parts added with the term they belong to (rule 4b), each with why.
     pub added: Vec<String>,
     /// How the training data were cut for cross-validation.
@@ -320,6 +323,7 @@ pub fn select(
         excluded,
         not_admitted,
         removed,
+        kept: Vec::new(),
         added,
         optimum: current.optimum,
         chosen,
