@@ -293,12 +293,12 @@ fn range_dict<'py>(
     Ok(d)
 }
 
-/// `delimiter` by its Python name.
 /// A bad value of the argument `name`: a `ValueError` naming it.
 fn argument(name: &str, why: String) -> PyErr {
     errors::value(format!("{name}: {why}"))
 }
 
+/// `delimiter` by its Python name.
 fn delimiter_named(name: &str) -> PyResult<Delimiter> {
     Ok(match name {
         "auto" => Delimiter::Auto,
