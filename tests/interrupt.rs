@@ -56,6 +56,30 @@ fn interrupt(args: &[&str], ready: &str, signal: i32) -> (Option<i32>, String) {
     (child.wait().unwrap().code(), seen)
 }
 
+/// A simulated record of `sine:0,0.5,1` for `duration_s` on `cells` cells,
+/// written to `d/data.csv`: the data the fit tests interrupt.
+fn sine_record(d: &Path, duration_s: &str, cells: &str) -> PathBuf {
+    let data = d.join("data.csv");
+    let sim = bin()
+        .args([
+            "simulate",
+            "--velocity",
+            "sine:0,0.5,1",
+            "--duration",
+            duration_s,
+        ])
+        .args(["--set", &format!("solver.cells={cells}"), "--out"])
+        .arg(&data)
+        .output()
+        .unwrap();
+    assert!(
+        sim.status.success(),
+        "{}",
+        String::from_utf8_lossy(&sim.stderr)
+    );
+    data
+}
+
 #[test]
 fn sigint_and_sigterm_stop_simulate_and_remove_its_temporary_file() {
     for (signal, code) in [(libc::SIGINT, 130), (libc::SIGTERM, 143)] {
@@ -150,22 +174,7 @@ fn sigterm_stops_a_replay_and_removes_its_temporary_output() {
 #[test]
 fn sigint_stops_a_fit_before_it_writes_anything() {
     let d = fresh_dir("interrupt", "fit");
-    let data = d.join("data.csv");
-    let sim = bin()
-        .args([
-            "simulate",
-            "--velocity",
-            "sine:0,0.5,1",
-            "--duration",
-            "4",
-            "--set",
-            "solver.cells=64",
-        ])
-        .arg("--out")
-        .arg(&data)
-        .output()
-        .unwrap();
-    assert!(sim.status.success());
+    let data = sine_record(&d, "4", "64");
     let out = d.join("fitted.yaml");
     let (rc, err) = interrupt(
         &[
@@ -190,14 +199,7 @@ fn sigint_stops_a_fit_before_it_writes_anything() {
 #[test]
 fn an_interrupted_fit_says_so_in_words_and_leaves_no_empty_report_folder() {
     let d = fresh_dir("interrupt", "fit-report");
-    let data = d.join("data.csv");
-    let sim = bin()
-        .args(["simulate", "--velocity", "sine:0,0.5,1", "--duration", "4"])
-        .args(["--set", "solver.cells=64", "--out"])
-        .arg(&data)
-        .output()
-        .unwrap();
-    assert!(sim.status.success());
+    let data = sine_record(&d, "4", "64");
     let report = d.join("report");
     let (rc, err) = interrupt(
         &[
@@ -263,14 +265,7 @@ fn a_second_signal_ends_at_once_and_still_removes_the_temporary_file() {
 #[test]
 fn an_interrupted_term_selection_writes_nothing_and_exits_130() {
     let d = fresh_dir("interrupt", "auto");
-    let data = d.join("data.csv");
-    let sim = bin()
-        .args(["simulate", "--velocity", "sine:0,0.5,1", "--duration", "2"])
-        .args(["--set", "solver.cells=32", "--out"])
-        .arg(&data)
-        .output()
-        .unwrap();
-    assert!(sim.status.success());
+    let data = sine_record(&d, "2", "32");
     let report = d.join("report");
     // Stopped while the candidates of the first step are fitted.
     let (rc, err) = interrupt(
@@ -297,21 +292,8 @@ fn an_interrupted_term_selection_writes_nothing_and_exits_130() {
 #[test]
 fn a_stop_during_the_classic_models_keeps_the_fitted_file_and_says_so() {
     let d = fresh_dir("interrupt", "baselines");
-    let data = d.join("data.csv");
     // A long record: the classic models take seconds on it.
-    let sim = bin()
-        .args([
-            "simulate",
-            "--velocity",
-            "sine:0,0.5,1",
-            "--duration",
-            "200",
-        ])
-        .args(["--set", "solver.cells=8", "--out"])
-        .arg(&data)
-        .output()
-        .unwrap();
-    assert!(sim.status.success());
+    let data = sine_record(&d, "200", "8");
     let out = d.join("fitted.yaml");
     let (rc, err) = interrupt(
         &[
