@@ -6,19 +6,7 @@ use super::*;
 #[test]
 fn auto_on_data_of_one_speed_without_a_reversal_keeps_the_smallest_set_and_says_why() {
     let d = dir("auto-one-speed");
-    let c = d.join("c.csv");
-    let (code, _, err) = run(&[
-        "simulate",
-        "--velocity",
-        "const:0.05",
-        "--duration",
-        "1",
-        "--set",
-        "solver.cells=32",
-        "--out",
-        c.to_str().unwrap(),
-    ]);
-    assert_eq!(code, 0, "{err}");
+    let c = simulate_record(&d, "c.csv", "const:0.05", "1", &[]);
     let mut text = String::from("t_s,velocity_m_s,friction_n\n");
     for (k, (t, v, f)) in simulated(&c).into_iter().enumerate() {
         text += &format!("{t},{v},{}\n", f + 20.0 * noise(k));
@@ -90,19 +78,7 @@ fn a_bound_that_excludes_the_value_the_chosen_scale_rests_on_is_an_error_naming_
 fn under_auto_a_bound_on_a_candidate_key_is_accepted_and_a_term_without_a_reversal_says_so() {
     let d = dir("auto-bounds");
     // One speed, no reversal: pre-sliding is no candidate, for that reason.
-    let c = d.join("c.csv");
-    let (code, _, err) = run(&[
-        "simulate",
-        "--velocity",
-        "const:0.05",
-        "--duration",
-        "1",
-        "--set",
-        "solver.cells=32",
-        "--out",
-        c.to_str().unwrap(),
-    ]);
-    assert_eq!(code, 0, "{err}");
+    let c = simulate_record(&d, "c.csv", "const:0.05", "1", &[]);
     let fit = |extra: &[&str]| {
         let mut args = vec![
             "fit",
@@ -153,21 +129,13 @@ fn under_auto_a_bound_on_a_candidate_key_is_accepted_and_a_term_without_a_revers
 #[test]
 fn under_auto_a_load_set_in_the_configuration_is_kept_and_without_one_the_scale_is_chosen() {
     let d = dir("configured-load");
-    let c = d.join("contact.csv");
-    let (code, _, err) = run(&[
-        "simulate",
-        "--velocity",
+    let c = simulate_record(
+        &d,
+        "contact.csv",
         "sine:0,0.05,1",
-        "--duration",
         "1",
-        "--set",
-        "solver.cells=32",
-        "--set",
-        "contact.load_n=2000",
-        "--out",
-        c.to_str().unwrap(),
-    ]);
-    assert_eq!(code, 0, "{err}");
+        &["contact.load_n=2000"],
+    );
     // The data without their load column: the load is not an input.
     let mut text = String::from("t_s,velocity_m_s,friction_n\n");
     for (t, v, f) in simulated(&c) {

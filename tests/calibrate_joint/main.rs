@@ -50,23 +50,33 @@ fn noise(k: usize) -> f64 {
     ((k as f64 * 12.9898).sin() * 43758.5453).fract() * 2.0 - 1.0
 }
 
+/// `simulate` on 32 cells with `velocity` for `seconds` and the extra
+/// `--set`s `sets`, written to `d/name`, whose path is returned.
+fn simulate_record(
+    d: &Path,
+    name: &str,
+    velocity: &str,
+    seconds: &str,
+    sets: &[&str],
+) -> std::path::PathBuf {
+    let out = d.join(name);
+    let mut args = vec!["simulate", "--velocity", velocity, "--duration", seconds];
+    args.extend(["--set", "solver.cells=32"]);
+    for s in sets {
+        args.extend(["--set", s]);
+    }
+    args.extend(["--out", out.to_str().unwrap()]);
+    let (code, _, err) = run(&args);
+    assert_eq!(code, 0, "{err}");
+    out
+}
+
 /// A joint's record through a 20 mm lever, written with the joint's
 /// column names (`velocity_rad_s`, `torque_nm`): `seconds` of a 0.5 Hz
 /// sine of `amplitude_rad_s`.
 fn joint_record(d: &Path, amplitude_rad_s: f64, seconds: f64) -> std::path::PathBuf {
-    let c = d.join("contact.csv");
-    let (code, _, err) = run(&[
-        "simulate",
-        "--velocity",
-        &format!("sine:0,{},0.5", 0.02 * amplitude_rad_s),
-        "--duration",
-        &seconds.to_string(),
-        "--set",
-        "solver.cells=32",
-        "--out",
-        c.to_str().unwrap(),
-    ]);
-    assert_eq!(code, 0, "{err}");
+    let velocity = format!("sine:0,{},0.5", 0.02 * amplitude_rad_s);
+    let c = simulate_record(d, "contact.csv", &velocity, &seconds.to_string(), &[]);
     let mut text = String::from("t_s,velocity_rad_s,torque_nm\n");
     for (t, v, f) in simulated(&c).into_iter().step_by(10) {
         text += &format!("{t},{},{}\n", v / 0.02, f * 0.02);

@@ -9,19 +9,7 @@ use super::*;
 fn a_rotary_joint_is_fitted_in_rad_s_and_newton_metres_and_its_file_drives_the_contact_through_the_chosen_lever(
 ) {
     let d = dir("rotary");
-    let c = d.join("contact.csv");
-    let (code, _, err) = run(&[
-        "simulate",
-        "--velocity",
-        "sine:0,0.05,1",
-        "--duration",
-        "2",
-        "--set",
-        "solver.cells=32",
-        "--out",
-        c.to_str().unwrap(),
-    ]);
-    assert_eq!(code, 0, "{err}");
+    let c = simulate_record(&d, "contact.csv", "sine:0,0.05,1", "2", &[]);
     // The same motion seen at a joint through a 20 mm lever: rad/s, N·m.
     let r = 0.02;
     let rows = simulated(&c);
