@@ -4,7 +4,7 @@
 //! naming its key.
 
 mod common;
-use common::cli::run;
+use common::cli::{quick_fit, run};
 
 use friction_node::config::Config;
 use std::path::Path;
@@ -38,24 +38,13 @@ fn the_fitted_file_carries_the_training_range_and_the_report_splits_the_validati
     simulate(&slow, 0.02);
     simulate(&fast, 0.08);
     let out = d.join("fitted.yaml");
-    let (code, stdout, err) = run(&[
-        "fit",
-        slow.to_str().unwrap(),
+    let extra = [
         "--validate",
         fast.to_str().unwrap(),
         "--set",
-        "solver.cells=32",
-        "--set",
         "contact.load_n=500",
-        "--fit",
-        "contact.boundary_friction",
-        "--starts",
-        "1",
-        "--global-points",
-        "0",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    ];
+    let (code, stdout, err) = quick_fit(&slow, "contact.boundary_friction", &out, &extra);
     assert!(code == 0 || code == 4, "{err}");
     // The range is the training data's: up to 0.02 m/s each way.
     let fitted = Config::load(Some(&out), &[]).unwrap();

@@ -572,23 +572,10 @@ fn a_validation_file_without_the_named_columns_is_named_in_the_error() {
 fn expressions_call_functions_by_their_usual_names_and_an_unknown_one_lists_them() {
     let d = dir("functions");
     let curve = steady_curve(&d);
+    let out = d.join("f.yaml");
     let fit = |friction: &str| {
-        common::cli::run(&[
-            "fit",
-            curve.to_str().unwrap(),
-            "--friction",
-            friction,
-            "--set",
-            "solver.cells=32",
-            "--fit",
-            "contact.boundary_friction",
-            "--starts",
-            "1",
-            "--global-points",
-            "0",
-            "--out",
-            d.join("f.yaml").to_str().unwrap(),
-        ])
+        let keys = "contact.boundary_friction";
+        common::cli::quick_fit(&curve, keys, &out, &["--friction", friction])
     };
     // sqrt(x²) = |x|, cos(0) = 1, abs and tanh: the friction itself.
     let (code, stdout, stderr) =

@@ -4,7 +4,7 @@
 //! optimum), and only then predict the held-out part.
 
 mod common;
-use common::cli::run;
+use common::cli::{quick_fit, run};
 
 use std::path::Path;
 
@@ -60,24 +60,8 @@ struct Choices {
 
 fn fit(data: &Path, extra: &[&str]) -> Choices {
     let out = data.with_extension("yaml");
-    let mut args = vec![
-        "fit",
-        data.to_str().unwrap(),
-        "--set",
-        "solver.cells=32",
-        "--fit",
-        "auto",
-        "--starts",
-        "1",
-        "--global-points",
-        "0",
-        "--max-evaluations",
-        "20",
-        "--out",
-        out.to_str().unwrap(),
-    ];
-    args.extend_from_slice(extra);
-    let (code, stdout, err) = run(&args);
+    let args = [&["--max-evaluations", "20"], extra].concat();
+    let (code, stdout, err) = quick_fit(data, "auto", &out, &args);
     assert!(code == 0 || code == 4, "{err}");
     Choices {
         scale: err

@@ -145,24 +145,8 @@ fn under_auto_a_load_set_in_the_configuration_is_kept_and_without_one_the_scale_
     std::fs::write(&data, text).unwrap();
     let fit = |extra: &[&str]| {
         let out = d.join("f.yaml");
-        let mut args = vec![
-            "fit",
-            data.to_str().unwrap(),
-            "--set",
-            "solver.cells=32",
-            "--fit",
-            "auto",
-            "--starts",
-            "1",
-            "--global-points",
-            "0",
-            "--max-evaluations",
-            "10",
-            "--out",
-            out.to_str().unwrap(),
-        ];
-        args.extend_from_slice(extra);
-        let (code, _, err) = run(&args);
+        let args = [&["--max-evaluations", "10"], extra].concat();
+        let (code, _, err) = common::cli::quick_fit(&data, "auto", &out, &args);
         assert!(code == 0 || code == 4, "{err}");
         (err, Config::load(Some(&out), &[]).unwrap())
     };

@@ -55,6 +55,17 @@ pub fn run(args: &[&str]) -> (i32, String, String) {
     )
 }
 
+/// `fit DATA --fit KEYS` as the quick tests run it (one local run, no
+/// global phase, 32 cells), written to `out`, with `extra` arguments after:
+/// (exit code, stdout, stderr).
+pub fn quick_fit(data: &Path, keys: &str, out: &Path, extra: &[&str]) -> (i32, String, String) {
+    let mut args = vec!["fit", data.to_str().unwrap(), "--fit", keys];
+    args.extend(["--starts", "1", "--global-points", "0"]);
+    args.extend(["--set", "solver.cells=32", "--out", out.to_str().unwrap()]);
+    args.extend_from_slice(extra);
+    run(&args)
+}
+
 /// `fit --rotary --fit auto` of the joint fixture `name`
 /// (`tests/fixtures/{name}-train.csv`, copied into a fresh directory of
 /// `suite`, validated on `{name}-validate.csv`), with `extra` arguments:
