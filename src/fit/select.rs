@@ -30,6 +30,11 @@
 //!    lighter form (a candidate whose keys are part of its own: the
 //!    Stribeck curve to its viscous rise), so that a first choice does not
 //!    block a better pair, nor a curve stand in for a term added later.
+//!    A set reached by taking a term away is also started where it would
+//!    be fitted alone (`trial.rs`, `own_starts`): at the warm optimum the
+//!    other keys carried a part of the removed term's effect (on joint draw
+//!    d82 a Stribeck peak beside a rising boundary rate), and its score must
+//!    not depend on the path that reached it.
 //! 3. The cost of a term: it pays only if it lowers the folds' mean squared
 //!    error by more than [`TERM_COST`] (1 %) of it **and** by more than the
 //!    standard error of that lowering over the folds (the one-standard-error

@@ -364,6 +364,39 @@ impl Ctx<'_> {
         out
     }
 
+    /// The starts a set reached by taking a term away has of its own: where
+    /// the warm optimum fits a key this set does not, the other keys there
+    /// carried a part of that term's effect (a Stribeck curve a peak beside
+    /// a rising boundary rate), and the set is also started where it would
+    /// be fitted alone: every key at its configured start, and the Stribeck
+    /// curve at each of its classic starts. A set's score does not depend
+    /// on the path that reached it.
+    fn own_starts(
+        &self,
+        specs: &[ParamSpec],
+        model: &super::physics_model::PhysicsModel,
+        map_fit: &super::prepared::MapFit,
+        warm: &Optimum,
+    ) -> Result<Vec<Vec<f64>>, FitError> {
+        let fits = |k: &str| {
+            model.parameters().iter().any(|q| q.name == k)
+                || map_fit.iter().any(|(_, q)| q.name == k)
+        };
+        if warm.iter().all(|(n, _)| fits(n)) {
+            return Ok(Vec::new());
+        }
+        let (cold, _) = model_for(self.p, specs, &[])?;
+        let start: Vec<f64> = cold
+            .parameters()
+            .iter()
+            .map(|q| q.start)
+            .chain(map_fit.iter().map(|(_, q)| q.start))
+            .collect();
+        let mut out = self.stribeck_starts(&cold, &start);
+        out.push(start);
+        Ok(out)
+    }
+
     /// Starts of a set whose Stribeck curve is new: `start` with the
     /// curve's speed and amplitude (and the direction asymmetry, where the
     /// set fits it) at each of [`stribeck_curves`], in contact units.
@@ -434,6 +467,9 @@ impl Ctx<'_> {
             ..Default::default()
         };
         options.extra_starts = self.extra_starts(&model, &map_fit, terms, warm, &placements);
+        options
+            .extra_starts
+            .extend(self.own_starts(&specs, &model, &map_fit, warm)?);
         let fitted = match fit(&model, &self.data, map_fit.clone(), &options) {
             Ok(o) => o,
             Err(FitError::Interrupted(i)) => return Err(FitError::Interrupted(i)),
@@ -556,6 +592,74 @@ pub(super) fn flags_of(o: &super::driver::FitOutcome) -> Vec<KeyFlag> {
 mod tests {
     use super::aicc;
     use approx::assert_relative_eq;
+
+    #[test]
+    fn a_set_reached_by_taking_a_term_away_is_also_started_where_it_would_be_fitted_alone() {
+        use super::super::candidates::{initial_specs, AUTO, BASE_KEY, STRIBECK};
+        use super::super::inputs::DataRequest;
+        use super::super::prepared::model_for;
+        use super::super::problem::Model;
+        use super::super::unknowns::ParamSpec;
+        use super::{set_specs_for, Ctx, STRIBECK_AMPLITUDE_KEY, STRIBECK_SPEED_KEY};
+        // A rising steady curve swept both ways: friction 20 N + 400 N·s/m v.
+        let d = std::env::temp_dir().join(format!("fn-own-starts-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        let csv = d.join("curve.csv");
+        let mut text = String::from("t_s,velocity_m_s,friction_n\n");
+        for k in 0..400 {
+            let t = k as f64 * 0.01;
+            let v = 0.05 * (1.5 * t).sin();
+            text += &format!("{t},{v},{}\n", 20.0 * (v / 1e-3).tanh() + 400.0 * v);
+        }
+        std::fs::write(&csv, text).unwrap();
+        let req = DataRequest {
+            files: vec![csv],
+            ..Default::default()
+        };
+        let auto = ParamSpec {
+            name: AUTO.into(),
+            bounds: None,
+            start: None,
+            if_chosen: false,
+        };
+        let (_, given, specs) = initial_specs(&[auto]);
+        let config = crate::config::Config::default();
+        let p = super::super::prepare::prepare(&config, &req, &specs, true).unwrap();
+        std::fs::remove_dir_all(&d).unwrap();
+        let search = super::super::options::SearchSettings::default();
+        let stop = crate::interrupt::Stop::new();
+        let ctx = Ctx::new(&p, &search, &given, &stop);
+        let set = [STRIBECK];
+        let specs = set_specs_for(&p, &given, &set);
+        // The Stribeck curve's optimum beside a boundary rate that carried
+        // the rise: a peak, the base at its lower end.
+        let mut warm: Vec<(String, f64)> = vec![
+            (BASE_KEY.into(), 0.03),
+            (STRIBECK_AMPLITUDE_KEY.into(), 50.0),
+            (STRIBECK_SPEED_KEY.into(), 1e-3),
+            ("drivetrain.viscous_n_s_m".into(), 0.0),
+        ];
+        let (model, map_fit) = model_for(&p, &specs, &warm).unwrap();
+        // Reached by adding to a set it holds: its warm start is its own.
+        let own = ctx.own_starts(&specs, &model, &map_fit, &warm).unwrap();
+        assert!(own.is_empty(), "{own:?}");
+        // Reached by taking the boundary rate away: also started alone.
+        warm.push(("contact.boundary_friction_rate".into(), 0.2));
+        let own = ctx.own_starts(&specs, &model, &map_fit, &warm).unwrap();
+        let (cold, _) = model_for(&p, &specs, &[]).unwrap();
+        let configured: Vec<f64> = cold.parameters().iter().map(|q| q.start).collect();
+        let warmed: Vec<f64> = model.parameters().iter().map(|q| q.start).collect();
+        assert_ne!(configured, warmed, "the two starts differ");
+        assert!(own.contains(&configured), "{own:?} lacks {configured:?}");
+        // With the Stribeck curve at its classic starts (a curve fitted to
+        // the data by variable projection), not at the warm peak.
+        let at = |k: &str| cold.parameters().iter().position(|q| q.name == k).unwrap();
+        let (speed, amplitude) = (at(STRIBECK_SPEED_KEY), at(STRIBECK_AMPLITUDE_KEY));
+        assert!(own.len() > 1, "{own:?}");
+        assert!(own.iter().any(|x| x[amplitude] != configured[amplitude]
+            && x[speed] != configured[speed]
+            && x[amplitude] != 50.0));
+    }
 
     #[test]
     fn the_small_sample_akaike_criterion_is_n_ln_mse_plus_its_corrected_penalty() {
