@@ -189,6 +189,16 @@ fn film_placements(p: &Prepared) -> Vec<f64> {
         .collect()
 }
 
+/// The start of every key of `model` and every map coefficient of `map_fit`,
+/// in the order of the fit's parameter vector.
+fn starts_of(
+    model: &super::physics_model::PhysicsModel,
+    map_fit: &super::prepared::MapFit,
+) -> Vec<f64> {
+    let keys = model.parameters().iter().map(|q| q.start);
+    keys.chain(map_fit.iter().map(|(_, q)| q.start)).collect()
+}
+
 /// The drivetrain Stribeck curve's keys: its speed and its amplitude.
 const STRIBECK_SPEED_KEY: &str = "drivetrain.stribeck_speed_m_s";
 const STRIBECK_AMPLITUDE_KEY: &str = "drivetrain.stribeck_n";
@@ -336,12 +346,7 @@ impl Ctx<'_> {
             .flat_map(|c| c.keys.iter().copied())
             .filter(|k| warm.iter().all(|(n, _)| n != k))
             .collect();
-        let start: Vec<f64> = model
-            .parameters()
-            .iter()
-            .map(|q| q.start)
-            .chain(map_fit.iter().map(|(_, q)| q.start))
-            .collect();
+        let start = starts_of(model, map_fit);
         let mut out = Vec::new();
         for (i, q) in model.parameters().iter().enumerate() {
             if !new_keys.contains(&q.name.as_str()) {
@@ -386,12 +391,7 @@ impl Ctx<'_> {
             return Ok(Vec::new());
         }
         let (cold, _) = model_for(self.p, specs, &[])?;
-        let start: Vec<f64> = cold
-            .parameters()
-            .iter()
-            .map(|q| q.start)
-            .chain(map_fit.iter().map(|(_, q)| q.start))
-            .collect();
+        let start = starts_of(&cold, map_fit);
         let mut out = self.stribeck_starts(&cold, &start);
         out.push(start);
         Ok(out)
