@@ -2,7 +2,9 @@
 command line for the same inputs, Python exceptions for bad input."""
 
 import csv
+import inspect
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -204,6 +206,27 @@ def test_the_search_rules_are_the_clis_and_a_bad_rule_is_named(cli, tmp_path):
         with pytest.raises(ValueError) as e:
             fn.fit(data, keys, **{name: value})
         assert f"{name}: `{value}`" in str(e.value) and allowed in str(e.value)
+
+def test_fit_takes_every_default_of_the_command_line(cli):
+    """Each option `friction-node fit --help` gives a default is a parameter
+    of `fit` (dashes as underscores) with that default."""
+    params = inspect.signature(fn.fit).parameters
+    blocks = re.split(r"\n\s+(?:-\w, )?--", cli("fit", "--help").stdout)
+    checked = {}
+    for block in blocks[1:]:
+        flag = re.match(r"[a-z0-9-]+", block).group(0)
+        default = re.search(r"\[default: ([^\]]+)\]", block)
+        if default is None:
+            continue
+        name, text = flag.replace("-", "_"), default.group(1)
+        assert name in params, f"--{flag} [default: {text}] is not a parameter of fit"
+        ours = params[name].default
+        assert ours == type(ours)(text), f"{name}: fit's default {ours!r}, the command line's {text}"
+        checked[name] = ours
+    assert {"holdout", "starts", "global_points", "seed", "max_evaluations", "jacobian",
+            "later_runs", "linear_keys", "cheap_keys", "skip", "delimiter", "velocity",
+            "friction", "smooth"} <= set(checked), checked
+
 
 def test_a_fit_from_python_writes_the_report_the_cli_writes_section_for_section(cli, tmp_path):
     # One flow (fit/request.rs) for both: the same sections, --fit auto's

@@ -111,6 +111,8 @@ pub struct FitArgs {
     /// Data rows to skip at the start of every CSV file.
     #[arg(long, default_value = "0")]
     pub skip: usize,
+    /// Column separator of CSV data (`auto`: comma, semicolon or tab,
+    /// whichever the first line uses; runs of spaces when it has none).
     #[arg(long, value_enum, default_value = "auto")]
     pub delimiter: DelimiterArg,
     /// Time, s, as an expression of the columns (default: `t_s`; none: a steady curve).
@@ -345,4 +347,37 @@ pub fn run(config: &Config, args: &FitArgs) -> Result<()> {
         std::process::exit(4);
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    /// `fit`'s arguments as the command line parses them.
+    #[derive(Parser)]
+    struct Fit {
+        #[command(flatten)]
+        args: FitArgs,
+    }
+
+    #[test]
+    fn the_command_lines_defaults_are_the_librarys() {
+        let args = Fit::try_parse_from([
+            "fit",
+            "data.csv",
+            "--fit",
+            "contact.boundary_friction",
+            "--out",
+            "fitted.yaml",
+        ])
+        .expect("the least a fit needs parses")
+        .args;
+        let req = args.request().expect("a request");
+        assert_eq!(req.search, SearchSettings::default());
+        assert_eq!(req.data.mapping, Mapping::default());
+        assert_eq!(req.data.delimiter, Delimiter::default());
+        assert_eq!((req.data.holdout, req.data.skip), (0.0, 0));
+        assert!(!req.data.rotary && !req.baselines);
+    }
 }
