@@ -207,6 +207,7 @@ def test_the_search_rules_are_the_clis_and_a_bad_rule_is_named(cli, tmp_path):
             fn.fit(data, keys, **{name: value})
         assert f"{name}: `{value}`" in str(e.value) and allowed in str(e.value)
 
+
 def test_fit_takes_every_default_of_the_command_line(cli):
     """Each option `friction-node fit --help` gives a default is a parameter
     of `fit` (dashes as underscores) with that default."""
