@@ -119,14 +119,6 @@ pub const CANDIDATES: &[Candidate] = &[
     },
 ];
 
-/// Terms that grow without end past the data, faster than the viscous
-/// rise a classic curve holds: the drivetrain quadratic. Such a term is
-/// admitted into a set only where the set's fit tells its coefficient
-/// from zero (its 95 % interval excludes zero), `select.rs` rule 9: where
-/// the data cannot, they do not show the start of its growth, and past
-/// them it adds what they never showed.
-pub const SHOWN_BEFORE_ADMITTED: &[&str] = &["drivetrain quadratic"];
-
 /// The keys of the catalogue that are not candidates, and why.
 pub const NOT_CANDIDATES: &[(&str, &str)] = &[
     (

@@ -131,7 +131,7 @@
 //!    falls to past them, a regime change they do not show.
 //! 9. A term that grows without end past the data faster than the viscous
 //!    rise (the drivetrain quadratic,
-//!    [`SHOWN_BEFORE_ADMITTED`](super::candidates::SHOWN_BEFORE_ADMITTED))
+//!    [`SHOWN_BEFORE_ADMITTED`](super::admission::SHOWN_BEFORE_ADMITTED))
 //!    is admitted into a set only where the set's fit tells its
 //!    coefficient from zero: its 95 % interval excludes zero. The folds
 //!    reach one speed range past the rest (about 1.25× on a steady

@@ -4,7 +4,8 @@
 //! scored by cross-validation, each fold predicted by the set refitted
 //! without it.
 
-use super::candidates::{set_keys, set_specs, CANDIDATES, FILM, FILM_KEY, SHOWN_BEFORE_ADMITTED};
+use super::admission::unshown;
+use super::candidates::{set_keys, set_specs, CANDIDATES, FILM, FILM_KEY};
 use super::contact_scale::slow_speed;
 use super::cross_validate::cross_validate;
 use super::data::{Data, Folds};
@@ -516,43 +517,6 @@ impl Ctx<'_> {
             aicc,
         })
     }
-}
-
-/// Why the set `terms`, fitted as `o`, is not admitted (`select.rs` rule
-/// 9): a term of [`SHOWN_BEFORE_ADMITTED`] whose key's 95 % interval at
-/// `o` does not exclude zero (or has no finite bound: the data do not
-/// determine it). None when every such term is shown.
-fn unshown(terms: &[&'static str], o: &super::driver::FitOutcome) -> Option<String> {
-    for t in terms.iter().filter(|t| SHOWN_BEFORE_ADMITTED.contains(t)) {
-        let c = CANDIDATES.iter().find(|c| c.name == *t)?;
-        for key in c.keys {
-            let Some(j) = o.params.iter().position(|q| q.name == *key) else {
-                continue;
-            };
-            let (lo, hi) = o
-                .statistics
-                .interval95
-                .get(j)
-                .copied()
-                .unwrap_or((f64::NAN, f64::NAN));
-            let (lo_ok, hi_ok) = (lo > 0.0 && lo.is_finite(), hi < 0.0 && hi.is_finite());
-            if !(lo_ok || hi_ok) {
-                let others: Vec<&str> = terms.iter().copied().filter(|x| x != t).collect();
-                return Some(format!(
-                    "{t}{}: its fit gives `{key}` = {} with a 95 % interval [{}, {}] that holds zero; a term that grows without end past the data is admitted only where they show it",
-                    if others.is_empty() {
-                        String::new()
-                    } else {
-                        format!(" beside {}", others.join(", "))
-                    },
-                    crate::text::Num::sig(o.best[j], 4),
-                    crate::text::Num::sig(lo, 3),
-                    crate::text::Num::sig(hi, 3)
-                ));
-            }
-        }
-    }
-    None
 }
 
 /// Per fitted parameter of `o`: its name, whether it ended at a bound or

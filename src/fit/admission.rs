@@ -1,0 +1,118 @@
+//! `--fit auto`'s rule 9: a term that grows without end past the data
+//! faster than the viscous rise is admitted into a set only where the
+//! set's fit shows the start of that growth inside the data.
+//!
+//! | symbol | meaning | unit |
+//! |---|---|---|
+//! | c₂ | the drivetrain's quadratic loss, F = c₂ v² sgn v | N·s²/m² |
+//!
+//! Shown: the 95 % interval of c₂ excludes zero. Where it holds zero, the
+//! folds may still favour the term (they reach one speed range past the
+//! rest, about 1.25× on a steady curve, where a curvature of the noise or
+//! of a Stribeck dip's bottom pays), and past the data it adds a growth
+//! with v² that they never showed.
+
+use super::candidates::CANDIDATES;
+use super::driver::FitOutcome;
+
+/// Terms that grow without end past the data, faster than the viscous
+/// rise a classic curve holds: the drivetrain quadratic. Such a term is
+/// admitted into a set only where the set's fit tells its coefficient
+/// from zero (its 95 % interval excludes zero), `select.rs` rule 9: where
+/// the data cannot, they do not show the start of its growth, and past
+/// them it adds what they never showed.
+pub const SHOWN_BEFORE_ADMITTED: &[&str] = &["drivetrain quadratic"];
+
+/// Why the set `terms`, fitted as `o`, is not admitted: a term of
+/// [`SHOWN_BEFORE_ADMITTED`] whose key's 95 % interval at `o` does not
+/// exclude zero (or has no finite bound: the data do not determine it).
+/// None when every such term is shown.
+pub fn unshown(terms: &[&'static str], o: &FitOutcome) -> Option<String> {
+    unshown_by(terms, |key| fitted(o, key))
+}
+
+/// [`unshown`] with `fitted` giving a fitted key's value and 95 % interval
+/// (None: the key is not fitted).
+fn unshown_by(
+    terms: &[&'static str],
+    fitted: impl Fn(&str) -> Option<(f64, f64, f64)>,
+) -> Option<String> {
+    for t in terms.iter().filter(|t| SHOWN_BEFORE_ADMITTED.contains(t)) {
+        let Some(c) = CANDIDATES.iter().find(|c| c.name == *t) else {
+            continue;
+        };
+        for key in c.keys {
+            let Some((value, lo, hi)) = fitted(key) else {
+                continue;
+            };
+            let (lo_ok, hi_ok) = (lo > 0.0 && lo.is_finite(), hi < 0.0 && hi.is_finite());
+            if !(lo_ok || hi_ok) {
+                let others: Vec<&str> = terms.iter().copied().filter(|x| x != t).collect();
+                return Some(format!(
+                    "{t}{}: its fit gives `{key}` = {} with a 95 % interval [{}, {}] that holds zero; a term that grows without end past the data is admitted only where they show it",
+                    if others.is_empty() {
+                        String::new()
+                    } else {
+                        format!(" beside {}", others.join(", "))
+                    },
+                    crate::text::Num::sig(value, 4),
+                    crate::text::Num::sig(lo, 3),
+                    crate::text::Num::sig(hi, 3)
+                ));
+            }
+        }
+    }
+    None
+}
+
+/// `key`'s value and 95 % interval at `o`; None when `key` is not fitted.
+/// An interval not computed reads as NaN, which shows nothing.
+fn fitted(o: &FitOutcome, key: &str) -> Option<(f64, f64, f64)> {
+    let j = o.params.iter().position(|q| q.name == key)?;
+    let (lo, hi) = o
+        .statistics
+        .interval95
+        .get(j)
+        .copied()
+        .unwrap_or((f64::NAN, f64::NAN));
+    Some((o.best[j], lo, hi))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const QUADRATIC: &str = "drivetrain quadratic";
+    const C2: &str = "drivetrain.quadratic_n_s2_m2";
+
+    /// `unshown_by` with one fitted key, `C2`, at `value` in `[lo, hi]`.
+    fn with_c2(terms: &[&'static str], (value, lo, hi): (f64, f64, f64)) -> Option<String> {
+        unshown_by(terms, move |k| (k == C2).then_some((value, lo, hi)))
+    }
+
+    #[test]
+    fn a_quadratic_whose_interval_holds_zero_is_not_admitted_and_the_report_says_why() {
+        let why = with_c2(&["drivetrain Stribeck", QUADRATIC], (5.0, -1.0, 11.0)).unwrap();
+        assert_eq!(
+            why,
+            "drivetrain quadratic beside drivetrain Stribeck: its fit gives `drivetrain.quadratic_n_s2_m2` = 5 with a 95 % interval [-1, 11] that holds zero; a term that grows without end past the data is admitted only where they show it"
+        );
+    }
+
+    #[test]
+    fn a_quadratic_whose_interval_excludes_zero_on_either_side_is_admitted() {
+        assert_eq!(with_c2(&[QUADRATIC], (5.0, 1.0, 9.0)), None);
+        assert_eq!(with_c2(&[QUADRATIC], (-5.0, -9.0, -1.0)), None);
+    }
+
+    #[test]
+    fn a_quadratic_whose_interval_was_not_computed_is_not_admitted() {
+        assert!(with_c2(&[QUADRATIC], (5.0, f64::NAN, f64::NAN)).is_some());
+        assert!(with_c2(&[QUADRATIC], (5.0, f64::NEG_INFINITY, f64::INFINITY)).is_some());
+    }
+
+    #[test]
+    fn a_set_without_such_a_term_is_admitted_whatever_its_keys() {
+        assert_eq!(with_c2(&["drivetrain viscous"], (5.0, -1.0, 11.0)), None);
+    }
+}
