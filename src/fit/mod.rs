@@ -77,8 +77,8 @@
 //! | `error.rs` | [`FitError`] (setup) and [`PredictError`] (no prediction at some parameter values) |
 //! | `units.rs` | the data's units: m/s and N, or rad/s and N·m |
 
-#[cfg(feature = "mcap")]
 pub mod admission;
+#[cfg(feature = "mcap")]
 pub mod bag_input;
 pub mod baselines;
 pub mod bound_polish;
