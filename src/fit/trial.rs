@@ -223,10 +223,35 @@ fn stribeck_curves(p: &Prepared) -> Vec<super::classic_regression::GridCurve> {
         .iter()
         .filter_map(|s| s.series(&p.data.map_values).ok())
         .collect();
-    [false, true]
+    let mut out: Vec<_> = [false, true]
         .into_iter()
         .filter_map(|offset| super::classic_regression::stribeck_curve_by_grid(&series, offset))
-        .collect()
+        .collect();
+    // A time series passes through zero smoothly at its reversals (the
+    // bristle), and a steady curve fitted there spends its rise on that
+    // crossing: a sign function at a few thousandths of the top speed
+    // (draw 88 of `docs/joint-series-draws.sh`: the curve of all samples
+    // rises at 0.009 rad/s, the joint's at 0.19). The same curves on the
+    // samples sliding faster than a tenth of the top speed are starts too.
+    if series.iter().any(|s| !s.steady) {
+        let sliding: Vec<_> = series
+            .iter()
+            .cloned()
+            .map(|mut s| {
+                if !s.steady {
+                    let top = s.velocity.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                    for (f, v) in s.fit.iter_mut().zip(&s.velocity) {
+                        *f = *f && v.abs() > 0.1 * top;
+                    }
+                }
+                s
+            })
+            .collect();
+        out.extend([false, true].into_iter().filter_map(|offset| {
+            super::classic_regression::stribeck_curve_by_grid(&sliding, offset)
+        }));
+    }
+    out
 }
 
 /// Where a new term's speed-like key starts besides its own start: the
@@ -364,7 +389,12 @@ impl Ctx<'_> {
                 out.push(x);
             }
         }
-        if new_keys.contains(&STRIBECK_SPEED_KEY) {
+        // The curve's classic starts where it is new, and where pre-sliding
+        // is new beside it: the bristle then takes the zero crossing that
+        // the curve alone may have fitted.
+        let presliding_new = new_keys.contains(&"contact.presliding_stiffness_n_m");
+        let holds_curve = model.parameters().iter().any(|q| q.name == STRIBECK_SPEED_KEY);
+        if new_keys.contains(&STRIBECK_SPEED_KEY) || (presliding_new && holds_curve) {
             out.extend(self.stribeck_starts(model, &start));
         }
         out
