@@ -27,8 +27,25 @@ pub const SHOWN_BEFORE_ADMITTED: &[&str] = &["drivetrain quadratic"];
 /// [`SHOWN_BEFORE_ADMITTED`] whose key's 95 % interval at `o` does not
 /// exclude zero (or has no finite bound: the data do not determine it).
 /// None when every such term is shown.
-pub fn unshown(terms: &[&'static str], o: &FitOutcome) -> Option<String> {
-    unshown_by(terms, |key| fitted(o, key))
+pub fn unshown(terms: &[&'static str], o: &FitOutcome, top_speed: f64) -> Option<String> {
+    if let Some(why) = unshown_by(terms, |key| fitted(o, key)) {
+        return Some(why);
+    }
+    if terms.contains(&"boundary rate") {
+        let (value, lo, hi) = fitted(o, "contact.boundary_activation_speed_m_s")?;
+        if !(hi < top_speed && lo.is_finite() && value < top_speed) {
+            let others: Vec<&str> = terms.iter().copied().filter(|x| *x != "boundary rate").collect();
+            return Some(format!(
+                "boundary rate beside {}: its fit places `contact.boundary_activation_speed_m_s` at {} with a 95 % interval [{}, {}] that reaches the data's top speed {}: a bend the data do not show",
+                others.join(", "),
+                crate::text::Num::sig(value, 4),
+                crate::text::Num::sig(lo, 3),
+                crate::text::Num::sig(hi, 3),
+                crate::text::Num::sig(top_speed, 4)
+            ));
+        }
+    }
+    None
 }
 
 /// [`unshown`] with `fitted` giving a fitted key's value and 95 % interval

@@ -506,7 +506,7 @@ impl Ctx<'_> {
             Err(FitError::Interrupted(i)) => return Err(FitError::Interrupted(i)),
             Err(_) => return Ok(self.unfitted(terms, "its fit failed")),
         };
-        if let Some(why) = unshown(terms, &fitted) {
+        if let Some(why) = unshown(terms, &fitted, self.p.model_scale.velocity_m_s) {
             self.not_admitted
                 .lock()
                 .unwrap_or_else(|p| p.into_inner())
