@@ -34,7 +34,11 @@ pub fn unshown(terms: &[&'static str], o: &FitOutcome, top_speed: f64) -> Option
     if terms.contains(&"boundary rate") {
         let (value, lo, hi) = fitted(o, "contact.boundary_activation_speed_m_s")?;
         if !(hi < top_speed && lo.is_finite() && value < top_speed) {
-            let others: Vec<&str> = terms.iter().copied().filter(|x| *x != "boundary rate").collect();
+            let others: Vec<&str> = terms
+                .iter()
+                .copied()
+                .filter(|x| *x != "boundary rate")
+                .collect();
             return Some(format!(
                 "boundary rate beside {}: its fit places `contact.boundary_activation_speed_m_s` at {} with a 95 % interval [{}, {}] that reaches the data's top speed {}: a bend the data do not show",
                 others.join(", "),

@@ -393,7 +393,10 @@ impl Ctx<'_> {
         // is new beside it: the bristle then takes the zero crossing that
         // the curve alone may have fitted.
         let presliding_new = new_keys.contains(&"contact.presliding_stiffness_n_m");
-        let holds_curve = model.parameters().iter().any(|q| q.name == STRIBECK_SPEED_KEY);
+        let holds_curve = model
+            .parameters()
+            .iter()
+            .any(|q| q.name == STRIBECK_SPEED_KEY);
         if new_keys.contains(&STRIBECK_SPEED_KEY) || (presliding_new && holds_curve) {
             out.extend(self.stribeck_starts(model, &start));
         }
