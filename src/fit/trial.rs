@@ -4,7 +4,7 @@
 //! scored by cross-validation, each fold predicted by the set refitted
 //! without it.
 
-use super::admission::unshown;
+use super::admission::{bend_unshown, unshown, BENT};
 use super::candidates::{set_keys, set_specs, CANDIDATES, FILM, FILM_KEY};
 use super::contact_scale::slow_speed;
 use super::cross_validate::cross_validate;
@@ -341,7 +341,10 @@ impl Ctx<'_> {
             return Ok(known);
         }
         let scored = self.score_set(terms, warm)?;
-        lock().push(scored.clone());
+        // A set scored as a smaller one (rule 9b) was cached as that one.
+        if same(&scored) {
+            lock().push(scored.clone());
+        }
         Ok(scored)
     }
 
@@ -509,12 +512,26 @@ impl Ctx<'_> {
             Err(FitError::Interrupted(i)) => return Err(FitError::Interrupted(i)),
             Err(_) => return Ok(self.unfitted(terms, "its fit failed")),
         };
-        if let Some(why) = unshown(terms, &fitted, self.p.model_scale.velocity_m_s) {
+        let not_admitted = |why: String| {
             self.not_admitted
                 .lock()
                 .unwrap_or_else(|p| p.into_inner())
-                .push(why);
+                .push(why)
+        };
+        if let Some(why) = unshown(terms, &fitted) {
+            not_admitted(why);
             return Ok(self.unfitted(terms, "not admitted (below)"));
+        }
+        if let Some(why) = bend_unshown(terms, &fitted, self.p.model_scale.velocity_m_s) {
+            // Rule 9b: the rate entering is refused; a rate chosen before
+            // gives way to the term that left its bend unshown.
+            if terms.last() == Some(&BENT) {
+                not_admitted(why);
+                return Ok(self.unfitted(terms, "not admitted (below)"));
+            }
+            not_admitted(format!("{why}; the set is tried without it"));
+            let rest: Vec<&'static str> = terms.iter().copied().filter(|t| *t != BENT).collect();
+            return self.try_set(&rest, &optimum_of(&fitted));
         }
         let fold_mse = cross_validate(
             &model,
@@ -540,16 +557,20 @@ impl Ctx<'_> {
                 simulations: model.film_solves(),
                 unscored: None,
             },
-            optimum: fitted
-                .params
-                .iter()
-                .map(|q| q.name.clone())
-                .zip(fitted.best.iter().copied())
-                .collect(),
+            optimum: optimum_of(&fitted),
             flags,
             aicc,
         })
     }
+}
+
+/// The fitted keys of `o` and their values.
+fn optimum_of(o: &super::driver::FitOutcome) -> Optimum {
+    o.params
+        .iter()
+        .map(|q| q.name.clone())
+        .zip(o.best.iter().copied())
+        .collect()
 }
 
 /// Per fitted parameter of `o`: its name, whether it ended at a bound or
