@@ -611,16 +611,16 @@ mod tests {
     use super::aicc;
     use approx::assert_relative_eq;
 
-    #[test]
-    fn a_set_reached_by_taking_a_term_away_is_also_started_where_it_would_be_fitted_alone() {
-        use super::super::candidates::{initial_specs, AUTO, BASE_KEY, STRIBECK};
+    use super::super::prepared::Prepared;
+    use super::super::unknowns::ParamSpec;
+
+    /// `--fit auto` prepared on a rising curve swept both ways, friction
+    /// 20 N + 400 N·s/m v (a Coulomb level and a viscous rise), and the
+    /// names given after `auto`.
+    fn prepared_on_a_rising_curve(tag: &str) -> (Prepared, Vec<ParamSpec>) {
+        use super::super::candidates::{initial_specs, AUTO};
         use super::super::inputs::DataRequest;
-        use super::super::prepared::model_for;
-        use super::super::problem::Model;
-        use super::super::unknowns::ParamSpec;
-        use super::{set_specs_for, Ctx, STRIBECK_AMPLITUDE_KEY, STRIBECK_SPEED_KEY};
-        // A rising steady curve swept both ways: friction 20 N + 400 N·s/m v.
-        let d = std::env::temp_dir().join(format!("fn-own-starts-{}", std::process::id()));
+        let d = std::env::temp_dir().join(format!("fn-{tag}-{}", std::process::id()));
         std::fs::create_dir_all(&d).unwrap();
         let csv = d.join("curve.csv");
         let mut text = String::from("t_s,velocity_m_s,friction_n\n");
@@ -644,6 +644,16 @@ mod tests {
         let config = crate::config::Config::default();
         let p = super::super::prepare::prepare(&config, &req, &specs, true).unwrap();
         std::fs::remove_dir_all(&d).unwrap();
+        (p, given)
+    }
+
+    #[test]
+    fn a_set_reached_by_taking_a_term_away_is_also_started_where_it_would_be_fitted_alone() {
+        use super::super::candidates::{BASE_KEY, STRIBECK};
+        use super::super::prepared::model_for;
+        use super::super::problem::Model;
+        use super::{set_specs_for, Ctx, STRIBECK_AMPLITUDE_KEY, STRIBECK_SPEED_KEY};
+        let (p, given) = prepared_on_a_rising_curve("own-starts");
         let search = super::super::options::SearchSettings::default();
         let stop = crate::interrupt::Stop::new();
         let ctx = Ctx::new(&p, &search, &given, &stop);
@@ -677,6 +687,39 @@ mod tests {
         assert!(own.iter().any(|x| x[amplitude] != configured[amplitude]
             && x[speed] != configured[speed]
             && x[amplitude] != 50.0));
+    }
+
+    #[test]
+    fn a_rate_whose_bend_a_newcomer_leaves_unshown_gives_way_and_one_entering_so_is_refused() {
+        use super::super::admission::BENT;
+        use super::Ctx;
+        const VISCOUS: &str = "drivetrain viscous";
+        // The viscous rise is the data's own; beside it a boundary rate has
+        // no bend to show.
+        let (p, given) = prepared_on_a_rising_curve("bend");
+        let search = super::super::options::SearchSettings::default();
+        let stop = crate::interrupt::Stop::new();
+        let ctx = Ctx::new(&p, &search, &given, &stop);
+        // The viscous rise added to a set holding the rate: the set is
+        // tried without the rate, and the report says so.
+        let displaced = ctx.try_set(&[BENT, VISCOUS], &Vec::new()).unwrap();
+        assert_eq!(displaced.tried.terms, vec![VISCOUS]);
+        assert_eq!(displaced.tried.unscored, None);
+        let alone = ctx.try_set(&[VISCOUS], &Vec::new()).unwrap();
+        assert_eq!(alone.tried.fold_mse, displaced.tried.fold_mse);
+        // The rate added to a set holding the viscous rise: refused.
+        let entering = ctx.try_set(&[VISCOUS, BENT], &Vec::new()).unwrap();
+        assert_eq!(entering.tried.terms, vec![VISCOUS, BENT]);
+        assert_eq!(entering.tried.unscored, Some("not admitted (below)"));
+        assert_eq!(entering.tried.cv_rms, f64::INFINITY);
+        let said = ctx.not_admitted.lock().unwrap().clone();
+        assert_eq!(said.len(), 2, "{said:?}");
+        assert!(said[0].starts_with("boundary rate beside drivetrain viscous: its fit places `contact.boundary_activation_speed_m_s`"), "{said:?}");
+        assert!(
+            said[0].ends_with("a bend the data do not show; the set is tried without it"),
+            "{said:?}"
+        );
+        assert!(said[1].ends_with("a bend the data do not show"), "{said:?}");
     }
 
     #[test]
