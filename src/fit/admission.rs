@@ -120,12 +120,7 @@ fn unshown_by(
 /// An interval not computed reads as NaN, which shows nothing.
 fn fitted(o: &FitOutcome, key: &str) -> Option<(f64, f64, f64)> {
     let j = o.params.iter().position(|q| q.name == key)?;
-    let (lo, hi) = o
-        .statistics
-        .interval95
-        .get(j)
-        .copied()
-        .unwrap_or((f64::NAN, f64::NAN));
+    let (lo, hi) = o.statistics.interval95_of(j);
     Some((o.best[j], lo, hi))
 }
 
