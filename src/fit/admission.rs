@@ -7,6 +7,7 @@
 //! | symbol | meaning | unit |
 //! |---|---|---|
 //! | c₂ | the drivetrain's quadratic loss, F = c₂ v² sgn v | N·s²/m² |
+//! | μ_r | the boundary rate, μ = μ_bl + μ_r asinh(\|v\|/v_a) | – |
 //! | v_a | the boundary rate's activation speed, its bend | m/s |
 //! | V | the data's top contact speed | m/s |
 //!
@@ -17,8 +18,9 @@
 //! with v² that they never showed.
 //!
 //! A bend is shown where v_a and its 95 % interval lie below V, with a
-//! finite lower end. Where the interval reaches V, the rate is a viscous
-//! rise inside the data that saturates where they stop. The term being
+//! finite lower end. Below v_a the rate rises linearly with |v|, past it
+//! logarithmically. Where the interval reaches V, the rate is a viscous
+//! rise inside the data that bends where they stop. The term being
 //! added is then refused. A term already chosen gives way: a newcomer
 //! that leaves the rate's bend unshown is tried in the set without the
 //! rate (`trial.rs`).
@@ -51,9 +53,10 @@ const BEND_KEY: &str = "contact.boundary_activation_speed_m_s";
 /// Why the boundary rate in `terms`, fitted as `o`, shows no bend: its
 /// activation speed v_a or the upper end of v_a's 95 % interval reaches
 /// `top_speed_m_s` (the data's top contact speed), or the interval has no
-/// finite lower end. Such a rate is a viscous rise that saturates where
-/// the data stop: inside them the viscous term says the same, and past
-/// them it bends where they never showed a bend (`select.rs` rule 9b).
+/// finite lower end. Such a rate is a viscous rise that bends where the
+/// data stop: inside them the viscous term says the same, and past them
+/// it flattens to a logarithmic growth they never showed (`select.rs`
+/// rule 9b).
 /// None when the set holds no rate or its bend is shown.
 pub fn bend_unshown(terms: &[&'static str], o: &FitOutcome, top_speed_m_s: f64) -> Option<String> {
     if !terms.contains(&BENT) {

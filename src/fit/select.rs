@@ -147,10 +147,11 @@
 //!    bend inside the data: its activation speed and that speed's 95 %
 //!    interval lie below the data's top speed
 //!    ([`bend_unshown`](super::admission::bend_unshown)). A bend at the
-//!    top is a viscous rise inside the data that saturates where they
-//!    stop, a regime change they do not show. On a rising joint with
+//!    top is a viscous rise inside the data that flattens where they
+//!    stop (μ_r asinh(|v|/v_a) turns from linear to logarithmic at v_a),
+//!    a regime change they do not show. On a rising joint with
 //!    ripple (draw 88 of `docs/joint-series-draws.sh`) such a rate paid
-//!    3.5 % on the folds and predicted a 2.5× faster motion 1.86× worse
+//!    3.5 % on the folds beside LuGre's own set and predicted a 2.5× faster motion 1.86× worse
 //!    than LuGre. A rate entering with its bend unshown is refused. A set
 //!    whose newcomer leaves an earlier rate's bend unshown is tried
 //!    without the rate: the newcomer displaces it (draw 64: the Stribeck
