@@ -1,16 +1,29 @@
 //! `--fit auto`'s rule 9: a term that grows without end past the data
 //! faster than the viscous rise is admitted into a set only where the
-//! set's fit shows the start of that growth inside the data.
+//! set's fit shows the start of that growth inside the data; rule 9b: a
+//! term that bends is kept only where the set's fit shows the bend inside
+//! the data.
 //!
 //! | symbol | meaning | unit |
 //! |---|---|---|
 //! | c₂ | the drivetrain's quadratic loss, F = c₂ v² sgn v | N·s²/m² |
+//! | μ_r | the boundary rate, μ = μ_bl + μ_r asinh(\|v\|/v_a) | – |
+//! | v_a | the boundary rate's activation speed, its bend | m/s |
+//! | V | the data's top contact speed | m/s |
 //!
 //! Shown: the 95 % interval of c₂ excludes zero. Where it holds zero, the
 //! folds may still favour the term (they reach one speed range past the
 //! rest, about 1.25× on a steady curve, where a curvature of the noise or
 //! of a Stribeck dip's bottom pays), and past the data it adds a growth
 //! with v² that they never showed.
+//!
+//! A bend is shown where v_a and its 95 % interval lie below V, with a
+//! finite lower end. Below v_a the rate rises linearly with |v|, past it
+//! logarithmically. Where the interval reaches V, the rate is a viscous
+//! rise inside the data that bends where they stop. The term being
+//! added is then refused. A term already chosen gives way: a newcomer
+//! that leaves the rate's bend unshown is tried in the set without the
+//! rate (`trial.rs`).
 
 use super::candidates::CANDIDATES;
 use super::driver::FitOutcome;
@@ -29,6 +42,47 @@ pub const SHOWN_BEFORE_ADMITTED: &[&str] = &["drivetrain quadratic"];
 /// None when every such term is shown.
 pub fn unshown(terms: &[&'static str], o: &FitOutcome) -> Option<String> {
     unshown_by(terms, |key| fitted(o, key))
+}
+
+/// The term whose bend must lie inside the data: the boundary rate.
+pub const BENT: &str = "boundary rate";
+
+/// Its bend: the activation speed v_a, in contact units (m/s).
+const BEND_KEY: &str = "contact.boundary_activation_speed_m_s";
+
+/// Why the boundary rate in `terms`, fitted as `o`, shows no bend: its
+/// activation speed v_a or the upper end of v_a's 95 % interval reaches
+/// `top_speed_m_s` (the data's top contact speed), or the interval has no
+/// finite lower end. Such a rate is a viscous rise that bends where the
+/// data stop: inside them the viscous term says the same, and past them
+/// it flattens to a logarithmic growth they never showed (`select.rs`
+/// rule 9b).
+/// None when the set holds no rate or its bend is shown.
+pub fn bend_unshown(terms: &[&'static str], o: &FitOutcome, top_speed_m_s: f64) -> Option<String> {
+    if !terms.contains(&BENT) {
+        return None;
+    }
+    bend_unshown_at(terms, fitted(o, BEND_KEY)?, top_speed_m_s)
+}
+
+/// [`bend_unshown`] with v_a's value and 95 % interval given.
+fn bend_unshown_at(
+    terms: &[&'static str],
+    (value, lo, hi): (f64, f64, f64),
+    top_speed_m_s: f64,
+) -> Option<String> {
+    if hi < top_speed_m_s && lo.is_finite() && value < top_speed_m_s {
+        return None;
+    }
+    let others: Vec<&str> = terms.iter().copied().filter(|x| *x != BENT).collect();
+    Some(format!(
+        "{BENT} beside {}: its fit places `{BEND_KEY}` at {} with a 95 % interval [{}, {}] that reaches the data's top speed {}: a bend the data do not show",
+        others.join(", "),
+        crate::text::Num::sig(value, 4),
+        crate::text::Num::sig(lo, 3),
+        crate::text::Num::sig(hi, 3),
+        crate::text::Num::sig(top_speed_m_s, 4)
+    ))
 }
 
 /// [`unshown`] with `fitted` giving a fitted key's value and 95 % interval
@@ -69,12 +123,7 @@ fn unshown_by(
 /// An interval not computed reads as NaN, which shows nothing.
 fn fitted(o: &FitOutcome, key: &str) -> Option<(f64, f64, f64)> {
     let j = o.params.iter().position(|q| q.name == key)?;
-    let (lo, hi) = o
-        .statistics
-        .interval95
-        .get(j)
-        .copied()
-        .unwrap_or((f64::NAN, f64::NAN));
+    let (lo, hi) = o.statistics.interval95_of(j);
     Some((o.best[j], lo, hi))
 }
 
@@ -109,6 +158,20 @@ mod tests {
     fn a_quadratic_whose_interval_was_not_computed_is_not_admitted() {
         assert!(with_c2(&[QUADRATIC], (5.0, f64::NAN, f64::NAN)).is_some());
         assert!(with_c2(&[QUADRATIC], (5.0, f64::NEG_INFINITY, f64::INFINITY)).is_some());
+    }
+
+    #[test]
+    fn a_rate_whose_bend_or_its_interval_reaches_the_top_speed_shows_no_bend() {
+        let terms = ["pre-sliding", BENT];
+        assert_eq!(bend_unshown_at(&terms, (0.2, 0.1, 0.3), 0.5), None);
+        let why = bend_unshown_at(&terms, (0.2, 0.1, 0.6), 0.5).unwrap();
+        assert_eq!(
+            why,
+            "boundary rate beside pre-sliding: its fit places `contact.boundary_activation_speed_m_s` at 0.2 with a 95 % interval [0.1, 0.6] that reaches the data's top speed 0.5: a bend the data do not show"
+        );
+        assert!(bend_unshown_at(&terms, (0.5, 0.4, 0.45), 0.5).is_some());
+        assert!(bend_unshown_at(&terms, (1e-8, 0.0, f64::INFINITY), 0.5).is_some());
+        assert!(bend_unshown_at(&terms, (0.2, f64::NAN, f64::NAN), 0.5).is_some());
     }
 
     #[test]

@@ -142,6 +142,20 @@
 //!    fresh random joint (seed 41, joint 23) the quadratic paid on the
 //!    folds (CV 0.0209 → 0.0124 N·m) at 0.82 ± 0.65 N·m·s²/rad² and
 //!    predicted 90 deg/s 35× worse than the Stribeck curve.
+//!
+//!    9b. The boundary rate is kept only where the set's fit shows its
+//!    bend inside the data: its activation speed and that speed's 95 %
+//!    interval lie below the data's top speed
+//!    ([`bend_unshown`](super::admission::bend_unshown)). A bend at the
+//!    top is a viscous rise inside the data that flattens where they
+//!    stop (μ_r asinh(|v|/v_a) turns from linear to logarithmic at v_a),
+//!    a regime change they do not show. On a rising joint with
+//!    ripple (draw 88 of `docs/joint-series-draws.sh`) such a rate paid
+//!    3.5 % on the folds beside LuGre's own set and predicted a 2.5× faster motion 1.86× worse
+//!    than LuGre. A rate entering with its bend unshown is refused. A set
+//!    whose newcomer leaves an earlier rate's bend unshown is tried
+//!    without the rate: the newcomer displaces it (draw 64: the Stribeck
+//!    curve beside a rate chosen first with its bend at 4 % of the top).
 //! 10. On a steady curve a term enters only where the whole curve supports
 //!     it as well as the folds (`curve_support.rs`): its set's small-sample
 //!     Akaike criterion on all the training points is below the current
@@ -188,7 +202,7 @@ pub struct Selection {
     pub tried: Vec<Tried>,
     /// Candidates left out on these data, each with why.
     pub excluded: Vec<String>,
-    /// Sets not admitted (rule 9), each with why.
+    /// Sets not admitted (rules 9 and 9b), each with why.
     pub not_admitted: Vec<String>,
     /// Terms chosen and then removed, each with why.
     pub removed: Vec<String>,

@@ -37,6 +37,20 @@ pub struct Statistics {
 }
 
 impl Statistics {
+    /// Parameter `j`'s 95 % interval; (NaN, NaN) where it was not
+    /// computed (a fit that stopped before its statistics).
+    pub fn interval95_of(&self, j: usize) -> (f64, f64) {
+        self.interval95
+            .get(j)
+            .copied()
+            .unwrap_or((f64::NAN, f64::NAN))
+    }
+
+    /// Parameter `j`'s standard error; NaN where it was not computed.
+    pub fn standard_error_of(&self, j: usize) -> f64 {
+        self.standard_error.get(j).copied().unwrap_or(f64::NAN)
+    }
+
     /// Pairs (i, j, ρ) with |ρ| above [`CORRELATION_FLAG`].
     pub fn correlated_pairs(&self) -> Vec<(usize, usize, f64)> {
         let n = self.correlation.len();

@@ -4,7 +4,7 @@
 //! scored by cross-validation, each fold predicted by the set refitted
 //! without it.
 
-use super::admission::unshown;
+use super::admission::{bend_unshown, unshown, BENT};
 use super::candidates::{set_keys, set_specs, CANDIDATES, FILM, FILM_KEY};
 use super::contact_scale::slow_speed;
 use super::cross_validate::cross_validate;
@@ -223,10 +223,35 @@ fn stribeck_curves(p: &Prepared) -> Vec<super::classic_regression::GridCurve> {
         .iter()
         .filter_map(|s| s.series(&p.data.map_values).ok())
         .collect();
-    [false, true]
+    let mut out: Vec<_> = [false, true]
         .into_iter()
         .filter_map(|offset| super::classic_regression::stribeck_curve_by_grid(&series, offset))
-        .collect()
+        .collect();
+    // A time series passes through zero smoothly at its reversals (the
+    // bristle), and a steady curve fitted there spends its rise on that
+    // crossing: a sign function at a few thousandths of the top speed
+    // (draw 88 of `docs/joint-series-draws.sh`: the curve of all samples
+    // rises at 0.009 rad/s, the joint's at 0.19). The same curves on the
+    // samples sliding faster than a tenth of the top speed are starts too.
+    if series.iter().any(|s| !s.steady) {
+        let sliding: Vec<_> = series
+            .iter()
+            .cloned()
+            .map(|mut s| {
+                if !s.steady {
+                    let top = s.velocity.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                    for (f, v) in s.fit.iter_mut().zip(&s.velocity) {
+                        *f = *f && v.abs() > 0.1 * top;
+                    }
+                }
+                s
+            })
+            .collect();
+        out.extend([false, true].into_iter().filter_map(|offset| {
+            super::classic_regression::stribeck_curve_by_grid(&sliding, offset)
+        }));
+    }
+    out
 }
 
 /// Where a new term's speed-like key starts besides its own start: the
@@ -316,7 +341,10 @@ impl Ctx<'_> {
             return Ok(known);
         }
         let scored = self.score_set(terms, warm)?;
-        lock().push(scored.clone());
+        // A set scored as a smaller one (rule 9b) was cached as that one.
+        if same(&scored) {
+            lock().push(scored.clone());
+        }
         Ok(scored)
     }
 
@@ -364,7 +392,15 @@ impl Ctx<'_> {
                 out.push(x);
             }
         }
-        if new_keys.contains(&STRIBECK_SPEED_KEY) {
+        // The curve's classic starts where it is new, and where pre-sliding
+        // is new beside it: the bristle then takes the zero crossing that
+        // the curve alone may have fitted.
+        let presliding_new = new_keys.contains(&"contact.presliding_stiffness_n_m");
+        let holds_curve = model
+            .parameters()
+            .iter()
+            .any(|q| q.name == STRIBECK_SPEED_KEY);
+        if new_keys.contains(&STRIBECK_SPEED_KEY) || (presliding_new && holds_curve) {
             out.extend(self.stribeck_starts(model, &start));
         }
         out
@@ -476,12 +512,26 @@ impl Ctx<'_> {
             Err(FitError::Interrupted(i)) => return Err(FitError::Interrupted(i)),
             Err(_) => return Ok(self.unfitted(terms, "its fit failed")),
         };
-        if let Some(why) = unshown(terms, &fitted) {
+        let not_admitted = |why: String| {
             self.not_admitted
                 .lock()
                 .unwrap_or_else(|p| p.into_inner())
-                .push(why);
+                .push(why)
+        };
+        if let Some(why) = unshown(terms, &fitted) {
+            not_admitted(why);
             return Ok(self.unfitted(terms, "not admitted (below)"));
+        }
+        if let Some(why) = bend_unshown(terms, &fitted, self.p.model_scale.velocity_m_s) {
+            // Rule 9b: the rate entering is refused; a rate chosen before
+            // gives way to the term that left its bend unshown.
+            if terms.last() == Some(&BENT) {
+                not_admitted(why);
+                return Ok(self.unfitted(terms, "not admitted (below)"));
+            }
+            not_admitted(format!("{why}; the set is tried without it"));
+            let rest: Vec<&'static str> = terms.iter().copied().filter(|t| *t != BENT).collect();
+            return self.try_set(&rest, &optimum_of(&fitted));
         }
         let fold_mse = cross_validate(
             &model,
@@ -507,16 +557,20 @@ impl Ctx<'_> {
                 simulations: model.film_solves(),
                 unscored: None,
             },
-            optimum: fitted
-                .params
-                .iter()
-                .map(|q| q.name.clone())
-                .zip(fitted.best.iter().copied())
-                .collect(),
+            optimum: optimum_of(&fitted),
             flags,
             aicc,
         })
     }
+}
+
+/// The fitted keys of `o` and their values.
+fn optimum_of(o: &super::driver::FitOutcome) -> Optimum {
+    o.params
+        .iter()
+        .map(|q| q.name.clone())
+        .zip(o.best.iter().copied())
+        .collect()
 }
 
 /// Per fitted parameter of `o`: its name, whether it ended at a bound or
@@ -557,16 +611,16 @@ mod tests {
     use super::aicc;
     use approx::assert_relative_eq;
 
-    #[test]
-    fn a_set_reached_by_taking_a_term_away_is_also_started_where_it_would_be_fitted_alone() {
-        use super::super::candidates::{initial_specs, AUTO, BASE_KEY, STRIBECK};
+    use super::super::prepared::Prepared;
+    use super::super::unknowns::ParamSpec;
+
+    /// `--fit auto` prepared on a rising curve swept both ways, friction
+    /// 20 N + 400 N·s/m v (a Coulomb level and a viscous rise), and the
+    /// names given after `auto`.
+    fn prepared_on_a_rising_curve(tag: &str) -> (Prepared, Vec<ParamSpec>) {
+        use super::super::candidates::{initial_specs, AUTO};
         use super::super::inputs::DataRequest;
-        use super::super::prepared::model_for;
-        use super::super::problem::Model;
-        use super::super::unknowns::ParamSpec;
-        use super::{set_specs_for, Ctx, STRIBECK_AMPLITUDE_KEY, STRIBECK_SPEED_KEY};
-        // A rising steady curve swept both ways: friction 20 N + 400 N·s/m v.
-        let d = std::env::temp_dir().join(format!("fn-own-starts-{}", std::process::id()));
+        let d = std::env::temp_dir().join(format!("fn-{tag}-{}", std::process::id()));
         std::fs::create_dir_all(&d).unwrap();
         let csv = d.join("curve.csv");
         let mut text = String::from("t_s,velocity_m_s,friction_n\n");
@@ -590,6 +644,16 @@ mod tests {
         let config = crate::config::Config::default();
         let p = super::super::prepare::prepare(&config, &req, &specs, true).unwrap();
         std::fs::remove_dir_all(&d).unwrap();
+        (p, given)
+    }
+
+    #[test]
+    fn a_set_reached_by_taking_a_term_away_is_also_started_where_it_would_be_fitted_alone() {
+        use super::super::candidates::{BASE_KEY, STRIBECK};
+        use super::super::prepared::model_for;
+        use super::super::problem::Model;
+        use super::{set_specs_for, Ctx, STRIBECK_AMPLITUDE_KEY, STRIBECK_SPEED_KEY};
+        let (p, given) = prepared_on_a_rising_curve("own-starts");
         let search = super::super::options::SearchSettings::default();
         let stop = crate::interrupt::Stop::new();
         let ctx = Ctx::new(&p, &search, &given, &stop);
@@ -623,6 +687,39 @@ mod tests {
         assert!(own.iter().any(|x| x[amplitude] != configured[amplitude]
             && x[speed] != configured[speed]
             && x[amplitude] != 50.0));
+    }
+
+    #[test]
+    fn a_rate_whose_bend_a_newcomer_leaves_unshown_gives_way_and_one_entering_so_is_refused() {
+        use super::super::admission::BENT;
+        use super::Ctx;
+        const VISCOUS: &str = "drivetrain viscous";
+        // The viscous rise is the data's own; beside it a boundary rate has
+        // no bend to show.
+        let (p, given) = prepared_on_a_rising_curve("bend");
+        let search = super::super::options::SearchSettings::default();
+        let stop = crate::interrupt::Stop::new();
+        let ctx = Ctx::new(&p, &search, &given, &stop);
+        // The viscous rise added to a set holding the rate: the set is
+        // tried without the rate, and the report says so.
+        let displaced = ctx.try_set(&[BENT, VISCOUS], &Vec::new()).unwrap();
+        assert_eq!(displaced.tried.terms, vec![VISCOUS]);
+        assert_eq!(displaced.tried.unscored, None);
+        let alone = ctx.try_set(&[VISCOUS], &Vec::new()).unwrap();
+        assert_eq!(alone.tried.fold_mse, displaced.tried.fold_mse);
+        // The rate added to a set holding the viscous rise: refused.
+        let entering = ctx.try_set(&[VISCOUS, BENT], &Vec::new()).unwrap();
+        assert_eq!(entering.tried.terms, vec![VISCOUS, BENT]);
+        assert_eq!(entering.tried.unscored, Some("not admitted (below)"));
+        assert_eq!(entering.tried.cv_rms, f64::INFINITY);
+        let said = ctx.not_admitted.lock().unwrap().clone();
+        assert_eq!(said.len(), 2, "{said:?}");
+        assert!(said[0].starts_with("boundary rate beside drivetrain viscous: its fit places `contact.boundary_activation_speed_m_s`"), "{said:?}");
+        assert!(
+            said[0].ends_with("a bend the data do not show; the set is tried without it"),
+            "{said:?}"
+        );
+        assert!(said[1].ends_with("a bend the data do not show"), "{said:?}");
     }
 
     #[test]

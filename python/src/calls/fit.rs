@@ -63,20 +63,8 @@ fn outcome_dict<'py>(py: Python<'py>, o: &FitOutcome) -> PyResult<Bound<'py, PyD
         r.set_item("name", &p.name)?;
         r.set_item("value", o.best[i])?;
         r.set_item("start", p.start)?;
-        r.set_item(
-            "std_error",
-            o.statistics
-                .standard_error
-                .get(i)
-                .copied()
-                .unwrap_or(f64::NAN),
-        )?;
-        let (lo95, hi95) = o
-            .statistics
-            .interval95
-            .get(i)
-            .copied()
-            .unwrap_or((f64::NAN, f64::NAN));
+        r.set_item("std_error", o.statistics.standard_error_of(i))?;
+        let (lo95, hi95) = o.statistics.interval95_of(i);
         r.set_item("ci95_low", lo95)?;
         r.set_item("ci95_high", hi95)?;
         r.set_item("lower_bound", p.lo)?;
