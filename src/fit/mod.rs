@@ -127,6 +127,7 @@ pub mod stop_reason;
 pub mod synthetic;
 pub mod table_columns;
 pub mod trial;
+mod trial_starts;
 pub mod units;
 pub mod unknowns;
 mod windowed;
