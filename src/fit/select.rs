@@ -31,7 +31,7 @@
 //!    Stribeck curve to its viscous rise), so that a first choice does not
 //!    block a better pair, nor a curve stand in for a term added later.
 //!    A set reached by taking a term away is also started where it would
-//!    be fitted alone (`trial.rs`, `own_starts`): at the warm optimum the
+//!    be fitted alone (`trial_starts.rs`, `Starts::own`): at the warm optimum the
 //!    other keys carried a part of the removed term's effect (on joint draw
 //!    d82 a Stribeck peak beside a rising boundary rate), and its score must
 //!    not depend on the path that reached it.

@@ -11,7 +11,7 @@ use super::data::{Data, Folds};
 use super::driver::fit;
 use super::options::{Options, SearchSettings};
 use super::prepared::{model_for, Prepared};
-use super::trial_starts::film_placements;
+use super::trial_starts::{film_placements, Starts};
 use super::unknowns::ParamSpec;
 use super::FitError;
 
@@ -133,9 +133,8 @@ pub(super) struct Ctx<'a> {
     /// when the set without them predicts the folds better, by the rule a
     /// term must meet to enter.
     pub(super) presumed: std::sync::OnceLock<Vec<&'static str>>,
-    /// The best Stribeck curves on the training data ([`stribeck_curves`]),
-    /// made once, when the first set with a new Stribeck term is tried.
-    pub(super) stribeck_curves: std::sync::OnceLock<Vec<super::classic_regression::GridCurve>>,
+    /// The starts of a set's fit besides its warm start.
+    pub(super) starts: Starts<'a>,
     /// Every set scored so far, by its terms in catalogue order: a set
     /// that the removal or the flag checks come back to is the same
     /// problem on the same folds, and is not fitted again.
@@ -164,7 +163,7 @@ impl<'a> Ctx<'a> {
             stop,
             given,
             presumed: std::sync::OnceLock::new(),
-            stribeck_curves: std::sync::OnceLock::new(),
+            starts: Starts::new(p),
             scored: std::sync::Mutex::new(Vec::new()),
             not_admitted: std::sync::Mutex::new(Vec::new()),
         }
@@ -289,10 +288,12 @@ impl Ctx<'_> {
             xtol: 1e-5,
             ..Default::default()
         };
-        options.extra_starts = self.extra_starts(&model, &map_fit, terms, warm, &placements);
+        options.extra_starts = self
+            .starts
+            .extra(&model, &map_fit, terms, warm, &placements);
         options
             .extra_starts
-            .extend(self.own_starts(&specs, &model, &map_fit, warm)?);
+            .extend(self.starts.own(&specs, &model, &map_fit, warm)?);
         let fitted = match fit(&model, &self.data, map_fit.clone(), &options) {
             Ok(o) => o,
             Err(FitError::Interrupted(i)) => return Err(FitError::Interrupted(i)),
@@ -456,11 +457,11 @@ mod tests {
         ];
         let (model, map_fit) = model_for(&p, &specs, &warm).unwrap();
         // Reached by adding to a set it holds: its warm start is its own.
-        let own = ctx.own_starts(&specs, &model, &map_fit, &warm).unwrap();
+        let own = ctx.starts.own(&specs, &model, &map_fit, &warm).unwrap();
         assert!(own.is_empty(), "{own:?}");
         // Reached by taking the boundary rate away: also started alone.
         warm.push(("contact.boundary_friction_rate".into(), 0.2));
-        let own = ctx.own_starts(&specs, &model, &map_fit, &warm).unwrap();
+        let own = ctx.starts.own(&specs, &model, &map_fit, &warm).unwrap();
         let (cold, _) = model_for(&p, &specs, &[]).unwrap();
         let configured: Vec<f64> = cold.parameters().iter().map(|q| q.start).collect();
         let warmed: Vec<f64> = model.parameters().iter().map(|q| q.start).collect();

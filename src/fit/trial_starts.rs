@@ -8,7 +8,6 @@ use super::candidates::{CANDIDATES, FILM_KEY};
 use super::contact_scale::slow_speed;
 use super::prepared::{model_for, Prepared};
 use super::problem::Model;
-use super::trial::{Ctx, Optimum};
 use super::unknowns::ParamSpec;
 use super::FitError;
 
@@ -115,15 +114,31 @@ fn placements(p: &Prepared, key: &str) -> Vec<f64> {
     }
 }
 
-impl Ctx<'_> {
+/// A selection's starts besides the warm one: on its prepared data, with
+/// the best Stribeck curves on its training data made once, when the first
+/// set with a new Stribeck term is tried.
+pub(super) struct Starts<'a> {
+    p: &'a Prepared,
+    stribeck_curves: std::sync::OnceLock<Vec<super::classic_regression::GridCurve>>,
+}
+
+impl<'a> Starts<'a> {
+    /// The starts of sets fitted on `p`.
+    pub(super) fn new(p: &'a Prepared) -> Self {
+        Starts {
+            p,
+            stribeck_curves: std::sync::OnceLock::new(),
+        }
+    }
+
     /// The starts besides the warm one: each key new to the set (not in
     /// `warm`) at each of its placements, the others at the warm start.
-    pub(super) fn extra_starts(
+    pub(super) fn extra(
         &self,
         model: &super::physics_model::PhysicsModel,
         map_fit: &super::prepared::MapFit,
         terms: &[&'static str],
-        warm: &Optimum,
+        warm: &[(String, f64)],
         film: &[f64],
     ) -> Vec<Vec<f64>> {
         let new_keys: Vec<&str> = terms
@@ -170,12 +185,12 @@ impl Ctx<'_> {
     /// be fitted alone: every key at its configured start, and the Stribeck
     /// curve at each of its classic starts. A set's score does not depend
     /// on the path that reached it.
-    pub(super) fn own_starts(
+    pub(super) fn own(
         &self,
         specs: &[ParamSpec],
         model: &super::physics_model::PhysicsModel,
         map_fit: &super::prepared::MapFit,
-        warm: &Optimum,
+        warm: &[(String, f64)],
     ) -> Result<Vec<Vec<f64>>, FitError> {
         let fits = |k: &str| {
             model.parameters().iter().any(|q| q.name == k)
