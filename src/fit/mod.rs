@@ -36,6 +36,7 @@
 //! | `curve_support.rs` | `--fit auto`'s rule 10: on a steady curve a term enters only where the whole curve's AICc is lowered too |
 //! | `removal.rs` | terms taken away during the selection: one that no longer pays, one flagged dead, one of two confounded terms; the lighter forms; whether a change pays |
 //! | `trial.rs` | one set of terms tried: fitted on the training data, scored by cross-validation |
+//! | `trial_starts.rs` | a trial's starts besides its warm one: new keys at their placements, the Stribeck curve at its classic curves, a set reached by taking a term away also where it would be fitted alone |
 //! | `admission.rs` | `--fit auto`'s rule 9: a term that grows without end past the data (the quadratic) admitted only where its fit tells its coefficient from zero |
 //! | `candidates.rs` | the candidate terms, the keys of a set, which candidates the data allow, the keys `--fit auto` starts from |
 //! | `compare.rs` | ours and the classic models fitted on the same data with the same optimiser |
