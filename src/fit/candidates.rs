@@ -23,7 +23,7 @@ pub struct Candidate {
     pub needs_varying_load: bool,
     /// A part of the term it requires, not a rival explanation: LuGre's
     /// bristle damping σ1 beside its stiffness σ0. Once that term is
-    /// chosen, the part is added unless the folds predict worse with it
+    /// chosen, the part is added unless the set without it pays over it
     /// (`select.rs`, rule 4b); rule 4's flags still drop it.
     pub part_of_requirement: bool,
 }

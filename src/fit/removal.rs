@@ -41,14 +41,25 @@ pub(super) fn is_scored(t: &Tried) -> bool {
     t.cv_rms.is_finite()
 }
 
-/// Whether a part of a chosen term ([`super::candidates::is_part`]) stays:
-/// the set `with` it predicts the folds no worse than the set `without`
-/// it (the folds' mean squared error not raised on average). A part is
-/// not a rival explanation that must pay for itself; it goes when the
-/// folds predict worse with it, or by a flag (rule 4).
-pub(super) fn keeps_part(without: &Tried, with: &Tried) -> bool {
-    let (gain, _) = paired(&without.fold_mse, &with.fold_mse);
+/// Whether the set `t` predicts the folds no worse than the set `than`:
+/// the folds' mean squared error not raised on average.
+pub(super) fn no_worse(than: &Tried, t: &Tried) -> bool {
+    let (gain, _) = paired(&than.fold_mse, &t.fold_mse);
     gain.is_finite() && gain >= 0.0
+}
+
+/// Whether a part of a chosen term ([`super::candidates::is_part`]) stays
+/// beside the set `without` it, the set `with` it scored: unless the set
+/// without it pays over the set with it ([`pays`], the yardstick a term
+/// meets to enter, mirrored). A part is not a rival explanation that must
+/// pay for itself: it is the chosen term's own physics (the bristle's
+/// damping, LuGre's σ1 beside its stiffness σ0), whose effect lasts the
+/// milliseconds of a reversal, which a training motion hardly weighs and a
+/// faster motion does. So it goes only where the folds show that it costs,
+/// beyond their spread and the cost of a term, or by a flag (rule 4); a
+/// rise of the folds' mean within their spread is no such showing.
+pub(super) fn part_stays(without: &Tried, with: &Tried) -> bool {
+    !pays(with, without).0
 }
 
 /// Whether a flagged presumed shape (rule 7) leaves the set `current`
@@ -65,7 +76,7 @@ pub(super) fn presumed_gives_way(current: &Scored, next: &Scored, reduced: bool)
     }
     pays(&current.tried, &next.tried).0
         || (reduced
-            && keeps_part(&current.tried, &next.tried)
+            && no_worse(&current.tried, &next.tried)
             && next.aicc - current.aicc < AICC_DECISIVE)
 }
 
@@ -108,15 +119,15 @@ pub(super) fn goes_of_pair(
 
 impl Ctx<'_> {
     /// Whether term `t` may leave the set `with` it for the set `without`
-    /// it (or its lighter form): a part of a chosen term when the folds
-    /// predict worse with it; a presumed term (rule 7) when the set
+    /// it (or its lighter form): a part of a chosen term when the set
+    /// without it pays over the set with it; a presumed term (rule 7) when the set
     /// without it pays over the set with it; any other term when it does
     /// not pay over the set without it.
     pub(super) fn may_leave(&self, t: &str, reduced: bool, without: &Tried, with: &Tried) -> bool {
         if (self.holds_rise(t) && !reduced) || !is_scored(without) {
             false
         } else if is_part(t) {
-            !keeps_part(without, with)
+            !part_stays(without, with)
         } else if self.is_presumed(t) {
             pays(with, without).0
         } else {
