@@ -179,7 +179,7 @@ impl Ctx<'_> {
                 .collect::<Result<_, FitError>>()?;
             tried.extend(scored.iter().map(|(_, _, s)| s.tried.clone()));
             // The one whose removal (or reduction) costs least, if the term
-            // does not pay over it (a part: if the set predicts worse with it).
+            // does not pay over it (a part: if the set without it pays over it).
             let Some((t, form, lighter)) = scored
                 .into_iter()
                 .filter(|(t, form, s)| self.may_leave(t, form.is_some(), &s.tried, &current.tried))
