@@ -41,7 +41,7 @@
 use super::candidates::is_part;
 use super::cross_validate::cv_rms;
 use super::prepared::Prepared;
-use super::removal::{change_text, flagged, goes_of_pair, holds_rise, lighter, part_stays, pays};
+use super::removal::{change_text, flagged, goes_of_pair, holds_rise, lighter, pays, term_stays};
 use super::select::{fitted_keys, Selection};
 use super::trial::{set_final_model, KeyFlag, Optimum, Scored, Tried};
 use super::unknowns::ParamSpec;
@@ -118,20 +118,14 @@ pub fn unconfirmed(s: &Selection, final_mse: &[f64], units: super::Units) -> Opt
 }
 
 /// Whether `term` of `s.chosen` stays beside the set `without` it, the
-/// chosen set scoring `with`: a part of a chosen term (rule 4b) unless the
-/// set without it pays over it; a presumed term (rule 7) unless the set
-/// without it pays over it; any other term if it pays. A term that holds a
-/// presumed rise, or a set without it that was not scored, stays.
+/// chosen set scoring `with` ([`term_stays`]: a part of a chosen term,
+/// rule 4b, or a presumed term, rule 7, unless the set without it pays
+/// over it; any other term if it pays). A term that holds a presumed rise,
+/// or a set without it that was not scored, stays.
 fn stays(s: &Selection, term: &'static str, without: &Tried, with: &Tried) -> bool {
-    if holds_rise(term, &s.presumed) || !super::removal::is_scored(without) {
-        true
-    } else if is_part(term) {
-        part_stays(without, with)
-    } else if s.presumed.contains(&term) {
-        !pays(with, without).0
-    } else {
-        pays(without, with).0
-    }
+    holds_rise(term, &s.presumed)
+        || !super::removal::is_scored(without)
+        || term_stays(is_part(term) || s.presumed.contains(&term), without, with)
 }
 
 impl Fallback {

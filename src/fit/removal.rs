@@ -48,18 +48,34 @@ pub(super) fn no_worse(than: &Tried, t: &Tried) -> bool {
     gain.is_finite() && gain >= 0.0
 }
 
-/// Whether a part of a chosen term ([`super::candidates::is_part`]) stays
-/// beside the set `without` it, the set `with` it scored: unless the set
-/// without it pays over the set with it ([`pays`], the yardstick a term
-/// meets to enter, mirrored). A part is not a rival explanation that must
-/// pay for itself: it is the chosen term's own physics (the bristle's
-/// damping, LuGre's σ1 beside its stiffness σ0), whose effect lasts the
-/// milliseconds of a reversal, which a training motion hardly weighs and a
-/// faster motion does. So it goes only where the folds show that it costs,
-/// beyond their spread and the cost of a term, or by a flag (rule 4); a
-/// rise of the folds' mean within their spread is no such showing.
-pub(super) fn part_stays(without: &Tried, with: &Tried) -> bool {
+/// Whether a held term stays beside the set `without` it, the set `with`
+/// it scored: unless the set without it pays over the set with it
+/// ([`pays`], the yardstick a term meets to enter, mirrored). Two kinds of
+/// term are held so (see [`term_stays`]):
+/// - a part of a chosen term ([`super::candidates::is_part`], rule 4b). A
+///   part is not a rival explanation that must pay for itself: it is the
+///   chosen term's own physics (the bristle's damping, LuGre's σ1 beside
+///   its stiffness σ0), whose effect lasts the milliseconds of a reversal,
+///   which a training motion hardly weighs and a faster motion does;
+/// - a presumed shape (rule 7), which the whole curve supports.
+///
+/// Either goes only where the folds show that it costs, beyond their
+/// spread and the cost of a term, or by a flag (rule 4); a rise of the
+/// folds' mean within their spread is no such showing.
+pub(super) fn held_stays(without: &Tried, with: &Tried) -> bool {
     !pays(with, without).0
+}
+
+/// Whether a term stays beside the set `without` it, the set `with` it
+/// scored: a `held` term (a part of a chosen term, or a presumed shape)
+/// unless the set without it pays over it ([`held_stays`]); any other term
+/// only if it pays over the set without it.
+pub(super) fn term_stays(held: bool, without: &Tried, with: &Tried) -> bool {
+    if held {
+        held_stays(without, with)
+    } else {
+        pays(without, with).0
+    }
 }
 
 /// Whether a flagged presumed shape (rule 7) leaves the set `current`
@@ -119,19 +135,15 @@ pub(super) fn goes_of_pair(
 
 impl Ctx<'_> {
     /// Whether term `t` may leave the set `with` it for the set `without`
-    /// it (or its lighter form): a part of a chosen term when the set
-    /// without it pays over the set with it; a presumed term (rule 7) when the set
-    /// without it pays over the set with it; any other term when it does
-    /// not pay over the set without it.
+    /// it (or its lighter form): where it does not stay ([`term_stays`],
+    /// a part of a chosen term or a presumed term being held). A term that
+    /// holds a presumed rise, unless reduced, and a set without it that
+    /// was not scored, do not leave.
     pub(super) fn may_leave(&self, t: &str, reduced: bool, without: &Tried, with: &Tried) -> bool {
         if (self.holds_rise(t) && !reduced) || !is_scored(without) {
             false
-        } else if is_part(t) {
-            !part_stays(without, with)
-        } else if self.is_presumed(t) {
-            pays(with, without).0
         } else {
-            !pays(without, with).0
+            !term_stays(is_part(t) || self.is_presumed(t), without, with)
         }
     }
 

@@ -186,7 +186,7 @@ use super::cross_validate::paired;
 use super::curve_support::back_to_start;
 use super::options::SearchSettings;
 use super::prepared::Prepared;
-use super::removal::{cv, part_stays, pays};
+use super::removal::{cv, held_stays, pays};
 use super::stop_reason::{does_not_pay, not_supported};
 use super::trial::{Ctx, Scored, Tried};
 use super::unknowns::ParamSpec;
@@ -403,7 +403,7 @@ pub(super) fn fitted_keys(terms: &[&'static str], given: &[ParamSpec]) -> Vec<St
 impl Ctx<'_> {
     /// Rule 4b: each part of a chosen term that the set lacks
     /// ([`parts_to_add`]) is added unless the set without it pays over the
-    /// set with it ([`part_stays`]).
+    /// set with it ([`held_stays`]).
     fn add_parts(
         &self,
         mut current: Scored,
@@ -426,7 +426,7 @@ impl Ctx<'_> {
                 crate::text::Num::sig(se, 5),
                 cv(&with.tried, self.p)
             );
-            if part_stays(&current.tried, &with.tried) {
+            if held_stays(&current.tried, &with.tried) {
                 say(&format!("auto: + {change}: a part of {part_of}, kept as the set without it does not pay over it"));
                 added.push(format!("{change}: a part of {part_of}, which comes with it unless the set without it pays over it"));
                 current = with;
@@ -649,7 +649,7 @@ mod tests {
             &[0.9, 0.92, 1.35, 1.0],
         );
         assert!(!pays(&without.tried, &lower.tried).0);
-        assert!(part_stays(&without.tried, &lower.tried));
+        assert!(held_stays(&without.tried, &lower.tried));
         // d129 of `docs/joint-series-draws.sh`: one fold worse with it,
         // three better, the mean raised by half its standard error.
         let one_fold_worse = scored(
@@ -658,13 +658,13 @@ mod tests {
         );
         let (gain, se) = paired(&without.tried.fold_mse, &one_fold_worse.tried.fold_mse);
         assert!(gain < 0.0 && -gain < se, "{gain} ± {se}");
-        assert!(part_stays(&without.tried, &one_fold_worse.tried));
+        assert!(held_stays(&without.tried, &one_fold_worse.tried));
         let higher = scored(
             &["pre-sliding", "pre-sliding damping"],
             &[1.1, 1.1, 1.3, 1.2],
         );
         assert!(pays(&higher.tried, &without.tried).0);
-        assert!(!part_stays(&without.tried, &higher.tried));
+        assert!(!held_stays(&without.tried, &higher.tried));
     }
 
     #[test]
