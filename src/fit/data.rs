@@ -91,6 +91,38 @@ pub enum Folds {
     /// ranges (its points ranked by |v|: the slowest and the fastest are
     /// predicted from the rest).
     Within(usize),
+    /// Time series: this many contiguous time blocks, and one more fold,
+    /// the samples faster than [`FASTEST_FROM`] of the record's top speed
+    /// (predicted from the slower ones: a faster motion, as a steady
+    /// curve's fastest speed range). A steady source among them is cut as
+    /// by [`Folds::Within`] into as many speed ranges as there are folds.
+    Motion(usize),
+}
+
+/// The fastest fold of a time series ([`Folds::Motion`]): the samples whose
+/// speed exceeds this fraction of the record's top speed, predicted from
+/// the slower ones at up to 1.25× the speeds they were fitted on, about
+/// the reach of a steady curve's fastest quarter.
+pub const FASTEST_FROM: f64 = 0.8;
+
+/// The least share of a record's samples its fastest fold holds: where
+/// the record spends less of its time above [`FASTEST_FROM`] of its top
+/// speed (a brief peak), the fold starts lower, at this quantile of the
+/// speeds, so that its error is a mean over many samples, not one peak's.
+pub const FASTEST_SHARE: f64 = 0.05;
+
+/// The speed above which a time series' samples are its fastest fold
+/// ([`Folds::Motion`]): [`FASTEST_FROM`] of its top speed, or lower, at
+/// the speed that [`FASTEST_SHARE`] of its samples exceed.
+pub fn fastest_from(velocity: &[f64]) -> f64 {
+    let mut speed: Vec<f64> = velocity.iter().map(|v| v.abs()).collect();
+    speed.sort_by(f64::total_cmp);
+    let Some(&top) = speed.last() else {
+        return 0.0;
+    };
+    let k = ((speed.len() as f64) * (1.0 - FASTEST_SHARE)).floor() as usize;
+    let quantile = speed[k.min(speed.len() - 1)];
+    (FASTEST_FROM * top).min(quantile)
 }
 
 impl Folds {
@@ -98,6 +130,7 @@ impl Folds {
     pub fn count(self) -> usize {
         match self {
             Self::Files(n) | Self::Within(n) => n,
+            Self::Motion(n) => n + 1,
         }
     }
 
@@ -106,6 +139,19 @@ impl Folds {
         let n = s.len();
         match self {
             Self::Files(_) => vec![source; n],
+            Self::Motion(blocks) if s.steady => Self::Within(blocks + 1).of(source, s),
+            Self::Motion(blocks) => {
+                let from = fastest_from(&s.velocity);
+                (0..n)
+                    .map(|k| {
+                        if s.velocity[k].abs() > from {
+                            blocks
+                        } else {
+                            k * blocks / n.max(1)
+                        }
+                    })
+                    .collect()
+            }
             Self::Within(count) if s.steady => {
                 let mut order: Vec<usize> = (0..n).collect();
                 order.sort_by(|&a, &b| s.velocity[a].abs().total_cmp(&s.velocity[b].abs()));

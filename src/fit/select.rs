@@ -11,8 +11,10 @@
 //! **Rule** (one for every data set; nothing held out is ever seen):
 //! 1. Cross-validation by what the calibration is used for
 //!    (`cross_validate.rs`): several training files are each predicted
-//!    from the others; one time series is cut into contiguous time blocks;
-//!    one steady curve into contiguous speed ranges, so that the slowest
+//!    from the others; one time series is cut into contiguous time blocks,
+//!    and its samples above 80 % of its top speed are one more fold, a
+//!    faster motion predicted from the slower ones; one steady curve into
+//!    contiguous speed ranges, so that the slowest
 //!    and the fastest points are predicted from the rest (a term that
 //!    rises without end, or a regime the data do not reach, pays for it
 //!    there). Each fold is predicted by the set refitted without it.
