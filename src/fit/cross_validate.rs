@@ -28,7 +28,7 @@
 //! score our model's candidate sets and every classic model, so their
 //! cross-validated errors compare on one yardstick.
 
-use super::data::{Data, Folds, HoldOut};
+use super::data::{motion_cuts, Data, Folds, HoldOut};
 use super::driver::{fit, FitOutcome};
 use super::options::Options;
 use super::problem::Model;
@@ -62,14 +62,25 @@ pub const FOLDS: usize = 4;
 pub const FILES_FOR_FILE_FOLDS: usize = 3;
 
 /// The folds of `data`'s training sources: one per file when there are
-/// [`FILES_FOR_FILE_FOLDS`] or more, else [`FOLDS`] within each.
+/// [`FILES_FOR_FILE_FOLDS`] or more, else [`FOLDS`] within each, and a
+/// time series' fastest samples as one more ([`Folds::Motion`]) where
+/// every time series can be so cut ([`motion_cuts`]; a record at one
+/// speed cannot, and keeps its time blocks alone).
 pub fn folds_for(data: &Data) -> Folds {
     if data.train.len() >= FILES_FOR_FILE_FOLDS {
         Folds::Files(data.train.len())
-    } else if data.train.iter().all(|s| s.steady) {
-        Folds::Within(FOLDS)
     } else {
-        Folds::Motion(FOLDS)
+        let mut series = data.train.iter().filter(|s| !s.steady).peekable();
+        let motion = series.peek().is_some()
+            && series.all(|s| {
+                s.series(&data.map_values)
+                    .is_ok_and(|x| motion_cuts(&x, FOLDS))
+            });
+        if motion {
+            Folds::Motion(FOLDS)
+        } else {
+            Folds::Within(FOLDS)
+        }
     }
 }
 
@@ -271,5 +282,30 @@ mod tests {
         let top = sine.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
         approx::assert_relative_eq!(crate::fit::data::fastest_from(&sine), FASTEST_FROM * top);
         assert_eq!(crate::fit::data::fastest_from(&[]), 0.0);
+    }
+
+    #[test]
+    fn a_record_at_one_speed_keeps_its_time_blocks_alone() {
+        // Every sample at the top speed: a fastest fold would hold them all
+        // and leave the blocks and its own refit nothing to fit.
+        let mut text = String::from("t_s,velocity_m_s,friction_n\n");
+        for k in 0..400 {
+            let t = k as f64 * 0.01;
+            text += &format!("{t},0.05,{}\n", 1.0 + 0.01 * (k % 7) as f64);
+        }
+        let data = tests_data(&text, &Mapping::default());
+        assert_eq!(folds_for(&data), Folds::Within(FOLDS));
+        let s = data.train[0].series(&[]).unwrap();
+        assert!(!motion_cuts(&s, FOLDS));
+        // A record whose first quarter is all at its top speed would leave
+        // its first time block empty: time blocks alone as well.
+        let mut text = String::from("t_s,velocity_m_s,friction_n\n");
+        for k in 0..400 {
+            let t = k as f64 * 0.01;
+            let v = if k < 100 { 1.0 } else { 0.5 * (t * 3.0).sin() };
+            text += &format!("{t},{v},1.0\n");
+        }
+        let data = tests_data(&text, &Mapping::default());
+        assert_eq!(folds_for(&data), Folds::Within(FOLDS));
     }
 }

@@ -125,6 +125,25 @@ pub fn fastest_from(velocity: &[f64]) -> f64 {
     (FASTEST_FROM * top).min(quantile)
 }
 
+/// Whether the time series `s` can be cut into [`Folds::Motion`]`(blocks)`:
+/// its fastest fold leaves the slower samples the majority, and each time
+/// block keeps at least [`FASTEST_SHARE`] of the samples. A record at one
+/// speed (or mostly at its top) has no faster motion to predict from a
+/// slower one: every sample would be in the fastest fold, and the blocks
+/// and the refit without it would be empty.
+pub fn motion_cuts(s: &Series, blocks: usize) -> bool {
+    let n = s.len();
+    if n == 0 || blocks == 0 {
+        return false;
+    }
+    let mut count = vec![0usize; blocks + 1];
+    for f in Folds::Motion(blocks).of(0, s) {
+        count[f] += 1;
+    }
+    let least = ((FASTEST_SHARE * n as f64).ceil() as usize).max(1);
+    2 * count[blocks] <= n && count[..blocks].iter().all(|c| *c >= least)
+}
+
 impl Folds {
     /// How many folds there are.
     pub fn count(self) -> usize {
