@@ -183,6 +183,22 @@ mod tests {
         }
     }
 
+    /// Each fold's mean squared error of [`Line`] fitted to `data` and
+    /// refitted without the fold.
+    fn line_fold_mse(data: &Data, folds: Folds) -> Vec<f64> {
+        let model = Line(vec![
+            FittedParameter::new("a", 1.0, -10.0, 10.0),
+            FittedParameter::new("b", 1.0, -10.0, 10.0),
+        ]);
+        let opts = Options {
+            global_points: 0,
+            starts: 1,
+            ..Default::default()
+        };
+        let all = fit(&model, data, vec![], &opts).unwrap();
+        cross_validate(&model, data, &[], &all.best, folds, &opts).unwrap()
+    }
+
     #[test]
     fn a_steady_curve_is_cut_by_speed_and_each_range_predicted_from_the_rest() {
         // A line with a kink at its fast end: the fastest range is
@@ -200,17 +216,7 @@ mod tests {
         let s = data.train[0].series(&[]).unwrap();
         // Two points per range, ranked by speed whatever the table's order.
         assert_eq!(folds.of(0, &s), vec![3, 3, 2, 2, 1, 1, 0, 0]);
-        let model = Line(vec![
-            FittedParameter::new("a", 1.0, -10.0, 10.0),
-            FittedParameter::new("b", 1.0, -10.0, 10.0),
-        ]);
-        let opts = Options {
-            global_points: 0,
-            starts: 1,
-            ..Default::default()
-        };
-        let all = fit(&model, &data, vec![], &opts).unwrap();
-        let mse = cross_validate(&model, &data, &[], &all.best, folds, &opts).unwrap();
+        let mse = line_fold_mse(&data, folds);
         // The fastest range, extrapolated from the line the rest lie on,
         // misses it by the kink: 1 N exactly. The others are predicted by
         // lines the kink bends, and miss by less.
@@ -244,21 +250,11 @@ mod tests {
                 assert_eq!(*fold, k * FOLDS / n, "sample {k}");
             }
         }
-        let model = Line(vec![
-            FittedParameter::new("a", 1.0, -10.0, 10.0),
-            FittedParameter::new("b", 1.0, -10.0, 10.0),
-        ]);
-        let opts = Options {
-            global_points: 0,
-            starts: 1,
-            ..Default::default()
-        };
-        let all = fit(&model, &data, vec![], &opts).unwrap();
-        let mse = cross_validate(&model, &data, &[], &all.best, folds, &opts).unwrap();
+        let mse = line_fold_mse(&data, folds);
         // The fastest fold, extrapolated from the slower samples alone
-        // (all on the line), misses by the bend: 0.5 N, a mean squared
+        // (all on the line), misses by the step: 0.5 N, a mean squared
         // error of 0.25 N². Each time block is predicted by a line the
-        // fast samples of the other folds bend, and misses by less.
+        // fast samples of the other folds pull, and misses by less.
         approx::assert_relative_eq!(mse[FOLDS], 0.25, max_relative = 1e-6);
         assert!(
             mse[..FOLDS].iter().all(|m| *m > 0.0 && *m < 0.25),
