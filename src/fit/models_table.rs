@@ -261,16 +261,11 @@ fn held_out_squared_errors(o: &FitOutcome) -> Vec<f64> {
         .collect()
 }
 
-/// The means of `batches` contiguous batches of `x` (as equal as the
+/// The means of `batches` contiguous batches of `x` (`stats::contiguous`: as equal as the
 /// length allows; one per sample when there are fewer samples).
 fn batch_means(x: &[f64], batches: usize) -> Vec<f64> {
-    let b = batches.min(x.len()).max(1);
-    (0..b)
-        .map(|i| {
-            let (lo, hi) = (i * x.len() / b, (i + 1) * x.len() / b);
-            x[lo..hi].iter().sum::<f64>() / (hi - lo).max(1) as f64
-        })
-        .filter(|_| !x.is_empty())
+    super::stats::contiguous(x.len(), batches)
+        .map(|r| x[r.clone()].iter().sum::<f64>() / r.len() as f64)
         .collect()
 }
 

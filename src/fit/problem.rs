@@ -123,6 +123,10 @@ pub struct Problem<'a> {
     /// The model's parameters, then the fitted map coefficients.
     pub params: Vec<FittedParameter>,
     fitted_samples: usize,
+    /// Each training source's fitted samples, in the residuals' order,
+    /// and whether it is a steady curve (its points independent) or a
+    /// time series (its samples consecutive in time).
+    fitted_by_source: Vec<(usize, bool)>,
     friction_scale: f64,
     /// The series of every source (training, held out, validation) with
     /// their inputs' fingerprints, when no map coefficient is fitted (they
@@ -161,11 +165,14 @@ impl<'a> Problem<'a> {
         let mut params = model.parameters().to_vec();
         params.extend(map_fit.iter().map(|(_, p)| p.clone()));
         let mut fitted_samples = 0;
+        let mut fitted_by_source = Vec::with_capacity(data.train.len());
         let mut scale = 0.0f64;
         for (i, s) in data.train.iter().enumerate() {
             let mut series = s.series(&data.map_values)?;
             data.holdout.apply(&mut series, i);
-            fitted_samples += series.fit.iter().filter(|f| **f).count();
+            let fitted = series.fit.iter().filter(|f| **f).count();
+            fitted_by_source.push((fitted, series.steady));
+            fitted_samples += fitted;
             scale = series.friction.iter().fold(scale, |m, f| m.max(f.abs()));
         }
         if scale == 0.0 {
@@ -210,6 +217,7 @@ impl<'a> Problem<'a> {
             map_fit,
             params,
             fitted_samples,
+            fitted_by_source,
             friction_scale: scale,
             fixed,
             recent: Mutex::new(Vec::new()),
@@ -408,6 +416,12 @@ impl<'a> Problem<'a> {
     /// Samples the cost sums over.
     pub fn fitted_samples(&self) -> usize {
         self.fitted_samples
+    }
+
+    /// Each training source's fitted samples in the residuals' order, and
+    /// whether it is a steady curve (see `stats::batches`).
+    pub fn fitted_by_source(&self) -> &[(usize, bool)] {
+        &self.fitted_by_source
     }
 
     /// `x` as the optimiser's unbounded variables.

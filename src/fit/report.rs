@@ -48,6 +48,14 @@ pub fn parameter_table(o: &FitOutcome) -> String {
         }
         s.push('\n');
     }
+    if o.statistics.batches > 0 {
+        let _ = write!(
+            s,
+            "\nStandard errors and intervals from {} batches of the residuals (each time series cut into {} contiguous ones, each steady point one): a time series' consecutive samples are not independent news. Never below those of independent residuals.\n",
+            o.statistics.batches,
+            super::stats::BATCHES
+        );
+    }
     s
 }
 

@@ -138,7 +138,9 @@
 //!    coefficient from zero: its 95 % interval excludes zero. The folds
 //!    reach one speed range past the rest (about 1.25× on a steady
 //!    curve); a quadratic that pays there while the data cannot tell it
-//!    from zero is a curvature of the noise or of a Stribeck dip's bottom,
+//!    from zero (on a time series by its batches' interval, `stats.rs`:
+//!    consecutive samples are not independent news) is a curvature of the
+//!    noise or of a Stribeck dip's bottom,
 //!    and it grows with the square of the speed past them (the issue's
 //!    "no regime change past the data unless they show its start"). On a
 //!    fresh random joint (seed 41, joint 23) the quadratic paid on the
