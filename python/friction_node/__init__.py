@@ -326,7 +326,9 @@ class FitResult:
     """What ``fit`` returns.
 
     ``parameters`` (DataFrame: name, value, std_error, ci95_low, ci95_high,
-    start, bounds, at_bound), ``converged``, ``train_rms_n``,
+    start, bounds, at_bound; on a time series the errors come from
+    ``error_batches`` contiguous batches of the residuals, 0 where every
+    sample counted as independent), ``converged``, ``train_rms_n``,
     ``held_out_rms_n``, ``models`` (DataFrame, one row per model: ours and,
     with ``baselines=True``, Coulomb + viscous, Stribeck, LuGre on the same
     data with the same optimiser), ``direction_table`` (with baselines: every
@@ -346,6 +348,7 @@ class FitResult:
 
         self.raw = raw
         self.parameters = pd.DataFrame(raw["parameters"])
+        self.error_batches = raw["error_batches"]
         self.converged = raw["converged"]
         self.train_rms_n = raw["train_rms_n"]
         self.held_out_rms_n = raw["held_out_rms_n"]

@@ -57,6 +57,7 @@ fn outcome_dict<'py>(py: Python<'py>, o: &FitOutcome) -> PyResult<Bound<'py, PyD
     d.set_item("wall_s", o.wall_s)?;
     d.set_item("sigma_n", o.statistics.sigma)?;
     d.set_item("rank_deficient", o.statistics.rank_deficient)?;
+    d.set_item("error_batches", o.statistics.batches)?;
     let params = PyList::empty(py);
     for (i, p) in o.params.iter().enumerate() {
         let r = PyDict::new(py);
