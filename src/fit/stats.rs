@@ -161,19 +161,16 @@ pub fn from_jacobian(
         }
     };
     let cov = &inv * sigma2;
+    // A rank-deficient fit has no finite error to estimate.
     let (variance, batches) = if rank_deficient {
-        ((0..n).map(|j| cov[(j, j)]).collect(), 0)
+        (vec![f64::INFINITY; n], 0)
     } else {
         variances(jac, r0, &inv, sigma2, problem.fitted_by_source())
     };
     let mut standard_error = Vec::with_capacity(n);
     let mut interval95 = Vec::with_capacity(n);
     for (j, p) in problem.params.iter().enumerate() {
-        let se_s = if rank_deficient {
-            f64::INFINITY
-        } else {
-            variance[j].max(0.0).sqrt()
-        };
+        let se_s = variance[j].max(0.0).sqrt();
         let s = p.scaled(x[j]);
         standard_error.push(if p.log { x[j] * se_s } else { se_s });
         interval95.push((p.unscaled(s - 1.96 * se_s), p.unscaled(s + 1.96 * se_s)));
@@ -230,7 +227,7 @@ fn variances(
 /// series: each time series cut into [`BATCHES`] contiguous batches (fewer
 /// when it has fewer samples), each steady point a batch of its own. None
 /// when every source is a steady curve (C₀ holds).
-pub fn batches(fitted_by_source: &[(usize, bool)]) -> Option<Vec<Range<usize>>> {
+fn batches(fitted_by_source: &[(usize, bool)]) -> Option<Vec<Range<usize>>> {
     if fitted_by_source.iter().all(|(_, steady)| *steady) {
         return None;
     }
@@ -249,7 +246,7 @@ pub fn batches(fitted_by_source: &[(usize, bool)]) -> Option<Vec<Range<usize>>> 
 
 /// `parts` contiguous ranges covering 0..len, as equal as the length
 /// allows (one per index when there are fewer indices; none when len is 0).
-pub fn contiguous(len: usize, parts: usize) -> impl Iterator<Item = Range<usize>> {
+pub(super) fn contiguous(len: usize, parts: usize) -> impl Iterator<Item = Range<usize>> {
     let b = parts.min(len);
     (0..b).map(move |i| i * len / b..(i + 1) * len / b)
 }
@@ -257,7 +254,7 @@ pub fn contiguous(len: usize, parts: usize) -> impl Iterator<Item = Range<usize>
 /// C_B: the covariance of the scaled parameters from the batches' scores,
 /// B/(B − n) (JᵀJ)⁻¹ (Σ_b S_b S_bᵀ) (JᵀJ)⁻¹ (see the module's table).
 /// `inv` is (JᵀJ)⁻¹; `batches` has more than n batches.
-pub fn batch_covariance(
+fn batch_covariance(
     jac: &DMatrix<f64>,
     r0: &[f64],
     inv: &DMatrix<f64>,
