@@ -25,6 +25,13 @@
 # generator (a torque sensor's offset: τ + c both ways); the curves and
 # noise are those of OFFSET=0.
 #
+# POWER=p (with CURVES=random) bends each random joint's viscous part:
+# b ω₉₀ sgn ω |ω/ω₉₀|^δ, with δ uniform in p–1 from its own generator
+# (ω₉₀ = 90 deg/s, so the part at 90 deg/s is that of POWER=1). A rise
+# that bends below the line as speed grows, as a film's shear or a
+# grease's thinning gives and neither classic has; the curves, offsets
+# and noise are those of POWER=1.
+#
 # Usage: docs/arm-steady-draws.sh [OUT_DIR] [BIN]   (default: out/arm-steady-draws)
 # DRAWS=20 sets the draws per curve.
 set -euo pipefail
@@ -36,16 +43,18 @@ CURVES=${CURVES:-peak rise}
 SEED=${SEED:-2026}
 OFFSET=${OFFSET:-0}
 WS_MAX=${WS_MAX:-0.5}
+POWER=${POWER:-1}
 mkdir -p "$OUT"
 [ -x "$BIN" ] || cargo build --release --quiet
 . docs/bench-lib.sh
 
-python3 - "$OUT" "$DRAWS" "$CURVES" "$SEED" "$OFFSET" "$WS_MAX" <<'PY'
+python3 - "$OUT" "$DRAWS" "$CURVES" "$SEED" "$OFFSET" "$WS_MAX" "$POWER" <<'PY'
 import math, random, sys
 out, draws, names, family = sys.argv[1], int(sys.argv[2]), sys.argv[3].split(), int(sys.argv[4])
 offset = float(sys.argv[5])
 ws_max = float(sys.argv[6])
-offsets = {}
+power = float(sys.argv[7])
+offsets, powers = {}, {}
 train = [0.5, 1.0, 2.0, 3.0, 5.0, 7.0, 10.0, 13.0, 16.0, 20.0]
 validate = [25.0, 35.0, 45.0, 60.0, 75.0, 90.0]
 curves = {"peak": (1.2, 1.8, 0.05, 2.0), "rise": (1.2, 0.6, 0.1, 1.0)}
@@ -64,29 +73,36 @@ if names == ["random"]:
         with open(f"{out}/random-offsets.txt", "w") as f:
             for n, c in offsets.items():
                 f.write(f"{n} {c:.4g}\n")
+    if power < 1.0:
+        prng = random.Random(f"{family} power")
+        powers = {n: prng.uniform(power, 1.0) for n in curves}
+        with open(f"{out}/random-powers.txt", "w") as f:
+            for n, d in powers.items():
+                f.write(f"{n} {d:.4g}\n")
     with open(f"{out}/random-curves.txt", "w") as f:
         for n, (fc, fs, ws, b) in curves.items():
             f.write(f"{n} {fc:.4g} {fs:.4g} {ws:.4g} {b:.4g}\n")
 else:
     curves = {n: curves[n] for n in names}
-def write(path, speeds, p, seed, c=0.0):
+def write(path, speeds, p, seed, c=0.0, delta=1.0):
     fc, fs, ws, b = p
     rng = random.Random(seed)
+    w90 = math.radians(90.0)
     with open(path, "w") as f:
         f.write("velocity_rad_s,friction_nm\n")
         for deg in speeds:
             for sign in (1.0, -1.0):
                 w = sign * math.radians(deg)
-                tau = sign * (fc + (fs - fc) * math.exp(-(w / ws) ** 2)) + b * w + c
+                tau = sign * (fc + (fs - fc) * math.exp(-(w / ws) ** 2)) + (b * w if delta == 1.0 else b * w90 * math.copysign(abs(w / w90) ** delta, w)) + c
                 f.write(f"{w},{tau * (1 + rng.gauss(0, 0.01))}\n")
 for name, p in curves.items():
     for seed in (range(1, draws + 1) if not name.startswith("random") else [1]):
         # Each random joint gets its own noise (until stop 70 every one of
         # them drew seed 1's, so the family's noise was one draw repeated).
         noise = seed if not name.startswith("random") else 1000 * family + int(name[6:])
-        c = offsets.get(name, 0.0)
-        write(f"{out}/{name}-{seed}-train.csv", train, p, noise, c)
-        write(f"{out}/{name}-{seed}-validate.csv", validate, p, 100000 + noise if name.startswith("random") else 100 + seed, c)
+        c, delta = offsets.get(name, 0.0), powers.get(name, 1.0)
+        write(f"{out}/{name}-{seed}-train.csv", train, p, noise, c, delta)
+        write(f"{out}/{name}-{seed}-validate.csv", validate, p, 100000 + noise if name.startswith("random") else 100 + seed, c, delta)
 PY
 
 if [ "$CURVES" = random ]; then

@@ -25,6 +25,11 @@
 # START=sliding starts it at the steady state of the first sample, as a
 # recording begun in motion finds it. Every row of
 # docs/joint-series-results.md before stop 87 is START=rest.
+# VELOCITY=true (the default) gives the tool the joint's true speed;
+# VELOCITY=encoder gives it what a robot's controller has: the angle read by
+# a 17-bit encoder (2π/2^17 rad), differenced over a sample and filtered
+# forward and backward by a 2nd-order Butterworth at 50 Hz (the friction is
+# still made by the true speed).
 # DRAWS=12 sets the last draw (about 1 min each), FIRST=1 the first: draws
 # 1-12 are those the rule was developed on, 13-24 were first run after it.
 set -euo pipefail
@@ -39,10 +44,36 @@ mkdir -p "$OUT"
 
 START=${START:-rest}
 case "$START" in rest|sliding) ;; *) echo "START must be rest or sliding, not '$START'" >&2; exit 2 ;; esac
-python3 - "$OUT" "$DRAWS" "$FIRST" "$START" <<'PY'
+VELOCITY=${VELOCITY:-true}
+case "$VELOCITY" in true|encoder) ;; *) echo "VELOCITY must be true or encoder, not '$VELOCITY'" >&2; exit 2 ;; esac
+python3 - "$OUT" "$DRAWS" "$FIRST" "$START" "$VELOCITY" <<'PY'
 import math, random, sys
 out, draws, first = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
-start = sys.argv[4]
+start, velocity = sys.argv[4], sys.argv[5]
+def butter2(x, fc=50.0, fs=1000.0):
+    """A 2nd-order Butterworth low-pass (bilinear), one pass."""
+    k = math.tan(math.pi * fc / fs)
+    n = 1 / (1 + math.sqrt(2) * k + k * k)
+    b0, b1, b2 = k * k * n, 2 * k * k * n, k * k * n
+    a1, a2 = 2 * (k * k - 1) * n, (1 - math.sqrt(2) * k + k * k) * n
+    y, x1, x2, y1, y2 = [], x[0], x[0], x[0], x[0]
+    for v in x:
+        out_ = b0 * v + b1 * x1 + b2 * x2 - a1 * y1 - a2 * y2
+        x2, x1, y2, y1 = x1, v, y1, out_
+        y.append(out_)
+    return y
+def measured(t, w):
+    """The speed a controller reads: the angle on a 17-bit encoder,
+    differenced, filtered forward and backward (zero phase)."""
+    if velocity == "true":
+        return w
+    q, theta = 2 * math.pi / 2 ** 17, [0.0]
+    for k in range(1, len(w)):
+        theta.append(theta[-1] + 0.5 * (w[k] + w[k - 1]) * (t[k] - t[k - 1]))
+    counts = [math.floor(a / q) * q for a in theta]
+    d = [(counts[min(k + 1, len(t) - 1)] - counts[max(k - 1, 0)])
+         / (t[min(k + 1, len(t) - 1)] - t[max(k - 1, 0)]) for k in range(len(t))]
+    return butter2(butter2(d)[::-1])[::-1]
 
 def motion(rnd, top):
     """A smooth multi-sine ω(s) with its top speed over the first 60 s at `top`."""
@@ -96,7 +127,7 @@ for d in range(first, draws + 1):
         noise = random.Random(7 * d + (part == "fast"))
         with open(f"{out}/d{d}-{part}.csv", "w") as fh:
             fh.write("t_s,velocity_rad_s,friction_n_m\n")
-            for a, x, y in zip(t, w, f):
+            for a, x, y in zip(t, measured(t, w), f):
                 fh.write(f"{a:.3f},{x:.6g},{y + noise.gauss(0, 0.01 * rms):.6g}\n")
     print(f"| d{d} | {fc:.3g} | {fs:.3g} | {ws:.3g} | {b:.3g} | {s0:.4g} | {s1:.3g} | {top:.3g} | "
           f"{'yes' if ripple else 'no'} |", file=open(f"{out}/d{d}.params", "w"))
