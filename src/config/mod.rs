@@ -200,6 +200,8 @@ impl Config {
             drivetrain: crate::physics::Drivetrain {
                 coulomb: d.coulomb_n,
                 viscous: d.viscous_n_s_m,
+                viscous_exponent: d.viscous_exponent,
+                viscous_reference_speed: d.viscous_reference_speed_m_s,
                 load_coefficient: d.load_coefficient,
                 quadratic: d.quadratic_n_s2_m2,
                 coulomb_asymmetry: d.coulomb_asymmetry_n,

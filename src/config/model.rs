@@ -195,8 +195,14 @@ pub enum ViscosityModelKind {
 pub struct DrivetrainConfig {
     /// Constant friction, signed with the velocity, N.
     pub coulomb_n: f64,
-    /// Friction proportional to the velocity, N·s/m.
+    /// Friction proportional to the velocity, N·s/m (with an exponent
+    /// below 1, the slope at `viscous_reference_speed_m_s`).
     pub viscous_n_s_m: f64,
+    /// The viscous rise's exponent δ: 1 a straight rise, below 1 a rise
+    /// b v_b sgn v |v/v_b|^δ that bends below the line as speed grows.
+    pub viscous_exponent: f64,
+    /// v_b, the speed at which the bent viscous rise equals b v_b, m/s.
+    pub viscous_reference_speed_m_s: f64,
     /// Friction proportional to the normal load (rolling elements).
     pub load_coefficient: f64,
     /// Loss growing with the square of the speed, N·s²/m².
@@ -218,6 +224,8 @@ impl Default for DrivetrainConfig {
         Self {
             coulomb_n: d.coulomb,
             viscous_n_s_m: d.viscous,
+            viscous_exponent: d.viscous_exponent,
+            viscous_reference_speed_m_s: d.viscous_reference_speed,
             load_coefficient: d.load_coefficient,
             quadratic_n_s2_m2: d.quadratic,
             coulomb_asymmetry_n: d.coulomb_asymmetry,

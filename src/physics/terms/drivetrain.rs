@@ -3,7 +3,8 @@
 //! gear mesh), which no contact model should be asked to absorb.
 //!
 //! ```text
-//! F_dt = (F_cd + c_N F_ext + ΔF_s e^(−(v/v_s)²)) tanh(v / v_reg) + ΔF_cd |tanh(v / v_reg)| + b v + c_q v |v|
+//! F_dt = (F_cd + c_N F_ext + ΔF_s e^(−(v/v_s)²)) tanh(v / v_reg) + ΔF_cd |tanh(v / v_reg)| + F_b(v) + c_q v |v|
+//! F_b(v) = b v_b sgn v |v / v_b|^δ   (δ = 1: b v, whatever v_b)
 //! F_total = F_f + F_dt
 //! ```
 //!
@@ -14,7 +15,9 @@
 //! | c_N | friction proportional to the normal load (rolling elements carrying it) | – |
 //! | ΔF_s | the static level's excess over the Coulomb level (Stribeck): F_cd + ΔF_s at rest, decaying to F_cd over v_s; negative: a friction that rises with speed to F_cd | N |
 //! | v_s | the Stribeck speed | m/s |
-//! | b | viscous drivetrain friction | N·s/m |
+//! | b | viscous drivetrain friction: the slope of F_b at v_b | N·s/m |
+//! | δ | the viscous rise's exponent: 1 a straight rise; below 1 a rise that bends below the line as speed grows, as a rolling bearing's viscous moment grows with (ν n)^(2/3) (Palmgren) and a film's shear over a film that thickens with speed | – |
+//! | v_b | the speed at which F_b = b v_b: where b is read (a fit sets it to the data's top speed, so that b and δ are told apart) | m/s |
 //! | c_q | loss growing with the square of the speed (churning, windage, iron and eddy losses of a motor, reflected to the slider) | N·s²/m² |
 //! | v_reg | the contact's sign regularisation (the same tanh) | m/s |
 //!
@@ -22,7 +25,7 @@
 //! With pre-sliding on (`presliding.rs`) the terms that act at zero speed,
 //! (F_cd + c_N F_ext + ΔF_s e^(−(v/v_s)²)) sgn v + ΔF_cd |sgn v|, are part of
 //! the bristle's level (a reversal's compliance is the whole axis's), and
-//! only b v + c_q v|v| is added beside it.
+//! only F_b(v) + c_q v|v| is added beside it.
 //!
 //! With these terms the classic models are special cases of ours: Coulomb +
 //! viscous (F_cd, b), Stribeck with its static level above or below the
@@ -64,6 +67,26 @@ const KEYS: &[TermKey] = &[
         live: true,
         fit: data(2.0, 1),
         meaning: "viscous drivetrain friction",
+    },
+    TermKey {
+        key: "drivetrain.viscous_exponent",
+        symbol: "δ",
+        unit: "–",
+        lo: End::Closed(0.1),
+        hi: End::Closed(1.0),
+        live: true,
+        fit: FitScale::FromStart,
+        meaning: "the viscous rise's exponent: 1 straight, below 1 bending below the line as speed grows",
+    },
+    TermKey {
+        key: "drivetrain.viscous_reference_speed_m_s",
+        symbol: "v_b",
+        unit: "m/s",
+        lo: End::Open(0.0),
+        hi: End::Closed(100.0),
+        live: true,
+        fit: FitScale::FromStart,
+        meaning: "the speed at which the bent viscous rise equals b v_b",
     },
     TermKey {
         key: "drivetrain.load_coefficient",
@@ -146,6 +169,10 @@ pub struct Drivetrain {
     pub coulomb: f64,
     /// b, N·s/m.
     pub viscous: f64,
+    /// δ, dimensionless (1: a straight rise).
+    pub viscous_exponent: f64,
+    /// v_b, m/s.
+    pub viscous_reference_speed: f64,
     /// c_N, dimensionless.
     pub load_coefficient: f64,
     /// c_q, N·s²/m².
@@ -158,6 +185,9 @@ pub struct Drivetrain {
     pub stribeck_speed: f64,
 }
 
+/// The viscous rise's reference speed when none is set, m/s.
+pub const DEFAULT_VISCOUS_REFERENCE_SPEED_M_S: f64 = 1.0;
+
 /// The Stribeck speed when none is set, m/s.
 pub const DEFAULT_STRIBECK_SPEED_M_S: f64 = 0.01;
 
@@ -167,6 +197,8 @@ impl Default for Drivetrain {
         Self {
             coulomb: 0.0,
             viscous: 0.0,
+            viscous_exponent: 1.0,
+            viscous_reference_speed: DEFAULT_VISCOUS_REFERENCE_SPEED_M_S,
             load_coefficient: 0.0,
             quadratic: 0.0,
             coulomb_asymmetry: 0.0,
@@ -199,7 +231,7 @@ impl FrictionTerm for Drivetrain {
         self.level_at_rest(at.v, at.s, at.load)
     }
 
-    /// b v + c_q v |v|.
+    /// F_b(v) + c_q v |v|.
     #[inline(always)]
     fn beside(&self, at: &At) -> f64 {
         self.rate_terms(at.v)
@@ -226,6 +258,8 @@ impl FrictionTerm for Drivetrain {
         match key {
             "drivetrain.coulomb_n" => Some(&mut self.coulomb),
             "drivetrain.viscous_n_s_m" => Some(&mut self.viscous),
+            "drivetrain.viscous_exponent" => Some(&mut self.viscous_exponent),
+            "drivetrain.viscous_reference_speed_m_s" => Some(&mut self.viscous_reference_speed),
             "drivetrain.load_coefficient" => Some(&mut self.load_coefficient),
             "drivetrain.quadratic_n_s2_m2" => Some(&mut self.quadratic),
             "drivetrain.stribeck_n" => Some(&mut self.stribeck),
@@ -265,10 +299,7 @@ impl Drivetrain {
     /// (the rigid contact's tanh(v/v_reg)).
     #[inline(always)]
     pub fn force_at(&self, v: f64, load: f64, s: f64) -> f64 {
-        self.level(v, load) * s
-            + self.coulomb_asymmetry * s.abs()
-            + self.viscous * v
-            + self.quadratic * v * v.abs()
+        self.level(v, load) * s + self.coulomb_asymmetry * s.abs() + self.rate_terms(v)
     }
 
     /// The terms that act at zero speed, at speed `v` with the sign `s` of
@@ -280,10 +311,23 @@ impl Drivetrain {
         self.level(v, load) * s + self.coulomb_asymmetry * s.abs()
     }
 
-    /// The terms that vanish with the speed: b v + c_q v |v| (outside the
-    /// bristle, as LuGre's viscous term is).
+    /// The terms that vanish with the speed: F_b(v) + c_q v |v| (outside
+    /// the bristle, as LuGre's viscous term is).
+    #[inline(always)]
     pub fn rate_terms(&self, v: f64) -> f64 {
-        self.viscous * v + self.quadratic * v * v.abs()
+        self.viscous_rise(v) + self.quadratic * v * v.abs()
+    }
+
+    /// F_b(v) = b v_b sgn v |v/v_b|^δ: b v, bit for bit, when δ = 1.
+    #[inline(always)]
+    #[allow(clippy::float_cmp)] // δ = 1 exactly is the straight rise, the default, bit for bit
+    pub fn viscous_rise(&self, v: f64) -> f64 {
+        if self.viscous_exponent == 1.0 {
+            self.viscous * v
+        } else {
+            let vb = self.viscous_reference_speed;
+            self.viscous * vb * (v.abs() / vb).powf(self.viscous_exponent).copysign(v)
+        }
     }
 }
 
@@ -332,6 +376,30 @@ mod tests {
         );
         assert_eq!(force(&d, 0.0, 0.0, 1e-6), 0.0);
         assert!(!d.is_zero());
+    }
+
+    #[test]
+    fn a_bent_viscous_rise_equals_b_v_b_at_v_b_and_grows_with_the_power_delta_of_speed() {
+        let d = Drivetrain {
+            viscous: 50.0,
+            viscous_exponent: 2.0 / 3.0,
+            viscous_reference_speed: 0.1,
+            ..Default::default()
+        };
+        approx::assert_relative_eq!(d.rate_terms(0.1), 5.0, max_relative = 1e-12);
+        // Eight times the speed: four times the force (8^(2/3)), odd in v.
+        approx::assert_relative_eq!(d.rate_terms(0.8), 20.0, max_relative = 1e-12);
+        approx::assert_relative_eq!(d.rate_terms(-0.8), -20.0, max_relative = 1e-12);
+        assert_eq!(d.rate_terms(0.0), 0.0);
+        // Below the line b v past v_b, above it inside.
+        assert!(d.rate_terms(0.8) < 50.0 * 0.8 && d.rate_terms(0.01) > 50.0 * 0.01);
+        // δ = 1: b v, whatever the reference speed, bit for bit.
+        let straight = Drivetrain {
+            viscous: 50.0,
+            viscous_reference_speed: 0.1,
+            ..Default::default()
+        };
+        assert_eq!(straight.rate_terms(0.37), 50.0 * 0.37);
     }
 
     #[test]
