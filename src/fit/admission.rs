@@ -2,16 +2,19 @@
 //! faster than the viscous rise is admitted into a set only where the
 //! set's fit shows the start of that growth inside the data; rule 9b: a
 //! term that bends is kept only where the set's fit shows the bend inside
-//! the data.
+//! the data; rule 9c: a viscous rise is bent only where the set's fit
+//! tells its exponent from the straight rise's.
 //!
 //! | symbol | meaning | unit |
 //! |---|---|---|
 //! | c₂ | the drivetrain's quadratic loss, F = c₂ v² sgn v | N·s²/m² |
+//! | δ | the viscous rise's exponent, F = b v_b sgn v \|v/v_b\|^δ | – |
 //! | μ_r | the boundary rate, μ = μ_bl + μ_r asinh(\|v\|/v_a) | – |
 //! | v_a | the boundary rate's activation speed, its bend | m/s |
 //! | V | the data's top contact speed | m/s |
 //!
-//! Shown: the 95 % interval of c₂ excludes zero. Where it holds zero, the
+//! Shown: the 95 % interval of c₂ excludes zero; of δ, excludes 1 (the
+//! straight rise, past which the bent rise predicts less and less). Where it holds zero, the
 //! folds may still favour the term (they reach one speed range past the
 //! rest, about 1.25× on a steady curve, where a curvature of the noise or
 //! of a Stribeck dip's bottom pays), and past the data it adds a growth
@@ -28,13 +31,18 @@
 use super::candidates::CANDIDATES;
 use super::driver::FitOutcome;
 
-/// Terms that grow without end past the data, faster than the viscous
-/// rise a classic curve holds: the drivetrain quadratic. Such a term is
-/// admitted into a set only where the set's fit tells its coefficient
-/// from zero (its 95 % interval excludes zero), `select.rs` rule 9: where
-/// the data cannot, they do not show the start of its growth, and past
-/// them it adds what they never showed.
-pub const SHOWN_BEFORE_ADMITTED: &[&str] = &["drivetrain quadratic"];
+/// Terms whose effect past the data grows with the speed away from the
+/// straight viscous rise a classic curve holds, each with the value of
+/// its key that is that rise: the drivetrain quadratic (0; it grows
+/// faster) and the bend (δ = 1; it grows slower). Such a term is admitted
+/// into a set only where the set's fit tells its key from that value (its
+/// 95 % interval excludes it), `select.rs` rules 9 and 9c: where the data
+/// cannot, they do not show the start of the departure, and past them it
+/// adds what they never showed.
+pub const SHOWN_BEFORE_ADMITTED: &[(&str, f64)] = &[
+    ("drivetrain quadratic", 0.0),
+    (super::candidates::BEND, 1.0),
+];
 
 /// Why the set `terms`, fitted as `o`, is not admitted: a term of
 /// [`SHOWN_BEFORE_ADMITTED`] whose key's 95 % interval at `o` does not
@@ -91,7 +99,10 @@ fn unshown_by(
     terms: &[&'static str],
     fitted: impl Fn(&str) -> Option<(f64, f64, f64)>,
 ) -> Option<String> {
-    for t in terms.iter().filter(|t| SHOWN_BEFORE_ADMITTED.contains(t)) {
+    for (t, straight) in SHOWN_BEFORE_ADMITTED
+        .iter()
+        .filter(|(t, _)| terms.contains(t))
+    {
         let Some(c) = CANDIDATES.iter().find(|c| c.name == *t) else {
             continue;
         };
@@ -99,11 +110,19 @@ fn unshown_by(
             let Some((value, lo, hi)) = fitted(key) else {
                 continue;
             };
-            let (lo_ok, hi_ok) = (lo > 0.0 && lo.is_finite(), hi < 0.0 && hi.is_finite());
+            let (lo_ok, hi_ok) = (
+                lo > *straight && lo.is_finite(),
+                hi < *straight && hi.is_finite(),
+            );
             if !(lo_ok || hi_ok) {
                 let others: Vec<&str> = terms.iter().copied().filter(|x| x != t).collect();
+                let (holds, what) = if *straight == 0.0 {
+                    ("zero".to_string(), "grows without end")
+                } else {
+                    (format!("{straight} (the straight rise)"), "bends")
+                };
                 return Some(format!(
-                    "{t}{}: its fit gives `{key}` = {} with a 95 % interval [{}, {}] that holds zero; a term that grows without end past the data is admitted only where they show it",
+                    "{t}{}: its fit gives `{key}` = {} with a 95 % interval [{}, {}] that holds {holds}; a term that {what} past the data is admitted only where they show it",
                     if others.is_empty() {
                         String::new()
                     } else {
@@ -172,6 +191,26 @@ mod tests {
         assert!(bend_unshown_at(&terms, (0.5, 0.4, 0.45), 0.5).is_some());
         assert!(bend_unshown_at(&terms, (1e-8, 0.0, f64::INFINITY), 0.5).is_some());
         assert!(bend_unshown_at(&terms, (0.2, f64::NAN, f64::NAN), 0.5).is_some());
+    }
+
+    #[test]
+    fn a_bend_whose_exponents_interval_holds_the_straight_rise_is_not_admitted() {
+        const DELTA: &str = "drivetrain.viscous_exponent";
+        let bend = super::super::candidates::BEND;
+        let with = |(value, lo, hi): (f64, f64, f64)| {
+            unshown_by(&["drivetrain viscous", bend], move |k| {
+                (k == DELTA).then_some((value, lo, hi))
+            })
+        };
+        let why = with((0.45, 0.08, 2.5)).unwrap();
+        assert_eq!(
+            why,
+            "drivetrain bend beside drivetrain viscous: its fit gives `drivetrain.viscous_exponent` = 0.45 with a 95 % interval [0.08, 2.5] that holds 1 (the straight rise); a term that bends past the data is admitted only where they show it"
+        );
+        assert_eq!(with((0.62, 0.55, 0.69)), None);
+        assert!(with((0.62, f64::NAN, f64::NAN)).is_some());
+        // Zero, the quadratic's straight value, is not the bend's.
+        assert_eq!(with((0.62, 0.3, 0.9)), None);
     }
 
     #[test]

@@ -90,6 +90,19 @@ pub const CANDIDATES: &[Candidate] = &[
         part_of_requirement: false,
     },
     Candidate {
+        // The viscous rise bent below the line, b v_b sgn v |v/v_b|^δ with
+        // δ < 1: a rolling bearing's viscous moment grows with (ν n)^(2/3)
+        // (Palmgren), a film's shear with the speed over a film that
+        // thickens with it. Only on a viscous rise (the viscous term, or
+        // the Stribeck curve that holds it), and only where the fit tells
+        // δ from 1 (rule 9c, `admission.rs`).
+        name: BEND,
+        keys: &["drivetrain.viscous_exponent"],
+        requires: Some(VISCOUS),
+        needs_varying_load: false,
+        part_of_requirement: false,
+    },
+    Candidate {
         // The classic Stribeck curve on our level: the static excess, its
         // speed and the viscous rise (a dip needs the rise beside it; alone
         // neither pays).
@@ -128,6 +141,10 @@ pub const NOT_CANDIDATES: &[(&str, &str)] = &[
     (
         "contact.sign_regularization_m_s",
         "a numerical device, not a property of the contact",
+    ),
+    (
+        "drivetrain.viscous_reference_speed_m_s",
+        "where the bent viscous rise's slope is read: set to the data's top speed",
     ),
     (
         "contact.width_load_exponent",
@@ -364,6 +381,8 @@ pub(super) const STRIBECK: &str = "drivetrain Stribeck";
 /// The drivetrain's viscous rise (Coulomb + viscous with the base), the
 /// other classic shape of rule 7.
 pub(super) const VISCOUS: &str = "drivetrain viscous";
+/// The viscous rise bent below the line (its exponent δ < 1).
+pub(super) const BEND: &str = "drivetrain bend";
 /// The drivetrain's direction asymmetry (a level higher one way than the
 /// other: an offset of the moving friction), which rule 7 also compares
 /// the classic shapes beside.

@@ -7,7 +7,7 @@
 //! Rule 7b: where the direction asymmetry lowers the criterion by more
 //! than [`AICC_SUPPORT`], the shapes are compared beside it.
 
-use super::candidates::{lighter_forms, set_keys, Candidate, ASYMMETRY, STRIBECK, VISCOUS};
+use super::candidates::{lighter_forms, set_keys, Candidate, ASYMMETRY, BEND, STRIBECK, VISCOUS};
 use super::trial::{Ctx, Scored, Tried, AICC_SUPPORT};
 use super::FitError;
 
@@ -103,17 +103,22 @@ pub(super) fn presumed_terms(terms: &[&'static str], shapes: &[&'static str]) ->
     presumed
 }
 
+/// A shape's name: its terms but the asymmetry beside them ("drivetrain
+/// viscous + drivetrain bend"), or "the base alone".
+fn shape_name(terms: &[&'static str]) -> String {
+    let named: Vec<&str> = terms.iter().copied().filter(|t| *t != ASYMMETRY).collect();
+    if named.is_empty() {
+        "the base alone".into()
+    } else {
+        named.join(" + ")
+    }
+}
+
 /// Each shape's criterion in words ("drivetrain viscous −43.6, …"), a
 /// set beside the asymmetry named by its shape.
 fn criteria(sets: &[Scored]) -> String {
     sets.iter()
-        .map(|s| {
-            let name = match s.tried.terms.first().copied() {
-                Some(ASYMMETRY) | None => "the base alone",
-                Some(t) => t,
-            };
-            format!("{name} {:.1}", s.aicc)
-        })
+        .map(|s| format!("{} {:.1}", shape_name(&s.tried.terms), s.aicc))
         .collect::<Vec<_>>()
         .join(", ")
 }
@@ -147,13 +152,19 @@ impl Ctx<'_> {
     /// criterion on all the training points ([`super::trial::aicc`]) is
     /// within [`AICC_SUPPORT`] of the lowest), and that shape is presumed
     /// with its viscous rise ([`presumed_terms`]; how it may leave:
-    /// `removal::holds_rise`, `removal::presumed_gives_way`). With `shapes`
-    /// empty (a time series) the start is the base.
+    /// `removal::holds_rise`, `removal::presumed_gives_way`). With `bends`
+    /// each shape is also tried with its viscous rise bent (rule 7c: the
+    /// bend is a shape of the rise, as the Stribeck curve is of the
+    /// level, and is compared with them, one key more than its shape's,
+    /// where rule 9c admits it); the bend itself is not presumed. With
+    /// `shapes` empty (a time series) the start is the base.
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn presume(
         &self,
         base: Scored,
         shapes: &[&'static str],
         offset: bool,
+        bends: bool,
         tried: &mut Vec<Tried>,
         start: &mut String,
         say: &(dyn Fn(&str) + Sync),
@@ -162,7 +173,13 @@ impl Ctx<'_> {
         for s in shapes {
             let t = self.try_set(&[*s], &sets[0].optimum)?;
             tried.push(t.tried.clone());
+            let warm = t.optimum.clone();
             sets.push(t);
+            if bends {
+                let b = self.try_set(&[*s, BEND], &warm)?;
+                tried.push(b.tried.clone());
+                sets.push(b);
+            }
         }
         let aiccs: Vec<f64> = sets.iter().map(|s| s.aicc).collect();
         let mut list = criteria(&sets);
@@ -182,15 +199,17 @@ impl Ctx<'_> {
             .into_iter()
             .nth(start_shape(&compared, shapes.contains(&VISCOUS)))
             .expect("start_shape is an index of the sets");
-        let presumed = presumed_terms(&best.tried.terms, shapes);
+        let unbent: Vec<&'static str> = best
+            .tried
+            .terms
+            .iter()
+            .copied()
+            .filter(|t| *t != BEND)
+            .collect();
+        let presumed = presumed_terms(&unbent, shapes);
         let _ = self.presumed.set(presumed);
         if !shapes.is_empty() {
-            let shape = best
-                .tried
-                .terms
-                .first()
-                .copied()
-                .unwrap_or("the base alone");
+            let shape = unbent.first().copied().unwrap_or("the base alone");
             let stays = if shape == VISCOUS {
                 "it stays unless its key ends at zero"
             } else if shape == STRIBECK {
@@ -204,7 +223,13 @@ impl Ctx<'_> {
                 )
             } else {
                 format!(
-                    "the selection starts from {shape}, the classic shape the whole steady curve supports (small-sample Akaike criterion on all the training points: {list}); {stays}"
+                    "the selection starts from {}, the classic shape the whole steady curve supports (small-sample Akaike criterion on all the training points: {list}); {stays}{}",
+                    shape_name(&best.tried.terms),
+                    if best.tried.terms.contains(&BEND) {
+                        "; the bend is not presumed"
+                    } else {
+                        ""
+                    }
                 )
             };
             say(&format!("auto: {why}"));

@@ -516,7 +516,8 @@ pub fn joint_equivalent(
         "contact.presliding_damping_n_s_m" => (value * g * g, pick("N·m·s/rad", "N·s/m")),
         "contact.boundary_activation_speed_m_s"
         | "contact.sign_regularization_m_s"
-        | "drivetrain.stribeck_speed_m_s" => (value / g, pick("rad/s", "m/s")),
+        | "drivetrain.stribeck_speed_m_s"
+        | "drivetrain.viscous_reference_speed_m_s" => (value / g, pick("rad/s", "m/s")),
         _ => return None,
     })
 }

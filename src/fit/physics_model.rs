@@ -88,6 +88,10 @@ impl FilmTraces {
 /// inputs alone ([`Model::linear_parameters`]).
 const LINEAR_KEYS: [&str; 2] = ["drivetrain.viscous_n_s_m", "drivetrain.quadratic_n_s2_m2"];
 
+/// The viscous rise's exponent: fitted, the viscous key is no longer
+/// linear with a fixed slope.
+const BENT_KEY: &str = "drivetrain.viscous_exponent";
+
 /// Film traces kept: enough for the sources of one Jacobian's base point
 /// and the film columns beside it.
 const TRACES_KEPT: usize = 16;
@@ -293,10 +297,13 @@ impl Model for PhysicsModel {
     }
 
     fn linear_parameters(&self) -> Vec<usize> {
+        // A fitted exponent changes the viscous rise's slope b ↦ F_b.
+        let bent = self.names.iter().any(|n| n == BENT_KEY);
         self.names
             .iter()
             .enumerate()
             .filter(|(_, n)| LINEAR_KEYS.contains(&n.as_str()))
+            .filter(|(_, n)| !(bent && n.as_str() == LINEAR_KEYS[0]))
             .map(|(i, _)| i)
             .collect()
     }
@@ -431,6 +438,28 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn a_fitted_viscous_exponent_makes_the_viscous_slope_depend_on_it_so_the_viscous_key_is_not_linear(
+    ) {
+        let mut config = Config::default();
+        config.solver.cells = 32;
+        config.drivetrain.viscous_reference_speed_m_s = 1.0;
+        let keys = [
+            ("drivetrain.viscous_n_s_m", 0.0, 1e4, 300.0),
+            ("drivetrain.viscous_exponent", 0.1, 1.0, 1.0),
+            ("drivetrain.quadratic_n_s2_m2", 0.0, 1e4, 800.0),
+        ];
+        let model = model_of(&config, &keys);
+        assert_eq!(model.linear_parameters(), vec![2]);
+        // The slope of b at v = 0.5 m/s: v_b |v/v_b|^δ, 0.5 straight and
+        // 0.5^0.5 with δ = 0.5.
+        let s = series(vec![0.0, 1.0], vec![0.5, 0.5], true);
+        let at = |x: &[f64]| model.predict(x, &s).unwrap()[1];
+        let slope = |d: f64| (at(&[400.0, d, 0.0]) - at(&[300.0, d, 0.0])) / 100.0;
+        assert_relative_eq!(slope(1.0), 0.5, max_relative = 1e-6);
+        assert_relative_eq!(slope(0.5), 0.5f64.sqrt(), max_relative = 1e-6);
     }
 
     #[test]

@@ -87,6 +87,34 @@ fn model_setup(
     Ok((c, Some(l), contact_scale))
 }
 
+/// Where the viscous rise may bend (its exponent fitted, or `--fit auto`,
+/// which may choose the bend) and the configuration leaves its reference
+/// speed v_b at the default, v_b is the data's top contact speed: b is
+/// then the rise's slope where the data end, and b and δ are told apart
+/// (at v_b = 1 m/s, far above a joint's contact speeds, ln|v/v_b| is
+/// nearly the same at every sample and δ moves the rise as b does).
+fn read_viscous_rise_at_top_speed(
+    model: &mut Config,
+    given: &Config,
+    auto: bool,
+    key_specs: &[ParamSpec],
+    scale: &DataScale,
+) {
+    let bent = auto
+        || key_specs
+            .iter()
+            .any(|s| s.name == "drivetrain.viscous_exponent");
+    let default = Config::default().drivetrain.viscous_reference_speed_m_s;
+    let top = scale.velocity_m_s;
+    if bent
+        && given.drivetrain.viscous_reference_speed_m_s == default
+        && top.is_finite()
+        && top > 0.0
+    {
+        model.drivetrain.viscous_reference_speed_m_s = top.min(100.0);
+    }
+}
+
 fn load_range(sources: &[Source], map: &[f64], load_n: f64) -> Result<(f64, f64), FitError> {
     let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
     for s in sources {
@@ -239,7 +267,7 @@ pub fn prepare(
     // statement of the contact's scale, and is kept.
     let load_configured = config.contact.load_n != Config::default().contact.load_n;
     let choose_scale = req.rotary || (auto && !load_given && !load_configured);
-    let (model_config, contact_scale, model_scale) = model_setup(
+    let (mut model_config, contact_scale, model_scale) = model_setup(
         config,
         req.units(),
         choose_scale,
@@ -249,6 +277,7 @@ pub fn prepare(
         scale,
         &mut notes,
     )?;
+    read_viscous_rise_at_top_speed(&mut model_config, config, auto, &key_specs, &model_scale);
     let gain = contact_scale.as_ref().map_or(1.0, |l| l.gain);
     let model = PhysicsModel::new(&model_config, &key_specs, &model_scale)?.with_gain(gain);
     Ok(Prepared {

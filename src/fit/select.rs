@@ -184,7 +184,9 @@
 //! The report lists every set tried with its CV error per fold, the set
 //! chosen and why the selection stopped.
 
-use super::candidates::{candidates_here, holds, parts_to_add, set_keys, Candidate, ASYMMETRY};
+use super::candidates::{
+    candidates_here, holds, parts_to_add, set_keys, Candidate, ASYMMETRY, BEND,
+};
 use super::classic_shape::{classic_shapes, without_subsumed};
 use super::cross_validate::paired;
 use super::curve_support::back_to_start;
@@ -312,7 +314,8 @@ pub fn select(
     };
     let mut start = String::new();
     let offset = candidates.iter().any(|c| c.name == ASYMMETRY);
-    let current = ctx.presume(base, &shapes, offset, &mut tried, &mut start, say)?;
+    let bends = candidates.iter().any(|c| c.name == BEND);
+    let current = ctx.presume(base, &shapes, offset, bends, &mut tried, &mut start, say)?;
     let start_set = current.clone();
     let (current, why) =
         ctx.stepwise(current, &candidates, steady, &mut tried, &mut removed, say)?;

@@ -1,0 +1,49 @@
+//! Rule 7c of `--fit auto` (`fit/classic_shape.rs`): a steady curve's
+//! viscous rise may bend below the line, b v_b sgn v |v/v_b|^δ with δ < 1
+//! (`physics::terms::drivetrain`), as a rolling bearing's viscous moment
+//! grows with (ν n)^(2/3) (Palmgren) and a film's shear over a film that
+//! thickens with speed. The joint of `tests/fixtures/joint-bearing-bend-*.csv`
+//! is a bearing's: τ(ω) = f_c sgn ω + 1.5 N·m · sgn ω |ω/ω₉₀|^(2/3) with f_c
+//! 1 N·m and ω₉₀ = 90 deg/s, 1 % noise, fitted at 0.5–20 deg/s both ways
+//! and predicting 25–90 deg/s (`docs/arm-steady-draws.sh`'s writer, its
+//! `POWER`). Neither classic can bend: Coulomb + viscous extrapolates its
+//! line (held out 0.51 N·m), the Stribeck curve bends its level at the
+//! data's top speed and rises steeply past it (0.69 N·m).
+
+mod common;
+
+/// The value in column `col` of `model`'s row in the models table.
+fn cell(stdout: &str, model: &str, col: usize) -> String {
+    let row = stdout
+        .lines()
+        .find(|l| l.starts_with(&format!("| {model} |")))
+        .unwrap_or_else(|| panic!("no row {model}: {stdout}"));
+    row.split('|').nth(col).unwrap().trim().to_string()
+}
+
+#[test]
+fn a_bearings_viscous_rise_that_bends_is_fitted_bent_and_predicted_past_the_data_better_than_either_classic(
+) {
+    let (code, stdout, err) =
+        common::cli::fit_joint_fixture("viscous-bend", "joint-bearing-bend", &["--baselines"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        stdout.contains("Chosen: boundary friction, drivetrain viscous, drivetrain bend."),
+        "{stdout}"
+    );
+    let keys = cell(&stdout, "friction-node", 3);
+    let delta: f64 = keys
+        .split("drivetrain.viscous_exponent=")
+        .nth(1)
+        .and_then(|s| s.split([',', ' ']).next())
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| panic!("no exponent in {keys}"));
+    approx::assert_abs_diff_eq!(delta, 2.0 / 3.0, epsilon = 0.1);
+    let held = |m: &str| -> f64 { cell(&stdout, m, 7).parse().unwrap() };
+    let best_classic = held("Coulomb + viscous").min(held("Stribeck"));
+    assert!(
+        held("friction-node") < 0.2 * best_classic,
+        "ours {} against the best classic {best_classic}",
+        held("friction-node")
+    );
+}
