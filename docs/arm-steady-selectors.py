@@ -29,13 +29,13 @@ Two rules aim at the prediction past the data rather than the fit inside:
   of the top speed): a curve whose speed sits at the data's top shows no
   bend that it can be told apart by.
 
-And one shape the tool does not have (stop 90): each classic shape with
-its viscous part bent, b sgn w |w/w90|^d (d in 0.2-1 on a grid, w90 = 90
-deg/s), as a rolling bearing's viscous moment grows with (nu n)^(2/3)
-(Palmgren) and a film's shear with speed over a film that thickens; the
-classic shape chosen by its AICc (margin 2), then bent where the bend
-lowers the AICc by more than t. Its ratio is still to the better of the
-two classic shapes.
+And rule 7c (stop 90): each classic shape also with its viscous part
+bent, b sgn w |w/w90|^d (d in 0.2-1 on a grid, w90 = 90 deg/s), as a
+rolling bearing's viscous moment grows with (nu n)^(2/3) (Palmgren); the
+simplest of the four shapes (by their parameter count: 2, 3, 4, 5) within
+t of the lowest AICc, a bent one only where d's 95 % (Wald) interval
+excludes 1 (rule 9c). Its ratio is still to the better of the two classic
+shapes, so it can fall below 1.
 
 Usage: docs/arm-steady-selectors.py DIR [DIR ...]    (NumPy)
 """
@@ -166,14 +166,26 @@ def bent_st(w, ws, d):
 
 
 def bent_fits(w, y, top):
-    """Both classic shapes with the viscous part bent: ((SSE, design) of
-    Coulomb + bent viscous, of Stribeck + bent viscous), each the best on
-    its grid."""
+    """Both classic shapes with the viscous part bent: ((SSE, d, whether
+    d's 95 % Wald interval excludes 1) of Coulomb + bent viscous, (SSE,
+    w_s, d, the same) of Stribeck + bent viscous), each the best on its
+    grid."""
     cv = min(((sse(bent_cv(w, d), y, lsq(bent_cv(w, d), y)), d) for d in BENDS), key=lambda t: t[0])
     st = min(((sse(bent_st(w, v, d), y, lsq(bent_st(w, v, d), y)), v, d)
               for v in np.exp(np.linspace(math.log(top / 1000), math.log(top), 60)) for d in BENDS[::2]),
              key=lambda t: t[0])
-    return cv, st
+    n, u, sg = len(w), abs(w) / W90, np.sign(w)
+
+    def shown(jac, s, k, d):
+        c = s / (n - k) * np.linalg.pinv(jac.T @ jac)
+        return d + 1.96 * math.sqrt(max(c[-1, -1], 0.0)) < 1.0
+
+    c1 = lsq(bent_cv(w, cv[1]), y)
+    jv = np.c_[sg, sg * u ** cv[1], c1[1] * sg * u ** cv[1] * np.log(u)]
+    c2 = lsq(bent_st(w, st[1], st[2]), y)
+    e, d2 = np.exp(-((w / st[1]) ** 2)), st[2]
+    js = np.c_[sg, sg * e, c2[1] * sg * e * 2 * w**2 / st[1] ** 3, sg * u ** d2, c2[2] * sg * u ** d2 * np.log(u)]
+    return (cv[0], cv[1], shown(jv, cv[0], 3, cv[1])), (st[0], st[1], st[2], shown(js, st[0], 5, d2))
 
 
 def joint(train, validate, made):
@@ -195,10 +207,11 @@ def joint(train, validate, made):
         "fic": fic(w, cc, ws, cs, ss),
         "ws_inside": ws < 0.9 * top,
     }
-    (sv_b, d_v), (ss_b, ws_b, d_s) = bent_fits(w, y, top)
+    (sv_b, d_v, shown_v), (ss_b, ws_b, d_s, shown_s) = bent_fits(w, y, top)
     j["held_vb"] = rms(bent_cv(wv, d_v) @ lsq(bent_cv(w, d_v), y))
     j["held_sb"] = rms(bent_st(wv, ws_b, d_s) @ lsq(bent_st(w, ws_b, d_s), y))
-    j["aicc_vb"], j["aicc_sb"] = aicc(sv_b, n, 3), aicc(ss_b, n, 5)
+    j["aicc_vb"] = aicc(sv_b, n, 3) if shown_v else math.inf
+    j["aicc_sb"] = aicc(ss_b, n, 5) if shown_s else math.inf
     j["cv_warm"] = fold_mse(w, y, top, ws, True)
     j["cv_cold"] = fold_mse(w, y, top, ws, False)
     return j
@@ -237,12 +250,13 @@ def main(dirs):
         wt = 1 / (1 + math.exp(-x))
         held.append(float(np.sqrt(np.mean((wt * j["pred_s"] + (1 - wt) * j["pred_v"] - j["yv"]) ** 2))))
     row("Akaike-weighted average of the two", held)
-    for t in (2, 4, 7):
+    for t in (2, 4):
         held = []
         for j in joints:
-            c = "s" if j["aicc_s"] < j["aicc_v"] - 2 else "v"
-            held.append(j[f"held_{c}b"] if j[f"aicc_{c}b"] < j[f"aicc_{c}"] - t else j[f"held_{c}"])
-        row(f"(not in the tool) the classic shape by AICc > 2, bent where that lowers it by more than {t}", held)
+            shapes = [(j[f"aicc_{k}"], j[f"held_{k}"]) for k in ("v", "vb", "s", "sb")]
+            lowest = min(a for a, _ in shapes)
+            held.append(next(h for a, h in shapes if a <= lowest + t))
+        row(f"rule 7c: the simplest of the four shapes within {t} of the lowest AICc (bent where d is shown)", held)
 
 
 if __name__ == "__main__":

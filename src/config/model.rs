@@ -195,8 +195,8 @@ pub enum ViscosityModelKind {
 pub struct DrivetrainConfig {
     /// Constant friction, signed with the velocity, N.
     pub coulomb_n: f64,
-    /// Friction proportional to the velocity, N·s/m (with an exponent
-    /// below 1, the slope at `viscous_reference_speed_m_s`).
+    /// Friction proportional to the velocity, N·s/m (bent: its force at
+    /// `viscous_reference_speed_m_s` over that speed).
     pub viscous_n_s_m: f64,
     /// The viscous rise's exponent δ: 1 a straight rise, below 1 a rise
     /// b v_b sgn v |v/v_b|^δ that bends below the line as speed grows.

@@ -297,7 +297,7 @@ impl Model for PhysicsModel {
     }
 
     fn linear_parameters(&self) -> Vec<usize> {
-        // A fitted exponent changes the viscous rise's slope b ↦ F_b.
+        // A fitted exponent makes the viscous rise F_v depend on it as well as on b.
         let bent = self.names.iter().any(|n| n == BENT_KEY);
         self.names
             .iter()

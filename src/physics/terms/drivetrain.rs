@@ -3,8 +3,8 @@
 //! gear mesh), which no contact model should be asked to absorb.
 //!
 //! ```text
-//! F_dt = (F_cd + c_N F_ext + ΔF_s e^(−(v/v_s)²)) tanh(v / v_reg) + ΔF_cd |tanh(v / v_reg)| + F_b(v) + c_q v |v|
-//! F_b(v) = b v_b sgn v |v / v_b|^δ   (δ = 1: b v, whatever v_b)
+//! F_dt = (F_cd + c_N F_ext + ΔF_s e^(−(v/v_s)²)) tanh(v / v_reg) + ΔF_cd |tanh(v / v_reg)| + F_v(v) + c_q v |v|
+//! F_v(v) = b v_b sgn v |v / v_b|^δ   (δ = 1: b v, whatever v_b)
 //! F_total = F_f + F_dt
 //! ```
 //!
@@ -15,9 +15,9 @@
 //! | c_N | friction proportional to the normal load (rolling elements carrying it) | – |
 //! | ΔF_s | the static level's excess over the Coulomb level (Stribeck): F_cd + ΔF_s at rest, decaying to F_cd over v_s; negative: a friction that rises with speed to F_cd | N |
 //! | v_s | the Stribeck speed | m/s |
-//! | b | viscous drivetrain friction: the slope of F_b at v_b | N·s/m |
+//! | b | viscous drivetrain friction (bent: F_v(v_b) / v_b) | N·s/m |
 //! | δ | the viscous rise's exponent: 1 a straight rise; below 1 a rise that bends below the line as speed grows, as a rolling bearing's viscous moment grows with (ν n)^(2/3) (Palmgren) and a film's shear over a film that thickens with speed | – |
-//! | v_b | the speed at which F_b = b v_b: where b is read (a fit sets it to the data's top speed, so that b and δ are told apart) | m/s |
+//! | v_b | the speed at which F_v = b v_b: where b is read (a fit sets it to the data's top speed, so that b and δ are told apart) | m/s |
 //! | c_q | loss growing with the square of the speed (churning, windage, iron and eddy losses of a motor, reflected to the slider) | N·s²/m² |
 //! | v_reg | the contact's sign regularisation (the same tanh) | m/s |
 //!
@@ -25,7 +25,7 @@
 //! With pre-sliding on (`presliding.rs`) the terms that act at zero speed,
 //! (F_cd + c_N F_ext + ΔF_s e^(−(v/v_s)²)) sgn v + ΔF_cd |sgn v|, are part of
 //! the bristle's level (a reversal's compliance is the whole axis's), and
-//! only F_b(v) + c_q v|v| is added beside it.
+//! only F_v(v) + c_q v|v| is added beside it.
 //!
 //! With these terms the classic models are special cases of ours: Coulomb +
 //! viscous (F_cd, b), Stribeck with its static level above or below the
@@ -231,7 +231,7 @@ impl FrictionTerm for Drivetrain {
         self.level_at_rest(at.v, at.s, at.load)
     }
 
-    /// F_b(v) + c_q v |v|.
+    /// F_v(v) + c_q v |v|.
     #[inline(always)]
     fn beside(&self, at: &At) -> f64 {
         self.rate_terms(at.v)
@@ -311,14 +311,14 @@ impl Drivetrain {
         self.level(v, load) * s + self.coulomb_asymmetry * s.abs()
     }
 
-    /// The terms that vanish with the speed: F_b(v) + c_q v |v| (outside
+    /// The terms that vanish with the speed: F_v(v) + c_q v |v| (outside
     /// the bristle, as LuGre's viscous term is).
     #[inline(always)]
     pub fn rate_terms(&self, v: f64) -> f64 {
         self.viscous_rise(v) + self.quadratic * v * v.abs()
     }
 
-    /// F_b(v) = b v_b sgn v |v/v_b|^δ: b v, bit for bit, when δ = 1.
+    /// F_v(v) = b v_b sgn v |v/v_b|^δ: b v, bit for bit, when δ = 1.
     #[inline(always)]
     #[allow(clippy::float_cmp)] // δ = 1 exactly is the straight rise, the default, bit for bit
     pub fn viscous_rise(&self, v: f64) -> f64 {
