@@ -17,8 +17,8 @@ use std::path::Path;
 
 #[test]
 fn a_stribeck_speed_on_its_bound_ends_the_fit_converged_there() {
-    let fixture = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/fixtures/joint-speed-at-bound-train.csv");
+    let fixture =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/joint-speed-at-bound-train.csv");
     let d = common::cli::fresh_dir("at-a-bound", "joint-speed-at-bound");
     let out = d.join("f.yaml");
     let (code, stdout, err) = common::cli::run(&[
