@@ -30,6 +30,11 @@
 # a 17-bit encoder (2π/2^17 rad), differenced over a sample and filtered
 # forward and backward by a 2nd-order Butterworth at 50 Hz (the friction is
 # still made by the true speed).
+# POWER=p bends each joint's viscous part: b ω_top sgn ω |ω/ω_top|^δ
+# with δ uniform in p–1 from the draw's own generator (ω_top the training
+# motion's top speed, where the part is that of POWER=1), as a bearing's
+# viscous moment grows with (ν n)^(2/3); the joints, motions and noise are
+# those of POWER=1.
 # DRAWS=12 sets the last draw (about 1 min each), FIRST=1 the first: draws
 # 1-12 are those the rule was developed on, 13-24 were first run after it.
 set -euo pipefail
@@ -45,11 +50,12 @@ mkdir -p "$OUT"
 START=${START:-rest}
 case "$START" in rest|sliding) ;; *) echo "START must be rest or sliding, not '$START'" >&2; exit 2 ;; esac
 VELOCITY=${VELOCITY:-true}
+POWER=${POWER:-1}
 case "$VELOCITY" in true|encoder) ;; *) echo "VELOCITY must be true or encoder, not '$VELOCITY'" >&2; exit 2 ;; esac
-python3 - "$OUT" "$DRAWS" "$FIRST" "$START" "$VELOCITY" <<'PY'
+python3 - "$OUT" "$DRAWS" "$FIRST" "$START" "$VELOCITY" "$POWER" <<'PY'
 import math, random, sys
 out, draws, first = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
-start, velocity = sys.argv[4], sys.argv[5]
+start, velocity, power = sys.argv[4], sys.argv[5], float(sys.argv[6])
 def butter2(x, fc=50.0, fs=1000.0):
     """A 2nd-order Butterworth low-pass (bilinear), one pass."""
     k = math.tan(math.pi * fc / fs)
@@ -82,7 +88,7 @@ def motion(rnd, top):
     peak = max(abs(shape(k * 1e-3)) for k in range(60000))
     return lambda s: top * shape(s) / peak
 
-def lugre(t, w, p, ripple):
+def lugre(t, w, p, ripple, delta=1.0, top=1.0):
     # z advanced exactly over 20 sub-steps per sample (ω linear between
     # samples, constant over a sub-step): stable at any σ0.
     fc, fs, ws, b, s0, s1, amp, periods = p
@@ -99,7 +105,8 @@ def lugre(t, w, p, ripple):
                 z = zs + (z - zs) * math.exp(-abs(y) * h / g(y))
                 theta += y * h
         dz = x - abs(x) * z / g(x)
-        tau = s0 * z + s1 * dz + b * x
+        rise = b * x if delta == 1.0 else b * top * math.copysign(abs(x / top) ** delta, x)
+        tau = s0 * z + s1 * dz + rise
         if ripple:
             tau += amp * fc * math.sin(periods * theta)
         out.append(tau)
@@ -118,11 +125,12 @@ for d in range(first, draws + 1):
     ripple = d % 2 == 0
     p = (fc, fs, ws, b, s0, s1, 0.03, rnd.randint(6, 20))
     w_of = motion(random.Random(rnd.randrange(1 << 30)), top)
+    delta = random.Random(f"{d} power").uniform(power, 1.0) if power < 1.0 else 1.0
     for part, speed, duration in (("train", 1.0, 60.0), ("fast", 2.5, 24.0)):
         # The faster motion: the same path at 2.5x the speed.
         t = [k * 1e-3 for k in range(int(duration * 1000))]
         w = [speed * w_of(speed * s) for s in t]
-        f = lugre(t, w, p, ripple)
+        f = lugre(t, w, p, ripple, delta, top)
         rms = math.sqrt(sum(x * x for x in f) / len(f))
         noise = random.Random(7 * d + (part == "fast"))
         with open(f"{out}/d{d}-{part}.csv", "w") as fh:
@@ -130,7 +138,8 @@ for d in range(first, draws + 1):
             for a, x, y in zip(t, measured(t, w), f):
                 fh.write(f"{a:.3f},{x:.6g},{y + noise.gauss(0, 0.01 * rms):.6g}\n")
     print(f"| d{d} | {fc:.3g} | {fs:.3g} | {ws:.3g} | {b:.3g} | {s0:.4g} | {s1:.3g} | {top:.3g} | "
-          f"{'yes' if ripple else 'no'} |", file=open(f"{out}/d{d}.params", "w"))
+          f"{'yes' if ripple else 'no'}{f', δ {delta:.3g}' if delta != 1.0 else ''} |",
+          file=open(f"{out}/d{d}.params", "w"))
 PY
 
 for d in $(seq "$FIRST" "$DRAWS"); do
