@@ -89,8 +89,8 @@ fn model_setup(
 
 /// Where the viscous rise may bend (its exponent fitted, or `--fit auto`,
 /// which may choose the bend) and the configuration leaves its reference
-/// speed v_b at the default, v_b is the data's top contact speed: b is
-/// then the rise's slope where the data end, and b and δ are told apart
+/// speed v_b at the default, v_b is the training data's top contact
+/// speed: b is then F_v there over that speed, and b and δ are told apart
 /// (at v_b = 1 m/s, far above a joint's contact speeds, ln|v/v_b| is
 /// nearly the same at every sample and δ moves the rise as b does).
 fn read_viscous_rise_at_top_speed(
