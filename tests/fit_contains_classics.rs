@@ -20,52 +20,10 @@ fn dir(name: &str) -> common::cli::FreshDir {
     common::cli::fresh_dir("contains-classics", name)
 }
 
-/// Point-to-point moves at 1 kHz (the motion of docs/classic-synthetic.sh,
-/// shorter): top speeds of 5 to 200 mm/s either way, ramps at 2 m/s², a
-/// flat of 0.5 s and a dwell of 0.2 s.
-fn motion(duration: f64) -> Vec<(f64, f64)> {
-    let tops = [
-        0.02, -0.2, 0.005, 0.1, -0.05, 0.2, -0.02, 0.05, -0.1, -0.005,
-    ];
-    let (flat, dwell) = (0.5, 0.2);
-    let mut out = Vec::new();
-    let mut t0 = 0.0;
-    let mut k = 0usize;
-    'outer: for vm in tops.iter().cycle() {
-        let r = f64::abs(*vm) / 2.0;
-        let len = 2.0 * r + flat + dwell;
-        loop {
-            let t = k as f64 * 1e-3;
-            if t > duration {
-                break 'outer;
-            }
-            let s = t - t0;
-            if s >= len {
-                break;
-            }
-            let v = if s < r {
-                vm * s / r
-            } else if s < r + flat {
-                *vm
-            } else if s < 2.0 * r + flat {
-                vm * (2.0 * r + flat - s) / r
-            } else {
-                0.0
-            };
-            // To the nanometre per second, as docs/point-to-point-motion.py
-            // writes it: the end of a ramp is at rest, not at 4e-16 m/s.
-            out.push((t, (v * 1e9).round() / 1e9));
-            k += 1;
-        }
-        t0 += len;
-    }
-    out
-}
-
 /// F(v) = sgn v (f_c + (f_s − f_c) e^(−(v/v_s)²)) + b v with 1 % white
 /// noise, as a CSV `t_s,velocity_m_s,friction_n`.
 fn stribeck_record(path: &Path, fc: f64, fs: f64, vs: f64, b: f64) {
-    let m = motion(8.0);
+    let m = common::motion::point_to_point(8.0, 1.0);
     let f: Vec<f64> = m
         .iter()
         .map(|(_, v)| {

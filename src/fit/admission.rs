@@ -26,7 +26,10 @@
 //! rise inside the data that bends where they stop. The term being
 //! added is then refused. A term already chosen gives way: a newcomer
 //! that leaves the rate's bend unshown is tried in the set without the
-//! rate (`trial.rs`).
+//! rate (`trial.rs`). So does a quadratic or a bend chosen before: a
+//! newcomer that leaves it unshown (the bristle's damping, beside which
+//! a bend's exponent no longer differs from 1) explains what it did, and
+//! the set is tried without it.
 
 use super::candidates::CANDIDATES;
 use super::driver::FitOutcome;
@@ -44,11 +47,11 @@ pub const SHOWN_BEFORE_ADMITTED: &[(&str, f64)] = &[
     (super::candidates::BEND, 1.0),
 ];
 
-/// Why the set `terms`, fitted as `o`, is not admitted: a term of
-/// [`SHOWN_BEFORE_ADMITTED`] whose key's 95 % interval at `o` does not
-/// exclude zero (or has no finite bound: the data do not determine it).
-/// None when every such term is shown.
-pub fn unshown(terms: &[&'static str], o: &FitOutcome) -> Option<String> {
+/// The term of [`SHOWN_BEFORE_ADMITTED`] in the set `terms`, fitted as
+/// `o`, whose key's 95 % interval at `o` does not exclude its straight
+/// value (or has no finite bound: the data do not determine it), and why
+/// the set is not admitted with it. None when every such term is shown.
+pub fn unshown(terms: &[&'static str], o: &FitOutcome) -> Option<(&'static str, String)> {
     unshown_by(terms, |key| fitted(o, key))
 }
 
@@ -98,7 +101,7 @@ fn bend_unshown_at(
 fn unshown_by(
     terms: &[&'static str],
     fitted: impl Fn(&str) -> Option<(f64, f64, f64)>,
-) -> Option<String> {
+) -> Option<(&'static str, String)> {
     for (t, straight) in SHOWN_BEFORE_ADMITTED
         .iter()
         .filter(|(t, _)| terms.contains(t))
@@ -121,7 +124,7 @@ fn unshown_by(
                 } else {
                     (format!("{straight} (the straight rise)"), "bends")
                 };
-                return Some(format!(
+                return Some((*t, format!(
                     "{t}{}: its fit gives `{key}` = {} with a 95 % interval [{}, {}] that holds {holds}; a term that {what} past the data is admitted only where they show it",
                     if others.is_empty() {
                         String::new()
@@ -131,7 +134,7 @@ fn unshown_by(
                     crate::text::Num::sig(value, 4),
                     crate::text::Num::sig(lo, 3),
                     crate::text::Num::sig(hi, 3)
-                ));
+                )));
             }
         }
     }
@@ -155,7 +158,10 @@ mod tests {
 
     /// `unshown_by` with one fitted key, `C2`, at `value` in `[lo, hi]`.
     fn with_c2(terms: &[&'static str], (value, lo, hi): (f64, f64, f64)) -> Option<String> {
-        unshown_by(terms, move |k| (k == C2).then_some((value, lo, hi)))
+        unshown_by(terms, move |k| (k == C2).then_some((value, lo, hi))).map(|(t, why)| {
+            assert_eq!(t, QUADRATIC);
+            why
+        })
     }
 
     #[test]
@@ -200,6 +206,10 @@ mod tests {
         let with = |(value, lo, hi): (f64, f64, f64)| {
             unshown_by(&["drivetrain viscous", bend], move |k| {
                 (k == DELTA).then_some((value, lo, hi))
+            })
+            .map(|(t, why)| {
+                assert_eq!(t, bend);
+                why
             })
         };
         let why = with((0.45, 0.08, 2.5)).unwrap();

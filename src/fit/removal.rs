@@ -61,9 +61,11 @@ pub(super) fn no_worse(than: &Tried, t: &Tried) -> bool {
 ///
 /// Either goes only where the folds show that it costs, beyond their
 /// spread and the cost of a term, or by a flag (rule 4); a rise of the
-/// folds' mean within their spread is no such showing.
+/// folds' mean within their spread is no such showing. A set with it that
+/// could not be scored (not admitted by rule 9, or its fit failed) never
+/// stays: its infinite error has no spread to be within.
 pub(super) fn held_stays(without: &Tried, with: &Tried) -> bool {
-    !pays(with, without).0
+    is_scored(with) && !pays(with, without).0
 }
 
 /// Whether a term stays beside the set `without` it, the set `with` it

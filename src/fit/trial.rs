@@ -305,9 +305,17 @@ impl Ctx<'_> {
                 .unwrap_or_else(|p| p.into_inner())
                 .push(why)
         };
-        if let Some(why) = unshown(terms, &fitted) {
-            not_admitted(why);
-            return Ok(self.unfitted(terms, "not admitted (below)"));
+        if let Some((term, why)) = unshown(terms, &fitted) {
+            // Rules 9 and 9c: the term entering is refused; one chosen
+            // before gives way to the newcomer that left it unshown, as
+            // the rate does (rule 9b). A term nothing requires.
+            if terms.last() == Some(&term) {
+                not_admitted(why);
+                return Ok(self.unfitted(terms, "not admitted (below)"));
+            }
+            not_admitted(format!("{why}; the set is tried without it"));
+            let rest: Vec<&'static str> = terms.iter().copied().filter(|t| *t != term).collect();
+            return self.try_set(&rest, &optimum_of(&fitted));
         }
         if let Some(why) = bend_unshown(terms, &fitted, self.p.model_scale.velocity_m_s) {
             // Rule 9b: the rate entering is refused; a rate chosen before

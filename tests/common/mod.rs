@@ -4,6 +4,7 @@
 #![allow(dead_code)]
 
 pub mod cli;
+pub mod motion;
 
 use friction_node::config::{Config, StepMode};
 use friction_node::msgs::EstimateRecord;
