@@ -31,6 +31,7 @@
 //! | `confirm.rs` | `--fit auto`'s choice confirmed at the final fit's optimum: scored on the same folds, it falls back to the best set with one term fewer when it no longer pays over it, or to the lighter set of two chosen terms that are confounded at that optimum |
 //! | `selection_report.rs` | `--fit auto`'s report: the rule in words, every set tried with its error per fold, what was left out, not admitted, added and removed, the choice and why it stopped |
 //! | `select.rs` | `--fit auto`'s rule: stepwise with removal on cross-validation, terms that pay, dead terms dropped; its report |
+//! | `moves.rs` | the moves a step of `--fit auto` tries: each open candidate, and a term with the term it needs |
 //! | `stop_reason.rs` | why the stepwise selection stopped, in words: the best next term does not pay on the folds, or the whole curve's criterion refuses it |
 //! | `classic_shape.rs` | `--fit auto`'s rule 7: a steady curve starts from the classic shape its points support (AICc), which is presumed |
 //! | `curve_support.rs` | `--fit auto`'s rule 10: on a steady curve a term enters only where the whole curve's AICc is lowered too |
@@ -105,6 +106,7 @@ pub mod inertia_check;
 pub mod inputs;
 pub mod local_run;
 pub mod models_table;
+mod moves;
 pub mod multistart;
 pub mod options;
 pub mod physics_model;

@@ -305,27 +305,21 @@ impl Ctx<'_> {
                 .unwrap_or_else(|p| p.into_inner())
                 .push(why)
         };
-        if let Some((term, why)) = unshown(terms, &fitted) {
-            // Rules 9 and 9c: the term entering is refused; one chosen
-            // before gives way to the newcomer that left it unshown, as
-            // the rate does (rule 9b). A term nothing requires.
+        // Rules 9, 9b and 9c: a term the set's fit does not show (a
+        // quadratic or bend told from the straight rise, the rate's bend
+        // inside the data) is refused when it is the one entering; one
+        // chosen before gives way to the newcomer that left it unshown.
+        // Nothing requires such a term, so the rest is a set.
+        let unshown_term = unshown(terms, &fitted).or_else(|| {
+            bend_unshown(terms, &fitted, self.p.model_scale.velocity_m_s).map(|why| (BENT, why))
+        });
+        if let Some((term, why)) = unshown_term {
             if terms.last() == Some(&term) {
                 not_admitted(why);
                 return Ok(self.unfitted(terms, "not admitted (below)"));
             }
             not_admitted(format!("{why}; the set is tried without it"));
             let rest: Vec<&'static str> = terms.iter().copied().filter(|t| *t != term).collect();
-            return self.try_set(&rest, &optimum_of(&fitted));
-        }
-        if let Some(why) = bend_unshown(terms, &fitted, self.p.model_scale.velocity_m_s) {
-            // Rule 9b: the rate entering is refused; a rate chosen before
-            // gives way to the term that left its bend unshown.
-            if terms.last() == Some(&BENT) {
-                not_admitted(why);
-                return Ok(self.unfitted(terms, "not admitted (below)"));
-            }
-            not_admitted(format!("{why}; the set is tried without it"));
-            let rest: Vec<&'static str> = terms.iter().copied().filter(|t| *t != BENT).collect();
             return self.try_set(&rest, &optimum_of(&fitted));
         }
         let fold_mse = cross_validate(
