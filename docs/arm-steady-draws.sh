@@ -32,6 +32,12 @@
 # grease's thinning gives and neither classic has; the curves, offsets
 # and noise are those of POWER=1.
 #
+# SHAPE=q (with CURVES=random) gives each random joint's Stribeck fall its
+# own exponent, e^(−|ω/ω_s|^α) with α uniform in q–2 from its own
+# generator (both classics' fall is Gaussian, α = 2; measured joints give
+# 0.5–2): a shape neither classic nor ours has. The curves, offsets, bends
+# and noise are those of SHAPE=2.
+#
 # Usage: docs/arm-steady-draws.sh [OUT_DIR] [BIN]   (default: out/arm-steady-draws)
 # DRAWS=20 sets the draws per curve.
 set -euo pipefail
@@ -44,17 +50,19 @@ SEED=${SEED:-2026}
 OFFSET=${OFFSET:-0}
 WS_MAX=${WS_MAX:-0.5}
 POWER=${POWER:-1}
+SHAPE=${SHAPE:-2}
 mkdir -p "$OUT"
 [ -x "$BIN" ] || cargo build --release --quiet
 . docs/bench-lib.sh
 
-python3 - "$OUT" "$DRAWS" "$CURVES" "$SEED" "$OFFSET" "$WS_MAX" "$POWER" <<'PY'
+python3 - "$OUT" "$DRAWS" "$CURVES" "$SEED" "$OFFSET" "$WS_MAX" "$POWER" "$SHAPE" <<'PY'
 import math, random, sys
 out, draws, names, family = sys.argv[1], int(sys.argv[2]), sys.argv[3].split(), int(sys.argv[4])
 offset = float(sys.argv[5])
 ws_max = float(sys.argv[6])
 power = float(sys.argv[7])
-offsets, powers = {}, {}
+shape = float(sys.argv[8])
+offsets, powers, shapes = {}, {}, {}
 train = [0.5, 1.0, 2.0, 3.0, 5.0, 7.0, 10.0, 13.0, 16.0, 20.0]
 validate = [25.0, 35.0, 45.0, 60.0, 75.0, 90.0]
 curves = {"peak": (1.2, 1.8, 0.05, 2.0), "rise": (1.2, 0.6, 0.1, 1.0)}
@@ -79,12 +87,18 @@ if names == ["random"]:
         with open(f"{out}/random-powers.txt", "w") as f:
             for n, d in powers.items():
                 f.write(f"{n} {d:.4g}\n")
+    if shape < 2.0:
+        srng = random.Random(f"{family} shape")
+        shapes = {n: srng.uniform(shape, 2.0) for n in curves}
+        with open(f"{out}/random-shapes.txt", "w") as f:
+            for n, a in shapes.items():
+                f.write(f"{n} {a:.4g}\n")
     with open(f"{out}/random-curves.txt", "w") as f:
         for n, (fc, fs, ws, b) in curves.items():
             f.write(f"{n} {fc:.4g} {fs:.4g} {ws:.4g} {b:.4g}\n")
 else:
     curves = {n: curves[n] for n in names}
-def write(path, speeds, p, seed, c=0.0, delta=1.0):
+def write(path, speeds, p, seed, c=0.0, delta=1.0, alpha=2.0):
     fc, fs, ws, b = p
     rng = random.Random(seed)
     w90 = math.radians(90.0)
@@ -93,16 +107,16 @@ def write(path, speeds, p, seed, c=0.0, delta=1.0):
         for deg in speeds:
             for sign in (1.0, -1.0):
                 w = sign * math.radians(deg)
-                tau = sign * (fc + (fs - fc) * math.exp(-(w / ws) ** 2)) + (b * w if delta == 1.0 else b * w90 * math.copysign(abs(w / w90) ** delta, w)) + c
+                tau = sign * (fc + (fs - fc) * math.exp(-abs(w / ws) ** alpha)) + (b * w if delta == 1.0 else b * w90 * math.copysign(abs(w / w90) ** delta, w)) + c
                 f.write(f"{w},{tau * (1 + rng.gauss(0, 0.01))}\n")
 for name, p in curves.items():
     for seed in (range(1, draws + 1) if not name.startswith("random") else [1]):
         # Each random joint gets its own noise (until stop 70 every one of
         # them drew seed 1's, so the family's noise was one draw repeated).
         noise = seed if not name.startswith("random") else 1000 * family + int(name[6:])
-        c, delta = offsets.get(name, 0.0), powers.get(name, 1.0)
-        write(f"{out}/{name}-{seed}-train.csv", train, p, noise, c, delta)
-        write(f"{out}/{name}-{seed}-validate.csv", validate, p, 100000 + noise if name.startswith("random") else 100 + seed, c, delta)
+        c, delta, alpha = offsets.get(name, 0.0), powers.get(name, 1.0), shapes.get(name, 2.0)
+        write(f"{out}/{name}-{seed}-train.csv", train, p, noise, c, delta, alpha)
+        write(f"{out}/{name}-{seed}-validate.csv", validate, p, 100000 + noise if name.startswith("random") else 100 + seed, c, delta, alpha)
 PY
 
 if [ "$CURVES" = random ]; then
