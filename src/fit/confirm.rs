@@ -41,7 +41,10 @@
 use super::candidates::is_part;
 use super::cross_validate::cv_rms;
 use super::prepared::Prepared;
-use super::removal::{change_text, flagged, goes_of_pair, holds_rise, lighter, pays, term_stays};
+use super::removal::{
+    change_text, flagged, goes_of_pair, holds_rise, lighter, pays, taken_back, term_stays,
+    with_fuller_options,
+};
 use super::select::{fitted_keys, Selection};
 use super::trial::{set_final_model, KeyFlag, Optimum, Scored, Tried};
 use super::unknowns::ParamSpec;
@@ -217,6 +220,7 @@ pub(super) fn confounded_at_final(
     if other_may_go {
         options.extend(lighter(&s.chosen, other, Some(other_key)));
     }
+    let options = with_fuller_options(options, &|u| !presumed(u));
     let (t, form, set) = options
         .iter()
         .filter_map(|(t, form, terms)| {
@@ -232,7 +236,7 @@ pub(super) fn confounded_at_final(
         })
         .min_by(|a, b| a.2.tried.cv_rms.total_cmp(&b.2.tried.cv_rms))?;
     let u = units.force();
-    let change = change_text(t, form);
+    let change = change_text(t, form) + &taken_back(&s.chosen, &set.tried.terms);
     let why = format!(
         "{change}: at the final fit's optimum {}, so one of the two goes, the one whose set the folds missed least (CV RMS {} {u}; the chosen set at that optimum {} {u})",
         f.why,

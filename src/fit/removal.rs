@@ -253,6 +253,9 @@ impl Ctx<'_> {
             if let Some((other, other_key)) = f.confounded.filter(|_| other_may_go) {
                 options.extend(lighter(&current.tried.terms, other, Some(other_key)));
             }
+            if f.confounded.is_some() {
+                options = with_fuller_options(options, &|u| !self.is_presumed(u));
+            }
             let scored: Vec<(&'static str, Option<&'static str>, Scored)> = options
                 .par_iter()
                 .map(|(t, form, terms)| Ok((*t, *form, self.try_set(terms, &current.optimum)?)))
@@ -281,7 +284,8 @@ impl Ctx<'_> {
                 kept.push(f.term);
                 continue;
             };
-            let change = change_text(t, form);
+            let change =
+                change_text(t, form) + &taken_back(&current.tried.terms, &next.tried.terms);
             let outcome = if f.confounded.is_some() {
                 "so one of the two goes (the one the folds miss least)"
             } else {
@@ -361,6 +365,29 @@ pub(super) fn flagged(s: &Scored, kept: &[&'static str]) -> Option<Flagged> {
         })
 }
 
+/// `options` (as [`lighter`] gives them), each set without its term also
+/// with a fuller form taken back ([`with_fuller_forms`]) where `may(u)`
+/// lets the form `u` be taken back (a steady curve's presumed shape is
+/// rule 7's choice, not taken back).
+pub(super) fn with_fuller_options(
+    options: Vec<(&'static str, Option<&'static str>, Vec<&'static str>)>,
+    may: &dyn Fn(&str) -> bool,
+) -> Vec<(&'static str, Option<&'static str>, Vec<&'static str>)> {
+    let mut out = Vec::new();
+    for (t, form, terms) in options {
+        if form.is_none() {
+            for (set, _, _) in with_fuller_forms(&terms)
+                .into_iter()
+                .filter(|(_, u, _)| may(u))
+            {
+                out.push((t, None, set));
+            }
+        }
+        out.push((t, form, terms));
+    }
+    out
+}
+
 /// The sets lighter than `set` by its term `t`: `t` replaced by each of
 /// its lighter forms (those without `flagged_key`), then `t` removed with
 /// the terms that require it. Each as (t, the form taking its place, the
@@ -392,6 +419,45 @@ pub(super) fn lighter(
         .collect();
     out.push((t, None, without));
     out
+}
+
+/// The sets that one of two confounded terms leaves behind when it goes
+/// outright: `without`, and `without` with a lighter form in it taken back
+/// to a fuller form that holds it (the viscous rise back to the Stribeck
+/// curve), one at a time. A newcomer can make a chosen term give way to a
+/// lighter form (rule 2's removal: the Stribeck curve to its rise beside a
+/// boundary rate); when the data then cannot tell the newcomer from that
+/// form and the newcomer goes, the reason the fuller form gave way goes
+/// with it. Each as (the set, the form taken back, the fuller form).
+pub(super) fn with_fuller_forms(
+    without: &[&'static str],
+) -> Vec<(Vec<&'static str>, &'static str, &'static str)> {
+    let mut out = Vec::new();
+    for u in without {
+        for c in CANDIDATES.iter().filter(|c| !without.contains(&c.name)) {
+            if !lighter_forms(c.name, &[]).contains(u) {
+                continue;
+            }
+            let set: Vec<&'static str> = without
+                .iter()
+                .map(|x| if x == u { c.name } else { *x })
+                .collect();
+            if c.requires.is_none_or(|r| holds(&set, r)) {
+                out.push((set, *u, c.name));
+            }
+        }
+    }
+    out
+}
+
+/// What a set differs from `from` by, beside the change: the fuller forms
+/// taken back (", drivetrain viscous back to drivetrain Stribeck"), or "".
+pub(super) fn taken_back(from: &[&'static str], to: &[&'static str]) -> String {
+    with_fuller_forms(from)
+        .into_iter()
+        .filter(|(_, u, c)| !to.contains(u) && to.contains(c))
+        .map(|(_, u, c)| format!(", {u} back to {c}"))
+        .collect()
 }
 
 /// "− t", or "t → form" when a lighter form takes its place.
@@ -438,6 +504,46 @@ mod tests {
             partner: Some(partner.into()),
         }];
         s
+    }
+
+    #[test]
+    fn a_confounded_term_that_goes_leaves_its_set_also_with_the_fuller_form_it_displaced() {
+        // d190's path (a LuGre joint whose Stribeck fall is not Gaussian):
+        // the boundary rate made the Stribeck curve give way to its rise,
+        // then the data could not tell the rate from that rise.
+        let chosen = [
+            "pre-sliding",
+            "pre-sliding damping",
+            "boundary rate",
+            VISCOUS,
+        ];
+        let options = with_fuller_options(lighter(&chosen, "boundary rate", None), &|_| true);
+        let back = ["pre-sliding", "pre-sliding damping", "drivetrain Stribeck"];
+        let sets: Vec<&Vec<&str>> = options.iter().map(|(_, _, s)| s).collect();
+        assert!(
+            sets.iter()
+                .any(|s| s.len() == 3 && back.iter().all(|t| s.contains(t))),
+            "{sets:?}"
+        );
+        // The set without the rate as it is stays an option.
+        assert!(
+            sets.iter().any(|s| s.len() == 3 && s.contains(&VISCOUS)),
+            "{sets:?}"
+        );
+        assert_eq!(
+            taken_back(&chosen, &back),
+            ", drivetrain viscous back to drivetrain Stribeck"
+        );
+        // A form that may not be taken back (a steady curve's presumed
+        // shape) is not.
+        let kept = with_fuller_options(lighter(&chosen, "boundary rate", None), &|u| u != VISCOUS);
+        assert!(
+            kept.iter()
+                .all(|(_, _, s)| !s.contains(&"drivetrain Stribeck")),
+            "{kept:?}"
+        );
+        // A set without a lighter form has nothing to take back.
+        assert!(with_fuller_forms(&["pre-sliding", "film"]).is_empty());
     }
 
     #[test]

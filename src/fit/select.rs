@@ -53,7 +53,9 @@
 //!    two terms are confounded: the data cannot tell them apart, each
 //!    extrapolates its own way (a quadratic loss against a viscous one),
 //!    and the folds' preference between them is noise. One of the two
-//!    goes, whichever the folds miss least.
+//!    goes, whichever the folds miss least; the set it leaves is also
+//!    tried with a fuller form taken back (`removal::with_fuller_forms`:
+//!    the rise back to the Stribeck curve that a boundary rate displaced).
 //!    Rule 4b, before these flags are read: a candidate that is a part of
 //!    a chosen term, not a rival explanation
 //!    ([`Candidate::part_of_requirement`]: the pre-sliding bristle's
