@@ -40,11 +40,9 @@
 
 use super::candidates::is_part;
 use super::cross_validate::cv_rms;
+use super::lighter_sets::{change_text, lighter, taken_back, with_fuller_options};
 use super::prepared::Prepared;
-use super::removal::{
-    change_text, flagged, goes_of_pair, holds_rise, lighter, pays, taken_back, term_stays,
-    with_fuller_options,
-};
+use super::removal::{flagged, goes_of_pair, holds_rise, pays, term_stays};
 use super::select::{fitted_keys, Selection};
 use super::trial::{set_final_model, KeyFlag, Optimum, Scored, Tried};
 use super::unknowns::ParamSpec;

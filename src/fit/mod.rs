@@ -35,7 +35,8 @@
 //! | `stop_reason.rs` | why the stepwise selection stopped, in words: the best next term does not pay on the folds, or the whole curve's criterion refuses it |
 //! | `classic_shape.rs` | `--fit auto`'s rule 7: a steady curve starts from the classic shape its points support (AICc), which is presumed |
 //! | `curve_support.rs` | `--fit auto`'s rule 10: on a steady curve a term enters only where the whole curve's AICc is lowered too |
-//! | `removal.rs` | terms taken away during the selection: one that no longer pays, one flagged dead, one of two confounded terms; the lighter forms; whether a change pays |
+//! | `removal.rs` | terms taken away during the selection: one that no longer pays, one flagged dead, one of two confounded terms; whether a change pays |
+//! | `lighter_sets.rs` | the sets a removal may go to: a term's lighter forms, the term taken away, a displaced fuller form taken back; the change's words |
 //! | `trial.rs` | one set of terms tried: fitted on the training data, scored by cross-validation |
 //! | `trial_starts.rs` | a trial's starts besides its warm one: new keys at their placements, the Stribeck curve at its classic curves, a set reached by taking a term away also where it would be fitted alone |
 //! | `admission.rs` | `--fit auto`'s rule 9: a term that grows without end past the data (the quadratic) admitted only where its fit tells its coefficient from zero |
@@ -104,6 +105,7 @@ mod film_run;
 mod held_out;
 pub mod inertia_check;
 pub mod inputs;
+mod lighter_sets;
 pub mod local_run;
 pub mod models_table;
 mod moves;

@@ -54,7 +54,7 @@
 //!    extrapolates its own way (a quadratic loss against a viscous one),
 //!    and the folds' preference between them is noise. One of the two
 //!    goes, whichever the folds miss least; the set it leaves is also
-//!    tried with a fuller form taken back (`removal::with_fuller_forms`:
+//!    tried with a fuller form taken back (`lighter_sets::with_fuller_forms`:
 //!    the rise back to the Stribeck curve that a boundary rate displaced).
 //!    Rule 4b, before these flags are read: a candidate that is a part of
 //!    a chosen term, not a rival explanation
