@@ -75,24 +75,21 @@ if names == ["random"]:
         ratio = rng.uniform(0.4, 2.0)
         curves[f"random{k}"] = (fc, fc * (1.0 if k % 3 == 0 else ratio), logu(0.005, ws_max),
                                 logu(0.05, 3.0) * fc / math.radians(90.0))
+    def per_joint(what, draw):
+        """Each joint's own value from the family's generator for `what`,
+        written to random-{what}s.txt."""
+        rng_ = random.Random(f"{family} {what}")
+        values = {n: draw(rng_, p) for n, p in curves.items()}
+        with open(f"{out}/random-{what}s.txt", "w") as f:
+            for n, x in values.items():
+                f.write(f"{n} {x:.4g}\n")
+        return values
     if offset > 0.0:
-        orng = random.Random(f"{family} offset")
-        offsets = {n: orng.uniform(-offset, offset) * p[0] for n, p in curves.items()}
-        with open(f"{out}/random-offsets.txt", "w") as f:
-            for n, c in offsets.items():
-                f.write(f"{n} {c:.4g}\n")
+        offsets = per_joint("offset", lambda r, p: r.uniform(-offset, offset) * p[0])
     if power < 1.0:
-        prng = random.Random(f"{family} power")
-        powers = {n: prng.uniform(power, 1.0) for n in curves}
-        with open(f"{out}/random-powers.txt", "w") as f:
-            for n, d in powers.items():
-                f.write(f"{n} {d:.4g}\n")
+        powers = per_joint("power", lambda r, p: r.uniform(power, 1.0))
     if shape < 2.0:
-        srng = random.Random(f"{family} shape")
-        shapes = {n: srng.uniform(shape, 2.0) for n in curves}
-        with open(f"{out}/random-shapes.txt", "w") as f:
-            for n, a in shapes.items():
-                f.write(f"{n} {a:.4g}\n")
+        shapes = per_joint("shape", lambda r, p: r.uniform(shape, 2.0))
     with open(f"{out}/random-curves.txt", "w") as f:
         for n, (fc, fs, ws, b) in curves.items():
             f.write(f"{n} {fc:.4g} {fs:.4g} {ws:.4g} {b:.4g}\n")
