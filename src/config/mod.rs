@@ -207,6 +207,7 @@ impl Config {
                 coulomb_asymmetry: d.coulomb_asymmetry_n,
                 stribeck: d.stribeck_n,
                 stribeck_speed: d.stribeck_speed_m_s,
+                stribeck_exponent: d.stribeck_exponent,
             },
             ..Default::default()
         }

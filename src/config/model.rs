@@ -213,8 +213,11 @@ pub struct DrivetrainConfig {
     /// The static level's excess over the Coulomb level (Stribeck), N;
     /// negative: a friction that rises with speed to the Coulomb level.
     pub stribeck_n: f64,
-    /// The Stribeck speed, m/s: the excess decays as e^(−(v/v_s)²).
+    /// The Stribeck speed, m/s: the excess decays as e^(−|v/v_s|^α_s).
     pub stribeck_speed_m_s: f64,
+    /// The Stribeck fall's exponent α_s: 2 the Gaussian fall of the
+    /// classic curve and LuGre; below 2 a fall with a longer tail.
+    pub stribeck_exponent: f64,
 }
 
 impl Default for DrivetrainConfig {
@@ -231,6 +234,7 @@ impl Default for DrivetrainConfig {
             coulomb_asymmetry_n: d.coulomb_asymmetry,
             stribeck_n: d.stribeck,
             stribeck_speed_m_s: d.stribeck_speed,
+            stribeck_exponent: d.stribeck_exponent,
         }
     }
 }

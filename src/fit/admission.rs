@@ -45,6 +45,7 @@ use super::driver::FitOutcome;
 pub const SHOWN_BEFORE_ADMITTED: &[(&str, f64)] = &[
     ("drivetrain quadratic", 0.0),
     (super::candidates::BEND, 1.0),
+    (super::candidates::STRIBECK_SHAPE, 2.0),
 ];
 
 /// The term of [`SHOWN_BEFORE_ADMITTED`] in the set `terms`, fitted as
@@ -121,6 +122,8 @@ fn unshown_by(
                 let others: Vec<&str> = terms.iter().copied().filter(|x| x != t).collect();
                 let (holds, what) = if *straight == 0.0 {
                     ("zero".to_string(), "grows without end")
+                } else if *t == super::candidates::STRIBECK_SHAPE {
+                    (format!("{straight} (the Gaussian fall)"), "falls otherwise")
                 } else {
                     (format!("{straight} (the straight rise)"), "bends")
                 };

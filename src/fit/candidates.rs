@@ -103,6 +103,19 @@ pub const CANDIDATES: &[Candidate] = &[
         part_of_requirement: false,
     },
     Candidate {
+        // The Stribeck fall's own exponent: measured falls have 0.5–2
+        // (Armstrong-Hélouvry), the classic curve and LuGre 2. Only on the
+        // Stribeck curve, and only where the fit tells α_s from 2 (rule
+        // 9c, `admission.rs`): elsewhere the bend or the rate takes up the
+        // tail a Gaussian fall misses, and bends the prediction past the
+        // data.
+        name: STRIBECK_SHAPE,
+        keys: &["drivetrain.stribeck_exponent"],
+        requires: Some(STRIBECK),
+        needs_varying_load: false,
+        part_of_requirement: false,
+    },
+    Candidate {
         // The classic Stribeck curve on our level: the static excess, its
         // speed and the viscous rise (a dip needs the rise beside it; alone
         // neither pays).
@@ -378,6 +391,9 @@ pub(super) const FILM: &str = "film";
 /// The drivetrain's Stribeck curve, one of the classic shapes a steady
 /// curve may be presumed to have (`select.rs`, rule 7).
 pub(super) const STRIBECK: &str = "drivetrain Stribeck";
+
+/// The Stribeck fall's exponent (a fuller form of the curve's shape).
+pub(super) const STRIBECK_SHAPE: &str = "drivetrain Stribeck shape";
 /// The drivetrain's viscous rise (Coulomb + viscous with the base), the
 /// other classic shape of rule 7.
 pub(super) const VISCOUS: &str = "drivetrain viscous";

@@ -146,6 +146,16 @@ const KEYS: &[TermKey] = &[
         meaning: "the Stribeck speed: the static excess decays as e^(−(v/v_s)²)",
     },
     TermKey {
+        key: "drivetrain.stribeck_exponent",
+        symbol: "α_s",
+        unit: "–",
+        lo: End::Closed(0.3),
+        hi: End::Closed(4.0),
+        live: true,
+        fit: FitScale::FromStart,
+        meaning: "the Stribeck fall's exponent: the static excess decays as e^(−|v/v_s|^α_s); 2 the Gaussian fall of the classic curve and LuGre",
+    },
+    TermKey {
         key: "drivetrain.coulomb_asymmetry_n",
         symbol: "ΔF_cd",
         unit: "N",
@@ -183,6 +193,8 @@ pub struct Drivetrain {
     pub stribeck: f64,
     /// v_s, m/s.
     pub stribeck_speed: f64,
+    /// α_s, dimensionless (2: the Gaussian fall).
+    pub stribeck_exponent: f64,
 }
 
 /// The viscous rise's reference speed when none is set, m/s.
@@ -204,6 +216,7 @@ impl Default for Drivetrain {
             coulomb_asymmetry: 0.0,
             stribeck: 0.0,
             stribeck_speed: DEFAULT_STRIBECK_SPEED_M_S,
+            stribeck_exponent: 2.0,
         }
     }
 }
@@ -264,6 +277,7 @@ impl FrictionTerm for Drivetrain {
             "drivetrain.quadratic_n_s2_m2" => Some(&mut self.quadratic),
             "drivetrain.stribeck_n" => Some(&mut self.stribeck),
             "drivetrain.stribeck_speed_m_s" => Some(&mut self.stribeck_speed),
+            "drivetrain.stribeck_exponent" => Some(&mut self.stribeck_exponent),
             "drivetrain.coulomb_asymmetry_n" => Some(&mut self.coulomb_asymmetry),
             _ => None,
         }
@@ -285,13 +299,17 @@ impl Drivetrain {
     /// ΔF_s e^(−(v/v_s)²) (the Stribeck part only when it is on: off, the
     /// level is the one before it, bit for bit).
     #[inline(always)]
+    #[allow(clippy::float_cmp)] // α_s = 2 exactly is the Gaussian fall, the default, bit for bit
     fn level(&self, v: f64, load: f64) -> f64 {
         let base = self.coulomb + self.load_coefficient * load;
         if self.stribeck == 0.0 {
             base
-        } else {
+        } else if self.stribeck_exponent == 2.0 {
             let x = v / self.stribeck_speed;
             base + self.stribeck * (-x * x).exp()
+        } else {
+            let x = (v / self.stribeck_speed).abs();
+            base + self.stribeck * (-x.powf(self.stribeck_exponent)).exp()
         }
     }
 
@@ -400,6 +418,43 @@ mod tests {
             ..Default::default()
         };
         assert_eq!(straight.rate_terms(0.37), 50.0 * 0.37);
+    }
+
+    #[test]
+    fn a_stribeck_fall_with_its_own_exponent_keeps_its_level_at_rest_and_at_v_s_and_a_longer_tail_below_2(
+    ) {
+        let gauss = Drivetrain {
+            coulomb: 10.0,
+            stribeck: 3.0,
+            stribeck_speed: 0.01,
+            ..Default::default()
+        };
+        let tail = Drivetrain {
+            stribeck_exponent: 1.0,
+            ..gauss
+        };
+        // At v_s both have e^-1 of the excess; at rest both the static level.
+        approx::assert_relative_eq!(
+            tail.level_at_rest(0.01, 1.0, 0.0),
+            10.0 + 3.0 / std::f64::consts::E,
+            max_relative = 1e-12
+        );
+        approx::assert_relative_eq!(tail.level_at_rest(0.0, 1.0, 0.0), 13.0);
+        // At 3 v_s: e^-3 of it against the Gaussian's e^-9; odd in v.
+        approx::assert_relative_eq!(
+            tail.level_at_rest(0.03, 1.0, 0.0),
+            10.0 + 3.0 * (-3.0f64).exp(),
+            max_relative = 1e-12
+        );
+        approx::assert_relative_eq!(
+            gauss.level_at_rest(0.03, 1.0, 0.0),
+            10.0 + 3.0 * (-9.0f64).exp(),
+            max_relative = 1e-12
+        );
+        assert_eq!(
+            tail.force_at(-0.03, 0.0, -1.0),
+            -tail.force_at(0.03, 0.0, 1.0)
+        );
     }
 
     #[test]
