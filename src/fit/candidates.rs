@@ -21,11 +21,30 @@ pub struct Candidate {
     pub requires: Option<&'static str>,
     /// Only when the training loads vary.
     pub needs_varying_load: bool,
+    /// How it stands to the term it requires ([`Tie`]).
+    pub tie: Tie,
+}
+
+/// How a candidate stands to the term it requires.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Tie {
+    /// A term of its own: where a key of it correlates above 0.95 with a
+    /// key of another chosen term, the data cannot tell the two apart
+    /// (rule 4), and one of them goes.
+    Own,
     /// A part of the term it requires, not a rival explanation: LuGre's
     /// bristle damping σ1 beside its stiffness σ0. Once that term is
     /// chosen, the part is added unless the set without it pays over it
     /// (`select.rs`, rule 4b); rule 4's flags still drop it.
-    pub part_of_requirement: bool,
+    Part,
+    /// The form of the term it requires, not a rival explanation: an
+    /// exponent whose null value gives the plain form (the bend's δ = 1,
+    /// the Stribeck fall's α_s = 2). An exponent trades against its own
+    /// term's level by the way the form is written, so their correlation
+    /// is no sign of two explanations: it is a plain flag (rule 4, the
+    /// folds decide), and whether the data show the exponent is rule 9c's
+    /// question (its interval, which that correlation widens).
+    Refinement,
 }
 
 /// The candidate terms, in the order they are tried.
@@ -35,7 +54,7 @@ pub const CANDIDATES: &[Candidate] = &[
         keys: &["lubricant.viscosity_pa_s"],
         requires: None,
         needs_varying_load: false,
-        part_of_requirement: false,
+        tie: Tie::Own,
     },
     Candidate {
         name: "boundary rate",
@@ -45,35 +64,35 @@ pub const CANDIDATES: &[Candidate] = &[
         ],
         requires: None,
         needs_varying_load: false,
-        part_of_requirement: false,
+        tie: Tie::Own,
     },
     Candidate {
         name: "pre-sliding",
         keys: &["contact.presliding_stiffness_n_m"],
         requires: None,
         needs_varying_load: false,
-        part_of_requirement: false,
+        tie: Tie::Own,
     },
     Candidate {
         name: "pre-sliding damping",
         keys: &["contact.presliding_damping_n_s_m"],
         requires: Some("pre-sliding"),
         needs_varying_load: false,
-        part_of_requirement: true,
+        tie: Tie::Part,
     },
     Candidate {
         name: "drivetrain Coulomb",
         keys: &["drivetrain.coulomb_n"],
         requires: None,
         needs_varying_load: false,
-        part_of_requirement: false,
+        tie: Tie::Own,
     },
     Candidate {
         name: VISCOUS,
         keys: &["drivetrain.viscous_n_s_m"],
         requires: None,
         needs_varying_load: false,
-        part_of_requirement: false,
+        tie: Tie::Own,
     },
     Candidate {
         // The quadratic rise only on top of the viscous rise (the viscous
@@ -87,7 +106,7 @@ pub const CANDIDATES: &[Candidate] = &[
         keys: &["drivetrain.quadratic_n_s2_m2"],
         requires: Some(VISCOUS),
         needs_varying_load: false,
-        part_of_requirement: false,
+        tie: Tie::Own,
     },
     Candidate {
         // The viscous rise bent below the line, b v_b sgn v |v/v_b|^δ with
@@ -100,7 +119,7 @@ pub const CANDIDATES: &[Candidate] = &[
         keys: &["drivetrain.viscous_exponent"],
         requires: Some(VISCOUS),
         needs_varying_load: false,
-        part_of_requirement: false,
+        tie: Tie::Refinement,
     },
     Candidate {
         // The Stribeck fall's own exponent: measured falls have 0.5–2
@@ -113,7 +132,7 @@ pub const CANDIDATES: &[Candidate] = &[
         keys: &["drivetrain.stribeck_exponent"],
         requires: Some(STRIBECK),
         needs_varying_load: false,
-        part_of_requirement: false,
+        tie: Tie::Refinement,
     },
     Candidate {
         // The classic Stribeck curve on our level: the static excess, its
@@ -127,21 +146,21 @@ pub const CANDIDATES: &[Candidate] = &[
         ],
         requires: None,
         needs_varying_load: false,
-        part_of_requirement: false,
+        tie: Tie::Own,
     },
     Candidate {
         name: ASYMMETRY,
         keys: &["drivetrain.coulomb_asymmetry_n"],
         requires: None,
         needs_varying_load: false,
-        part_of_requirement: false,
+        tie: Tie::Own,
     },
     Candidate {
         name: "drivetrain load",
         keys: &["drivetrain.load_coefficient"],
         requires: None,
         needs_varying_load: true,
-        part_of_requirement: false,
+        tie: Tie::Own,
     },
 ];
 
@@ -266,27 +285,25 @@ pub(super) fn needs_unheld(o: &str, terms: &[&'static str]) -> bool {
     requirement(o).is_some_and(|r| !holds(terms, r))
 }
 
-/// Whether candidate `t` is a part of the term it requires
-/// ([`Candidate::part_of_requirement`]).
+/// Whether candidate `t` is a part of the term it requires ([`Tie::Part`]).
 pub(super) fn is_part(t: &str) -> bool {
-    CANDIDATES
-        .iter()
-        .any(|c| c.name == t && c.part_of_requirement)
+    CANDIDATES.iter().any(|c| c.name == t && c.tie == Tie::Part)
 }
 
 /// Whether terms `a` and `b` are one element: one is a part of the other
-/// ([`Candidate::part_of_requirement`], the bristle's damping beside its
-/// stiffness), so they are not two explanations of the data.
+/// ([`Tie::Part`], the bristle's damping beside its stiffness) or its form
+/// ([`Tie::Refinement`], the Stribeck fall's exponent beside the curve),
+/// so they are not two explanations of the data.
 pub(super) fn one_element(a: &str, b: &str) -> bool {
-    let part_of = |p: &str, t: &str| {
+    let tied_to = |p: &str, t: &str| {
         CANDIDATES
             .iter()
-            .any(|c| c.name == p && c.part_of_requirement && c.requires == Some(t))
+            .any(|c| c.name == p && c.tie != Tie::Own && c.requires == Some(t))
     };
-    part_of(a, b) || part_of(b, a)
+    tied_to(a, b) || tied_to(b, a)
 }
 
-/// The parts ([`Candidate::part_of_requirement`]) among `candidates` that
+/// The parts ([`Tie::Part`]) among `candidates` that
 /// `terms` lacks while holding the term each requires, and that add a key
 /// the set does not fit already.
 pub(super) fn parts_to_add(
@@ -297,7 +314,7 @@ pub(super) fn parts_to_add(
     candidates
         .iter()
         .copied()
-        .filter(|c| c.part_of_requirement && !terms.contains(&c.name))
+        .filter(|c| c.tie == Tie::Part && !terms.contains(&c.name))
         .filter(|c| c.requires.is_some_and(|r| holds(terms, r)))
         .filter(|c| c.keys.iter().any(|k| !fitted.contains(k)))
         .collect()

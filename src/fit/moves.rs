@@ -2,7 +2,7 @@
 //! candidate alone, and each candidate whose requirement the set lacks
 //! together with a candidate that holds it.
 
-use super::candidates::{holds, set_keys, Candidate};
+use super::candidates::{holds, set_keys, Candidate, Tie};
 
 /// The candidates a step tries beside `terms`: not chosen yet, their
 /// requirement chosen, and adding a key the set does not fit already (the
@@ -39,7 +39,7 @@ pub(super) fn open_moves(
     let mut moves: Vec<Vec<&'static str>> = singles.iter().map(|c| vec![c.name]).collect();
     for c in candidates
         .iter()
-        .filter(|c| !c.part_of_requirement && !terms.contains(&c.name))
+        .filter(|c| c.tie != Tie::Part && !terms.contains(&c.name))
     {
         let Some(r) = c.requires.filter(|r| !holds(terms, r)) else {
             continue;

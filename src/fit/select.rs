@@ -58,7 +58,7 @@
 //!    the rise back to the Stribeck curve that a boundary rate displaced).
 //!    Rule 4b, before these flags are read: a candidate that is a part of
 //!    a chosen term, not a rival explanation
-//!    ([`Candidate::part_of_requirement`]: the pre-sliding bristle's
+//!    (`Tie::Part`: the pre-sliding bristle's
 //!    damping, LuGre's σ1 beside its stiffness σ0), comes with that term
 //!    unless the set without it pays over it. It need not pay by rule 3:
 //!    its effect lasts the milliseconds of a reversal's pre-sliding, which
@@ -67,7 +67,11 @@
 //!    damping at zero or at its bound goes unless the set without it
 //!    predicts worse. Its correlation with its own stiffness is such a
 //!    plain flag, not a confounding (a part and its term are one element,
-//!    not two explanations that extrapolate each their own way).
+//!    not two explanations that extrapolate each their own way). So is a
+//!    form's exponent beside its own term (`Tie::Refinement`: the bend's
+//!    δ, the Stribeck fall's α_s), which trades against the term's level
+//!    by the way the form is written; whether the data show it is rule
+//!    9c's question.
 //! 5. The film: when the contact's scale was chosen from the data (its
 //!    transition far above them, `contact_scale.rs`), the film candidate is
 //!    also started with viscosities that place the transition inside the
