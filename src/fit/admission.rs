@@ -3,7 +3,9 @@
 //! set's fit shows the start of that growth inside the data; rule 9b: a
 //! term that bends is kept only where the set's fit shows the bend inside
 //! the data; rule 9c: a viscous rise is bent only where the set's fit
-//! tells its exponent from the straight rise's.
+//! tells its exponent from the straight rise's, and a Stribeck fall
+//! shaped only where it tells its exponent from the Gaussian fall's and
+//! shows the fall and the rise beside it ([`SHOWN_BESIDE`]).
 //!
 //! | symbol | meaning | unit |
 //! |---|---|---|
@@ -47,6 +49,23 @@ pub const SHOWN_BEFORE_ADMITTED: &[(&str, f64)] = &[
     (super::candidates::BEND, 1.0),
     (super::candidates::STRIBECK_SHAPE, 2.0),
 ];
+
+/// Refinements of a form that the data tell from its null value only
+/// where the keys beside it are shown as well (their 95 % intervals
+/// exclude zero): the Stribeck fall's exponent beside the fall's level and
+/// the viscous rise above it. The exponent shapes the approach to the
+/// rise, and the approach and the rise's slope trade: where the slope is
+/// not shown, a fall that ends slowly takes up what a steeper rise would,
+/// and past the data the slope is what counts. On the steady families
+/// 823 and 827 (`SHAPE=0.5`, ten speeds of 0.5–20 deg/s predicting 25–90)
+/// six joints admitted the exponent with the slope's interval holding
+/// zero: four predicted 1.5–7.1× worse than the best classic, two
+/// 0.70–0.73×. The bend is not here: it shapes the rise itself, and its
+/// own interval speaks for the rise past the data.
+pub const SHOWN_BESIDE: &[(&str, &[&str])] = &[(
+    super::candidates::STRIBECK_SHAPE,
+    &["drivetrain.stribeck_n", "drivetrain.viscous_n_s_m"],
+)];
 
 /// The term of [`SHOWN_BEFORE_ADMITTED`] in the set `terms`, fitted as
 /// `o`, whose key's 95 % interval at `o` does not exclude its straight
@@ -140,8 +159,36 @@ fn unshown_by(
                 )));
             }
         }
+        if let Some(why) = beside_unshown(t, terms, &fitted) {
+            return Some((*t, why));
+        }
     }
     None
+}
+
+/// Why refinement `t` of `terms` is not admitted for a key beside it that
+/// its fit leaves unshown ([`SHOWN_BESIDE`]: the interval holds zero or
+/// has no finite bound); None when there is none.
+fn beside_unshown(
+    t: &'static str,
+    terms: &[&'static str],
+    fitted: impl Fn(&str) -> Option<(f64, f64, f64)>,
+) -> Option<String> {
+    let (_, keys) = SHOWN_BESIDE.iter().find(|(r, _)| *r == t)?;
+    keys.iter().find_map(|key| {
+        let (value, lo, hi) = fitted(key)?;
+        let shown = (lo > 0.0 && lo.is_finite()) || (hi < 0.0 && hi.is_finite());
+        (!shown).then(|| {
+            let others: Vec<&str> = terms.iter().copied().filter(|x| *x != t).collect();
+            format!(
+                "{t} beside {}: its fit leaves `{key}` = {} with a 95 % interval [{}, {}] that holds zero; the fall's shape is told from the rise beside it only where the data show both",
+                others.join(", "),
+                crate::text::Num::sig(value, 4),
+                crate::text::Num::sig(lo, 3),
+                crate::text::Num::sig(hi, 3)
+            )
+        })
+    })
 }
 
 /// `key`'s value and 95 % interval at `o`; None when `key` is not fitted.
@@ -224,6 +271,40 @@ mod tests {
         assert!(with((0.62, f64::NAN, f64::NAN)).is_some());
         // Zero, the quadratic's straight value, is not the bend's.
         assert_eq!(with((0.62, 0.3, 0.9)), None);
+    }
+
+    #[test]
+    fn a_stribeck_exponent_beside_a_rise_its_fit_leaves_unshown_is_not_admitted() {
+        // Joint 4 of the steady family 827 (SHAPE=0.5): alpha_s 1.247 in
+        // [1.02, 1.52], told from 2, but the viscous key's interval
+        // [-851, 1.01e4] holds zero; admitted, it predicted 25-90 deg/s
+        // 7.1x worse than the Stribeck classic.
+        let shape = super::super::candidates::STRIBECK_SHAPE;
+        let terms = ["drivetrain Stribeck", shape];
+        let with = |b: (f64, f64, f64)| {
+            unshown_by(&terms, move |k| match k {
+                "drivetrain.stribeck_exponent" => Some((1.247, 1.023, 1.519)),
+                "drivetrain.stribeck_n" => Some((-75.7, -84.9, -66.5)),
+                "drivetrain.viscous_n_s_m" => Some(b),
+                _ => None,
+            })
+        };
+        let (t, why) = with((4627.0, -851.3, 10105.0)).unwrap();
+        assert_eq!(t, shape);
+        assert_eq!(
+            why,
+            "drivetrain Stribeck shape beside drivetrain Stribeck: its fit leaves `drivetrain.viscous_n_s_m` = 4627 with a 95 % interval [-851, 10100] that holds zero; the fall's shape is told from the rise beside it only where the data show both"
+        );
+        // The rise shown (the time-series draw d199): admitted.
+        assert_eq!(with((1.8302e5, 1.8276e5, 1.8329e5)), None);
+        // The bend is not held to the keys beside it.
+        let bend = super::super::candidates::BEND;
+        let bent = unshown_by(&["drivetrain viscous", bend], |k| match k {
+            "drivetrain.viscous_exponent" => Some((0.1, 0.0138, 0.727)),
+            "drivetrain.viscous_n_s_m" => Some((6.66e4, -4.37e4, 1.77e5)),
+            _ => None,
+        });
+        assert_eq!(bent, None);
     }
 
     #[test]
