@@ -172,6 +172,16 @@
 //!    curve beside a rate chosen first with its bend at 4 % of the top).
 //!    A quadratic or a bend chosen before gives way to a newcomer that
 //!    leaves it unshown in the same way (`trial.rs`).
+//!
+//!    9c. The bend (δ in b v_b sgn v |v/v_b|^δ) is admitted only where the
+//!    set's fit tells δ from 1, the straight rise; the Stribeck fall's own
+//!    exponent (α_s in ΔF_s e^(−|v/v_s|^α_s)) only where it tells α_s from
+//!    2, the Gaussian fall of the classic curve and LuGre, **and** shows the
+//!    fall and the rise beside it (their keys' intervals exclude zero,
+//!    [`SHOWN_BESIDE`](super::admission::SHOWN_BESIDE)): the approach to
+//!    the rise and the rise's slope trade, and where the slope is not
+//!    shown a fall that ends slowly takes up what a steeper rise would,
+//!    the slope that carries past the data.
 //! 10. On a steady curve a term enters only where the whole curve supports
 //!     it as well as the folds (`curve_support.rs`): its set's small-sample
 //!     Akaike criterion on all the training points is below the current
