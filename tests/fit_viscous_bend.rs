@@ -48,31 +48,17 @@ fn a_bearings_viscous_rise_that_bends_is_fitted_bent_and_predicted_past_the_data
     );
 }
 
-/// F(v) = sgn v (f_c + (f_s − f_c) e^(−(v/v_s)²)) + sgn v b_top |v/v_top|^δ
-/// along `motion`, with 1 % white noise (seed `seed`), as a CSV
-/// `t_s,velocity_m_s,friction_n`.
-fn bent_stribeck_record(path: &std::path::Path, motion: &[(f64, f64)], seed: u64) {
-    use rand::SeedableRng;
-    use std::fmt::Write as _;
-    let (fc, fs, vs, b_top, v_top, delta) = (1.0, 0.5, 0.02, 1.0, 0.2, 0.6);
-    let f: Vec<f64> = motion
-        .iter()
-        .map(|&(_, v): &(f64, f64)| {
-            let sgn = if v == 0.0 { 0.0 } else { v.signum() };
-            sgn * (fc
-                + (fs - fc) * (-(v / vs).powi(2)).exp()
-                + b_top * (v / v_top).abs().powf(delta))
-        })
-        .collect();
-    let rms = (f.iter().map(|x| x * x).sum::<f64>() / f.len() as f64).sqrt();
-    let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
-    let mut s = String::from("t_s,velocity_m_s,friction_n\n");
-    for ((t, v), f) in motion.iter().zip(&f) {
-        let noise = friction_node::fit::synthetic::gaussian(&mut rng, 0.01 * rms);
-        writeln!(s, "{t},{v},{}", f + noise).unwrap();
-    }
-    std::fs::write(path, s).unwrap();
-}
+/// The drive of the time-series test: a saturating rise from 0.5 to 1 N
+/// by 20 mm/s (a Gaussian fall) over a viscous part bent to δ 0.6.
+const BENT_STRIBECK: common::records::Drive = common::records::Drive {
+    fc: 1.0,
+    fs: 0.5,
+    vs: 0.02,
+    alpha: 2.0,
+    b_top: 1.0,
+    v_top: 0.2,
+    delta: 0.6,
+};
 
 #[test]
 fn on_a_time_series_a_saturating_rise_whose_viscous_part_bends_is_reached_with_the_bend_not_taken_by_the_boundary_rate(
@@ -89,8 +75,8 @@ fn on_a_time_series_a_saturating_rise_whose_viscous_part_bends_is_reached_with_t
     // now 0.016 N, the curve bent to δ 0.6).
     let d = common::cli::fresh_dir("viscous-bend", "time-series");
     let (train, fast) = (d.join("train.csv"), d.join("fast.csv"));
-    bent_stribeck_record(&train, &common::motion::point_to_point(8.0, 1.0), 17);
-    bent_stribeck_record(&fast, &common::motion::point_to_point(8.0, 2.0), 18);
+    BENT_STRIBECK.write_record(&train, &common::motion::point_to_point(8.0, 1.0), 17);
+    BENT_STRIBECK.write_record(&fast, &common::motion::point_to_point(8.0, 2.0), 18);
     let out = d.join("fit.yaml");
     let (code, stdout, err) = common::cli::run(&[
         "fit",

@@ -5,6 +5,7 @@
 
 pub mod cli;
 pub mod motion;
+pub mod records;
 
 use friction_node::config::{Config, StepMode};
 use friction_node::msgs::EstimateRecord;

@@ -1,0 +1,48 @@
+//! The synthetic friction records the fit tests calibrate on.
+
+/// A drive's steady friction: a Stribeck fall with its own exponent over a
+/// viscous rise that may bend,
+/// F(v) = sgn v (f_c + (f_s − f_c) e^(−|v/v_s|^α)) + sgn v b_top |v/v_top|^δ.
+///
+/// | symbol | meaning | unit |
+/// |---|---|---|
+/// | f_c, f_s | the sliding level and the level at rest | N |
+/// | v_s, α | the Stribeck speed and the fall's exponent (2: Gaussian) | m/s, – |
+/// | b_top, v_top, δ | the viscous part at v_top and its exponent (1: straight) | N, m/s, – |
+#[derive(Debug, Clone, Copy)]
+pub struct Drive {
+    pub fc: f64,
+    pub fs: f64,
+    pub vs: f64,
+    pub alpha: f64,
+    pub b_top: f64,
+    pub v_top: f64,
+    pub delta: f64,
+}
+
+impl Drive {
+    /// The friction at speed `v` (m/s), in N.
+    pub fn friction(&self, v: f64) -> f64 {
+        let sgn = if v == 0.0 { 0.0 } else { v.signum() };
+        sgn * (self.fc
+            + (self.fs - self.fc) * (-(v / self.vs).abs().powf(self.alpha)).exp()
+            + self.b_top * (v / self.v_top).abs().powf(self.delta))
+    }
+
+    /// The friction along `motion` (`(t_s, velocity_m_s)`) with white
+    /// noise of 1 % of its RMS (seed `seed`), written to `path` as a CSV
+    /// `t_s,velocity_m_s,friction_n`.
+    pub fn write_record(&self, path: &std::path::Path, motion: &[(f64, f64)], seed: u64) {
+        use rand::SeedableRng;
+        use std::fmt::Write as _;
+        let f: Vec<f64> = motion.iter().map(|&(_, v)| self.friction(v)).collect();
+        let rms = (f.iter().map(|x| x * x).sum::<f64>() / f.len() as f64).sqrt();
+        let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+        let mut s = String::from("t_s,velocity_m_s,friction_n\n");
+        for ((t, v), f) in motion.iter().zip(&f) {
+            let noise = friction_node::fit::synthetic::gaussian(&mut rng, 0.01 * rms);
+            writeln!(s, "{t},{v},{}", f + noise).unwrap();
+        }
+        std::fs::write(path, s).unwrap();
+    }
+}
