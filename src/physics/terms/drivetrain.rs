@@ -3,7 +3,7 @@
 //! gear mesh), which no contact model should be asked to absorb.
 //!
 //! ```text
-//! F_dt = (F_cd + c_N F_ext + ΔF_s e^(−(v/v_s)²)) tanh(v / v_reg) + ΔF_cd |tanh(v / v_reg)| + F_v(v) + c_q v |v|
+//! F_dt = (F_cd + c_N F_ext + ΔF_s e^(−|v/v_s|^α_s)) tanh(v / v_reg) + ΔF_cd |tanh(v / v_reg)| + F_v(v) + c_q v |v|
 //! F_v(v) = b v_b sgn v |v / v_b|^δ   (δ = 1: b v, whatever v_b)
 //! F_total = F_f + F_dt
 //! ```
@@ -15,6 +15,7 @@
 //! | c_N | friction proportional to the normal load (rolling elements carrying it) | – |
 //! | ΔF_s | the static level's excess over the Coulomb level (Stribeck): F_cd + ΔF_s at rest, decaying to F_cd over v_s; negative: a friction that rises with speed to F_cd | N |
 //! | v_s | the Stribeck speed | m/s |
+//! | α_s | the Stribeck fall's exponent: 2 (the default) the Gaussian fall of the classic curve and LuGre; measured falls 0.5–2, whose tails are longer | – |
 //! | b | viscous drivetrain friction (bent: F_v(v_b) / v_b) | N·s/m |
 //! | δ | the viscous rise's exponent: 1 a straight rise; below 1 a rise that bends below the line as speed grows, as a rolling bearing's viscous moment grows with (ν n)^(2/3) (Palmgren) and a film's shear over a film that thickens with speed | – |
 //! | v_b | the speed at which F_v = b v_b: where b is read (a fit sets it to the data's top speed, so that b and δ are told apart) | m/s |
@@ -23,7 +24,7 @@
 //!
 //! All zero by default: the estimate is then the contact's alone, bit for bit.
 //! With pre-sliding on (`presliding.rs`) the terms that act at zero speed,
-//! (F_cd + c_N F_ext + ΔF_s e^(−(v/v_s)²)) sgn v + ΔF_cd |sgn v|, are part of
+//! (F_cd + c_N F_ext + ΔF_s e^(−|v/v_s|^α_s)) sgn v + ΔF_cd |sgn v|, are part of
 //! the bristle's level (a reversal's compliance is the whole axis's), and
 //! only F_v(v) + c_q v|v| is added beside it.
 //!
@@ -143,7 +144,7 @@ const KEYS: &[TermKey] = &[
         // viscous joint fitted at 0.5–20 deg/s chose such a curve and
         // predicted 25–90 deg/s up to 6.5× worse than Coulomb + viscous.
         fit: FitScale::Speed { lo: 1e-3, hi: 1.0 },
-        meaning: "the Stribeck speed: the static excess decays as e^(−(v/v_s)²)",
+        meaning: "the Stribeck speed: the static excess decays as e^(−(speed/v_s)^α_s)",
     },
     TermKey {
         key: "drivetrain.stribeck_exponent",
@@ -153,7 +154,7 @@ const KEYS: &[TermKey] = &[
         hi: End::Closed(4.0),
         live: true,
         fit: FitScale::FromStart,
-        meaning: "the Stribeck fall's exponent: the static excess decays as e^(−|v/v_s|^α_s); 2 the Gaussian fall of the classic curve and LuGre",
+        meaning: "the Stribeck fall's exponent α_s of that decay; 2 (the default) the Gaussian fall of the classic curve and LuGre",
     },
     TermKey {
         key: "drivetrain.coulomb_asymmetry_n",
@@ -238,7 +239,7 @@ impl FrictionTerm for Drivetrain {
         self.force_at(at.v, at.load, at.s)
     }
 
-    /// (F_cd + c_N F + ΔF_s e^(−(v/v_s)²)) s + ΔF_cd |s| with s = sgn v.
+    /// (F_cd + c_N F + ΔF_s e^(−|v/v_s|^α_s)) s + ΔF_cd |s| with s = sgn v.
     #[inline(always)]
     fn carried(&self, at: &At) -> f64 {
         self.level_at_rest(at.v, at.s, at.load)
