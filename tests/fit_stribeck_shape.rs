@@ -9,15 +9,6 @@
 
 mod common;
 
-/// The value in column `col` of `model`'s row in the models table.
-fn cell(stdout: &str, model: &str, col: usize) -> String {
-    let row = stdout
-        .lines()
-        .find(|l| l.starts_with(&format!("| {model} |")))
-        .unwrap_or_else(|| panic!("no row {model}: {stdout}"));
-    row.split('|').nth(col).unwrap().trim().to_string()
-}
-
 /// A drive whose friction rises from 0.5 to 1 N with a fall of exponent
 /// 0.8 (a long tail: at 3 v_s, 9 % of the rise is left) over a straight
 /// viscous part of 1 N at 0.2 m/s.
@@ -36,40 +27,14 @@ fn a_stribeck_fall_with_a_long_tail_is_fitted_with_its_own_exponent_and_predicts
 ) {
     // 8 s of point-to-point moves up to 0.2 m/s, predicting the same
     // moves twice as fast.
-    let d = common::cli::fresh_dir("stribeck-shape", "time-series");
-    let (train, fast) = (d.join("train.csv"), d.join("fast.csv"));
-    LONG_TAIL.write_record(&train, &common::motion::point_to_point(8.0, 1.0), 21);
-    LONG_TAIL.write_record(&fast, &common::motion::point_to_point(8.0, 2.0), 22);
-    let out = d.join("fit.yaml");
-    let (code, stdout, err) = common::cli::run(&[
-        "fit",
-        train.to_str().unwrap(),
-        "--validate",
-        fast.to_str().unwrap(),
-        "--fit",
-        "auto",
-        "--baselines",
-        "--set",
-        "solver.cells=16",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let (code, stdout, err) = LONG_TAIL.fit_auto_on_moves("stribeck-shape", (21, 22));
     assert_eq!(code, 0, "{err}");
-    let chosen = stdout
-        .lines()
-        .find(|l| l.starts_with("Chosen: "))
-        .unwrap_or_else(|| panic!("no chosen set: {stdout}"));
+    let chosen = common::cli::chosen(&stdout);
     assert!(chosen.contains("drivetrain Stribeck shape"), "{chosen}");
     assert!(!chosen.contains("drivetrain bend"), "{chosen}");
-    let keys = cell(&stdout, "friction-node", 3);
-    let alpha: f64 = keys
-        .split("drivetrain.stribeck_exponent=")
-        .nth(1)
-        .and_then(|s| s.split([',', ' ']).next())
-        .and_then(|s| s.parse().ok())
-        .unwrap_or_else(|| panic!("no exponent in {keys}"));
+    let alpha = common::cli::fitted_key(&stdout, "drivetrain.stribeck_exponent");
     approx::assert_abs_diff_eq!(alpha, 0.8, epsilon = 0.15);
-    let held = |m: &str| -> f64 { cell(&stdout, m, 7).parse().unwrap() };
+    let held = |m: &str| common::cli::held_out(&stdout, m);
     let best_classic = ["Coulomb + viscous", "Stribeck", "LuGre"]
         .iter()
         .filter(|m| stdout.contains(&format!("| {m} |")))

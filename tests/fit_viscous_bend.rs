@@ -12,15 +12,6 @@
 
 mod common;
 
-/// The value in column `col` of `model`'s row in the models table.
-fn cell(stdout: &str, model: &str, col: usize) -> String {
-    let row = stdout
-        .lines()
-        .find(|l| l.starts_with(&format!("| {model} |")))
-        .unwrap_or_else(|| panic!("no row {model}: {stdout}"));
-    row.split('|').nth(col).unwrap().trim().to_string()
-}
-
 #[test]
 fn a_bearings_viscous_rise_that_bends_is_fitted_bent_and_predicted_past_the_data_better_than_either_classic(
 ) {
@@ -31,15 +22,9 @@ fn a_bearings_viscous_rise_that_bends_is_fitted_bent_and_predicted_past_the_data
         stdout.contains("Chosen: boundary friction, drivetrain viscous, drivetrain bend."),
         "{stdout}"
     );
-    let keys = cell(&stdout, "friction-node", 3);
-    let delta: f64 = keys
-        .split("drivetrain.viscous_exponent=")
-        .nth(1)
-        .and_then(|s| s.split([',', ' ']).next())
-        .and_then(|s| s.parse().ok())
-        .unwrap_or_else(|| panic!("no exponent in {keys}"));
+    let delta = common::cli::fitted_key(&stdout, "drivetrain.viscous_exponent");
     approx::assert_abs_diff_eq!(delta, 2.0 / 3.0, epsilon = 0.1);
-    let held = |m: &str| -> f64 { cell(&stdout, m, 7).parse().unwrap() };
+    let held = |m: &str| common::cli::held_out(&stdout, m);
     let best_classic = held("Coulomb + viscous").min(held("Stribeck"));
     assert!(
         held("friction-node") < 0.2 * best_classic,
@@ -73,35 +58,15 @@ fn on_a_time_series_a_saturating_rise_whose_viscous_part_bends_is_reached_with_t
     // went as confounded with the rate, and ours predicted the faster
     // moves 1.13× worse than the Stribeck classic (0.103 N against 0.091;
     // now 0.016 N, the curve bent to δ 0.6).
-    let d = common::cli::fresh_dir("viscous-bend", "time-series");
-    let (train, fast) = (d.join("train.csv"), d.join("fast.csv"));
-    BENT_STRIBECK.write_record(&train, &common::motion::point_to_point(8.0, 1.0), 17);
-    BENT_STRIBECK.write_record(&fast, &common::motion::point_to_point(8.0, 2.0), 18);
-    let out = d.join("fit.yaml");
-    let (code, stdout, err) = common::cli::run(&[
-        "fit",
-        train.to_str().unwrap(),
-        "--validate",
-        fast.to_str().unwrap(),
-        "--fit",
-        "auto",
-        "--baselines",
-        "--set",
-        "solver.cells=16",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let (code, stdout, err) = BENT_STRIBECK.fit_auto_on_moves("viscous-bend", (17, 18));
     assert_eq!(code, 0, "{err}");
-    let chosen = stdout
-        .lines()
-        .find(|l| l.starts_with("Chosen: "))
-        .unwrap_or_else(|| panic!("no chosen set: {stdout}"));
+    let chosen = common::cli::chosen(&stdout);
     assert!(
         chosen.contains("drivetrain Stribeck, drivetrain bend")
             && !chosen.contains("boundary rate"),
         "{chosen}"
     );
-    let held = |m: &str| -> f64 { cell(&stdout, m, 7).parse().unwrap() };
+    let held = |m: &str| common::cli::held_out(&stdout, m);
     assert!(
         held("friction-node") < 0.5 * held("Stribeck"),
         "ours {} against the Stribeck classic {}",

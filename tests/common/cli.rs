@@ -91,3 +91,35 @@ pub fn fit_joint_fixture(suite: &str, name: &str, extra: &[&str]) -> (i32, Strin
     args.extend_from_slice(extra);
     run(&args)
 }
+
+/// The value in column `col` of `model`'s row in a fit's models table.
+pub fn models_cell(stdout: &str, model: &str, col: usize) -> String {
+    let row = stdout
+        .lines()
+        .find(|l| l.starts_with(&format!("| {model} |")))
+        .unwrap_or_else(|| panic!("no row {model}: {stdout}"));
+    row.split('|').nth(col).unwrap().trim().to_string()
+}
+
+/// The held-out RMS of `model` in a fit's models table.
+pub fn held_out(stdout: &str, model: &str) -> f64 {
+    models_cell(stdout, model, 7).parse().unwrap()
+}
+
+/// The value ours fitted to `key`, read from its row of the models table.
+pub fn fitted_key(stdout: &str, key: &str) -> f64 {
+    let keys = models_cell(stdout, "friction-node", 3);
+    keys.split(&format!("{key}="))
+        .nth(1)
+        .and_then(|s| s.split([',', ' ']).next())
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| panic!("no {key} in {keys}"))
+}
+
+/// The line of `--fit auto`'s output that names the chosen set.
+pub fn chosen(stdout: &str) -> &str {
+    stdout
+        .lines()
+        .find(|l| l.starts_with("Chosen: "))
+        .unwrap_or_else(|| panic!("no chosen set: {stdout}"))
+}

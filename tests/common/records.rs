@@ -45,4 +45,29 @@ impl Drive {
         }
         std::fs::write(path, s).unwrap();
     }
+
+    /// `fit --fit auto --baselines` on 8 s of point-to-point moves of this
+    /// drive (noise seed `seeds.0`), validated on the same moves twice as
+    /// fast (seed `seeds.1`), 16 cells, in a fresh directory of `suite`:
+    /// (exit code, stdout, stderr).
+    pub fn fit_auto_on_moves(&self, suite: &str, seeds: (u64, u64)) -> (i32, String, String) {
+        let d = super::cli::fresh_dir(suite, "time-series");
+        let (train, fast) = (d.join("train.csv"), d.join("fast.csv"));
+        self.write_record(&train, &super::motion::point_to_point(8.0, 1.0), seeds.0);
+        self.write_record(&fast, &super::motion::point_to_point(8.0, 2.0), seeds.1);
+        let out = d.join("fit.yaml");
+        super::cli::run(&[
+            "fit",
+            train.to_str().unwrap(),
+            "--validate",
+            fast.to_str().unwrap(),
+            "--fit",
+            "auto",
+            "--baselines",
+            "--set",
+            "solver.cells=16",
+            "--out",
+            out.to_str().unwrap(),
+        ])
+    }
 }
