@@ -105,10 +105,9 @@ fn bend_unshown_at(
     if hi < top_speed_m_s && lo.is_finite() && value < top_speed_m_s {
         return None;
     }
-    let others: Vec<&str> = terms.iter().copied().filter(|x| *x != BENT).collect();
     Some(format!(
-        "{BENT} beside {}: its fit places `{BEND_KEY}` at {} with a 95 % interval [{}, {}] that reaches the data's top speed {}: a bend the data do not show",
-        others.join(", "),
+        "{BENT}{}: its fit places `{BEND_KEY}` at {} with a 95 % interval [{}, {}] that reaches the data's top speed {}: a bend the data do not show",
+        beside(terms, BENT),
         crate::text::Num::sig(value, 4),
         crate::text::Num::sig(lo, 3),
         crate::text::Num::sig(hi, 3),
@@ -138,7 +137,6 @@ fn unshown_by(
                 hi < *straight && hi.is_finite(),
             );
             if !(lo_ok || hi_ok) {
-                let others: Vec<&str> = terms.iter().copied().filter(|x| x != t).collect();
                 let (holds, what) = if *straight == 0.0 {
                     ("zero".to_string(), "grows without end")
                 } else if *t == super::candidates::STRIBECK_SHAPE {
@@ -148,11 +146,7 @@ fn unshown_by(
                 };
                 return Some((*t, format!(
                     "{t}{}: its fit gives `{key}` = {} with a 95 % interval [{}, {}] that holds {holds}; a term that {what} past the data is admitted only where they show it",
-                    if others.is_empty() {
-                        String::new()
-                    } else {
-                        format!(" beside {}", others.join(", "))
-                    },
+                    beside(terms, t),
                     crate::text::Num::sig(value, 4),
                     crate::text::Num::sig(lo, 3),
                     crate::text::Num::sig(hi, 3)
@@ -179,16 +173,26 @@ fn beside_unshown(
         let (value, lo, hi) = fitted(key)?;
         let shown = (lo > 0.0 && lo.is_finite()) || (hi < 0.0 && hi.is_finite());
         (!shown).then(|| {
-            let others: Vec<&str> = terms.iter().copied().filter(|x| *x != t).collect();
             format!(
-                "{t} beside {}: its fit leaves `{key}` = {} with a 95 % interval [{}, {}] that holds zero; the fall's shape is told from the rise beside it only where the data show both",
-                others.join(", "),
+                "{t}{}: its fit leaves `{key}` = {} with a 95 % interval [{}, {}] that holds zero; the fall's shape is told from the rise beside it only where the data show both",
+                beside(terms, t),
                 crate::text::Num::sig(value, 4),
                 crate::text::Num::sig(lo, 3),
                 crate::text::Num::sig(hi, 3)
             )
         })
     })
+}
+
+/// " beside a, b": the terms of `terms` other than `t`, as a refusal names
+/// them; empty where `t` stands alone on the base (the boundary friction).
+fn beside(terms: &[&'static str], t: &str) -> String {
+    let others: Vec<&str> = terms.iter().copied().filter(|x| *x != t).collect();
+    if others.is_empty() {
+        String::new()
+    } else {
+        format!(" beside {}", others.join(", "))
+    }
 }
 
 /// `key`'s value and 95 % interval at `o`; None when `key` is not fitted.
@@ -247,6 +251,12 @@ mod tests {
         assert!(bend_unshown_at(&terms, (0.5, 0.4, 0.45), 0.5).is_some());
         assert!(bend_unshown_at(&terms, (1e-8, 0.0, f64::INFINITY), 0.5).is_some());
         assert!(bend_unshown_at(&terms, (0.2, f64::NAN, f64::NAN), 0.5).is_some());
+    }
+
+    #[test]
+    fn a_refusal_of_a_term_alone_on_the_base_names_no_empty_set_beside_it() {
+        let why = bend_unshown_at(&[BENT], (0.2, 0.1, 0.6), 0.5).unwrap();
+        assert!(why.starts_with("boundary rate: its fit places"), "{why}");
     }
 
     #[test]
