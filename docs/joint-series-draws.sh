@@ -40,7 +40,7 @@
 # (LuGre's and ours are Gaussian, α = 2; measured joints give 0.5–2,
 # Armstrong-Hélouvry 1994): a shape no model has. The joints, motions and
 # noise are those of SHAPE=2.
-# DRAWS=12 sets the last draw (about 1 min each), FIRST=1 the first: draws
+# DRAWS=12 sets the last draw (80-350 s each on 2 cores), FIRST=1 the first: draws
 # 1-12 are those the rule was developed on, 13-24 were first run after it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
