@@ -115,10 +115,16 @@ fn shape_name(terms: &[&'static str]) -> String {
 }
 
 /// Each shape's criterion in words ("drivetrain viscous −43.6, …"), a
-/// set beside the asymmetry named by its shape.
+/// set beside the asymmetry named by its shape; a set that has none says
+/// why ("not admitted (below)": rule 9c refused its bend), not "inf".
 fn criteria(sets: &[Scored]) -> String {
     sets.iter()
-        .map(|s| format!("{} {:.1}", shape_name(&s.tried.terms), s.aicc))
+        .map(|s| match s.tried.unscored {
+            Some(why) if !s.aicc.is_finite() => {
+                format!("{} {why}", shape_name(&s.tried.terms))
+            }
+            _ => format!("{} {:.1}", shape_name(&s.tried.terms), s.aicc),
+        })
         .collect::<Vec<_>>()
         .join(", ")
 }
@@ -275,6 +281,17 @@ mod tests {
         // None could (a curve at one speed): the base, not a rise the
         // data cannot show.
         assert_eq!(start_shape(&[-20.3, f64::INFINITY, f64::INFINITY], true), 0);
+    }
+
+    #[test]
+    fn a_shape_refused_before_its_criterion_says_why_not_inf() {
+        let rise = Scored::with_folds(&[VISCOUS], &[1.0], -43.62);
+        let mut bent = Scored::with_folds(&[VISCOUS, BEND], &[f64::INFINITY], f64::INFINITY);
+        bent.tried.unscored = Some("not admitted (below)");
+        assert_eq!(
+            criteria(&[rise, bent]),
+            "drivetrain viscous -43.6, drivetrain viscous + drivetrain bend not admitted (below)"
+        );
     }
 
     #[test]
