@@ -32,6 +32,7 @@ use super::problem::Model;
 use super::series::Series;
 use super::unknowns::{DataScale, FittedParameter};
 use crate::physics::sgn;
+use crate::physics::terms::drivetrain::exp_neg;
 
 /// The classic friction models fitted beside ours.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -307,7 +308,7 @@ fn starts(kind: BaselineKind, form: LoadForm, s: &Samples, v_scale: f64) -> Opti
 }
 
 fn g(l: &Levels, v: f64) -> f64 {
-    l.fc + (l.fs - l.fc) * (-(v / l.vs).powi(2)).exp()
+    l.fc + (l.fs - l.fc) * exp_neg((v / l.vs).powi(2))
 }
 
 impl Model for Baseline {

@@ -17,6 +17,7 @@
 
 use super::series::Series;
 use crate::physics::sgn;
+use crate::physics::terms::drivetrain::exp_neg;
 use nalgebra::{DMatrix, DVector};
 
 /// How a classic model's friction levels follow the normal load.
@@ -112,7 +113,7 @@ pub(super) fn design_rows(
             match vs {
                 None => row.extend(level_columns(form, sg, n)),
                 Some(vs) => {
-                    let e = (-(v / vs).powi(2)).exp();
+                    let e = exp_neg((v / vs).powi(2));
                     row.extend(level_columns(form, sg * (1.0 - e), n));
                     row.extend(level_columns(form, sg * e, n));
                 }
@@ -210,7 +211,7 @@ mod tests {
         s.friction = s
             .velocity
             .iter()
-            .map(|&v| sgn(v) * (fc + (fs - fc) * (-(v / vs).powi(2)).exp()) + b * v + c)
+            .map(|&v| sgn(v) * (fc + (fs - fc) * exp_neg((v / vs).powi(2))) + b * v + c)
             .collect();
         s.t = (0..n).map(|k| k as f64).collect();
         s.fit = vec![true; n];
