@@ -89,7 +89,7 @@ pub const AICC_DECISIVE: f64 = 10.0;
 /// sum of squares n·rms²: n ln(rms²) + 2k + 2k(k+1)/(n−k−1). `k` counts
 /// the fitted parameters, not the noise variance beside them (Hurvich &
 /// Tsai count both): counting σ² too penalises the Stribeck curve more,
-/// and on 96 random joints (`docs/fit-auto-rules.md`, rule 8) that lost more (a
+/// and on 96 random joints (`docs/fit-auto-judged.md`, "steady curves") that lost more (a
 /// rise started from the viscous rise predicted 14× worse); +∞ when
 /// n ≤ k + 1 or the fit failed, −∞ for an exact fit. Lower is better; it estimates the fit's error on new
 /// samples of the same kind (asymptotically leave-one-out
