@@ -178,7 +178,21 @@ impl BoundaryRate {
     /// μ_r asinh(v/v_a): the signed, rate-dependent part of the coefficient
     /// at velocity `v` (m/s).
     pub fn signed_term(&self, v: f64) -> f64 {
-        self.sensitivity * (v / self.activation_speed).asinh()
+        self.sensitivity * self.asinh_at(v)
+    }
+
+    /// asinh(v/v_a) at velocity `v` (m/s): the part of the term a fit may
+    /// hold for a whole film trace ([`At::rate_asinh`]).
+    pub fn asinh_at(&self, v: f64) -> f64 {
+        (v / self.activation_speed).asinh()
+    }
+
+    /// μ_r asinh(v/v_a) at `at`, with the asinh `at` holds if any.
+    fn signed_at(&self, at: &At) -> f64 {
+        match at.rate_asinh {
+            Some(a) => self.sensitivity * a,
+            None => self.signed_term(at.v),
+        }
     }
 }
 
@@ -193,11 +207,11 @@ impl FrictionTerm for BoundaryRate {
 
     /// F_asp μ_r asinh(v/v_a): odd in v, no sign needed.
     fn force(&self, at: &At) -> f64 {
-        at.f_asp * self.signed_term(at.v)
+        at.f_asp * self.signed_at(at)
     }
 
     fn carried(&self, at: &At) -> f64 {
-        at.f_asp * self.signed_term(at.v)
+        at.f_asp * self.signed_at(at)
     }
 
     fn beside(&self, _: &At) -> f64 {

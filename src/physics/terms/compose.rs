@@ -189,8 +189,23 @@ impl super::FrictionTerms {
     #[inline(always)]
     pub fn friction(
         &self,
+        inputs: (f64, f64),
+        film: (f64, f64),
+        states: &mut super::TermStates,
+        how: BristleMove,
+    ) -> (f64, f64) {
+        self.friction_with_rate(inputs, film, None, states, how)
+    }
+
+    /// [`friction`](Self::friction) with the boundary rate's asinh(v/v_a)
+    /// given when the caller holds it ([`At::rate_asinh`]): the same
+    /// numbers, bit for bit, without the asinh.
+    #[inline(always)]
+    pub fn friction_with_rate(
+        &self,
         (v, load): (f64, f64),
         (f_visc, f_asp): (f64, f64),
+        rate_asinh: Option<f64>,
         states: &mut super::TermStates,
         how: BristleMove,
     ) -> (f64, f64) {
@@ -200,6 +215,7 @@ impl super::FrictionTerms {
             f_visc,
             f_asp,
             s: 0.0,
+            rate_asinh,
         };
         if !self.has_carrier() {
             at.s = self.regularised_sign(v);
@@ -254,6 +270,7 @@ impl super::FrictionTerms {
             f_visc,
             f_asp,
             s: 1.0,
+            rate_asinh: None,
         };
         let mu = self.sum_cof(&at).unwrap_or(0.0);
         let rate = if self.boundary_rate.is_on() {

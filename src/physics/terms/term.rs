@@ -46,6 +46,11 @@ pub struct At {
     /// s: tanh(v/v_reg) for the rigid contact's force, sgn v for the level
     /// pre-sliding carries.
     pub s: f64,
+    /// asinh(v/v_a) of the boundary rate at this `v`, when the caller
+    /// holds it (a fit recomposing along a kept film, whose speeds do not
+    /// change: `fit/film_run.rs`); `None`, the rate computes it. Either way
+    /// the same number, bit for bit.
+    pub rate_asinh: Option<f64>,
 }
 
 /// How the carrier's state moves in one evaluation.
