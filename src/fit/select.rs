@@ -384,10 +384,12 @@ pub fn select(
     })
 }
 
-/// `lines` with each line once, in the order first said.
+/// `lines` with each line once, sorted: the sets refused are tried side
+/// by side (the removal's alternatives on every core), so the order they
+/// were said in changes from run to run, and a report must not.
 fn once_each(mut lines: Vec<String>) -> Vec<String> {
-    let mut seen = std::collections::HashSet::new();
-    lines.retain(|n| seen.insert(n.clone()));
+    lines.sort_unstable();
+    lines.dedup();
     lines
 }
 
@@ -545,6 +547,15 @@ mod tests {
 
     fn scored(terms: &[&'static str], fold_mse: &[f64]) -> Scored {
         Scored::with_folds(terms, fold_mse, f64::NAN)
+    }
+
+    #[test]
+    fn the_refusals_are_listed_once_each_in_one_order_whatever_order_they_came_in() {
+        let said = |v: &[&str]| once_each(v.iter().map(|s| s.to_string()).collect());
+        let a = said(&["quadratic beside b", "bend beside a", "quadratic beside b"]);
+        let b = said(&["bend beside a", "quadratic beside b"]);
+        assert_eq!(a, b);
+        assert_eq!(a, ["bend beside a", "quadratic beside b"]);
     }
 
     #[test]
