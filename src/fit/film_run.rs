@@ -71,6 +71,10 @@ impl RateColumns {
         }
         let column: Arc<[f64]> = steps.iter().map(|st| rate.asinh_at(st[0])).collect();
         let mut kept = lock();
+        // Another thread may have kept it meanwhile: one entry per v_a.
+        if let Some((_, c)) = kept.iter().find(|(k, _)| *k == key) {
+            return Arc::clone(c);
+        }
         if kept.len() >= RATE_COLUMNS_KEPT {
             kept.pop();
         }
