@@ -40,6 +40,17 @@
 # (LuGre's and ours are Gaussian, α = 2; measured joints give 0.5–2,
 # Armstrong-Hélouvry 1994): a shape no model has. The joints, motions and
 # noise are those of SHAPE=2.
+# OFFSET=x adds to each joint's torque a constant c drawn uniform in
+# ±x·f_c from the draw's own generator, on both motions: what a torque
+# sensor's or a current sensor's offset, or a gravity model's error at the
+# joint's mean pose, leaves in the friction derived from a drive (τ + c
+# both ways, at rest as well). No classic has it. The joints, motions and
+# noise draws are those of OFFSET=0 (the noise is 1 % of the torque's RMS,
+# the offset's included).
+# RIPPLE=a sets the angle ripple's amplitude to a·f_c on the draws that
+# have one (0.03 by default; a harmonic drive's or a cogging motor's can be
+# several times that). The joints, motions and noise draws are those of
+# RIPPLE=0.03.
 # DRAWS=12 sets the last draw (80-350 s each on 2 cores), FIRST=1 the first: draws
 # 1-12 are those the rule was developed on, 13-24 were first run after it.
 set -euo pipefail
@@ -57,11 +68,14 @@ case "$START" in rest|sliding) ;; *) echo "START must be rest or sliding, not '$
 VELOCITY=${VELOCITY:-true}
 POWER=${POWER:-1}
 SHAPE=${SHAPE:-2}
+OFFSET=${OFFSET:-0}
+RIPPLE=${RIPPLE:-0.03}
 case "$VELOCITY" in true|encoder) ;; *) echo "VELOCITY must be true or encoder, not '$VELOCITY'" >&2; exit 2 ;; esac
-python3 - "$OUT" "$DRAWS" "$FIRST" "$START" "$VELOCITY" "$POWER" "$SHAPE" <<'PY'
+python3 - "$OUT" "$DRAWS" "$FIRST" "$START" "$VELOCITY" "$POWER" "$SHAPE" "$OFFSET" "$RIPPLE" <<'PY'
 import math, random, sys
 out, draws, first = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
 start, velocity, power, shape = sys.argv[4], sys.argv[5], float(sys.argv[6]), float(sys.argv[7])
+offset, ripple_amp = float(sys.argv[8]), float(sys.argv[9])
 def butter2(x, fc=50.0, fs=1000.0):
     """A 2nd-order Butterworth low-pass (bilinear), one pass."""
     k = math.tan(math.pi * fc / fs)
@@ -94,7 +108,7 @@ def motion(rnd, top):
     peak = max(abs(shape(k * 1e-3)) for k in range(60000))
     return lambda s: top * shape(s) / peak
 
-def lugre(t, w, p, ripple, delta=1.0, top=1.0, alpha=2.0):
+def lugre(t, w, p, ripple, delta=1.0, top=1.0, alpha=2.0, c=0.0):
     # z advanced exactly over 20 sub-steps per sample (ω linear between
     # samples, constant over a sub-step): stable at any σ0.
     fc, fs, ws, b, s0, s1, amp, periods = p
@@ -112,7 +126,7 @@ def lugre(t, w, p, ripple, delta=1.0, top=1.0, alpha=2.0):
                 theta += y * h
         dz = x - abs(x) * z / g(x)
         rise = b * x if delta == 1.0 else b * top * math.copysign(abs(x / top) ** delta, x)
-        tau = s0 * z + s1 * dz + rise
+        tau = s0 * z + s1 * dz + rise + c
         if ripple:
             tau += amp * fc * math.sin(periods * theta)
         out.append(tau)
@@ -129,15 +143,16 @@ for d in range(first, draws + 1):
     s0 = math.exp(rnd.uniform(math.log(200.0), math.log(5000.0)))
     s1 = s0 * rnd.uniform(0.002, 0.01)
     ripple = d % 2 == 0
-    p = (fc, fs, ws, b, s0, s1, 0.03, rnd.randint(6, 20))
+    p = (fc, fs, ws, b, s0, s1, ripple_amp, rnd.randint(6, 20))
     w_of = motion(random.Random(rnd.randrange(1 << 30)), top)
     delta = random.Random(f"{d} power").uniform(power, 1.0) if power < 1.0 else 1.0
     alpha = random.Random(f"{d} shape").uniform(shape, 2.0) if shape < 2.0 else 2.0
+    c = random.Random(f"{d} offset").uniform(-offset, offset) * fc if offset > 0.0 else 0.0
     for part, speed, duration in (("train", 1.0, 60.0), ("fast", 2.5, 24.0)):
         # The faster motion: the same path at 2.5x the speed.
         t = [k * 1e-3 for k in range(int(duration * 1000))]
         w = [speed * w_of(speed * s) for s in t]
-        f = lugre(t, w, p, ripple, delta, top, alpha)
+        f = lugre(t, w, p, ripple, delta, top, alpha, c)
         rms = math.sqrt(sum(x * x for x in f) / len(f))
         noise = random.Random(7 * d + (part == "fast"))
         with open(f"{out}/d{d}-{part}.csv", "w") as fh:
@@ -145,8 +160,9 @@ for d in range(first, draws + 1):
             for a, x, y in zip(t, measured(t, w), f):
                 fh.write(f"{a:.3f},{x:.6g},{y + noise.gauss(0, 0.01 * rms):.6g}\n")
     print(f"| d{d} | {fc:.3g} | {fs:.3g} | {ws:.3g} | {b:.3g} | {s0:.4g} | {s1:.3g} | {top:.3g} | "
-          f"{'yes' if ripple else 'no'}{f', δ {delta:.3g}' if delta != 1.0 else ''}"
-          f"{f', α {alpha:.3g}' if alpha != 2.0 and kind != 'none' else ''} |",
+          f"{'no' if not ripple else 'yes' if ripple_amp == 0.03 else f'yes, {ripple_amp:.3g} f_c'}{f', δ {delta:.3g}' if delta != 1.0 else ''}"
+          f"{f', α {alpha:.3g}' if alpha != 2.0 and kind != 'none' else ''}"
+          f"{f', offset {c:.3g}' if c != 0.0 else ''} |",
           file=open(f"{out}/d{d}.params", "w"))
 PY
 
