@@ -138,9 +138,9 @@ impl FitRequest {
         };
         let mut ours =
             self.fit_confirmed(&mut p, &given, selection.as_mut(), progress, stop, &say)?;
-        let mut extra_md = selection.as_ref().map_or(String::new(), |s| {
-            super::selection_report::report(s, p.data.units)
-        });
+        let mut extra_md = selection
+            .as_ref()
+            .map_or(String::new(), |s| selection_md(s, &p, &say));
         extra_md.insert_str(0, &range_and_inertia(&p, &mut ours, &say));
         let yaml = super::report::fitted_yaml(&ours.config, &ours.outcome, &p.names, &ours.map);
         if let Some(o) = &outputs.fitted {
@@ -174,6 +174,26 @@ impl FitRequest {
 /// The report's first sections: the range the calibration saw (also
 /// attached to the fitted file) and, when the residual follows the
 /// acceleration, that warning (also said).
+/// The selection's section of the report, with the offset advice where it
+/// applies (said as well).
+fn selection_md(s: &Selection, p: &Prepared, say: &dyn Fn(&str)) -> String {
+    let mut md = super::selection_report::report(s, p.data.units);
+    let time_series = p.data.train.iter().any(|t| !t.steady);
+    let advice =
+        super::selection_report::offset_advice(&s.chosen, time_series, !p.map_fit.is_empty());
+    if let Some(a) = advice {
+        say(
+            "auto: the direction asymmetry was chosen, which vanishes at rest, where an \
+             offset in the friction as derived stays: if the data may carry one, fit it \
+             as a map (--friction '(FRICTION) - c' --map c=0 --fit auto,c) and compare \
+             the CV (the report says more)",
+        );
+        md.push('\n');
+        md.push_str(&a);
+    }
+    md
+}
+
 fn range_and_inertia(p: &Prepared, ours: &mut OursFitted, say: &dyn Fn(&str)) -> String {
     let gain = p.contact_scale.as_ref().map_or(1.0, |s| s.gain);
     let mut md = super::calibrated_range::attach(&mut ours.config, &ours.outcome, gain);
