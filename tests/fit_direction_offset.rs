@@ -21,6 +21,11 @@
 //! out); started also at the best curves of a grid of speeds
 //! (`classic_regression::stribeck_curve_by_grid`, as the classic is started) it
 //! finds the curve (0.0033 N·m).
+//!
+//! Rule 12 (`fit/offset_try.rs`): on a time series, an offset stays at
+//! rest, where the direction asymmetry vanishes; where the asymmetry is
+//! chosen, the calibration is run again with an offset fitted as a map,
+//! kept only where it pays.
 
 mod common;
 
@@ -88,4 +93,68 @@ fn a_curve_taken_one_way_only_has_no_direction_asymmetry_to_choose() {
     assert!(
         !stdout.contains("Chosen: boundary friction, drivetrain Stribeck, drivetrain asymmetry")
     );
+}
+
+/// A drive's time series (8 s of point-to-point moves with dwells at
+/// rest, `common::motion`), its friction a Stribeck curve plus `extra(v)`,
+/// fitted with `--fit auto --baselines` and validated on the same moves
+/// twice as fast: (exit code, stdout, stderr).
+fn fit_moves_with(name: &str, extra: impl Fn(f64) -> f64 + Copy) -> (i32, String, String) {
+    let drive = common::records::Drive {
+        fc: 1.0,
+        fs: 1.5,
+        vs: 0.01,
+        alpha: 2.0,
+        b_top: 0.5,
+        v_top: 0.2,
+        delta: 1.0,
+    };
+    drive.fit_auto_on_moves_with("direction-offset", name, (5, 6), extra)
+}
+
+/// The value rule 12's paragraph gives the offset (`friction_offset = V`
+/// or `fitted at V`).
+fn offset_said(stdout: &str) -> f64 {
+    let at = stdout
+        .find("friction_offset = ")
+        .map(|i| i + "friction_offset = ".len())
+        .or_else(|| stdout.find("(fitted at ").map(|i| i + "(fitted at ".len()))
+        .unwrap_or_else(|| panic!("rule 12 gave no offset: {stdout}"));
+    let v = stdout[at..].split_whitespace().next().unwrap();
+    v.parse().unwrap_or_else(|_| panic!("`{v}` in {stdout}"))
+}
+
+#[test]
+fn an_offset_that_stays_at_rest_is_fitted_as_a_map_where_the_asymmetry_was_chosen() {
+    // 0.2 N at rest and both ways, a fifth of the sliding level.
+    let (code, stdout, err) = fit_moves_with("offset-at-rest", |_| 0.2);
+    assert_eq!(code, 0, "{err}");
+    assert!(stdout.contains("It pays, and is kept"), "{stdout}");
+    approx::assert_relative_eq!(offset_said(&stdout), 0.2, max_relative = 0.05);
+    // The classic models are fitted through the same map: ours predicts
+    // the faster moves as well as the generating form's classic.
+    let ours = held_out(&stdout, "friction-node");
+    let stribeck = held_out(&stdout, "Stribeck");
+    assert!(
+        ours < 1.05 * stribeck,
+        "ours {ours} against Stribeck {stribeck}"
+    );
+}
+
+#[test]
+fn a_level_that_differs_by_direction_while_sliding_is_not_taken_for_an_offset() {
+    // 0.2 N more forward and 0.2 N less backward while sliding, nothing at
+    // rest: the asymmetry itself.
+    let (code, stdout, err) =
+        fit_moves_with("level-by-direction", |v| if v == 0.0 { 0.0 } else { 0.2 });
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        stdout.contains("drivetrain asymmetry") && stdout.contains("(rule 12)"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("It does not pay") && !stdout.contains("It pays, and is kept"),
+        "{stdout}"
+    );
+    assert!(offset_said(&stdout).abs() < 0.05, "{stdout}");
 }

@@ -298,6 +298,7 @@ impl FitArgs {
                     temperature: self.temperature_topic.clone(),
                 },
                 rotary: self.rotary,
+                friction_offset: None,
             },
             params: self.specs()?,
             search: SearchSettings {

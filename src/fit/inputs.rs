@@ -47,6 +47,11 @@ pub struct DataRequest {
     /// (the lever arm and the contact's load are chosen from the data, see
     /// `rotary.rs`, unless the configuration's one contact has a gain).
     pub rotary: bool,
+    /// A map coefficient subtracted from the friction as read: the
+    /// friction column or expression, once a joint's or a unit's column is
+    /// resolved, is read as (FRICTION) − NAME (`--fit auto`'s rule 12,
+    /// `offset_try.rs`; NAME must be among the mapping's coefficients).
+    pub friction_offset: Option<String>,
 }
 
 impl Default for DataRequest {
@@ -62,6 +67,7 @@ impl Default for DataRequest {
             delimiter: Delimiter::Auto,
             topics: TopicChoice::default(),
             rotary: false,
+            friction_offset: None,
         }
     }
 }

@@ -26,6 +26,7 @@
 //! | file | content |
 //! |---|---|
 //! | `request.rs` | a calibration as data ([`request::FitRequest`]) and its one flow, `run`, for the command line and Python: prepare → select → fit ours → the fitted file → the classic models → the report |
+//! | `offset_try.rs` | `--fit auto`'s rule 12: where the direction asymmetry was chosen on a time series, the calibration again with an offset fitted as an input map, kept where it pays |
 //! | `prepare.rs` | data → our model: the sources (the held-out part cut off first), scales, keys, maps, the contact's scale |
 //! | `table_columns.rs` | a table's columns as a fit's inputs: a joint's columns under `--rotary` (deg/s, rpm converted), a time column named with its unit, what was meant when a default column is missing, the columns not read |
 //! | `confirm.rs` | `--fit auto`'s choice confirmed at the final fit's optimum: scored on the same folds, it falls back to the best set with one term fewer when it no longer pays over it, or to the lighter set of two chosen terms that are confounded at that optimum |
@@ -110,6 +111,7 @@ pub mod local_run;
 pub mod models_table;
 mod moves;
 pub mod multistart;
+pub mod offset_try;
 pub mod options;
 pub mod physics_model;
 pub mod prepare;

@@ -151,7 +151,10 @@ fn read_sources(req: &DataRequest, notes: &mut Vec<String>) -> Result<Sources, F
             table_columns::refuse_joint_columns(&req.mapping, &table)?;
             table_columns::linear_columns(&req.mapping, &table, notes)
         };
-        let mapping = table_columns::time_column(mapping, &table, notes)?;
+        let mut mapping = table_columns::time_column(mapping, &table, notes)?;
+        if let Some(c) = &req.friction_offset {
+            mapping.friction = format!("({}) - {c}", mapping.friction);
+        }
         notes.extend(table_columns::unread_columns(&mapping, &table));
         Ok((Source::new(table, &mapping)?, mapping))
     };

@@ -17,6 +17,7 @@ use super::compare::{fit_baselines, fit_ours, OursFitted};
 use super::confirm::Fallback;
 use super::driver::FitOutcome;
 use super::inputs::DataRequest;
+use super::offset_try;
 use super::options::{LabelledProgress, SearchSettings};
 use super::prepare::prepare;
 use super::prepared::Prepared;
@@ -24,6 +25,7 @@ use super::select::{select_terms, Selection};
 use super::{FitError, ParamSpec};
 use crate::config::Config;
 use crate::interrupt::Stop;
+use crate::text::Num;
 use std::path::PathBuf;
 
 /// Everything a calibration needs besides the base configuration.
@@ -114,13 +116,6 @@ impl FitRequest {
             }
         };
         self.check()?;
-        // With `auto`: the base key and the names given; the selection adds
-        // terms to them.
-        let (auto, given, specs) = initial_specs(&self.params);
-        let mut p = prepare(config, &self.data, &specs, auto)?;
-        for n in &p.notes {
-            say(n);
-        }
         // Outputs are checked before any computation; a report folder made
         // here is removed again if the fit fails or is stopped.
         if let Some(o) = &outputs.fitted {
@@ -131,16 +126,24 @@ impl FitRequest {
             .as_deref()
             .map(crate::output::prepare_output_dir)
             .transpose()?;
-        let mut selection = if auto {
-            Some(select_terms(&mut p, &given, &self.search, &say, stop)?)
-        } else {
-            None
-        };
-        let mut ours =
-            self.fit_confirmed(&mut p, &given, selection.as_mut(), progress, stop, &say)?;
-        let mut extra_md = selection
-            .as_ref()
-            .map_or(String::new(), |s| selection_md(s, &p, &say));
+        let (mut p, mut selection, mut ours) = self.ours_selected(config, progress, stop, &say)?;
+        let offset_md = self.offset_tried(
+            config,
+            &mut p,
+            &mut selection,
+            &mut ours,
+            progress,
+            stop,
+            &say,
+        )?;
+        let mut extra_md = selection.as_ref().map_or(String::new(), |s| {
+            let md = super::selection_report::report(s, p.data.units);
+            if offset_md.is_empty() {
+                md
+            } else {
+                md + "\n" + &offset_md
+            }
+        });
         extra_md.insert_str(0, &range_and_inertia(&p, &mut ours, &say));
         let yaml = super::report::fitted_yaml(&ours.config, &ours.outcome, &p.names, &ours.map);
         if let Some(o) = &outputs.fitted {
@@ -174,26 +177,6 @@ impl FitRequest {
 /// The report's first sections: the range the calibration saw (also
 /// attached to the fitted file) and, when the residual follows the
 /// acceleration, that warning (also said).
-/// The selection's section of the report, with the offset advice where it
-/// applies (said as well).
-fn selection_md(s: &Selection, p: &Prepared, say: &dyn Fn(&str)) -> String {
-    let mut md = super::selection_report::report(s, p.data.units);
-    let time_series = p.data.train.iter().any(|t| !t.steady);
-    let advice =
-        super::selection_report::offset_advice(&s.chosen, time_series, !p.map_fit.is_empty());
-    if let Some(a) = advice {
-        say(
-            "auto: the direction asymmetry was chosen, which vanishes at rest, where an \
-             offset in the friction as derived stays: if the data may carry one, fit it \
-             as a map (--friction '(FRICTION) - c' --map c=0 --fit auto,c) and compare \
-             the CV (the report says more)",
-        );
-        md.push('\n');
-        md.push_str(&a);
-    }
-    md
-}
-
 fn range_and_inertia(p: &Prepared, ours: &mut OursFitted, say: &dyn Fn(&str)) -> String {
     let gain = p.contact_scale.as_ref().map_or(1.0, |s| s.gain);
     let mut md = super::calibrated_range::attach(&mut ours.config, &ours.outcome, gain);
@@ -205,6 +188,97 @@ fn range_and_inertia(p: &Prepared, ours: &mut OursFitted, say: &dyn Fn(&str)) ->
         );
     }
     md
+}
+
+impl FitRequest {
+    /// The data prepared, `--fit auto`'s selection (with `auto`) and our
+    /// fit, confirmed on the selection's folds.
+    fn ours_selected(
+        &self,
+        config: &Config,
+        progress: Option<&LabelledProgress>,
+        stop: &Stop,
+        say: &(dyn Fn(&str) + Sync),
+    ) -> Result<(Prepared, Option<Selection>, OursFitted), FitError> {
+        // With `auto`: the base key and the names given; the selection adds
+        // terms to them.
+        let (auto, given, specs) = initial_specs(&self.params);
+        let mut p = prepare(config, &self.data, &specs, auto)?;
+        for n in &p.notes {
+            say(n);
+        }
+        let mut selection = if auto {
+            Some(select_terms(&mut p, &given, &self.search, say, stop)?)
+        } else {
+            None
+        };
+        let ours = self.fit_confirmed(&mut p, &given, selection.as_mut(), progress, stop, say)?;
+        Ok((p, selection, ours))
+    }
+
+    /// Rule 12 (`offset_try.rs`): where the direction asymmetry was chosen
+    /// on a time series with no map fitted, the calibration again with an
+    /// offset fitted as a map; where the offset pays, that calibration
+    /// replaces `p`, `selection` and `ours`. Returns the selection section's
+    /// paragraph on it (empty where the rule does not apply).
+    #[allow(clippy::too_many_arguments)] // the flow's state, handed on once
+    fn offset_tried(
+        &self,
+        config: &Config,
+        p: &mut Prepared,
+        selection: &mut Option<Selection>,
+        ours: &mut OursFitted,
+        progress: Option<&LabelledProgress>,
+        stop: &Stop,
+        say: &(dyn Fn(&str) + Sync),
+    ) -> Result<String, FitError> {
+        let Some((data, params)) =
+            offset_try::with_offset(&self.data, &self.params, p, selection.as_ref())
+        else {
+            return Ok(String::new());
+        };
+        let alt = FitRequest {
+            data,
+            params,
+            ..self.clone()
+        };
+        let units = p.data.units;
+        say("auto: the direction asymmetry was chosen on a time series, which vanishes at rest where an offset stays: the calibration runs again with an offset fitted as a map (rule 12)");
+        let with_offset = |l: &str| say(&format!("(with the offset) {l}"));
+        let (p2, s2, o2) = match alt.ours_selected(config, progress, stop, &with_offset) {
+            Ok(t) => t,
+            Err(FitError::Interrupted(i)) => return Err(FitError::Interrupted(i)),
+            Err(e) => {
+                let why = e.to_string();
+                say(&format!("auto: the offset could not be weighed: {why}"));
+                return Ok(offset_try::paragraph(None, Some(&why), units));
+            }
+        };
+        // The request keeps `auto`, so the run again has its selection.
+        let Some(s2) = s2 else {
+            return Ok(String::new());
+        };
+        let v = offset_try::weigh(ours, &o2, &s2);
+        if let Some(v) = &v {
+            say(&format!(
+                "auto: the offset {} (CV RMS {} with it, {} without; fitted at {})",
+                if v.kept {
+                    "pays and is kept"
+                } else {
+                    "does not pay"
+                },
+                Num::sig(v.cv_with, 5),
+                Num::sig(v.cv_without, 5),
+                Num::sig(v.offset, 5),
+            ));
+            if v.kept {
+                *p = p2;
+                *selection = Some(s2);
+                *ours = o2;
+            }
+        }
+        Ok(offset_try::paragraph(v.as_ref(), None, units))
+    }
 }
 
 impl FitRequest {

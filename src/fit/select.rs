@@ -202,6 +202,12 @@
 //!     rise ended at zero, and the base alone (criterion −83.3 against
 //!     the curve's −174.6) predicted 90 deg/s 1.9× worse than the
 //!     Stribeck classic.
+//! 12. On a time series where the direction asymmetry was chosen and no
+//!     map is fitted, an offset in the friction as derived (which stays
+//!     at rest, where the asymmetry vanishes) is tried as an input map
+//!     in a second selection, and kept where it pays over the first by
+//!     rule 3 (`offset_try.rs`, called from `request.rs` once the first
+//!     is confirmed).
 //!
 //! The report lists every set tried with its CV error per fold, the set
 //! chosen and why the selection stopped.

@@ -3,7 +3,6 @@
 //! out, the sets not admitted, the start, the terms added and removed,
 //! the set chosen and why the steps stopped.
 
-use super::candidates::ASYMMETRY;
 use super::cross_validate::TERM_COST;
 use super::select::Selection;
 use std::fmt::Write as _;
@@ -69,46 +68,4 @@ pub fn report(s: &Selection, units: super::Units) -> String {
         s.wall_s
     );
     md
-}
-
-/// Advice where `--fit auto` chose the direction asymmetry on a time series
-/// and no input map is fitted: the asymmetry is a friction level that
-/// differs by direction while sliding and vanishes at rest, where an offset
-/// in the friction as derived (a sensor's zero, a gravity model's error)
-/// stays. Measured on LuGre joints with such an offset
-/// (`docs/fit-auto-judged.md`, stop 97): the asymmetry alone left ours
-/// 1.06–1.86× its error without the offset, a fitted map 0.81–1.01×.
-pub fn offset_advice(chosen: &[&str], time_series: bool, maps_fitted: bool) -> Option<String> {
-    (time_series && !maps_fitted && chosen.contains(&ASYMMETRY)).then(|| {
-        "**An offset, or a level that differs by direction?** The direction asymmetry \
-         was chosen: a friction level higher one way than the other while sliding, which \
-         vanishes at rest. An offset in the friction as derived (a torque or current \
-         sensor's zero, a gravity model's error, a weight on a vertical axis) stays at rest \
-         as well, which the asymmetry misses at every reversal (the reversal rows of \
-         \"Residual by direction of motion\"). If the data may carry one, fit it as an \
-         input map beside the terms and compare the CV: `--friction '(FRICTION) - c' \
-         --map c=0 --fit auto,c`, FRICTION your friction column or expression. On joints \
-         with an offset the asymmetry alone left 1.06–1.86× the error the same joints \
-         give without it, and the map 0.81–1.01× (`docs/fit-auto-judged.md`, stop 97).\n"
-            .to_string()
-    })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_offset_advice_is_given_where_the_asymmetry_was_chosen_on_a_time_series_without_a_map() {
-        let chosen = ["pre-sliding", ASYMMETRY];
-        let advice = offset_advice(&chosen, true, false).expect("advice");
-        assert!(advice.contains("--map c=0 --fit auto,c"), "{advice}");
-        assert!(advice.contains("vanishes at rest"), "{advice}");
-        // A steady curve passes through no rest: the two are one there.
-        assert_eq!(offset_advice(&chosen, false, false), None);
-        // A map fitted already (an offset, an effective area) is the user's.
-        assert_eq!(offset_advice(&chosen, true, true), None);
-        // Without the asymmetry there is nothing to tell apart.
-        assert_eq!(offset_advice(&["pre-sliding"], true, false), None);
-    }
 }

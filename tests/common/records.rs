@@ -33,9 +33,25 @@ impl Drive {
     /// noise of 1 % of its RMS (seed `seed`), written to `path` as a CSV
     /// `t_s,velocity_m_s,friction_n`.
     pub fn write_record(&self, path: &std::path::Path, motion: &[(f64, f64)], seed: u64) {
+        self.write_record_with(path, motion, seed, |_| 0.0);
+    }
+
+    /// [`Self::write_record`] with `extra(v)` added to the friction at
+    /// each speed v (an offset at rest as well, a level by direction), the
+    /// noise 1 % of the sum's RMS.
+    pub fn write_record_with(
+        &self,
+        path: &std::path::Path,
+        motion: &[(f64, f64)],
+        seed: u64,
+        extra: impl Fn(f64) -> f64,
+    ) {
         use rand::SeedableRng;
         use std::fmt::Write as _;
-        let f: Vec<f64> = motion.iter().map(|&(_, v)| self.friction(v)).collect();
+        let f: Vec<f64> = motion
+            .iter()
+            .map(|&(_, v)| self.friction(v) + extra(v))
+            .collect();
         let rms = (f.iter().map(|x| x * x).sum::<f64>() / f.len() as f64).sqrt();
         let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
         let mut s = String::from("t_s,velocity_m_s,friction_n\n");
@@ -51,10 +67,23 @@ impl Drive {
     /// fast (seed `seeds.1`), 16 cells, in a fresh directory of `suite`:
     /// (exit code, stdout, stderr).
     pub fn fit_auto_on_moves(&self, suite: &str, seeds: (u64, u64)) -> (i32, String, String) {
-        let d = super::cli::fresh_dir(suite, "time-series");
+        self.fit_auto_on_moves_with(suite, "time-series", seeds, |_| 0.0)
+    }
+
+    /// [`Self::fit_auto_on_moves`] with `extra(v)` added to the friction
+    /// (see [`Self::write_record_with`]), in the fresh directory `name`.
+    pub fn fit_auto_on_moves_with(
+        &self,
+        suite: &str,
+        name: &str,
+        seeds: (u64, u64),
+        extra: impl Fn(f64) -> f64 + Copy,
+    ) -> (i32, String, String) {
+        let d = super::cli::fresh_dir(suite, name);
         let (train, fast) = (d.join("train.csv"), d.join("fast.csv"));
-        self.write_record(&train, &super::motion::point_to_point(8.0, 1.0), seeds.0);
-        self.write_record(&fast, &super::motion::point_to_point(8.0, 2.0), seeds.1);
+        let motion = |scale| super::motion::point_to_point(8.0, scale);
+        self.write_record_with(&train, &motion(1.0), seeds.0, extra);
+        self.write_record_with(&fast, &motion(2.0), seeds.1, extra);
         let out = d.join("fit.yaml");
         super::cli::run(&[
             "fit",

@@ -187,6 +187,7 @@ pub fn fit<'py>(
                 temperature: temperature_topic,
             },
             rotary,
+            friction_offset: None,
         },
         params: param_specs(&keys, &bounds, &starts_at).map_err(errors::fit)?,
         search: with_rules(
