@@ -416,7 +416,8 @@ fn transfer(
             &scale,
             mean_abs,
             &series,
-        );
+        )
+        .with_max_step(base.solver.dt_s);
         let mut opts = options(o, kind.label());
         opts.max_evaluations = 2000;
         rows.push(ModelRow::from(&fit(&b, &d, vec![], &opts)?));

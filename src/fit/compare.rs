@@ -137,13 +137,15 @@ pub fn fit_baselines(
             skipped.push("LuGre skipped: on steady curves it is Stribeck".to_string());
             continue;
         }
+        // LuGre's bristle on no coarser a step than our model's film.
         let model = Baseline::from_data(
             kind,
             LoadForm::for_data(p.loads_vary, p.load_given),
             &p.scale,
             p.mean_abs_n,
             &series,
-        );
+        )
+        .with_max_step(p.model_config.solver.dt_s);
         let mut opts = baseline_options(search, kind, progress, stop);
         // Each model contains the one before it: it also starts from that
         // one's optimum, so it never ends worse than the simpler model; and
