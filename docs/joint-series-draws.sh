@@ -51,6 +51,22 @@
 # have one (0.03 by default; a harmonic drive's or a cogging motor's can be
 # several times that). The joints, motions and noise draws are those of
 # RIPPLE=0.03.
+# GRAVITY=x adds to each joint's torque g sin(θ + φ), g drawn uniform in
+# ±x·f_c and φ in 0–2π from the draw's own generator, θ the joint's angle
+# (0 at the start): what a gravity model's error leaves in the friction
+# derived from a joint's drive on an arm whose link swings (the torque's
+# part that follows the pose, not the motion; the faster motion takes
+# the same path, so the same error). No model has it. The joints, motions
+# and noise draws are those of GRAVITY=0 (the noise is 1 % of the
+# torque's RMS, the error's included).
+# NOISE=x sets the white noise's standard deviation to x times the torque's
+# RMS (0.01 by default; a torque derived from a motor's current is often
+# several times noisier). The joints and motions are those of NOISE=0.01,
+# the noise draws scaled.
+# RATE=hz keeps every (1000/hz)-th sample of both motions (1000 by
+# default; a robot's log is often at 100-500 Hz): the friction and the
+# encoder's filtered speed are made at 1 kHz, as a controller makes them,
+# and logged at the lower rate. hz must divide 1000.
 # DRAWS=12 sets the last draw (80-350 s each on 2 cores), FIRST=1 the first: draws
 # 1-12 are those the rule was developed on, 13-24 were first run after it.
 set -euo pipefail
@@ -70,12 +86,19 @@ POWER=${POWER:-1}
 SHAPE=${SHAPE:-2}
 OFFSET=${OFFSET:-0}
 RIPPLE=${RIPPLE:-0.03}
+NOISE=${NOISE:-0.01}
+GRAVITY=${GRAVITY:-0}
+RATE=${RATE:-1000}
+case "$RATE" in *[!0-9]*|'') echo "RATE must be a whole number of Hz dividing 1000, not '$RATE'" >&2; exit 2 ;; esac
+[ "$RATE" -gt 0 ] && [ $((1000 % RATE)) -eq 0 ] || { echo "RATE must divide 1000, not '$RATE'" >&2; exit 2; }
 case "$VELOCITY" in true|encoder) ;; *) echo "VELOCITY must be true or encoder, not '$VELOCITY'" >&2; exit 2 ;; esac
-python3 - "$OUT" "$DRAWS" "$FIRST" "$START" "$VELOCITY" "$POWER" "$SHAPE" "$OFFSET" "$RIPPLE" <<'PY'
+python3 - "$OUT" "$DRAWS" "$FIRST" "$START" "$VELOCITY" "$POWER" "$SHAPE" "$OFFSET" "$RIPPLE" "$NOISE" "$RATE" "$GRAVITY" <<'PY'
 import math, random, sys
 out, draws, first = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
 start, velocity, power, shape = sys.argv[4], sys.argv[5], float(sys.argv[6]), float(sys.argv[7])
 offset, ripple_amp = float(sys.argv[8]), float(sys.argv[9])
+noise_rel, every = float(sys.argv[10]), 1000 // int(sys.argv[11])
+gravity = float(sys.argv[12])
 def butter2(x, fc=50.0, fs=1000.0):
     """A 2nd-order Butterworth low-pass (bilinear), one pass."""
     k = math.tan(math.pi * fc / fs)
@@ -108,7 +131,7 @@ def motion(rnd, top):
     peak = max(abs(shape(k * 1e-3)) for k in range(60000))
     return lambda s: top * shape(s) / peak
 
-def lugre(t, w, p, ripple, delta=1.0, top=1.0, alpha=2.0, c=0.0):
+def lugre(t, w, p, ripple, delta=1.0, top=1.0, alpha=2.0, c=0.0, grav=(0.0, 0.0)):
     # z advanced exactly over 20 sub-steps per sample (ω linear between
     # samples, constant over a sub-step): stable at any σ0.
     fc, fs, ws, b, s0, s1, amp, periods = p
@@ -127,6 +150,8 @@ def lugre(t, w, p, ripple, delta=1.0, top=1.0, alpha=2.0, c=0.0):
         dz = x - abs(x) * z / g(x)
         rise = b * x if delta == 1.0 else b * top * math.copysign(abs(x / top) ** delta, x)
         tau = s0 * z + s1 * dz + rise + c
+        if grav[0]:
+            tau += grav[0] * math.sin(theta + grav[1])
         if ripple:
             tau += amp * fc * math.sin(periods * theta)
         out.append(tau)
@@ -148,21 +173,30 @@ for d in range(first, draws + 1):
     delta = random.Random(f"{d} power").uniform(power, 1.0) if power < 1.0 else 1.0
     alpha = random.Random(f"{d} shape").uniform(shape, 2.0) if shape < 2.0 else 2.0
     c = random.Random(f"{d} offset").uniform(-offset, offset) * fc if offset > 0.0 else 0.0
+    gr = random.Random(f"{d} gravity")
+    grav = (gr.uniform(-gravity, gravity) * fc, gr.uniform(0.0, 2 * math.pi)) if gravity > 0.0 else (0.0, 0.0)
     for part, speed, duration in (("train", 1.0, 60.0), ("fast", 2.5, 24.0)):
         # The faster motion: the same path at 2.5x the speed.
         t = [k * 1e-3 for k in range(int(duration * 1000))]
         w = [speed * w_of(speed * s) for s in t]
-        f = lugre(t, w, p, ripple, delta, top, alpha, c)
+        f = lugre(t, w, p, ripple, delta, top, alpha, c, grav)
         rms = math.sqrt(sum(x * x for x in f) / len(f))
         noise = random.Random(7 * d + (part == "fast"))
         with open(f"{out}/d{d}-{part}.csv", "w") as fh:
             fh.write("t_s,velocity_rad_s,friction_n_m\n")
-            for a, x, y in zip(t, measured(t, w), f):
-                fh.write(f"{a:.3f},{x:.6g},{y + noise.gauss(0, 0.01 * rms):.6g}\n")
+            for k, (a, x, y) in enumerate(zip(t, measured(t, w), f)):
+                # The noise drawn at every 1 kHz sample, logged or not: the
+                # draws of RATE=1000 at the samples kept.
+                e = noise.gauss(0, noise_rel * rms)
+                if k % every == 0:
+                    fh.write(f"{a:.3f},{x:.6g},{y + e:.6g}\n")
     print(f"| d{d} | {fc:.3g} | {fs:.3g} | {ws:.3g} | {b:.3g} | {s0:.4g} | {s1:.3g} | {top:.3g} | "
           f"{'no' if not ripple else 'yes' if ripple_amp == 0.03 else f'yes, {ripple_amp:.3g} f_c'}{f', δ {delta:.3g}' if delta != 1.0 else ''}"
           f"{f', α {alpha:.3g}' if alpha != 2.0 and kind != 'none' else ''}"
-          f"{f', offset {c:.3g}' if c != 0.0 else ''} |",
+          f"{f', offset {c:.3g}' if c != 0.0 else ''}"
+          f"{f', gravity error {grav[0]:.3g} at φ {grav[1]:.3g}' if grav[0] != 0.0 else ''}"
+          f"{f', noise {100 * noise_rel:.3g} %' if noise_rel != 0.01 else ''}"
+          f"{f', logged at {1000 // every} Hz' if every != 1 else ''} |",
           file=open(f"{out}/d{d}.params", "w"))
 PY
 
