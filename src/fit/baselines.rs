@@ -35,7 +35,7 @@ use super::classic_regression::{
     design_rows, least_squares, level_columns, stribeck_grid, Samples,
 };
 use super::problem::Model;
-use super::series::Series;
+use super::series::{Series, STEP_SLACK};
 use super::unknowns::{DataScale, FittedParameter};
 use crate::physics::sgn;
 use crate::physics::terms::drivetrain::exp_neg;
@@ -105,10 +105,6 @@ pub struct Baseline {
     /// LuGre's longest integration step, s (∞: one step per sample).
     max_step_s: f64,
 }
-
-/// A sample interval up to this factor over the longest step is one step
-/// (a log's clock jitter does not double its steps).
-const STEP_SLACK: f64 = 1.01;
 
 /// Sub-steps of one sample interval at most (a gap in a log is crossed
 /// in as many, not in millions).

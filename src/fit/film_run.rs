@@ -14,7 +14,7 @@
 //! terms along the same film, bit for bit what the solver computes with
 //! them (`physics_model.rs` decides when a trace may be reused).
 
-use super::series::Series;
+use super::series::{Series, STEP_SLACK};
 use super::PredictError;
 use crate::config::{Config, ViscosityLaw};
 use crate::physics::terms::{BristleMove, FrictionTerm, FrictionTerms, TermStates};
@@ -196,10 +196,6 @@ struct Start {
     /// Whether it starts at rest (one sample interval before the first sample).
     at_rest: bool,
 }
-
-/// A first sample interval up to this factor over the solver's step is
-/// read as one step (a log's clock jitter).
-const STEP_SLACK: f64 = 1.01;
 
 impl Start {
     /// A series starts at rest when its first speed is 0, or no more than

@@ -18,6 +18,12 @@ use super::windowed::WindowedColumn;
 use super::FitError;
 use crate::table::Table;
 
+/// A sample interval up to this factor over a model's integration step
+/// counts as one step: a log's clock jitter neither doubles LuGre's steps
+/// (`baselines.rs`) nor makes a series' start read as a slow log's
+/// (`film_run.rs`).
+pub(super) const STEP_SLACK: f64 = 1.01;
+
 /// How the model's inputs come from a table's columns.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Mapping {
