@@ -17,8 +17,7 @@
 use super::series::{Series, STEP_SLACK};
 use super::PredictError;
 use crate::config::{Config, ViscosityLaw};
-use crate::physics::terms::{BristleMove, FrictionTerm, FrictionTerms, TermStates};
-use crate::physics::BoundaryRate;
+use crate::physics::terms::{BristleMove, FrictionTerm, FrictionTerms, Kept, TermStates};
 use crate::physics::{Estimate, Solver, Status, ViscosityModel};
 use std::sync::{Arc, Mutex};
 
@@ -40,42 +39,50 @@ pub(super) struct FilmTrace {
     /// The time series' sampling onto the data (see [`transient`]).
     pub(super) sampling: Option<Sampling>,
     /// The boundary rate's asinh(v/v_a) along the steps, for the last
-    /// activation speeds it was composed with ([`RateColumns`]).
-    pub(super) rate_columns: RateColumns,
+    /// activation speeds it was composed with ([`KeptColumns`]).
+    pub(super) rate_columns: KeptColumns,
+    /// The drivetrain's Stribeck fall e^(−|v/v_s|^α_s) along the steps, for
+    /// the last (v_s, α_s) it was composed with.
+    pub(super) fall_columns: KeptColumns,
 }
 
-/// The boundary rate's asinh(v/v_a) at a trace's steps, kept for the last
-/// [`RATE_COLUMNS_KEPT`] activation speeds v_a. A fit recomposes the
+/// A factor of the speed alone at a trace's steps (the boundary rate's
+/// asinh(v/v_a), the Stribeck fall e^(−|v/v_s|^α_s)), kept for the last
+/// [`COLUMNS_KEPT`] values of the keys it depends on. A fit recomposes the
 /// friction along one film many times (the cheap keys' profile, the
-/// Jacobian's columns) and mostly at a v_a it composed with just before
-/// (v_a fixed, or one of the columns moved): on the O-ring seal's
+/// Jacobian's columns) and mostly at the speed keys it composed with just
+/// before (the key fixed, or another column moved): on the O-ring seal's
 /// selection 92 % of the compositions, where the asinh took a fifth of the
-/// whole calibration's time (`perf`, stop 96). The numbers are those the
-/// term computes, bit for bit.
+/// whole calibration's time (`perf`, stop 96); on a robot joint's time
+/// series `exp` took 17 %, the fall's part of it kept here since stop 100.
+/// The numbers are those the term computes, bit for bit.
 #[derive(Default)]
-pub(super) struct RateColumns(Mutex<Vec<(u64, Arc<[f64]>)>>);
+pub(super) struct KeptColumns(Mutex<Vec<KeptColumn>>);
 
-/// Activation speeds whose columns a trace keeps: the last few a fit
-/// composed with (its current point and a Jacobian column moving v_a, on
-/// each of the cores).
-const RATE_COLUMNS_KEPT: usize = 4;
+/// One kept column: the bits of the key values it was computed at, and
+/// the factor at each step.
+type KeptColumn = ([u64; 2], Arc<[f64]>);
 
-impl RateColumns {
-    /// asinh(v/v_a) of `rate` at each of `steps`' speeds: kept, or computed
-    /// and kept.
-    fn get(&self, rate: &BoundaryRate, steps: &[[f64; 4]]) -> Arc<[f64]> {
-        let key = rate.activation_speed.to_bits();
+/// Key values whose columns a trace keeps: the last few a fit composed
+/// with (its current point and a Jacobian column moving the key, on each
+/// of the cores).
+const COLUMNS_KEPT: usize = 4;
+
+impl KeptColumns {
+    /// `factor` at each of `steps`' speeds for the key values `key`: kept,
+    /// or computed and kept.
+    fn get(&self, key: [u64; 2], steps: &[[f64; 4]], factor: impl Fn(f64) -> f64) -> Arc<[f64]> {
         let lock = || self.0.lock().unwrap_or_else(|p| p.into_inner());
         if let Some((_, c)) = lock().iter().find(|(k, _)| *k == key) {
             return Arc::clone(c);
         }
-        let column: Arc<[f64]> = steps.iter().map(|st| rate.asinh_at(st[0])).collect();
+        let column: Arc<[f64]> = steps.iter().map(|st| factor(st[0])).collect();
         let mut kept = lock();
-        // Another thread may have kept it meanwhile: one entry per v_a.
+        // Another thread may have kept it meanwhile: one entry per key.
         if let Some((_, c)) = kept.iter().find(|(k, _)| *k == key) {
             return Arc::clone(c);
         }
-        if kept.len() >= RATE_COLUMNS_KEPT {
+        if kept.len() >= COLUMNS_KEPT {
             kept.pop();
         }
         kept.insert(0, (key, Arc::clone(&column)));
@@ -100,16 +107,25 @@ impl FilmTrace {
 
     /// The friction at the series' samples with `terms` on this film.
     pub(super) fn compose(&self, terms: &FrictionTerms, s: &Series) -> Vec<f64> {
-        let rate = terms
-            .boundary_rate
-            .is_on()
-            .then(|| self.rate_columns.get(&terms.boundary_rate, &self.steps));
+        let r = &terms.boundary_rate;
+        let rate = r.is_on().then(|| {
+            let key = [r.activation_speed.to_bits(), 0];
+            self.rate_columns.get(key, &self.steps, |v| r.asinh_at(v))
+        });
+        let d = &terms.drivetrain;
+        let fall = d.has_stribeck().then(|| {
+            self.fall_columns
+                .get(d.stribeck_fall_key(), &self.steps, |v| d.stribeck_fall(v))
+        });
         let mut states = TermStates::default();
         let mut friction = |k: usize, how: BristleMove| {
             let st = &self.steps[k];
-            let asinh = rate.as_ref().map(|c| c[k]);
+            let kept = Kept {
+                rate_asinh: rate.as_ref().map(|c| c[k]),
+                stribeck_fall: fall.as_ref().map(|c| c[k]),
+            };
             terms
-                .friction_with_rate((st[0], st[1]), (st[2], st[3]), asinh, &mut states, how)
+                .friction_with_kept((st[0], st[1]), (st[2], st[3]), kept, &mut states, how)
                 .1
         };
         if self.steady {
@@ -314,7 +330,8 @@ pub(super) fn transient(
             steps: trace,
             times,
             sampling: Some(sampling),
-            rate_columns: RateColumns::default(),
+            rate_columns: KeptColumns::default(),
+            fall_columns: KeptColumns::default(),
         },
     ))
 }
@@ -387,7 +404,8 @@ pub(super) fn steady(config: &Config, s: &Series) -> Result<(Vec<f64>, FilmTrace
             steps: trace,
             times: Vec::new(),
             sampling: None,
-            rate_columns: RateColumns::default(),
+            rate_columns: KeptColumns::default(),
+            fall_columns: KeptColumns::default(),
         },
     ))
 }
@@ -513,7 +531,65 @@ pub(crate) mod tests {
             assert_ne!(bits(&earlier[0]), bits(&earlier[1]));
             assert_eq!(bits(&earlier[0]), bits(&earlier[2]));
             let kept = trace.rate_columns.0.lock().unwrap().len();
-            assert_eq!(kept, RATE_COLUMNS_KEPT);
+            assert_eq!(kept, COLUMNS_KEPT);
+        }
+    }
+
+    #[test]
+    fn a_kept_fall_column_recomposes_bit_for_bit_what_the_stribeck_term_computes() {
+        let mut config = Config::default();
+        config.solver.cells = 32;
+        let t: Vec<f64> = (0..=150).map(|k| k as f64 * 1e-3).collect();
+        let v: Vec<f64> = t.iter().map(|t| 0.02 * (20.0 * t).sin()).collect();
+        let s = series(t, v, false);
+        let (_, trace) = transient(&config, &s).unwrap();
+        let bits = |f: &[f64]| f.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        for stiffness in [0.0, 5e7] {
+            let mut terms = config.model().terms;
+            assert!(terms.set("contact.presliding_stiffness_n_m", stiffness));
+            assert!(terms.set("drivetrain.stribeck_n", 3.0));
+            let mut earlier: Vec<Vec<f64>> = Vec::new();
+            // (v_s, α_s): the Gaussian fall and one of its own exponent,
+            // each met again after others.
+            let shapes = [
+                (4e-3, 2.0),
+                (4e-3, 0.7),
+                (4e-3, 2.0),
+                (1e-3, 2.0),
+                (2e-3, 1.3),
+                (6e-3, 2.0),
+                (8e-3, 0.5),
+                (4e-3, 0.7),
+            ];
+            for (v_s, alpha) in shapes {
+                assert!(terms.set("drivetrain.stribeck_speed_m_s", v_s));
+                assert!(terms.set("drivetrain.stribeck_exponent", alpha));
+                let want = composed_by_the_terms(&trace, &terms, &s);
+                let got = trace.compose(&terms, &s);
+                assert_eq!(
+                    bits(&got),
+                    bits(&want),
+                    "v_s {v_s}, α_s {alpha}, k {stiffness}"
+                );
+                earlier.push(got);
+            }
+            // A column is the shape's own: another exponent at the same
+            // speed gives another friction, the same shape the same.
+            assert_ne!(bits(&earlier[0]), bits(&earlier[1]));
+            assert_eq!(bits(&earlier[0]), bits(&earlier[2]));
+            assert_eq!(bits(&earlier[1]), bits(&earlier[7]));
+            let kept = trace.fall_columns.0.lock().unwrap().len();
+            assert_eq!(kept, COLUMNS_KEPT);
+            // No Stribeck part: no column is made for it.
+            assert!(terms.set("drivetrain.stribeck_n", 0.0));
+            let before = trace.fall_columns.0.lock().unwrap().clone();
+            let got = trace.compose(&terms, &s);
+            assert_eq!(bits(&got), bits(&composed_by_the_terms(&trace, &terms, &s)));
+            let after = trace.fall_columns.0.lock().unwrap().clone();
+            assert_eq!(
+                before.iter().map(|e| e.0).collect::<Vec<_>>(),
+                after.iter().map(|e| e.0).collect::<Vec<_>>()
+            );
         }
     }
 

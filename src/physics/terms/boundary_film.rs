@@ -182,14 +182,14 @@ impl BoundaryRate {
     }
 
     /// asinh(v/v_a) at velocity `v` (m/s): the part of the term a fit may
-    /// hold for a whole film trace ([`At::rate_asinh`]).
+    /// hold for a whole film trace ([`Kept::rate_asinh`](super::Kept::rate_asinh)).
     pub fn asinh_at(&self, v: f64) -> f64 {
         (v / self.activation_speed).asinh()
     }
 
     /// μ_r asinh(v/v_a) at `at`, with the asinh `at` holds if any.
     fn signed_at(&self, at: &At) -> f64 {
-        match at.rate_asinh {
+        match at.kept.rate_asinh {
             Some(a) => self.sensitivity * a,
             None => self.signed_term(at.v),
         }

@@ -11,7 +11,7 @@
 //! on (not from 0.0), so that a model whose terms are off computes every
 //! number as without them, bit for bit, signed zeros included.
 
-use super::term::{At, BristleMove, FrictionTerm, Place};
+use super::term::{At, BristleMove, FrictionTerm, Kept, Place};
 
 /// `acc + x`, or `x` when nothing was summed yet.
 #[inline(always)]
@@ -194,18 +194,19 @@ impl super::FrictionTerms {
         states: &mut super::TermStates,
         how: BristleMove,
     ) -> (f64, f64) {
-        self.friction_with_rate(inputs, film, None, states, how)
+        self.friction_with_kept(inputs, film, Kept::default(), states, how)
     }
 
-    /// [`friction`](Self::friction) with the boundary rate's asinh(v/v_a)
-    /// given when the caller holds it ([`At::rate_asinh`]): the same
-    /// numbers, bit for bit, without the asinh.
+    /// [`friction`](Self::friction) with the factors of the speed the
+    /// caller holds ([`Kept`]: the boundary rate's asinh(v/v_a), the
+    /// Stribeck fall): the same numbers, bit for bit, without computing
+    /// them.
     #[inline(always)]
-    pub fn friction_with_rate(
+    pub fn friction_with_kept(
         &self,
         (v, load): (f64, f64),
         (f_visc, f_asp): (f64, f64),
-        rate_asinh: Option<f64>,
+        kept: Kept,
         states: &mut super::TermStates,
         how: BristleMove,
     ) -> (f64, f64) {
@@ -215,7 +216,7 @@ impl super::FrictionTerms {
             f_visc,
             f_asp,
             s: 0.0,
-            rate_asinh,
+            kept,
         };
         if !self.has_carrier() {
             at.s = self.regularised_sign(v);
@@ -270,7 +271,7 @@ impl super::FrictionTerms {
             f_visc,
             f_asp,
             s: 1.0,
-            rate_asinh: None,
+            kept: Kept::default(),
         };
         let mu = self.sum_cof(&at).unwrap_or(0.0);
         let rate = if self.boundary_rate.is_on() {

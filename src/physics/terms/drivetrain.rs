@@ -254,13 +254,13 @@ impl FrictionTerm for Drivetrain {
     /// F_dt with the rigid contact's s = tanh(v/v_reg).
     #[inline(always)]
     fn force(&self, at: &At) -> f64 {
-        self.force_at(at.v, at.load, at.s)
+        self.force_kept(at.v, at.load, at.s, at.kept.stribeck_fall)
     }
 
     /// (F_cd + c_N F + ΔF_s e^(−|v/v_s|^α_s)) s + ΔF_cd |s| with s = sgn v.
     #[inline(always)]
     fn carried(&self, at: &At) -> f64 {
-        self.level_at_rest(at.v, at.s, at.load)
+        self.level_at_rest_kept(at.v, at.s, at.load, at.kept.stribeck_fall)
     }
 
     /// F_v(v) + c_q v |v|.
@@ -315,28 +315,65 @@ impl Drivetrain {
     }
 
     /// The Coulomb level at speed `v` and load `load` (N): F_cd + c_N F +
-    /// ΔF_s e^(−(v/v_s)²) (the Stribeck part only when it is on: off, the
-    /// level is the one before it, bit for bit).
+    /// ΔF_s e^(−|v/v_s|^α_s) (the Stribeck part only when it is on: off,
+    /// the level is the one before it, bit for bit), with the fall `fall`
+    /// if the caller holds it.
     #[inline(always)]
-    #[allow(clippy::float_cmp)] // α_s = 2 exactly is the Gaussian fall, the default, bit for bit
-    fn level(&self, v: f64, load: f64) -> f64 {
+    fn level(&self, v: f64, load: f64, fall: Option<f64>) -> f64 {
         let base = self.coulomb + self.load_coefficient * load;
         if self.stribeck == 0.0 {
             base
-        } else if self.stribeck_exponent == 2.0 {
+        } else {
+            let fall = match fall {
+                Some(f) => f,
+                None => self.stribeck_fall(v),
+            };
+            base + self.stribeck * fall
+        }
+    }
+
+    /// The Stribeck fall e^(−|v/v_s|^α_s) at velocity `v` (m/s): the part
+    /// of the term a fit may hold for a whole film trace
+    /// ([`Kept::stribeck_fall`](super::Kept::stribeck_fall)); the Gaussian
+    /// e^(−(v/v_s)²) when α_s = 2.
+    #[inline(always)]
+    #[allow(clippy::float_cmp)] // α_s = 2 exactly is the Gaussian fall, the default, bit for bit
+    pub fn stribeck_fall(&self, v: f64) -> f64 {
+        if self.stribeck_exponent == 2.0 {
             let x = v / self.stribeck_speed;
-            base + self.stribeck * exp_neg(x * x)
+            exp_neg(x * x)
         } else {
             let x = (v / self.stribeck_speed).abs();
-            base + self.stribeck * exp_neg(x.powf(self.stribeck_exponent))
+            exp_neg(x.powf(self.stribeck_exponent))
         }
+    }
+
+    /// The key of the fall's shape (v_s, α_s): two drivetrains with the
+    /// same key have the same [`stribeck_fall`](Self::stribeck_fall) at
+    /// every speed.
+    pub fn stribeck_fall_key(&self) -> [u64; 2] {
+        [
+            self.stribeck_speed.to_bits(),
+            self.stribeck_exponent.to_bits(),
+        ]
+    }
+
+    /// Whether the Stribeck part is on (ΔF_s ≠ 0).
+    pub fn has_stribeck(&self) -> bool {
+        self.stribeck != 0.0
     }
 
     /// F_dt at velocity `v` (m/s) and load `load` (N), with the sign `s`
     /// (the rigid contact's tanh(v/v_reg)).
     #[inline(always)]
     pub fn force_at(&self, v: f64, load: f64, s: f64) -> f64 {
-        self.level(v, load) * s + self.coulomb_asymmetry * s.abs() + self.rate_terms(v)
+        self.force_kept(v, load, s, None)
+    }
+
+    /// [`force_at`](Self::force_at) with the fall `fall` if held.
+    #[inline(always)]
+    fn force_kept(&self, v: f64, load: f64, s: f64, fall: Option<f64>) -> f64 {
+        self.level(v, load, fall) * s + self.coulomb_asymmetry * s.abs() + self.rate_terms(v)
     }
 
     /// The terms that act at zero speed, at speed `v` with the sign `s` of
@@ -345,7 +382,13 @@ impl Drivetrain {
     /// the compliance at a reversal is the whole axis's, not the contact's
     /// alone.
     pub fn level_at_rest(&self, v: f64, s: f64, load: f64) -> f64 {
-        self.level(v, load) * s + self.coulomb_asymmetry * s.abs()
+        self.level_at_rest_kept(v, s, load, None)
+    }
+
+    /// [`level_at_rest`](Self::level_at_rest) with the fall `fall` if held.
+    #[inline(always)]
+    fn level_at_rest_kept(&self, v: f64, s: f64, load: f64, fall: Option<f64>) -> f64 {
+        self.level(v, load, fall) * s + self.coulomb_asymmetry * s.abs()
     }
 
     /// The terms that vanish with the speed: F_v(v) + c_q v |v| (outside

@@ -74,7 +74,7 @@ use drivetrain::Drivetrain;
 pub use keys::{End, FitScale, Interval, TermKey};
 use presliding::Presliding;
 use soft_width::WidthLaw;
-pub use term::{At, BristleMove, FrictionTerm, Place};
+pub use term::{At, BristleMove, FrictionTerm, Kept, Place};
 
 // The list of terms, in the composition's order: adding a term is its file
 // (its type implementing `FrictionTerm`, its equation, symbol table and

@@ -46,11 +46,21 @@ pub struct At {
     /// s: tanh(v/v_reg) for the rigid contact's force, sgn v for the level
     /// pre-sliding carries.
     pub s: f64,
-    /// asinh(v/v_a) of the boundary rate at this `v`, when the caller
-    /// holds it (a fit recomposing along a kept film, whose speeds do not
-    /// change: `fit/film_run.rs`); `None`, the rate computes it. Either way
-    /// the same number, bit for bit.
+    /// The factors of this `v` the caller holds ([`Kept`]).
+    pub kept: Kept,
+}
+
+/// Factors of the speed alone that a caller may hold for a term: a fit
+/// recomposes the friction along a kept film, whose speeds do not change,
+/// many times at the same few values of a term's speed keys
+/// (`fit/film_run.rs`). `None`: the term computes the factor. Either way
+/// the same number, bit for bit.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Kept {
+    /// asinh(v/v_a) of the boundary rate.
     pub rate_asinh: Option<f64>,
+    /// The drivetrain's Stribeck fall e^(−|v/v_s|^α_s).
+    pub stribeck_fall: Option<f64>,
 }
 
 /// How the carrier's state moves in one evaluation.
