@@ -44,17 +44,22 @@ pub(super) struct FilmTrace {
     /// The drivetrain's Stribeck fall e^(−|v/v_s|^α_s) along the steps, for
     /// the last (v_s, α_s) it was composed with.
     pub(super) fall_columns: KeptColumns,
+    /// The drivetrain's viscous bend |v/v_b|^δ along the steps, for the
+    /// last (δ, v_b) it was composed with.
+    pub(super) bend_columns: KeptColumns,
 }
 
 /// A factor of the speed alone at a trace's steps (the boundary rate's
-/// asinh(v/v_a), the Stribeck fall e^(−|v/v_s|^α_s)), kept for the last
+/// asinh(v/v_a), the Stribeck fall e^(−|v/v_s|^α_s), the viscous bend
+/// |v/v_b|^δ), kept for the last
 /// [`COLUMNS_KEPT`] values of the keys it depends on. A fit recomposes the
 /// friction along one film many times (the cheap keys' profile, the
 /// Jacobian's columns) and mostly at the speed keys it composed with just
 /// before (the key fixed, or another column moved): on the O-ring seal's
 /// selection 92 % of the compositions, where the asinh took a fifth of the
 /// whole calibration's time (`perf`, stop 96); on a robot joint's time
-/// series `exp` took 17 %, the fall's part of it kept here since stop 100.
+/// series `exp` and `pow` took a fifth, the fall's and the bend's parts
+/// of them kept here since stop 100.
 /// The numbers are those the term computes, bit for bit.
 #[derive(Default)]
 pub(super) struct KeptColumns(Mutex<Vec<KeptColumn>>);
@@ -117,12 +122,17 @@ impl FilmTrace {
             self.fall_columns
                 .get(d.stribeck_fall_key(), &self.steps, |v| d.stribeck_fall(v))
         });
+        let bend = d.has_bend().then(|| {
+            self.bend_columns
+                .get(d.viscous_bend_key(), &self.steps, |v| d.viscous_bend(v))
+        });
         let mut states = TermStates::default();
         let mut friction = |k: usize, how: BristleMove| {
             let st = &self.steps[k];
             let kept = Kept {
                 rate_asinh: rate.as_ref().map(|c| c[k]),
                 stribeck_fall: fall.as_ref().map(|c| c[k]),
+                viscous_bend: bend.as_ref().map(|c| c[k]),
             };
             terms
                 .friction_with_kept((st[0], st[1]), (st[2], st[3]), kept, &mut states, how)
@@ -332,6 +342,7 @@ pub(super) fn transient(
             sampling: Some(sampling),
             rate_columns: KeptColumns::default(),
             fall_columns: KeptColumns::default(),
+            bend_columns: KeptColumns::default(),
         },
     ))
 }
@@ -406,6 +417,7 @@ pub(super) fn steady(config: &Config, s: &Series) -> Result<(Vec<f64>, FilmTrace
             sampling: None,
             rate_columns: KeptColumns::default(),
             fall_columns: KeptColumns::default(),
+            bend_columns: KeptColumns::default(),
         },
     ))
 }
@@ -501,8 +513,18 @@ pub(crate) mod tests {
         onto_samples(s, &trace.times, &forces, sampling)
     }
 
-    #[test]
-    fn a_kept_rate_column_recomposes_bit_for_bit_what_the_boundary_rate_computes() {
+    /// A kept column recomposes bit for bit what its term computes, along
+    /// one film, rigid and with the bristle: with the term set on by `on`,
+    /// at each of `shapes` in turn (the keys its column depends on; the
+    /// first and third the same, the second another). A column is its key
+    /// values' own: the second gives another friction, the third the
+    /// first's; the trace keeps the last [`COLUMNS_KEPT`]; with the term
+    /// off no column is made.
+    fn a_kept_column_recomposes_bit_for_bit(
+        on: (&str, f64),
+        shapes: &[Vec<(&str, f64)>],
+        columns: fn(&FilmTrace) -> &KeptColumns,
+    ) {
         let mut config = Config::default();
         config.solver.cells = 32;
         let t: Vec<f64> = (0..=150).map(|k| k as f64 * 1e-3).collect();
@@ -510,87 +532,95 @@ pub(crate) mod tests {
         let s = series(t, v, false);
         let (_, trace) = transient(&config, &s).unwrap();
         let bits = |f: &[f64]| f.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        let keys = |c: &KeptColumns| c.0.lock().unwrap().iter().map(|e| e.0).collect::<Vec<_>>();
         for stiffness in [0.0, 5e7] {
             let mut terms = config.model().terms;
             assert!(terms.set("contact.presliding_stiffness_n_m", stiffness));
-            assert!(terms.set("contact.boundary_friction_rate", 0.05));
+            assert!(terms.set(on.0, on.1));
             let mut earlier: Vec<Vec<f64>> = Vec::new();
-            for v_a in [1e-3, 3e-3, 1e-3, 1e-4, 2e-4, 5e-4, 7e-4, 3e-3] {
-                assert!(terms.set("contact.boundary_activation_speed_m_s", v_a));
+            for shape in shapes {
+                for &(key, value) in shape {
+                    assert!(terms.set(key, value), "{key}");
+                }
                 let want = composed_by_the_terms(&trace, &terms, &s);
                 let got = trace.compose(&terms, &s);
-                assert_eq!(
-                    bits(&got),
-                    bits(&want),
-                    "v_a = {v_a}, stiffness {stiffness}"
-                );
+                assert_eq!(bits(&got), bits(&want), "{shape:?}, stiffness {stiffness}");
                 earlier.push(got);
             }
-            // A column is the activation speed's own: another gives
-            // another friction, the same the same.
             assert_ne!(bits(&earlier[0]), bits(&earlier[1]));
             assert_eq!(bits(&earlier[0]), bits(&earlier[2]));
-            let kept = trace.rate_columns.0.lock().unwrap().len();
-            assert_eq!(kept, COLUMNS_KEPT);
+            assert_eq!(columns(&trace).0.lock().unwrap().len(), COLUMNS_KEPT);
+            assert!(terms.set(on.0, 0.0));
+            let before = keys(columns(&trace));
+            let got = trace.compose(&terms, &s);
+            assert_eq!(bits(&got), bits(&composed_by_the_terms(&trace, &terms, &s)));
+            assert_eq!(keys(columns(&trace)), before, "{} off", on.0);
         }
     }
 
     #[test]
+    fn a_kept_rate_column_recomposes_bit_for_bit_what_the_boundary_rate_computes() {
+        let v_a = "contact.boundary_activation_speed_m_s";
+        let shapes = vec![
+            vec![(v_a, 1e-3)],
+            vec![(v_a, 3e-3)],
+            vec![(v_a, 1e-3)],
+            vec![(v_a, 1e-4)],
+            vec![(v_a, 2e-4)],
+            vec![(v_a, 5e-4)],
+            vec![(v_a, 7e-4)],
+            vec![(v_a, 3e-3)],
+        ];
+        a_kept_column_recomposes_bit_for_bit(
+            ("contact.boundary_friction_rate", 0.05),
+            &shapes,
+            |t| &t.rate_columns,
+        );
+    }
+
+    #[test]
     fn a_kept_fall_column_recomposes_bit_for_bit_what_the_stribeck_term_computes() {
-        let mut config = Config::default();
-        config.solver.cells = 32;
-        let t: Vec<f64> = (0..=150).map(|k| k as f64 * 1e-3).collect();
-        let v: Vec<f64> = t.iter().map(|t| 0.02 * (20.0 * t).sin()).collect();
-        let s = series(t, v, false);
-        let (_, trace) = transient(&config, &s).unwrap();
-        let bits = |f: &[f64]| f.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-        for stiffness in [0.0, 5e7] {
-            let mut terms = config.model().terms;
-            assert!(terms.set("contact.presliding_stiffness_n_m", stiffness));
-            assert!(terms.set("drivetrain.stribeck_n", 3.0));
-            let mut earlier: Vec<Vec<f64>> = Vec::new();
-            // (v_s, α_s): the Gaussian fall and one of its own exponent,
-            // each met again after others.
-            let shapes = [
-                (4e-3, 2.0),
-                (4e-3, 0.7),
-                (4e-3, 2.0),
-                (1e-3, 2.0),
-                (2e-3, 1.3),
-                (6e-3, 2.0),
-                (8e-3, 0.5),
-                (4e-3, 0.7),
-            ];
-            for (v_s, alpha) in shapes {
-                assert!(terms.set("drivetrain.stribeck_speed_m_s", v_s));
-                assert!(terms.set("drivetrain.stribeck_exponent", alpha));
-                let want = composed_by_the_terms(&trace, &terms, &s);
-                let got = trace.compose(&terms, &s);
-                assert_eq!(
-                    bits(&got),
-                    bits(&want),
-                    "v_s {v_s}, α_s {alpha}, k {stiffness}"
-                );
-                earlier.push(got);
-            }
-            // A column is the shape's own: another exponent at the same
-            // speed gives another friction, the same shape the same.
-            assert_ne!(bits(&earlier[0]), bits(&earlier[1]));
-            assert_eq!(bits(&earlier[0]), bits(&earlier[2]));
-            assert_eq!(bits(&earlier[1]), bits(&earlier[7]));
-            let kept = trace.fall_columns.0.lock().unwrap().len();
-            assert_eq!(kept, COLUMNS_KEPT);
-            // No Stribeck part: no column is made for it.
-            assert!(terms.set("drivetrain.stribeck_n", 0.0));
-            let before = trace.fall_columns.0.lock().unwrap().clone();
-            let got = trace.compose(&terms, &s);
-            assert_eq!(bits(&got), bits(&composed_by_the_terms(&trace, &terms, &s)));
-            let after = trace.fall_columns.0.lock().unwrap().clone();
-            assert_eq!(
-                before.iter().map(|e| e.0).collect::<Vec<_>>(),
-                after.iter().map(|e| e.0).collect::<Vec<_>>()
-            );
-        }
+        // (v_s, α_s): the Gaussian fall and one of its own exponent at the
+        // same speed, each met again after others.
+        let (v_s, a) = (
+            "drivetrain.stribeck_speed_m_s",
+            "drivetrain.stribeck_exponent",
+        );
+        let shapes = vec![
+            vec![(v_s, 4e-3), (a, 2.0)],
+            vec![(v_s, 4e-3), (a, 0.7)],
+            vec![(v_s, 4e-3), (a, 2.0)],
+            vec![(v_s, 1e-3), (a, 2.0)],
+            vec![(v_s, 2e-3), (a, 1.3)],
+            vec![(v_s, 6e-3), (a, 2.0)],
+            vec![(v_s, 8e-3), (a, 0.5)],
+            vec![(v_s, 4e-3), (a, 0.7)],
+        ];
+        a_kept_column_recomposes_bit_for_bit(("drivetrain.stribeck_n", 3.0), &shapes, |t| {
+            &t.fall_columns
+        });
+    }
+
+    #[test]
+    fn a_kept_bend_column_recomposes_bit_for_bit_what_the_bent_viscous_rise_computes() {
+        // (δ, v_b): one exponent at two reference speeds, each met again;
+        // δ = 1 (straight) keeps no column and is the same bit for bit.
+        let (d, v_b) = (
+            "drivetrain.viscous_exponent",
+            "drivetrain.viscous_reference_speed_m_s",
+        );
+        let shapes = vec![
+            vec![(d, 0.6), (v_b, 0.02)],
+            vec![(d, 0.6), (v_b, 0.01)],
+            vec![(d, 0.6), (v_b, 0.02)],
+            vec![(d, 1.0), (v_b, 0.02)],
+            vec![(d, 0.3), (v_b, 0.02)],
+            vec![(d, 0.8), (v_b, 0.02)],
+            vec![(d, 0.6), (v_b, 0.01)],
+        ];
+        a_kept_column_recomposes_bit_for_bit(("drivetrain.viscous_n_s_m", 20.0), &shapes, |t| {
+            &t.bend_columns
+        });
     }
 
     #[test]

@@ -34,7 +34,7 @@
 //! bristle, σ0 and σ1): a calibration can always reach the best classic's
 //! training error, and the data say where the film adds to it.
 
-use super::term::{At, BristleMove, FrictionTerm, Place};
+use super::term::{At, BristleMove, FrictionTerm, Kept, Place};
 use super::{End, FitScale, TermKey};
 
 /// Past this a, e^(−a) is 0 in f64 (e^(−745.14) is below the smallest
@@ -254,7 +254,7 @@ impl FrictionTerm for Drivetrain {
     /// F_dt with the rigid contact's s = tanh(v/v_reg).
     #[inline(always)]
     fn force(&self, at: &At) -> f64 {
-        self.force_kept(at.v, at.load, at.s, at.kept.stribeck_fall)
+        self.force_kept(at.v, at.load, at.s, &at.kept)
     }
 
     /// (F_cd + c_N F + ΔF_s e^(−|v/v_s|^α_s)) s + ΔF_cd |s| with s = sgn v.
@@ -266,7 +266,7 @@ impl FrictionTerm for Drivetrain {
     /// F_v(v) + c_q v |v|.
     #[inline(always)]
     fn beside(&self, at: &At) -> f64 {
-        self.rate_terms(at.v)
+        self.rate_terms_kept(at.v, at.kept.viscous_bend)
     }
 
     /// None: the COF is the contact's.
@@ -334,7 +334,7 @@ impl Drivetrain {
 
     /// The Stribeck fall e^(−|v/v_s|^α_s) at velocity `v` (m/s): the part
     /// of the term a fit may hold for a whole film trace
-    /// ([`Kept::stribeck_fall`](super::Kept::stribeck_fall)); the Gaussian
+    /// ([`Kept::stribeck_fall`]); the Gaussian
     /// e^(−(v/v_s)²) when α_s = 2.
     #[inline(always)]
     #[allow(clippy::float_cmp)] // α_s = 2 exactly is the Gaussian fall, the default, bit for bit
@@ -367,13 +367,15 @@ impl Drivetrain {
     /// (the rigid contact's tanh(v/v_reg)).
     #[inline(always)]
     pub fn force_at(&self, v: f64, load: f64, s: f64) -> f64 {
-        self.force_kept(v, load, s, None)
+        self.force_kept(v, load, s, &Kept::default())
     }
 
-    /// [`force_at`](Self::force_at) with the fall `fall` if held.
+    /// [`force_at`](Self::force_at) with the factors `kept` holds.
     #[inline(always)]
-    fn force_kept(&self, v: f64, load: f64, s: f64, fall: Option<f64>) -> f64 {
-        self.level(v, load, fall) * s + self.coulomb_asymmetry * s.abs() + self.rate_terms(v)
+    fn force_kept(&self, v: f64, load: f64, s: f64, kept: &Kept) -> f64 {
+        self.level(v, load, kept.stribeck_fall) * s
+            + self.coulomb_asymmetry * s.abs()
+            + self.rate_terms_kept(v, kept.viscous_bend)
     }
 
     /// The terms that act at zero speed, at speed `v` with the sign `s` of
@@ -395,19 +397,58 @@ impl Drivetrain {
     /// the bristle, as LuGre's viscous term is).
     #[inline(always)]
     pub fn rate_terms(&self, v: f64) -> f64 {
-        self.viscous_rise(v) + self.quadratic * v * v.abs()
+        self.rate_terms_kept(v, None)
+    }
+
+    /// [`rate_terms`](Self::rate_terms) with the bend `bend` if held.
+    #[inline(always)]
+    fn rate_terms_kept(&self, v: f64, bend: Option<f64>) -> f64 {
+        self.viscous_rise_kept(v, bend) + self.quadratic * v * v.abs()
     }
 
     /// F_v(v) = b v_b sgn v |v/v_b|^δ: b v, bit for bit, when δ = 1.
     #[inline(always)]
-    #[allow(clippy::float_cmp)] // δ = 1 exactly is the straight rise, the default, bit for bit
     pub fn viscous_rise(&self, v: f64) -> f64 {
+        self.viscous_rise_kept(v, None)
+    }
+
+    /// [`viscous_rise`](Self::viscous_rise) with the bend |v/v_b|^δ if held.
+    #[inline(always)]
+    #[allow(clippy::float_cmp)] // δ = 1 exactly is the straight rise, the default, bit for bit
+    fn viscous_rise_kept(&self, v: f64, bend: Option<f64>) -> f64 {
         if self.viscous_exponent == 1.0 {
             self.viscous * v
         } else {
-            let vb = self.viscous_reference_speed;
-            self.viscous * vb * (v.abs() / vb).powf(self.viscous_exponent).copysign(v)
+            let bend = match bend {
+                Some(b) => b,
+                None => self.viscous_bend(v),
+            };
+            self.viscous * self.viscous_reference_speed * bend.copysign(v)
         }
+    }
+
+    /// The bend |v/v_b|^δ at velocity `v` (m/s): the part of a bent
+    /// viscous rise a fit may hold for a whole film trace
+    /// ([`Kept::viscous_bend`]).
+    #[inline(always)]
+    pub fn viscous_bend(&self, v: f64) -> f64 {
+        (v.abs() / self.viscous_reference_speed).powf(self.viscous_exponent)
+    }
+
+    /// The key of the bend's shape (δ, v_b): two drivetrains with the same
+    /// key have the same [`viscous_bend`](Self::viscous_bend) at every
+    /// speed.
+    pub fn viscous_bend_key(&self) -> [u64; 2] {
+        [
+            self.viscous_exponent.to_bits(),
+            self.viscous_reference_speed.to_bits(),
+        ]
+    }
+
+    /// Whether the viscous rise is on (b ≠ 0) and bends (δ ≠ 1).
+    #[allow(clippy::float_cmp)] // δ = 1 exactly is the straight rise
+    pub fn has_bend(&self) -> bool {
+        self.viscous != 0.0 && self.viscous_exponent != 1.0
     }
 }
 

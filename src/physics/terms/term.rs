@@ -61,6 +61,8 @@ pub struct Kept {
     pub rate_asinh: Option<f64>,
     /// The drivetrain's Stribeck fall e^(−|v/v_s|^α_s).
     pub stribeck_fall: Option<f64>,
+    /// The drivetrain's viscous bend |v/v_b|^δ.
+    pub viscous_bend: Option<f64>,
 }
 
 /// How the carrier's state moves in one evaluation.
