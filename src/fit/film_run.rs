@@ -14,12 +14,12 @@
 //! terms along the same film, bit for bit what the solver computes with
 //! them (`physics_model.rs` decides when a trace may be reused).
 
+use super::kept_columns::KeptColumns;
 use super::series::{Series, STEP_SLACK};
 use super::PredictError;
 use crate::config::{Config, ViscosityLaw};
 use crate::physics::terms::{BristleMove, FrictionTerm, FrictionTerms, Kept, TermStates};
 use crate::physics::{Estimate, Solver, Status, ViscosityModel};
-use std::sync::{Arc, Mutex};
 
 /// One film solution along a series: per solver step (the first the steady
 /// start), the inputs of the friction's composition.
@@ -47,52 +47,6 @@ pub(super) struct FilmTrace {
     /// The drivetrain's viscous bend |v/v_b|^δ along the steps, for the
     /// last (δ, v_b) it was composed with.
     pub(super) bend_columns: KeptColumns,
-}
-
-/// A factor of the speed alone at a trace's steps (the boundary rate's
-/// asinh(v/v_a), the Stribeck fall e^(−|v/v_s|^α_s), the viscous bend
-/// |v/v_b|^δ), kept for the last
-/// [`COLUMNS_KEPT`] values of the keys it depends on. A fit recomposes the
-/// friction along one film many times (the cheap keys' profile, the
-/// Jacobian's columns) and mostly at the speed keys it composed with just
-/// before (the key fixed, or another column moved): on the O-ring seal's
-/// selection 92 % of the compositions, where the asinh took a fifth of the
-/// whole calibration's time (`perf`, stop 96); on a robot joint's time
-/// series `exp` and `pow` took a fifth, the fall's and the bend's parts
-/// of them kept here since stop 100.
-/// The numbers are those the term computes, bit for bit.
-#[derive(Default)]
-pub(super) struct KeptColumns(Mutex<Vec<KeptColumn>>);
-
-/// One kept column: the bits of the key values it was computed at, and
-/// the factor at each step.
-type KeptColumn = ([u64; 2], Arc<[f64]>);
-
-/// Key values whose columns a trace keeps: the last few a fit composed
-/// with (its current point and a Jacobian column moving the key, on each
-/// of the cores).
-const COLUMNS_KEPT: usize = 4;
-
-impl KeptColumns {
-    /// `factor` at each of `steps`' speeds for the key values `key`: kept,
-    /// or computed and kept.
-    fn get(&self, key: [u64; 2], steps: &[[f64; 4]], factor: impl Fn(f64) -> f64) -> Arc<[f64]> {
-        let lock = || self.0.lock().unwrap_or_else(|p| p.into_inner());
-        if let Some((_, c)) = lock().iter().find(|(k, _)| *k == key) {
-            return Arc::clone(c);
-        }
-        let column: Arc<[f64]> = steps.iter().map(|st| factor(st[0])).collect();
-        let mut kept = lock();
-        // Another thread may have kept it meanwhile: one entry per key.
-        if let Some((_, c)) = kept.iter().find(|(k, _)| *k == key) {
-            return Arc::clone(c);
-        }
-        if kept.len() >= COLUMNS_KEPT {
-            kept.pop();
-        }
-        kept.insert(0, (key, Arc::clone(&column)));
-        column
-    }
 }
 
 /// Where a time series' samples fall between the solver's steps.
@@ -425,6 +379,7 @@ pub(super) fn steady(config: &Config, s: &Series) -> Result<(Vec<f64>, FilmTrace
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+    use crate::fit::kept_columns::COLUMNS_KEPT;
     use approx::assert_relative_eq;
 
     /// A series of velocities `v` at times `t` (a steady curve when
@@ -532,7 +487,6 @@ pub(crate) mod tests {
         let s = series(t, v, false);
         let (_, trace) = transient(&config, &s).unwrap();
         let bits = |f: &[f64]| f.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-        let keys = |c: &KeptColumns| c.0.lock().unwrap().iter().map(|e| e.0).collect::<Vec<_>>();
         for stiffness in [0.0, 5e7] {
             let mut terms = config.model().terms;
             assert!(terms.set("contact.presliding_stiffness_n_m", stiffness));
@@ -549,12 +503,12 @@ pub(crate) mod tests {
             }
             assert_ne!(bits(&earlier[0]), bits(&earlier[1]));
             assert_eq!(bits(&earlier[0]), bits(&earlier[2]));
-            assert_eq!(columns(&trace).0.lock().unwrap().len(), COLUMNS_KEPT);
+            assert_eq!(columns(&trace).keys().len(), COLUMNS_KEPT);
             assert!(terms.set(on.0, 0.0));
-            let before = keys(columns(&trace));
+            let before = columns(&trace).keys();
             let got = trace.compose(&terms, &s);
             assert_eq!(bits(&got), bits(&composed_by_the_terms(&trace, &terms, &s)));
-            assert_eq!(keys(columns(&trace)), before, "{} off", on.0);
+            assert_eq!(columns(&trace).keys(), before, "{} off", on.0);
         }
     }
 

@@ -63,6 +63,7 @@
 //! | `options.rs` | how a fit searches: the user's settings, each fit's options, the Jacobian and later-run rules |
 //! | `physics_model.rs` | our model as a predictor: its keys, its film reused when only the terms after it change, its linear keys |
 //! | `film_run.rs` | our model's film along a series (transient and steady solves), the trace it keeps, the friction recomposed along it |
+//! | `kept_columns.rs` | factors of the speed alone (the boundary rate's asinh, the Stribeck fall, the viscous bend) kept along a film trace for the last key values composed with |
 //! | `baselines.rs` | Coulomb + viscous, Stribeck, LuGre |
 //! | `classic_regression.rs` | the classic curves by linear least squares on the training samples (Stribeck on a grid of speeds): the classics' starts and our Stribeck term's |
 //! | `problem.rs` | the problem: a model, the data and its map coefficients, residuals, predictions |
@@ -106,6 +107,7 @@ mod film_run;
 mod held_out;
 pub mod inertia_check;
 pub mod inputs;
+mod kept_columns;
 mod lighter_sets;
 pub mod local_run;
 pub mod models_table;
